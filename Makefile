@@ -1,0 +1,95 @@
+# crashfree: build, run and test.
+#   make            release build: bin/crashfree and lib/libcrashfree.a (+ .mod files in lib/)
+#   make run        install what is missing, build, run the default deck, plot
+#   make test       install what is missing, build, unit tests (debug build) and regression tests
+#   make bench      performance figures (ns per element per cycle)
+#   make MODE=debug checked build in build/debug
+MODE ?= release
+FC := gfortran
+PYTHON ?= python3
+
+HDF5_INCLUDE ?= /usr/include/hdf5/serial
+HDF5_LIBDIR ?= /usr/lib/x86_64-linux-gnu/hdf5/serial
+LIBS := -L$(HDF5_LIBDIR) -lhdf5_fortran -lhdf5 -llapack -lblas
+
+BUILD := build/$(MODE)
+OBJ := $(BUILD)/obj
+MOD := $(BUILD)/mod
+ifeq ($(MODE),debug)
+  FFLAGS := -std=f2008 -Wall -Wextra -Wimplicit-interface -Wno-compare-reals -Wno-maybe-uninitialized \
+            -fcheck=all -ffpe-trap=invalid,zero,overflow -finit-real=snan -g -O0 -fbacktrace -fopenmp
+  LIBRARY := $(BUILD)/lib/libcrashfree.a
+  PROGRAM := $(BUILD)/bin/crashfree
+else
+  FFLAGS := -std=f2008 -O3 -march=native -funroll-loops -fopenmp -g -Wall -Wno-compare-reals \
+            -Wno-maybe-uninitialized
+  LIBRARY := lib/libcrashfree.a
+  PROGRAM := bin/crashfree
+endif
+FFLAGS += -J$(MOD) -I$(MOD) -I$(HDF5_INCLUDE)
+
+LIBRARY_SOURCES := $(sort $(shell find src -name '*.f90' ! -path 'src/app/*'))
+LIBRARY_OBJECTS := $(patsubst %.f90,$(OBJ)/%.o,$(notdir $(LIBRARY_SOURCES)))
+TEST_SUPPORT := tests/unit/testing.f90
+TEST_SOURCES := $(sort $(wildcard tests/unit/test_*.f90))
+TEST_PROGRAMS := $(patsubst tests/unit/%.f90,$(BUILD)/tests/%,$(TEST_SOURCES))
+ALL_SOURCES := $(LIBRARY_SOURCES) src/app/crashfree.f90 $(TEST_SUPPORT) $(TEST_SOURCES)
+
+vpath %.f90 $(sort $(dir $(ALL_SOURCES)))
+
+.PHONY: all deps run test unit regression bench clean debug
+all: $(PROGRAM)
+
+$(OBJ)/%.o: %.f90 | $(OBJ) $(MOD)
+	$(FC) $(FFLAGS) -c $< -o $@
+
+$(OBJ) $(MOD) $(BUILD)/tests $(dir $(LIBRARY)) $(dir $(PROGRAM)):
+	@mkdir -p $@
+
+$(LIBRARY): $(LIBRARY_OBJECTS) | $(dir $(LIBRARY))
+	@rm -f $@
+	ar rcs $@ $^
+ifeq ($(MODE),release)
+	@cp $(MOD)/*.mod lib/
+endif
+
+$(PROGRAM): $(OBJ)/crashfree.o $(LIBRARY) | $(dir $(PROGRAM))
+	$(FC) $(FFLAGS) $< $(LIBRARY) $(LIBS) -o $@
+
+$(BUILD)/tests/%: $(OBJ)/%.o $(OBJ)/testing.o $(LIBRARY) | $(BUILD)/tests
+	$(FC) $(FFLAGS) $< $(OBJ)/testing.o $(LIBRARY) $(LIBS) -o $@
+
+$(BUILD)/deps.mk: $(ALL_SOURCES) tools/fortran_deps.py
+	@mkdir -p $(BUILD)
+	@$(PYTHON) tools/fortran_deps.py $(OBJ) $(ALL_SOURCES) > $@
+
+ifeq ($(filter deps clean,$(MAKECMDGOALS)),)
+include $(BUILD)/deps.mk
+endif
+
+deps:
+	@bash tools/install_dependencies.sh
+
+debug:
+	@$(MAKE) --no-print-directory MODE=debug all
+
+# Unit tests: every tests/unit/test_*.f90 program; prints the sum of their counts.
+unit: $(TEST_PROGRAMS)
+	@bash tools/run_unit_tests.sh $(TEST_PROGRAMS)
+
+regression: $(PROGRAM)
+	@$(PYTHON) -m pytest -q tests/regression
+
+run: deps
+	@$(MAKE) --no-print-directory all
+	@bash tools/run_default.sh
+
+test: deps
+	@bash tools/run_all_tests.sh
+
+bench: deps
+	@$(MAKE) --no-print-directory all
+	@bash tools/bench.sh
+
+clean:
+	rm -rf build lib bin

@@ -1,0 +1,75 @@
+!> Load curves (*DEFINE_CURVE): piecewise-linear functions of time or of a material variable.
+module curves
+  use kinds, only: wp
+  implicit none
+  private
+
+  public :: curve_t, curve_value, curve_slope
+
+  !> One curve with its scale and offset factors already applied to the stored points:
+  !> stored abscissa = SFA * A + OFFA, stored ordinate = SFO * O + OFFO (LS-DYNA's convention).
+  type :: curve_t
+    integer :: id = 0
+    character(len=:), allocatable :: title
+    real(wp), allocatable :: abscissa(:)
+    real(wp), allocatable :: ordinate(:)
+  end type curve_t
+
+contains
+
+  !> Value of the curve at `x`: linear interpolation between points and linear extrapolation
+  !> from the last two (first two) points beyond the ends, as LS-DYNA does for load curves.
+  pure function curve_value(curve, x) result(value)
+    type(curve_t), intent(in) :: curve
+    real(wp), intent(in) :: x
+    real(wp) :: value
+    integer :: segment
+    if (size(curve%abscissa) == 1) then
+      value = curve%ordinate(1)
+      return
+    end if
+    segment = find_segment(curve%abscissa, x)
+    value = curve%ordinate(segment) + curve_slope_on(curve, segment)*(x - curve%abscissa(segment))
+  end function curve_value
+
+  !> Slope of the curve at `x` (of the segment containing `x`).
+  pure function curve_slope(curve, x) result(slope)
+    type(curve_t), intent(in) :: curve
+    real(wp), intent(in) :: x
+    real(wp) :: slope
+    if (size(curve%abscissa) == 1) then
+      slope = 0.0_wp
+      return
+    end if
+    slope = curve_slope_on(curve, find_segment(curve%abscissa, x))
+  end function curve_slope
+
+  pure function curve_slope_on(curve, segment) result(slope)
+    type(curve_t), intent(in) :: curve
+    integer, intent(in) :: segment
+    real(wp) :: slope, width
+    width = curve%abscissa(segment + 1) - curve%abscissa(segment)
+    if (width > 0.0_wp) then
+      slope = (curve%ordinate(segment + 1) - curve%ordinate(segment))/width
+    else
+      slope = 0.0_wp
+    end if
+  end function curve_slope_on
+
+  !> Index i of the segment [a(i), a(i+1)] holding x (bisection; ends extend outward).
+  pure function find_segment(abscissa, x) result(low)
+    real(wp), intent(in) :: abscissa(:)
+    real(wp), intent(in) :: x
+    integer :: low, high, middle
+    low = 1
+    high = size(abscissa)
+    do while (high - low > 1)
+      middle = (low + high)/2
+      if (x >= abscissa(middle)) then
+        low = middle
+      else
+        high = middle
+      end if
+    end do
+  end function find_segment
+end module curves

@@ -1,0 +1,179 @@
+!> The checked model: everything the deck defines, with ids resolved to array indices.
+!>
+!> The deck reader builds a `model_t` and checks every cross reference before any cycle runs;
+!> after that no code below the solver sees an id where it needs an index. Ids are kept beside
+!> the indices for messages and output.
+module model
+  use kinds, only: wp
+  use curves, only: curve_t
+  implicit none
+  private
+
+  public :: model_t, material_t, section_t, hourglass_t, part_t, node_set_t, part_set_t
+  public :: spc_t, prescribed_motion_t, nodal_load_t, rigid_wall_t, output_control_t
+
+  !> Material laws, numbered as LS-DYNA numbers them.
+  integer, parameter, public :: law_elastic = 1
+  integer, parameter, public :: law_plastic_kinematic = 3
+
+  !> How a part is discretised (`/mesh/parts/formulation`: "fe", "efg", "rigid").
+  integer, parameter, public :: formulation_fe = 1, formulation_efg = 2, formulation_rigid = 3
+
+  !> Prescribed-motion kinds (VAD).
+  integer, parameter, public :: motion_velocity = 0, motion_acceleration = 1, motion_displacement = 2
+
+  !> One material (*MAT_...). Fields not used by a law stay zero.
+  type :: material_t
+    integer :: id = 0
+    integer :: law = 0                      !< law_elastic, law_plastic_kinematic, ...
+    character(len=:), allocatable :: title
+    real(wp) :: density = 0.0_wp            !< RO
+    real(wp) :: youngs_modulus = 0.0_wp     !< E
+    real(wp) :: poissons_ratio = 0.0_wp     !< PR
+    ! *MAT_PLASTIC_KINEMATIC
+    real(wp) :: yield_stress = 0.0_wp       !< SIGY
+    real(wp) :: tangent_modulus = 0.0_wp    !< ETAN
+    real(wp) :: hardening_beta = 0.0_wp     !< BETA: 0 kinematic ... 1 isotropic
+    real(wp) :: rate_c = 0.0_wp             !< SRC, Cowper-Symonds C (0: no rate effect)
+    real(wp) :: rate_p = 0.0_wp             !< SRP, Cowper-Symonds P (0: no rate effect)
+    real(wp) :: failure_strain = 0.0_wp     !< FS (read and kept; erosion is not modelled)
+    real(wp) :: rate_formulation = 0.0_wp   !< VP: 0 scale yield stress, 1 viscoplastic
+  end type material_t
+
+  !> One solid section (*SECTION_SOLID).
+  type :: section_t
+    integer :: id = 0
+    character(len=:), allocatable :: title
+    integer :: element_formulation = 1     !< ELFORM: 1 one-point, 2 fully integrated S/R
+  end type section_t
+
+  !> One hourglass / bulk-viscosity definition (*HOURGLASS).
+  type :: hourglass_t
+    integer :: id = 0
+    character(len=:), allocatable :: title
+    integer :: hourglass_type = 0           !< IHQ as given (0: the *CONTROL_HOURGLASS default)
+    real(wp) :: coefficient = 0.1_wp        !< QM
+    real(wp) :: bulk_quadratic = 1.5_wp     !< Q1
+    real(wp) :: bulk_linear = 0.06_wp       !< Q2
+  end type hourglass_t
+
+  !> One part (*PART) with its references resolved. The hourglass and bulk-viscosity values
+  !> are the effective ones (part's *HOURGLASS, else *CONTROL_HOURGLASS, else LS-DYNA's
+  !> defaults), so element code never looks anything up.
+  type :: part_t
+    integer :: id = 0
+    character(len=:), allocatable :: title
+    integer :: section_id = 0, material_id = 0, hourglass_id = 0
+    integer :: section = 0, material = 0, hourglass = 0   !< indices (hourglass: 0 = none given)
+    integer :: formulation = formulation_fe
+    integer :: hourglass_type = 1
+    real(wp) :: hourglass_coefficient = 0.1_wp
+    real(wp) :: bulk_quadratic = 1.5_wp
+    real(wp) :: bulk_linear = 0.06_wp
+  end type part_t
+
+  !> *SET_NODE_LIST(_GENERATE), node indices.
+  type :: node_set_t
+    integer :: id = 0
+    character(len=:), allocatable :: title
+    integer, allocatable :: nodes(:)
+  end type node_set_t
+
+  !> *SET_PART_LIST, part indices.
+  type :: part_set_t
+    integer :: id = 0
+    character(len=:), allocatable :: title
+    integer, allocatable :: parts(:)
+  end type part_set_t
+
+  !> One constrained node (*BOUNDARY_SPC_NODE/_SET, expanded per node).
+  type :: spc_t
+    integer :: node = 0
+    logical :: fixed(3) = .false.           !< x, y, z translations (rotations do not apply to solids)
+  end type spc_t
+
+  !> One prescribed motion of one node and one translational direction.
+  type :: prescribed_motion_t
+    integer :: node = 0
+    integer :: direction = 0                 !< 1, 2, 3
+    integer :: kind = motion_velocity        !< VAD
+    integer :: curve = 0                     !< index into model%curves
+    real(wp) :: scale = 1.0_wp               !< SF
+    real(wp) :: birth = 0.0_wp
+    real(wp) :: death = 1.0e28_wp
+  end type prescribed_motion_t
+
+  !> One concentrated nodal load (*LOAD_NODE_POINT/_SET, expanded per node).
+  type :: nodal_load_t
+    integer :: node = 0
+    integer :: direction = 0                 !< 1, 2, 3
+    integer :: curve = 0                     !< index into model%curves
+    real(wp) :: scale = 1.0_wp
+  end type nodal_load_t
+
+  !> A planar rigid wall (*RIGIDWALL_PLANAR with its options).
+  type :: rigid_wall_t
+    integer :: id = 0
+    character(len=:), allocatable :: title
+    integer, allocatable :: nodes(:)         !< tracked (slave) node indices, exempted removed
+    real(wp) :: point(3) = 0.0_wp            !< tail of the normal: a point on the wall
+    real(wp) :: normal(3) = 0.0_wp           !< unit normal, pointing into the allowed half space
+    real(wp) :: offset = 0.0_wp              !< OFFSET
+    real(wp) :: birth = 0.0_wp, death = 1.0e20_wp
+    real(wp) :: friction = 0.0_wp            !< FRIC
+    logical :: finite = .false.
+    real(wp) :: edge_direction(3) = 0.0_wp   !< unit edge vector l (finite walls)
+    real(wp) :: length_l = 0.0_wp, length_m = 0.0_wp
+    logical :: moving = .false.
+    real(wp) :: mass = 0.0_wp, initial_speed = 0.0_wp
+    logical :: forces_requested = .false.     !< _FORCES option
+  end type rigid_wall_t
+
+  !> Output intervals and requests (*DATABASE_...). An interval of 0 means "not requested".
+  type :: output_control_t
+    real(wp) :: state_interval = 0.0_wp      !< *DATABASE_BINARY_D3PLOT DT (or ENDTIM/NPLTC)
+    real(wp) :: glstat_interval = 0.0_wp
+    real(wp) :: matsum_interval = 0.0_wp
+    real(wp) :: nodout_interval = 0.0_wp
+    real(wp) :: rwforc_interval = 0.0_wp
+    integer, allocatable :: history_nodes(:) !< node indices for nodout
+  end type output_control_t
+
+  !> The whole model.
+  type :: model_t
+    character(len=:), allocatable :: title
+    character(len=:), allocatable :: deck_path
+    ! nodes
+    integer, allocatable :: node_ids(:)
+    real(wp), allocatable :: coordinates(:, :)       !< (3, nodes), reference configuration
+    real(wp), allocatable :: initial_velocity(:, :)  !< (3, nodes)
+    ! solid elements
+    integer, allocatable :: solid_ids(:)
+    integer, allocatable :: solid_part(:)            !< part index of each solid
+    integer, allocatable :: solid_nodes(:, :)        !< (8, solids) node indices
+    ! properties
+    type(part_t), allocatable :: parts(:)
+    type(section_t), allocatable :: sections(:)
+    type(material_t), allocatable :: materials(:)
+    type(hourglass_t), allocatable :: hourglasses(:)
+    type(curve_t), allocatable :: curves(:)
+    type(node_set_t), allocatable :: node_sets(:)
+    type(part_set_t), allocatable :: part_sets(:)
+    ! boundary conditions and loads
+    type(spc_t), allocatable :: spcs(:)
+    type(prescribed_motion_t), allocatable :: motions(:)
+    type(nodal_load_t), allocatable :: loads(:)
+    type(rigid_wall_t), allocatable :: walls(:)
+    ! controls
+    real(wp) :: end_time = 0.0_wp                    !< ENDTIM
+    integer :: end_cycle = 0                         !< ENDCYC (0 = no limit)
+    real(wp) :: time_step_scale = 0.9_wp             !< TSSFAC
+    real(wp) :: initial_time_step = 0.0_wp           !< DTINIT (0 = computed)
+    real(wp) :: mass_scaled_time_step = 0.0_wp       !< DT2MS (0 = no mass scaling)
+    integer :: default_hourglass_type = 1            !< *CONTROL_HOURGLASS IHQ
+    real(wp) :: default_hourglass_coefficient = 0.1_wp !< *CONTROL_HOURGLASS QH
+    logical :: hourglass_energy_in_balance = .false. !< *CONTROL_ENERGY HGEN = 2
+    logical :: wall_energy_in_balance = .true.       !< *CONTROL_ENERGY RWEN = 2
+    type(output_control_t) :: output
+  end type model_t
+end module model

@@ -1,0 +1,25 @@
+!> What a run reports about itself: termination status, counts and the time per phase
+!> (the `/run` and `/timing` attributes of results.h5, and the end-of-run summary).
+module run_summary
+  use kinds, only: wp
+  implicit none
+  private
+
+  public :: run_summary_t
+
+  character(len=*), parameter, public :: status_normal = "normal termination"
+  character(len=*), parameter, public :: status_error = "error termination"
+
+  type :: run_summary_t
+    character(len=:), allocatable :: status      !< status_normal or status_error
+    character(len=:), allocatable :: message     !< empty, or the error message
+    real(wp) :: end_time = 0.0_wp                !< simulation time reached
+    integer :: cycles = 0
+    integer :: threads = 1
+    ! seconds
+    real(wp) :: wall_s = 0.0_wp, setup_s = 0.0_wp, output_s = 0.0_wp
+    real(wp) :: fe_solid_s = 0.0_wp, fe_shell_s = 0.0_wp, efg_s = 0.0_wp, contact_s = 0.0_wp
+    ! sizes
+    integer :: fe_elements = 0, efg_particles = 0, dofs_total = 0, dofs_efg = 0
+  end type run_summary_t
+end module run_summary

@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Install what crashfree needs and is missing: Debian packages for the build, Python packages
+# for post-processing and regression tests. Idempotent and quick when everything is there.
+set -euo pipefail
+
+debian_packages=(gfortran make libhdf5-dev libmetis-dev liblapack-dev libopenblas-dev python3 python3-pip)
+missing=()
+for package in "${debian_packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")
+done
+if ((${#missing[@]})); then
+  echo "crashfree: installing Debian packages: ${missing[*]}"
+  sudo_prefix=""
+  if [ "$(id -u)" -ne 0 ]; then sudo_prefix="sudo"; fi
+  export DEBIAN_FRONTEND=noninteractive
+  $sudo_prefix apt-get update -qq
+  $sudo_prefix apt-get install -y -qq "${missing[@]}" >/dev/null
+fi
+
+python=${PYTHON:-python3}
+if ! "$python" -c "import numpy, h5py, matplotlib, pytest" 2>/dev/null; then
+  echo "crashfree: installing Python packages from postproc/requirements.txt"
+  "$python" -m pip install -q -r postproc/requirements.txt 2>/dev/null \
+    || "$python" -m pip install -q --break-system-packages -r postproc/requirements.txt
+fi
