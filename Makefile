@@ -12,20 +12,18 @@ HDF5_INCLUDE ?= /usr/include/hdf5/serial
 HDF5_LIBDIR ?= /usr/lib/x86_64-linux-gnu/hdf5/serial
 LIBS := -L$(HDF5_LIBDIR) -lhdf5_fortran -lhdf5 -llapack -lblas
 
-BUILD := build/$(MODE)
+BUILD ?= build/$(MODE)
 OBJ := $(BUILD)/obj
 MOD := $(BUILD)/mod
 ifeq ($(MODE),debug)
   FFLAGS := -std=f2008 -Wall -Wextra -Wimplicit-interface -Wno-compare-reals -Wno-maybe-uninitialized \
             -fcheck=all -ffpe-trap=invalid,zero,overflow -finit-real=snan -g -O0 -fbacktrace -fopenmp
-  LIBRARY := $(BUILD)/lib/libcrashfree.a
-  PROGRAM := $(BUILD)/bin/crashfree
 else
   FFLAGS := -std=f2008 -O3 -march=native -funroll-loops -fopenmp -g -Wall -Wno-compare-reals \
             -Wno-maybe-uninitialized
-  LIBRARY := lib/libcrashfree.a
-  PROGRAM := bin/crashfree
 endif
+LIBRARY := $(BUILD)/lib/libcrashfree.a
+PROGRAM := $(BUILD)/bin/crashfree
 FFLAGS += -J$(MOD) -I$(MOD) -I$(HDF5_INCLUDE)
 
 LIBRARY_SOURCES := $(sort $(shell find src -name '*.f90' ! -path 'src/app/*'))
@@ -38,7 +36,16 @@ ALL_SOURCES := $(LIBRARY_SOURCES) src/app/crashfree.f90 $(TEST_SUPPORT) $(TEST_S
 vpath %.f90 $(sort $(dir $(ALL_SOURCES)))
 
 .PHONY: all deps run test unit regression bench clean debug
+# The release build is also published as bin/crashfree and lib/ (library and .mod files).
+ifeq ($(MODE),release)
+all: bin/crashfree
+bin/crashfree: $(PROGRAM)
+	@mkdir -p bin lib
+	@cp $(PROGRAM) bin/crashfree
+	@cp $(LIBRARY) $(MOD)/*.mod lib/
+else
 all: $(PROGRAM)
+endif
 
 $(OBJ)/%.o: %.f90 | $(OBJ) $(MOD)
 	$(FC) $(FFLAGS) -c $< -o $@
@@ -49,9 +56,6 @@ $(OBJ) $(MOD) $(BUILD)/tests $(dir $(LIBRARY)) $(dir $(PROGRAM)):
 $(LIBRARY): $(LIBRARY_OBJECTS) | $(dir $(LIBRARY))
 	@rm -f $@
 	ar rcs $@ $^
-ifeq ($(MODE),release)
-	@cp $(MOD)/*.mod lib/
-endif
 
 $(PROGRAM): $(OBJ)/crashfree.o $(LIBRARY) | $(dir $(PROGRAM))
 	$(FC) $(FFLAGS) $< $(LIBRARY) $(LIBS) -o $@
@@ -77,7 +81,7 @@ debug:
 unit: $(TEST_PROGRAMS)
 	@bash tools/run_unit_tests.sh $(TEST_PROGRAMS)
 
-regression: $(PROGRAM)
+regression: all
 	@$(PYTHON) -m pytest -q tests/regression
 
 run: deps

@@ -1,14 +1,144 @@
-!> One crashfree job: read the deck, run, write results; returns the exit status.
+!> One crashfree job: read and check the deck, set up, run, write results, summarise.
+!>
+!> Exit status: 0 normal termination; 1 error termination during the run (results up to that
+!> point are written); 2 the deck or the command line was rejected (nothing is run).
 module job
+  use kinds, only: wp
   use command_line, only: run_options_t
+  use error_handling, only: error_t, error_list_t
+  use model, only: model_t
+  use deck_reader, only: read_deck
+  use explicit_state, only: explicit_state_t
+  use explicit_setup, only: set_up_explicit_state
+  use explicit_solver, only: run_explicit
+  use results_file, only: results_file_t, open_results, close_results
+  use run_summary, only: run_summary_t, status_normal, status_error
+  use wall_clock, only: seconds_now
+  use progress_report, only: format_duration
+  use version, only: crashfree_version
+  use, intrinsic :: iso_fortran_env, only: error_unit
+  !$ use omp_lib, only: omp_set_num_threads, omp_get_max_threads
   implicit none
   private
+
   public :: run_job
+
 contains
+
   subroutine run_job(options, exit_status)
     type(run_options_t), intent(in) :: options
     integer, intent(out) :: exit_status
-    exit_status = 1
-    if (allocated(options%deck)) exit_status = 1
+    type(model_t) :: model
+    type(explicit_state_t) :: state
+    type(results_file_t) :: results
+    type(run_summary_t) :: summary
+    type(error_list_t) :: warnings
+    type(error_t), allocatable :: error, close_error
+    real(wp) :: started
+
+    started = seconds_now()
+    exit_status = 2
+    if (allocated(options%restart_file)) then
+      write (error_unit, '(a)') "crashfree: r=: restarts are not supported yet"
+      return
+    end if
+    summary%threads = select_threads(options%threads)
+    write (*, '(a)') "crashfree "//crashfree_version//": "//options%deck//" on "//trim(count_text(summary%threads))// &
+      " thread(s)"
+
+    call read_deck(options%deck, model, warnings, error, options%ignore_unknown)
+    if (warnings%count > 0) write (error_unit, '(a)') warnings%text
+    if (allocated(error)) then
+      write (error_unit, '(a)') error%message
+      write (error_unit, '(a)') "crashfree: the deck was rejected; nothing was run"
+      return
+    end if
+    call set_up_explicit_state(model, state, error)
+    if (allocated(error)) then
+      write (error_unit, '(a)') "crashfree: "//error%message
+      return
+    end if
+    call open_results(results, options%output_dir, options%job_id, model, summary%threads, error)
+    if (allocated(error)) then
+      write (error_unit, '(a)') "crashfree: "//error%message
+      return
+    end if
+    call describe_model(model, state, summary)
+    summary%setup_s = seconds_now() - started
+
+    call run_explicit(model, state, results, summary, error)
+
+    summary%wall_s = seconds_now() - started
+    if (allocated(error)) then
+      summary%status = status_error
+      summary%message = error%message
+      exit_status = 1
+    else
+      summary%status = status_normal
+      summary%message = ""
+      exit_status = 0
+    end if
+    call close_results(results, summary, close_error)
+    if (allocated(close_error)) then
+      write (error_unit, '(a)') "crashfree: "//close_error%message
+      exit_status = 1
+    end if
+    call print_summary(summary, options)
+    if (allocated(error)) write (error_unit, '(a)') "crashfree: error termination: "//error%message
   end subroutine run_job
+
+  !> ncpu=, else OMP_NUM_THREADS (the OpenMP runtime reads it), else all cores.
+  integer function select_threads(requested)
+    integer, intent(in) :: requested
+    select_threads = 1
+    !$ if (requested > 0) call omp_set_num_threads(requested)
+    !$ select_threads = omp_get_max_threads()
+  end function select_threads
+
+  subroutine describe_model(model, state, summary)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(in) :: state
+    type(run_summary_t), intent(inout) :: summary
+    character(len=200) :: line
+    summary%fe_elements = size(model%solid_ids)
+    summary%dofs_total = 3*size(model%node_ids)
+    write (line, '(a,i0,a,i0,a,i0,a)') "model: ", size(model%node_ids), " nodes, ", size(model%solid_ids), &
+      " solids in ", size(model%parts), " parts"
+    write (*, '(a)') trim(line)
+    write (line, '(a,es12.5,a,es12.5)') "mass: ", state%physical_mass, ", first time step ", state%next_time_step
+    write (*, '(a)') trim(line)
+    if (state%added_mass > 0.0_wp) then
+      write (line, '(a,es12.5,a,f0.3,a)') "mass scaling: added mass ", state%added_mass, " (", &
+        100.0_wp*state%added_mass/state%physical_mass, "% of the physical mass)"
+      write (*, '(a)') trim(line)
+    end if
+  end subroutine describe_model
+
+  subroutine print_summary(summary, options)
+    type(run_summary_t), intent(in) :: summary
+    type(run_options_t), intent(in) :: options
+    character(len=200) :: line
+    real(wp) :: per_element
+    write (*, '(a)') ""
+    write (*, '(a)') summary%status
+    write (line, '(a,i0,a,es12.5,a)') "  ", summary%cycles, " cycles to time ", summary%end_time, &
+      ", wall time "//format_duration(summary%wall_s)
+    write (*, '(a)') trim(line)
+    write (line, '(a,f10.3,a,f10.3,a,f10.3,a,f10.3)') "  seconds: setup", summary%setup_s, "  solids", &
+      summary%fe_solid_s, "  output", summary%output_s, "  other", &
+      max(0.0_wp, summary%wall_s - summary%setup_s - summary%fe_solid_s - summary%output_s)
+    write (*, '(a)') trim(line)
+    if (summary%cycles > 0 .and. summary%fe_elements > 0) then
+      per_element = 1.0e9_wp*summary%fe_solid_s/(real(summary%cycles, wp)*real(summary%fe_elements, wp))
+      write (line, '(a,f0.1,a)') "  solid elements: ", per_element, " ns per element per cycle"
+      write (*, '(a)') trim(line)
+    end if
+    write (*, '(a)') "  results: "//options%output_dir//"/"//options%job_id//".h5 (and .xdmf for ParaView)"
+  end subroutine print_summary
+
+  function count_text(value) result(text)
+    integer, intent(in) :: value
+    character(len=16) :: text
+    write (text, '(i0)') value
+  end function count_text
 end module job

@@ -1,0 +1,111 @@
+!> Nodal loads, single-point constraints and prescribed motions.
+!>
+!> Kinematic conditions act on the half-step velocities: a constrained or prescribed dof gets
+!> the velocity its condition demands for the coming step. The velocity change is an impulse
+!> from the support; the kinetic energy it adds, 1/2 m (v_new^2 - v_old^2), is booked as
+!> external work so that the energy balance closes.
+module boundary_conditions
+  use kinds, only: wp
+  use curves, only: curve_value
+  use model, only: model_t, motion_velocity, motion_acceleration, motion_displacement
+  implicit none
+  private
+
+  public :: assemble_nodal_loads, load_work, impose_kinematic_conditions, fixed_dof_mask
+
+contains
+
+  !> Which dofs are fixed by *BOUNDARY_SPC (x, y, z per node).
+  subroutine fixed_dof_mask(model, fixed)
+    type(model_t), intent(in) :: model
+    logical, intent(out) :: fixed(:, :)
+    integer :: k
+    fixed = .false.
+    do k = 1, size(model%spcs)
+      fixed(:, model%spcs(k)%node) = fixed(:, model%spcs(k)%node) .or. model%spcs(k)%fixed
+    end do
+  end subroutine fixed_dof_mask
+
+  !> External nodal forces at `time` (overwrites `external_force`).
+  subroutine assemble_nodal_loads(model, time, external_force)
+    type(model_t), intent(in) :: model
+    real(wp), intent(in) :: time
+    real(wp), intent(inout) :: external_force(:, :)
+    integer :: k
+    if (size(model%loads) == 0) return
+    do k = 1, size(model%loads)
+      associate (load => model%loads(k))
+        external_force(load%direction, load%node) = 0.0_wp
+      end associate
+    end do
+    do k = 1, size(model%loads)
+      associate (load => model%loads(k))
+        external_force(load%direction, load%node) = external_force(load%direction, load%node) &
+                                                    + load%scale*curve_value(model%curves(load%curve), time)
+      end associate
+    end do
+  end subroutine assemble_nodal_loads
+
+  !> Work of the nodal loads over the step, f . (v dt) summed over every dof (call with f at the
+  !> start and at the end of the step, each weighted 1/2).
+  function load_work(model, external_force, velocity, step) result(work)
+    type(model_t), intent(in) :: model
+    real(wp), intent(in) :: external_force(:, :), velocity(:, :), step
+    real(wp) :: work
+    work = 0.0_wp
+    if (size(model%loads) == 0) return
+    work = step*sum(external_force*velocity)
+  end function load_work
+
+  !> Set the half-step velocities demanded by SPCs and prescribed motions for the step from
+  !> `time` to `time + dt` (`average_dt` is the step of the velocity update). Returns the
+  !> kinetic energy the supports added (external work).
+  subroutine impose_kinematic_conditions(model, fixed, time, dt, average_dt, displacement, acceleration, &
+                                         mass, velocity, support_work)
+    type(model_t), intent(in) :: model
+    logical, intent(in) :: fixed(:, :)
+    real(wp), intent(in) :: time, dt, average_dt
+    real(wp), intent(in) :: displacement(:, :)
+    real(wp), intent(in) :: acceleration(:, :)
+    real(wp), intent(in) :: mass(:)
+    real(wp), intent(inout) :: velocity(:, :)
+    real(wp), intent(out) :: support_work
+    integer :: k, node, direction
+    real(wp) :: target, local_time, value
+
+    support_work = 0.0_wp
+    do k = 1, size(model%spcs)
+      node = model%spcs(k)%node
+      where (fixed(:, node)) velocity(:, node) = 0.0_wp
+    end do
+    do k = 1, size(model%motions)
+      associate (motion => model%motions(k))
+        node = motion%node
+        direction = motion%direction
+        select case (motion%kind)
+        case (motion_velocity)
+          local_time = time + 0.5_wp*dt
+        case (motion_acceleration)
+          local_time = time
+        case default
+          local_time = time + dt
+        end select
+        if (local_time < motion%birth .or. local_time > motion%death) cycle
+        value = motion%scale*curve_value(model%curves(motion%curve), local_time - motion%birth)
+        select case (motion%kind)
+        case (motion_velocity)
+          target = value
+        case (motion_acceleration)
+          ! replace the computed acceleration of this dof by the prescribed one
+          target = velocity(direction, node) + (value - acceleration(direction, node))*average_dt
+        case (motion_displacement)
+          target = (value - displacement(direction, node))/dt
+        case default
+          cycle
+        end select
+        support_work = support_work + 0.5_wp*mass(node)*(target**2 - velocity(direction, node)**2)
+        velocity(direction, node) = target
+      end associate
+    end do
+  end subroutine impose_kinematic_conditions
+end module boundary_conditions

@@ -1,0 +1,99 @@
+!> Energies of the whole model and of each part (glstat, matsum), summed in a fixed order.
+module energy_balance
+  use kinds, only: wp, block_size
+  use explicit_state, only: explicit_state_t
+  implicit none
+  private
+
+  public :: update_energy_totals, part_energies, total_energy, energy_ratio
+
+  !> Nodes per partial sum of the kinetic energy: partial sums over fixed chunks, added in
+  !> chunk order, keep the result independent of the thread count.
+  integer, parameter :: chunk_size = 4096
+
+contains
+
+  !> Kinetic energy and momentum at the integer step (v^{n+1} = v^{n+1/2} + dt/2 a^{n+1}) and
+  !> the sums of the element energies.
+  subroutine update_energy_totals(state)
+    type(explicit_state_t), intent(inout) :: state
+    integer :: chunk_count, chunk, first, last, node, b
+    real(wp) :: partial(4, max(1, (state%node_count + chunk_size - 1)/chunk_size)), velocity(3), half_step
+
+    chunk_count = (state%node_count + chunk_size - 1)/chunk_size
+    half_step = 0.5_wp*state%time_step
+    !$omp parallel do schedule(static) default(shared) private(chunk, first, last, node, velocity)
+    do chunk = 1, chunk_count
+      first = (chunk - 1)*chunk_size + 1
+      last = min(chunk*chunk_size, state%node_count)
+      partial(:, chunk) = 0.0_wp
+      do node = first, last
+        velocity = state%velocity(:, node) + half_step*state%acceleration(:, node)
+        partial(1, chunk) = partial(1, chunk) + state%mass(node)*dot_product(velocity, velocity)
+        partial(2:4, chunk) = partial(2:4, chunk) + state%mass(node)*velocity
+      end do
+    end do
+    !$omp end parallel do
+    state%energy%kinetic = 0.0_wp
+    state%energy%momentum = 0.0_wp
+    do chunk = 1, chunk_count
+      state%energy%kinetic = state%energy%kinetic + 0.5_wp*partial(1, chunk)
+      state%energy%momentum = state%energy%momentum + partial(2:4, chunk)
+    end do
+    state%energy%internal = 0.0_wp
+    state%energy%hourglass = 0.0_wp
+    do b = 1, size(state%blocks)
+      associate (block => state%blocks(b))
+        state%energy%internal = state%energy%internal + sum(block%internal_energy(1:block%element_count))
+        state%energy%hourglass = state%energy%hourglass + sum(block%hourglass_energy(1:block%element_count))
+      end associate
+    end do
+  end subroutine update_energy_totals
+
+  !> Kinetic, internal and hourglass energy of each part (indexed like model%parts). A node's
+  !> kinetic energy is shared among parts in proportion to the mass each element gives it.
+  subroutine part_energies(state, part_count, kinetic, internal, hourglass)
+    type(explicit_state_t), intent(in) :: state
+    integer, intent(in) :: part_count
+    real(wp), intent(out) :: kinetic(part_count), internal(part_count), hourglass(part_count)
+    integer :: b, corner, lane, node
+    real(wp) :: velocity(3), half_step
+    kinetic = 0.0_wp
+    internal = 0.0_wp
+    hourglass = 0.0_wp
+    half_step = 0.5_wp*state%time_step
+    do b = 1, size(state%blocks)
+      associate (block => state%blocks(b))
+        internal(block%part) = internal(block%part) + sum(block%internal_energy(1:block%element_count))
+        hourglass(block%part) = hourglass(block%part) + sum(block%hourglass_energy(1:block%element_count))
+        do corner = 1, 8
+          do lane = 1, block%element_count
+            node = block%nodes(lane, corner)
+            velocity = state%velocity(:, node) + half_step*state%acceleration(:, node)
+            kinetic(block%part) = kinetic(block%part) + &
+                                  0.5_wp*state%corner_mass(lane, corner, b)*dot_product(velocity, velocity)
+          end do
+        end do
+      end associate
+    end do
+  end subroutine part_energies
+
+  !> Total energy: kinetic + internal + hourglass + contact + rigid-wall (energy the walls took).
+  pure real(wp) function total_energy(state)
+    type(explicit_state_t), intent(in) :: state
+    total_energy = state%energy%kinetic + state%energy%internal + state%energy%hourglass + &
+                   state%energy%contact + state%energy%rigid_wall
+  end function total_energy
+
+  !> Energy ratio as in glstat: total / (initial total + external work); 1 is a perfect balance.
+  pure real(wp) function energy_ratio(state)
+    type(explicit_state_t), intent(in) :: state
+    real(wp) :: reference
+    reference = state%energy%initial_total + state%energy%external_work
+    if (abs(reference) > tiny(1.0_wp)) then
+      energy_ratio = total_energy(state)/reference
+    else
+      energy_ratio = 1.0_wp
+    end if
+  end function energy_ratio
+end module energy_balance

@@ -1,0 +1,141 @@
+!> Everything done once before the first cycle: element blocks, mass scaling, lumped nodal
+!> masses, the node -> corner gather list, the initial state and the first stable time step.
+module explicit_setup
+  use kinds, only: wp, block_size
+  use error_handling, only: error_t, make_error
+  use gather_list, only: build_gather_list
+  use model, only: model_t
+  use solid_block, only: solid_block_t, build_solid_blocks, solid_block_corner_masses, &
+                         solid_block_time_steps
+  use explicit_state, only: explicit_state_t
+  use boundary_conditions, only: fixed_dof_mask
+  use planar_rigid_walls, only: initialise_wall_states
+  implicit none
+  private
+
+  public :: set_up_explicit_state, corner_slot_to_mass_index
+
+contains
+
+  !> Build the state of cycle 0 from the checked model.
+  subroutine set_up_explicit_state(model, state, error)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(out) :: state
+    type(error_t), allocatable, intent(out) :: error
+    integer :: node_count, block_count
+
+    node_count = size(model%node_ids)
+    state%node_count = node_count
+    state%reference = model%coordinates
+    state%coordinates = model%coordinates
+    state%velocity = model%initial_velocity
+    allocate (state%displacement(3, node_count), state%acceleration(3, node_count), &
+              state%internal_force(3, node_count), state%external_force(3, node_count), &
+              state%reaction_force(3, node_count), state%mass(node_count), state%fixed(3, node_count))
+    state%displacement = 0.0_wp
+    state%acceleration = 0.0_wp
+    state%internal_force = 0.0_wp
+    state%external_force = 0.0_wp
+    state%reaction_force = 0.0_wp
+    call fixed_dof_mask(model, state%fixed)
+    where (state%fixed) state%velocity = 0.0_wp
+
+    call build_solid_blocks(model, state%blocks)
+    block_count = size(state%blocks)
+    allocate (state%corner_force(block_size, 8, 3, block_count), state%corner_mass(block_size, 8, block_count), &
+              state%block_time_step(block_count), state%block_critical_element(block_count), &
+              state%block_inverted_element(block_count))
+    state%corner_force = 0.0_wp
+    state%block_time_step = huge(1.0_wp)
+    state%block_critical_element = 0
+    state%block_inverted_element = 0
+
+    call scale_masses(model, state)
+    call build_node_corner_list(state)
+    call lump_nodal_masses(state)
+    call initialise_wall_states(model%walls, state%walls)
+    if (sum(state%mass) <= 0.0_wp) then
+      call make_error(error, "model: the elements give no mass (check densities and element volumes)")
+      return
+    end if
+  end subroutine set_up_explicit_state
+
+  !> Mass scaling (*CONTROL_TIMESTEP DT2MS): raise the density of every element whose stable
+  !> step is below |DT2MS| so that its step equals |DT2MS| (the step scales with 1/sqrt(rho)).
+  !> Done once, on the undeformed mesh; the added mass is reported.
+  subroutine scale_masses(model, state)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(inout) :: state
+    real(wp) :: element_time_step(block_size), target_step, factor
+    integer :: b, i
+
+    state%physical_mass = 0.0_wp
+    state%added_mass = 0.0_wp
+    target_step = abs(model%mass_scaled_time_step)
+    do b = 1, size(state%blocks)
+      associate (block => state%blocks(b))
+        state%physical_mass = state%physical_mass + &
+                              sum(block%density(1:block%element_count)*block%reference_volume(1:block%element_count))
+        if (target_step <= 0.0_wp) cycle
+        call solid_block_time_steps(block, model%materials(block%material), state%coordinates, element_time_step)
+        do i = 1, block%element_count
+          if (element_time_step(i) >= target_step) cycle
+          factor = (target_step/element_time_step(i))**2
+          state%added_mass = state%added_mass + (factor - 1.0_wp)*block%density(i)*block%reference_volume(i)
+          block%density(i) = block%density(i)*factor
+        end do
+      end associate
+    end do
+  end subroutine scale_masses
+
+  !> Node -> corner list. A slot is the position of the x component of one corner force in
+  !> `corner_force(block_size, 8, 3, blocks)` viewed as one array; y and z follow at
+  !> +8*block_size and +16*block_size.
+  subroutine build_node_corner_list(state)
+    type(explicit_state_t), intent(inout) :: state
+    integer, allocatable :: slot_node(:)
+    integer :: b, corner, lane
+
+    allocate (slot_node(block_size*24*size(state%blocks)))
+    slot_node = 0
+    do b = 1, size(state%blocks)
+      do corner = 1, 8
+        do lane = 1, state%blocks(b)%element_count
+          slot_node(force_slot(lane, corner, b)) = state%blocks(b)%nodes(lane, corner)
+        end do
+      end do
+    end do
+    call build_gather_list(state%node_count, slot_node, state%node_corners)
+  end subroutine build_node_corner_list
+
+  !> Lumped nodal masses: each node gathers its corner masses in slot order.
+  subroutine lump_nodal_masses(state)
+    type(explicit_state_t), intent(inout) :: state
+    integer :: b, node, k
+    real(wp), allocatable :: flat_mass(:)
+
+    do b = 1, size(state%blocks)
+      call solid_block_corner_masses(state%blocks(b), state%corner_mass(:, :, b))
+    end do
+    flat_mass = reshape(state%corner_mass, [size(state%corner_mass)])
+    do node = 1, state%node_count
+      state%mass(node) = 0.0_wp
+      do k = state%node_corners%offsets(node), state%node_corners%offsets(node + 1) - 1
+        state%mass(node) = state%mass(node) + flat_mass(corner_slot_to_mass_index(state%node_corners%corners(k)))
+      end do
+    end do
+  end subroutine lump_nodal_masses
+
+  pure integer function force_slot(lane, corner, block)
+    integer, intent(in) :: lane, corner, block
+    force_slot = lane + (corner - 1)*block_size + (block - 1)*block_size*24
+  end function force_slot
+
+  !> Position in `corner_mass(block_size, 8, blocks)` of the corner whose force slot is `slot`.
+  pure integer function corner_slot_to_mass_index(slot)
+    integer, intent(in) :: slot
+    integer :: block_offset
+    block_offset = (slot - 1)/(block_size*24)
+    corner_slot_to_mass_index = slot - block_offset*block_size*16
+  end function corner_slot_to_mass_index
+end module explicit_setup

@@ -1,0 +1,198 @@
+!> The explicit time loop (central difference), as a short sequence of named steps:
+!> velocities -> kinematic conditions and walls -> positions -> element forces -> external
+!> loads -> accelerations -> next time step -> output.
+module explicit_solver
+  use kinds, only: wp
+  use error_handling, only: error_t, make_error
+  use model, only: model_t
+  use explicit_state, only: explicit_state_t
+  use element_forces, only: compute_element_forces
+  use boundary_conditions, only: assemble_nodal_loads, load_work, impose_kinematic_conditions
+  use planar_rigid_walls, only: enforce_planar_walls
+  use energy_balance, only: update_energy_totals, total_energy
+  use run_output, only: output_plan_t, plan_output, write_due_output
+  use history_buffer, only: history_set_t
+  use results_file, only: results_file_t
+  use run_summary, only: run_summary_t
+  use progress_report, only: progress_t, start_progress, report_progress
+  use wall_clock, only: phase_timer_t, start_phase, stop_phase
+  implicit none
+  private
+
+  public :: run_explicit
+
+contains
+
+  !> Run from t = 0 to the end time (or end cycle). On a run-time error (inverted element,
+  !> non-finite state) the last state is written and `error` says what, where and when.
+  subroutine run_explicit(model, state, results, summary, error)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(inout) :: state
+    type(results_file_t), intent(inout) :: results
+    type(run_summary_t), intent(inout) :: summary
+    type(error_t), allocatable, intent(out) :: error
+    type(history_set_t) :: histories
+    type(output_plan_t) :: plan
+    type(progress_t) :: progress
+    type(phase_timer_t) :: element_timer, output_timer
+    type(error_t), allocatable :: output_error
+    real(wp) :: previous_step, step, work
+    logical :: finished, wrote_state
+
+    call plan_output(model, histories, plan)
+
+    ! cycle 0: forces and accelerations of the initial state
+    call start_phase(element_timer)
+    call compute_element_forces(model, state, 0.0_wp)
+    call stop_phase(element_timer)
+    call assemble_nodal_loads(model, 0.0_wp, state%external_force)
+    call compute_accelerations(state)
+    call select_time_step(model, state, is_first=.true.)
+    call update_energy_totals(state)
+    state%energy%initial_total = total_energy(state)
+    call check_state(model, state, error)
+    finished = allocated(error) .or. model%end_time <= 0.0_wp .and. model%end_cycle <= 0
+    call start_phase(output_timer)
+    call write_due_output(model, state, plan, histories, results, finished, wrote_state, output_error)
+    call stop_phase(output_timer)
+    call start_progress(progress, model%end_time, model%end_cycle)
+    previous_step = 0.0_wp
+
+    do while (.not. finished)
+      step = state%next_time_step
+      ! velocities at the half step, then the supports and walls correct them
+      call update_velocities(state, 0.5_wp*(previous_step + step))
+      call impose_kinematic_conditions(model, state%fixed, state%time, step, 0.5_wp*(previous_step + step), &
+                                       state%displacement, state%acceleration, state%mass, state%velocity, work)
+      state%energy%external_work = state%energy%external_work + work
+      if (size(model%walls) > 0) then
+        call enforce_planar_walls(model%walls, state%walls, state%time, step, state%coordinates, state%mass, &
+                                  state%velocity, work)
+        state%energy%rigid_wall = state%energy%rigid_wall + work
+      end if
+      call update_positions(state, step)
+      state%energy%external_work = state%energy%external_work + &
+                                   0.5_wp*load_work(model, state%external_force, state%velocity, step)
+      state%time = state%time + step
+      state%time_step = step
+      state%cycle = state%cycle + 1
+      previous_step = step
+
+      call start_phase(element_timer)
+      call compute_element_forces(model, state, step)
+      call stop_phase(element_timer)
+      call assemble_nodal_loads(model, state%time, state%external_force)
+      state%energy%external_work = state%energy%external_work + &
+                                   0.5_wp*load_work(model, state%external_force, state%velocity, step)
+      call compute_accelerations(state)
+      call select_time_step(model, state, is_first=.false.)
+      call check_state(model, state, error)
+
+      finished = allocated(error) .or. state%time >= model%end_time*(1.0_wp - 1.0e-12_wp) .or. &
+                 (model%end_cycle > 0 .and. state%cycle >= model%end_cycle)
+      call start_phase(output_timer)
+      call write_due_output(model, state, plan, histories, results, finished, wrote_state, output_error)
+      call stop_phase(output_timer)
+      if (allocated(output_error)) exit
+      call report_progress(progress, state%cycle, state%time, step, finished)
+    end do
+
+    if (allocated(output_error) .and. .not. allocated(error)) call move_alloc(output_error, error)
+    summary%end_time = state%time
+    summary%cycles = state%cycle
+    summary%fe_solid_s = element_timer%seconds
+    summary%output_s = output_timer%seconds
+  end subroutine run_explicit
+
+  !> a = (f_ext - f_int) / m; constrained dofs do not accelerate.
+  subroutine compute_accelerations(state)
+    type(explicit_state_t), intent(inout) :: state
+    integer :: node
+    !$omp parallel do schedule(static) default(shared) private(node)
+    do node = 1, state%node_count
+      if (state%mass(node) > 0.0_wp) then
+        state%acceleration(:, node) = (state%external_force(:, node) - state%internal_force(:, node))/state%mass(node)
+      else
+        state%acceleration(:, node) = 0.0_wp
+      end if
+      where (state%fixed(:, node)) state%acceleration(:, node) = 0.0_wp
+    end do
+    !$omp end parallel do
+  end subroutine compute_accelerations
+
+  !> v^{n+1/2} = v^{n-1/2} + a^n (dt^{n-1/2} + dt^{n+1/2}) / 2.
+  subroutine update_velocities(state, average_step)
+    type(explicit_state_t), intent(inout) :: state
+    real(wp), intent(in) :: average_step
+    integer :: node
+    !$omp parallel do schedule(static) default(shared) private(node)
+    do node = 1, state%node_count
+      state%velocity(:, node) = state%velocity(:, node) + average_step*state%acceleration(:, node)
+    end do
+    !$omp end parallel do
+  end subroutine update_velocities
+
+  !> u^{n+1} = u^n + dt v^{n+1/2}; x = X + u.
+  subroutine update_positions(state, step)
+    type(explicit_state_t), intent(inout) :: state
+    real(wp), intent(in) :: step
+    integer :: node
+    !$omp parallel do schedule(static) default(shared) private(node)
+    do node = 1, state%node_count
+      state%displacement(:, node) = state%displacement(:, node) + step*state%velocity(:, node)
+      state%coordinates(:, node) = state%reference(:, node) + state%displacement(:, node)
+    end do
+    !$omp end parallel do
+  end subroutine update_positions
+
+  !> Next step: TSSFAC times the smallest stable element step (never below |DT2MS| times TSSFAC
+  !> while mass scaling holds it there); DTINIT caps the first step.
+  subroutine select_time_step(model, state, is_first)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(inout) :: state
+    logical, intent(in) :: is_first
+    integer :: b, critical
+    real(wp) :: smallest
+    smallest = huge(1.0_wp)
+    critical = 0
+    do b = 1, size(state%blocks)
+      if (state%block_time_step(b) < smallest) then
+        smallest = state%block_time_step(b)
+        critical = state%block_critical_element(b)
+      end if
+    end do
+    state%next_time_step = model%time_step_scale*smallest
+    state%controlling_element = critical
+    if (is_first .and. model%initial_time_step > 0.0_wp) &
+      state%next_time_step = min(state%next_time_step, model%initial_time_step)
+  end subroutine select_time_step
+
+  !> Run-time failures, found after the parallel loops: an inverted element or a state that
+  !> is no longer finite.
+  subroutine check_state(model, state, error)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(in) :: state
+    type(error_t), allocatable, intent(out) :: error
+    integer :: b, element
+    character(len=256) :: text
+    do b = 1, size(state%blocks)
+      element = state%block_inverted_element(b)
+      if (element == 0) cycle
+      write (text, '(a,i0,a,i0,a,es12.5,a,i0)') "negative volume in solid element ", model%solid_ids(element), &
+        " (part ", model%parts(model%solid_part(element))%id, ") at time ", state%time, ", cycle ", state%cycle
+      call make_error(error, trim(text))
+      return
+    end do
+    if (.not. (state%next_time_step > 0.0_wp .and. state%next_time_step < huge(1.0_wp))) then
+      element = state%controlling_element
+      if (element > 0) then
+        write (text, '(a,es12.5,a,i0,a,i0,a,es12.5,a,i0)') "time step ", state%next_time_step, &
+          " is not usable (element ", model%solid_ids(element), ", part ", &
+          model%parts(model%solid_part(element))%id, ") at time ", state%time, ", cycle ", state%cycle
+      else
+        write (text, '(a,es12.5,a)') "time step ", state%next_time_step, " is not usable (no element sets it)"
+      end if
+      call make_error(error, trim(text))
+    end if
+  end subroutine check_state
+end module explicit_solver

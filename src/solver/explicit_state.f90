@@ -1,0 +1,70 @@
+!> Everything that changes during an explicit run, in structure-of-arrays form.
+!>
+!> Nodal arrays are `(3, nodes)`; element data lives in blocks (`solid_block_t`) whose kernels
+!> write one force per element corner into `corner_force(:, :, :, block)`. The gather list then
+!> sums the corners of each node in a fixed order, which keeps results bit-identical for any
+!> thread count.
+module explicit_state
+  use kinds, only: wp, block_size
+  use gather_list, only: gather_list_t
+  use solid_block, only: solid_block_t
+  implicit none
+  private
+
+  public :: explicit_state_t, wall_state_t, energy_totals_t
+
+  !> Running totals for the energy balance (glstat).
+  type :: energy_totals_t
+    real(wp) :: kinetic = 0.0_wp
+    real(wp) :: internal = 0.0_wp
+    real(wp) :: hourglass = 0.0_wp
+    real(wp) :: contact = 0.0_wp
+    real(wp) :: rigid_wall = 0.0_wp          !< energy taken out by rigid walls (stonewall energy)
+    real(wp) :: external_work = 0.0_wp       !< loads and prescribed motions
+    real(wp) :: initial_total = 0.0_wp
+    real(wp) :: momentum(3) = 0.0_wp         !< linear momentum of all nodes
+  end type energy_totals_t
+
+  !> Motion and accumulated force of one planar rigid wall.
+  type :: wall_state_t
+    real(wp) :: displacement = 0.0_wp        !< along the normal (moving walls)
+    real(wp) :: speed = 0.0_wp               !< along the normal (moving walls)
+    real(wp) :: force(3) = 0.0_wp            !< force on the wall in the last cycle
+    real(wp) :: impulse(3) = 0.0_wp          !< impulse on the wall since the last rwforc sample
+  end type wall_state_t
+
+  !> The state of the whole model at one cycle.
+  type :: explicit_state_t
+    integer :: node_count = 0
+    integer :: cycle = 0
+    real(wp) :: time = 0.0_wp
+    real(wp) :: time_step = 0.0_wp                       !< t^{n+1} - t^n of the last step
+    real(wp) :: next_time_step = 0.0_wp                  !< stable step for the coming cycle
+    integer :: controlling_element = 0                   !< solid index that set next_time_step
+    ! nodal arrays (3, nodes) and (nodes)
+    real(wp), allocatable :: reference(:, :)             !< X
+    real(wp), allocatable :: coordinates(:, :)           !< x = X + u
+    real(wp), allocatable :: displacement(:, :)
+    real(wp), allocatable :: velocity(:, :)              !< v^{n+1/2} during the cycle
+    real(wp), allocatable :: acceleration(:, :)
+    real(wp), allocatable :: internal_force(:, :)
+    real(wp), allocatable :: external_force(:, :)
+    real(wp), allocatable :: reaction_force(:, :)        !< at constrained dofs, for external work
+    real(wp), allocatable :: mass(:)
+    logical, allocatable :: fixed(:, :)                  !< SPC per dof
+    ! element blocks and their corner forces
+    type(solid_block_t), allocatable :: blocks(:)
+    real(wp), allocatable :: corner_force(:, :, :, :)    !< (block_size, 8, 3, blocks)
+    real(wp), allocatable :: corner_mass(:, :, :)        !< (block_size, 8, blocks)
+    real(wp), allocatable :: block_time_step(:)          !< per block, from its kernel
+    integer, allocatable :: block_critical_element(:)
+    integer, allocatable :: block_inverted_element(:)
+    type(gather_list_t) :: node_corners                  !< node -> (lane, corner, block) slots
+    ! walls
+    type(wall_state_t), allocatable :: walls(:)
+    ! bookkeeping
+    type(energy_totals_t) :: energy
+    real(wp) :: added_mass = 0.0_wp                      !< by mass scaling
+    real(wp) :: physical_mass = 0.0_wp
+  end type explicit_state_t
+end module explicit_state

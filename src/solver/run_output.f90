@@ -1,0 +1,219 @@
+!> What the run writes and when: states (d3plot), glstat, matsum, nodout and rwforc histories.
+!>
+!> Every output has an interval; it is written at t = 0, whenever the time passes the next
+!> multiple of its interval, and at the last cycle. Without a *DATABASE card, glstat and matsum
+!> (and rwforc for walls) are still recorded at ENDTIM/200 and states at ENDTIM/20, so every run
+!> can be plotted; nodout needs history nodes.
+module run_output
+  use kinds, only: wp
+  use error_handling, only: error_t
+  use model, only: model_t
+  use explicit_state, only: explicit_state_t
+  use history_buffer, only: history_set_t, add_history_series, append_history_row
+  use energy_balance, only: update_energy_totals, part_energies, total_energy, energy_ratio
+  use solid_block, only: solid_block_element_results
+  use results_file, only: results_file_t, write_state, write_histories
+  implicit none
+  private
+
+  public :: output_plan_t, plan_output, write_due_output
+
+  !> One periodic output.
+  type :: output_clock_t
+    real(wp) :: interval = 0.0_wp
+    real(wp) :: next_time = 0.0_wp
+    logical :: active = .false.
+  end type output_clock_t
+
+  !> Clocks and the positions of the history series.
+  type :: output_plan_t
+    type(output_clock_t) :: states, glstat, matsum, nodout, rwforc
+    integer :: glstat_series = 0
+    integer, allocatable :: matsum_series(:)     !< per part
+    integer, allocatable :: nodout_series(:)     !< per history node
+    integer, allocatable :: rwforc_series(:)     !< per wall
+    real(wp) :: last_rwforc_time = 0.0_wp
+    ! work arrays for the element results of a state, allocated once
+    real(wp), allocatable :: solid_stress(:, :), solid_plastic_strain(:)
+    real(wp), allocatable :: part_kinetic(:), part_internal(:), part_hourglass(:)
+  end type output_plan_t
+
+  character(len=32), parameter :: glstat_columns(12) = [character(len=32) :: "time", "time_step", &
+    "kinetic_energy", "internal_energy", "hourglass_energy", "contact_energy", "external_work", &
+    "total_energy", "rigid_wall_energy", "energy_ratio", "added_mass", "momentum"]
+  integer, parameter :: glstat_widths(12) = [1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 3]
+
+contains
+
+  !> Set the clocks from the deck and create the history series.
+  subroutine plan_output(model, histories, plan)
+    type(model_t), intent(in) :: model
+    type(history_set_t), intent(inout) :: histories
+    type(output_plan_t), intent(out) :: plan
+    real(wp) :: default_history
+    integer :: capacity, k
+    character(len=32) :: label
+
+    default_history = model%end_time/200.0_wp
+    call set_clock(plan%states, model%output%state_interval, model%end_time/20.0_wp, .true.)
+    call set_clock(plan%glstat, model%output%glstat_interval, default_history, .true.)
+    call set_clock(plan%matsum, model%output%matsum_interval, plan%glstat%interval, .true.)
+    call set_clock(plan%rwforc, model%output%rwforc_interval, plan%glstat%interval, size(model%walls) > 0)
+    call set_clock(plan%nodout, model%output%nodout_interval, plan%glstat%interval, &
+                   size(model%output%history_nodes) > 0)
+
+    capacity = expected_rows(model, plan%glstat)
+    call add_history_series(histories, "glstat", glstat_columns, glstat_widths, &
+                            capacity, plan%glstat_series)
+    capacity = expected_rows(model, plan%matsum)
+    allocate (plan%matsum_series(size(model%parts)))
+    do k = 1, size(model%parts)
+      write (label, '(i0)') model%parts(k)%id
+      call add_history_series(histories, "matsum/"//trim(label), [character(len=32) :: "time", &
+                              "kinetic_energy", "internal_energy", "hourglass_energy"], [1, 1, 1, 1], &
+                              capacity, plan%matsum_series(k))
+    end do
+    allocate (plan%nodout_series(0), plan%rwforc_series(0))
+    if (plan%nodout%active) then
+      capacity = expected_rows(model, plan%nodout)
+      deallocate (plan%nodout_series)
+      allocate (plan%nodout_series(size(model%output%history_nodes)))
+      do k = 1, size(model%output%history_nodes)
+        write (label, '(i0)') model%node_ids(model%output%history_nodes(k))
+        call add_history_series(histories, "nodout/"//trim(label), [character(len=32) :: "time", &
+                                "displacement", "velocity", "acceleration"], [1, 3, 3, 3], capacity, &
+                                plan%nodout_series(k))
+      end do
+    end if
+    if (plan%rwforc%active) then
+      capacity = expected_rows(model, plan%rwforc)
+      deallocate (plan%rwforc_series)
+      allocate (plan%rwforc_series(size(model%walls)))
+      do k = 1, size(model%walls)
+        write (label, '(i0)') model%walls(k)%id
+        call add_history_series(histories, "rwforc/"//trim(label), [character(len=32) :: "time", "force"], &
+                                [1, 3], capacity, plan%rwforc_series(k))
+      end do
+    end if
+    allocate (plan%solid_stress(6, size(model%solid_ids)), plan%solid_plastic_strain(size(model%solid_ids)))
+    allocate (plan%part_kinetic(size(model%parts)), plan%part_internal(size(model%parts)), &
+              plan%part_hourglass(size(model%parts)))
+  end subroutine plan_output
+
+  subroutine set_clock(clock, interval, default_interval, active)
+    type(output_clock_t), intent(out) :: clock
+    real(wp), intent(in) :: interval, default_interval
+    logical, intent(in) :: active
+    clock%active = active
+    clock%interval = interval
+    if (clock%interval <= 0.0_wp) clock%interval = default_interval
+    clock%next_time = 0.0_wp
+  end subroutine set_clock
+
+  integer function expected_rows(model, clock)
+    type(model_t), intent(in) :: model
+    type(output_clock_t), intent(in) :: clock
+    expected_rows = 16
+    if (clock%interval > 0.0_wp) expected_rows = int(min(1.0e6_wp, model%end_time/clock%interval)) + 16
+  end function expected_rows
+
+  !> Whether a clock is due at `time` (and advance it); `last` forces every active output.
+  logical function clock_due(clock, time, last)
+    type(output_clock_t), intent(inout) :: clock
+    real(wp), intent(in) :: time
+    logical, intent(in) :: last
+    clock_due = .false.
+    if (.not. clock%active) return
+    if (time >= clock%next_time*(1.0_wp - 1.0e-12_wp) .or. last) then
+      clock_due = .true.
+      if (clock%interval > 0.0_wp) then
+        do while (clock%next_time <= time*(1.0_wp + 1.0e-12_wp))
+          clock%next_time = clock%next_time + clock%interval
+        end do
+      else
+        clock%next_time = huge(1.0_wp)
+      end if
+    end if
+  end function clock_due
+
+  !> Record the histories and write the state that are due at the state's time. `last` marks
+  !> the final cycle (normal or error termination): everything is written then.
+  subroutine write_due_output(model, state, plan, histories, results, last, wrote_state, error)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(inout) :: state
+    type(output_plan_t), intent(inout) :: plan
+    type(history_set_t), intent(inout) :: histories
+    type(results_file_t), intent(inout) :: results
+    logical, intent(in) :: last
+    logical, intent(out) :: wrote_state
+    type(error_t), allocatable, intent(out) :: error
+    logical :: glstat_due, matsum_due
+    integer :: k
+
+    wrote_state = .false.
+    glstat_due = clock_due(plan%glstat, state%time, last)
+    matsum_due = clock_due(plan%matsum, state%time, last)
+    if (glstat_due .or. matsum_due) call update_energy_totals(state)
+    if (glstat_due) then
+      call append_history_row(histories%series(plan%glstat_series), [state%time, state%next_time_step, &
+        state%energy%kinetic, state%energy%internal, state%energy%hourglass, state%energy%contact, &
+        state%energy%external_work, total_energy(state), state%energy%rigid_wall, energy_ratio(state), &
+        state%added_mass, state%energy%momentum])
+    end if
+    if (matsum_due) then
+      call part_energies(state, size(model%parts), plan%part_kinetic, plan%part_internal, plan%part_hourglass)
+      do k = 1, size(model%parts)
+        call append_history_row(histories%series(plan%matsum_series(k)), [state%time, plan%part_kinetic(k), &
+                                plan%part_internal(k), plan%part_hourglass(k)])
+      end do
+    end if
+    if (clock_due(plan%nodout, state%time, last)) then
+      do k = 1, size(plan%nodout_series)
+        associate (node => model%output%history_nodes(k))
+          call append_history_row(histories%series(plan%nodout_series(k)), [state%time, &
+            state%displacement(:, node), state%velocity(:, node) + 0.5_wp*state%time_step*state%acceleration(:, node), &
+            state%acceleration(:, node)])
+        end associate
+      end do
+    end if
+    if (clock_due(plan%rwforc, state%time, last)) call record_wall_forces(state, plan, histories)
+    if (clock_due(plan%states, state%time, last)) then
+      call write_current_state(state, plan, results, error)
+      if (allocated(error)) return
+      call write_histories(results, histories, error)
+      wrote_state = .true.
+    end if
+  end subroutine write_due_output
+
+  !> Wall force averaged over the sampling interval (impulse / interval), so that integrating
+  !> the rwforc history gives the impulse exactly; at t = 0 the force of the first cycle is 0.
+  subroutine record_wall_forces(state, plan, histories)
+    type(explicit_state_t), intent(inout) :: state
+    type(output_plan_t), intent(inout) :: plan
+    type(history_set_t), intent(inout) :: histories
+    integer :: k
+    real(wp) :: interval, force(3)
+    interval = state%time - plan%last_rwforc_time
+    do k = 1, size(plan%rwforc_series)
+      force = 0.0_wp
+      if (interval > 0.0_wp) force = state%walls(k)%impulse/interval
+      call append_history_row(histories%series(plan%rwforc_series(k)), [state%time, force])
+      state%walls(k)%impulse = 0.0_wp
+    end do
+    plan%last_rwforc_time = state%time
+  end subroutine record_wall_forces
+
+  subroutine write_current_state(state, plan, results, error)
+    type(explicit_state_t), intent(in) :: state
+    type(output_plan_t), intent(inout) :: plan
+    type(results_file_t), intent(inout) :: results
+    type(error_t), allocatable, intent(out) :: error
+    integer :: b
+    do b = 1, size(state%blocks)
+      call solid_block_element_results(state%blocks(b), plan%solid_stress, plan%solid_plastic_strain)
+    end do
+    call write_state(results, state%time, state%displacement, &
+                     state%velocity + 0.5_wp*state%time_step*state%acceleration, plan%solid_stress, &
+                     plan%solid_plastic_strain, error)
+  end subroutine write_current_state
+end module run_output

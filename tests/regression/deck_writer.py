@@ -1,0 +1,96 @@
+"""Write small LS-DYNA style keyword decks for the regression tests.
+
+Meshes are structured blocks of hexahedra, optionally with randomly perturbed interior nodes
+(irregular meshes for patch tests). Cards are written in LS-DYNA's fixed format, so the tests
+also exercise the reader's column handling.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+def block_mesh(counts, lengths, origin=(0.0, 0.0, 0.0), perturbation=0.0, seed=1):
+    """Nodes (n,3) and hexahedra (m,8, 0-based) of a box split into counts = (nx, ny, nz) cells.
+
+    `perturbation` moves every node that is not on the box's boundary by up to that fraction
+    of the local cell size in each direction (a reproducible irregular mesh)."""
+    nx, ny, nz = counts
+    axes = [np.linspace(o, o + length, n + 1) for o, length, n in zip(origin, lengths, counts)]
+    grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1)  # (nx+1, ny+1, nz+1, 3)
+    if perturbation > 0.0:
+        rng = np.random.default_rng(seed)
+        cell = np.array(lengths) / np.array(counts)
+        shift = rng.uniform(-perturbation, perturbation, grid.shape) * cell
+        interior = np.zeros(grid.shape[:3], bool)
+        interior[1:-1, 1:-1, 1:-1] = True
+        grid[interior] += shift[interior]
+    nodes = grid.reshape(-1, 3)
+
+    def index(i, j, k):
+        return (i * (ny + 1) + j) * (nz + 1) + k
+
+    elements = []
+    for i in range(nx):
+        for j in range(ny):
+            for k in range(nz):
+                elements.append([index(i, j, k), index(i + 1, j, k), index(i + 1, j + 1, k), index(i, j + 1, k),
+                                 index(i, j, k + 1), index(i + 1, j, k + 1), index(i + 1, j + 1, k + 1),
+                                 index(i, j + 1, k + 1)])
+    return nodes, np.array(elements, dtype=int)
+
+
+def boundary_node_mask(nodes, tolerance=1e-9):
+    """Nodes on the bounding box of the mesh."""
+    low, high = nodes.min(axis=0), nodes.max(axis=0)
+    return np.any((np.abs(nodes - low) < tolerance) | (np.abs(nodes - high) < tolerance), axis=1)
+
+
+def nodes_card(nodes, first_id=1):
+    lines = ["*NODE"]
+    for k, (x, y, z) in enumerate(nodes):
+        lines.append(f"{k + first_id:8d}{x:16.9e}{y:16.9e}{z:16.9e}{0:8d}{0:8d}")
+    return "\n".join(lines)
+
+
+def solids_card(elements, part_id=1, first_id=1, first_node_id=1):
+    lines = ["*ELEMENT_SOLID"]
+    for k, corners in enumerate(elements):
+        ids = "".join(f"{c + first_node_id:8d}" for c in corners)
+        lines.append(f"{k + first_id:8d}{part_id:8d}{ids}")
+    return "\n".join(lines)
+
+
+def fields(*values, width=10):
+    """One fixed-format card from values (None = blank field). Reals are written exactly when
+    their shortest form fits the field, else rounded to the digits the field holds."""
+    text = ""
+    for value in values:
+        if value is None:
+            text += " " * width
+        elif isinstance(value, float):
+            shortest = repr(value)
+            if len(shortest) > width:
+                shortest = f"{value:.{width - 7}e}"
+            text += f"{shortest:>{width}}"
+        else:
+            text += f"{value:>{width}}"
+    return text
+
+
+def round_to_node_card(nodes):
+    """Coordinates exactly as the reader will see them in a *NODE card (16-column fields)."""
+    return np.array([[float(f"{x:16.9e}") for x in row] for row in nodes])
+
+
+def node_list_set(set_id, node_ids):
+    lines = ["*SET_NODE_LIST", fields(set_id)]
+    for start in range(0, len(node_ids), 8):
+        lines.append("".join(f"{n:10d}" for n in node_ids[start:start + 8]))
+    return "\n".join(lines)
+
+
+def write_deck(path, *blocks):
+    """Join keyword blocks into a deck that starts with *KEYWORD and ends with *END."""
+    text = "*KEYWORD\n" + "\n".join(blocks) + "\n*END\n"
+    path.write_text(text)
+    return path

@@ -1,0 +1,88 @@
+"""One hexahedron in uniaxial stress (symmetry planes x = 0, y = 0, z = 0; the x = 1 face
+pulled slowly). *MAT_PLASTIC_KINEMATIC: the stress follows the bilinear law in logarithmic
+strain (slope E, then ETAN after SIGY); with Cowper-Symonds the yield stress is scaled by
+1 + (rate / C)^(1 / P)."""
+import numpy as np
+import pytest
+
+from deck_writer import block_mesh, fields, nodes_card, node_list_set, solids_card, write_deck
+
+E, NU, SIGY, ETAN = 200.0, 0.3, 0.25, 2.0     # GPa
+PULL_SPEED = 0.05                             # mm/ms on a 1 mm element: strain rate 0.05 / ms
+RAMP = 0.05                                   # ms to reach the pull speed smoothly
+
+
+def uniaxial_deck(path, element_formulation, rate_c=0.0, rate_p=0.0):
+    nodes, elements = block_mesh((1, 1, 1), (1.0, 1.0, 1.0))
+    on = {axis: list(np.flatnonzero(np.abs(nodes[:, axis]) < 1e-9) + 1) for axis in range(3)}
+    pulled = list(np.flatnonzero(np.abs(nodes[:, 0] - 1.0) < 1e-9) + 1)
+    spc = ["*BOUNDARY_SPC_NODE"]
+    for axis in range(3):
+        for node in on[axis]:
+            dofs = [1 if a == axis else 0 for a in range(3)]
+            spc.append(fields(node, 0, *dofs, 0, 0, 0))
+    curve = "\n".join(f"{t:20.6e}{min(t / RAMP, 1.0):20.6e}" for t in np.linspace(0.0, RAMP, 11)) + \
+        f"\n{10.0:20.6e}{1.0:20.6e}"
+    return write_deck(
+        path,
+        "*CONTROL_TERMINATION\n" + fields(0.8),
+        "*DATABASE_BINARY_D3PLOT\n" + fields(0.01),
+        "*PART\nelement\n" + fields(1, 1, 1),
+        "*SECTION_SOLID\n" + fields(1, element_formulation),
+        "*MAT_PLASTIC_KINEMATIC\n" + fields(1, 7.85e-6, E, NU, SIGY, ETAN, 1.0) + "\n" +
+        fields(rate_c, rate_p),
+        "*DEFINE_CURVE\n" + fields(1) + "\n" + curve,
+        node_list_set(1, pulled),
+        "*BOUNDARY_PRESCRIBED_MOTION_SET\n" + fields(1, 1, 0, 1, PULL_SPEED),
+        "\n".join(spc),
+        nodes_card(nodes),
+        solids_card(elements),
+    )
+
+
+def stress_strain(run):
+    with run.open() as results:
+        strains, stresses = [], []
+        nodes = results["mesh/nodes/coordinates"][...]
+        pulled = np.abs(nodes[:, 0] - 1.0) < 1e-9
+        for name in sorted(results["states"]):
+            state = results["states"][name]
+            stretch = 1.0 + state["displacement"][pulled, 0].mean()
+            strains.append(np.log(stretch))
+            stresses.append(state["solid_stress"][0, 0])
+    return np.array(strains), np.array(stresses)
+
+
+def bilinear(strain, yield_stress):
+    elastic = E * strain
+    plastic = yield_stress + ETAN * (strain - yield_stress / E)
+    return np.where(strain < yield_stress / E, elastic, plastic)
+
+
+@pytest.mark.parametrize("element_formulation", [1, 2])
+def test_stress_follows_bilinear_law(tmp_path, run_deck, element_formulation):
+    run = run_deck(uniaxial_deck(tmp_path / "uniaxial.k", element_formulation))
+    assert run.status == 0, run.stderr
+    strain, stress = stress_strain(run)
+    assert strain[-1] > 0.03
+    away_from_knee = np.abs(strain - SIGY / E) > 2e-4
+    expected = bilinear(strain, SIGY)
+    error = np.abs(stress - expected)[away_from_knee].max()
+    assert error < 0.01 * SIGY, f"largest deviation {error:.4g} GPa"
+    # lateral stresses vanish (uniaxial stress)
+    with run.open() as results:
+        last = results["states"][sorted(results["states"])[-1]]["solid_stress"][0]
+    assert abs(last[1]) < 1e-3 * SIGY and abs(last[2]) < 1e-3 * SIGY
+
+
+def test_cowper_symonds_scales_the_yield_stress(tmp_path, run_deck):
+    rate_c, rate_p = 0.5, 5.0      # 1/ms and exponent
+    run = run_deck(uniaxial_deck(tmp_path / "rate.k", 1, rate_c, rate_p))
+    assert run.status == 0, run.stderr
+    strain, stress = stress_strain(run)
+    rate = PULL_SPEED / np.exp(strain[-1])      # true strain rate at the end (v / current length)
+    factor = 1.0 + (rate / rate_c) ** (1.0 / rate_p)
+    plastic_strain = strain[-1] - stress[-1] / E
+    hardening = E * ETAN / (E - ETAN)
+    expected = factor * (SIGY + hardening * plastic_strain)
+    assert abs(stress[-1] - expected) / expected < 0.01, f"{stress[-1]:.5g} vs {expected:.5g}"
