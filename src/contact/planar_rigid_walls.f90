@@ -5,7 +5,10 @@
 !> it exactly on the wall at the end of the step. The velocity change is an impulse; its sum over
 !> the nodes is the force on the wall (Hallquist, LS-DYNA Theory Manual, "Stonewalls").
 !> A moving wall has a mass and a speed along its normal and receives the opposite impulse.
-!> The kinetic energy that the constraint removes is the wall ("stonewall") energy.
+!> The wall ("stonewall") energy is the work the wall does on the nodes, counted as energy taken
+!> out: for central differences the work of an impulse J applied at t^n is J . (v^{n-1/2} +
+!> v^{n+1/2}) / 2, which removes a striking node's kinetic energy and is zero for a node that
+!> rests on the wall.
 module planar_rigid_walls
   use kinds, only: wp
   use model, only: rigid_wall_t
@@ -25,16 +28,21 @@ contains
     allocate (states(size(walls)))
     do w = 1, size(walls)
       states(w)%speed = merge(walls(w)%initial_speed, 0.0_wp, walls(w)%moving)
+      states(w)%mass = merge(walls(w)%mass, 0.0_wp, walls(w)%moving)
+      states(w)%normal = walls(w)%normal
     end do
   end subroutine initialise_wall_states
 
   !> Correct the half-step velocities of the nodes that would cross a wall during the step
-  !> `dt` starting at `time`. Returns the kinetic energy removed (wall energy increment).
-  subroutine enforce_planar_walls(walls, states, time, dt, coordinates, mass, velocity, energy_removed)
+  !> `dt` starting at `time`. `velocity` holds v^{n+1/2} computed from `acceleration` a^n with
+  !> the step `average_dt`. Returns the energy the walls took (wall energy increment).
+  subroutine enforce_planar_walls(walls, states, time, dt, average_dt, coordinates, acceleration, mass, &
+                                  velocity, energy_removed)
     type(rigid_wall_t), intent(in) :: walls(:)
     type(wall_state_t), intent(inout) :: states(:)
-    real(wp), intent(in) :: time, dt
+    real(wp), intent(in) :: time, dt, average_dt
     real(wp), intent(in) :: coordinates(:, :)   !< x^n
+    real(wp), intent(in) :: acceleration(:, :)  !< a^n
     real(wp), intent(in) :: mass(:)
     real(wp), intent(inout) :: velocity(:, :)   !< v^{n+1/2}
     real(wp), intent(out) :: energy_removed
@@ -72,8 +80,8 @@ contains
         call apply_wall_friction(walls(w)%friction, normal, old_velocity, velocity(:, node))
         impulse = mass(node)*(velocity(:, node) - old_velocity)
         total_impulse = total_impulse + impulse
-        energy_removed = energy_removed + 0.5_wp*mass(node)* &
-                         (dot_product(old_velocity, old_velocity) - dot_product(velocity(:, node), velocity(:, node)))
+        energy_removed = energy_removed - 0.5_wp*dot_product(impulse, velocity(:, node) + old_velocity &
+                                                             - average_dt*acceleration(:, node))
       end do
       ! the wall receives the opposite impulse
       states(w)%force = -total_impulse/dt
@@ -81,9 +89,10 @@ contains
       if (walls(w)%moving) then
         states(w)%displacement = states(w)%displacement + wall_speed*dt
         if (walls(w)%mass > 0.0_wp) then
-          energy_removed = energy_removed + 0.5_wp*walls(w)%mass*wall_speed**2
+          ! the wall's kinetic energy counts as the model's: the wall energy is what the walls
+          ! took from the nodes less what they kept as motion (the dissipated part)
           states(w)%speed = wall_speed - dot_product(total_impulse, normal)/walls(w)%mass
-          energy_removed = energy_removed - 0.5_wp*walls(w)%mass*states(w)%speed**2
+          energy_removed = energy_removed - 0.5_wp*walls(w)%mass*(states(w)%speed**2 - wall_speed**2)
         end if
       end if
     end do

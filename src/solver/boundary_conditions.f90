@@ -1,9 +1,9 @@
 !> Nodal loads, single-point constraints and prescribed motions.
 !>
 !> Kinematic conditions act on the half-step velocities: a constrained or prescribed dof gets
-!> the velocity its condition demands for the coming step. The velocity change is an impulse
-!> from the support; the kinetic energy it adds, 1/2 m (v_new^2 - v_old^2), is booked as
-!> external work so that the energy balance closes.
+!> the velocity its condition demands for the coming step. The velocity change is an impulse J
+!> from the support at t^n; its work in the central-difference sense, J (v^{n-1/2} + v^{n+1/2})/2,
+!> is booked as external work so that the energy balance closes.
 module boundary_conditions
   use kinds, only: wp
   use curves, only: curve_value
@@ -11,7 +11,8 @@ module boundary_conditions
   implicit none
   private
 
-  public :: assemble_nodal_loads, load_work, impose_kinematic_conditions, fixed_dof_mask
+  public :: assemble_nodal_loads, load_work, impose_kinematic_conditions, fixed_dof_mask, &
+            hold_prescribed_accelerations
 
 contains
 
@@ -25,6 +26,27 @@ contains
       fixed(:, model%spcs(k)%node) = fixed(:, model%spcs(k)%node) .or. model%spcs(k)%fixed
     end do
   end subroutine fixed_dof_mask
+
+  !> Prescribed dofs follow their motion, not the forces: their acceleration is the prescribed
+  !> one (VAD = 1) or zero (velocity and displacement are imposed on the half-step velocities),
+  !> so that integer-step velocities, kinetic energy and output show the prescribed motion.
+  subroutine hold_prescribed_accelerations(model, time, acceleration)
+    type(model_t), intent(in) :: model
+    real(wp), intent(in) :: time
+    real(wp), intent(inout) :: acceleration(:, :)
+    integer :: k
+    do k = 1, size(model%motions)
+      associate (motion => model%motions(k))
+        if (time < motion%birth .or. time > motion%death) cycle
+        if (motion%kind == motion_acceleration) then
+          acceleration(motion%direction, motion%node) = &
+            motion%scale*curve_value(model%curves(motion%curve), time - motion%birth)
+        else
+          acceleration(motion%direction, motion%node) = 0.0_wp
+        end if
+      end associate
+    end do
+  end subroutine hold_prescribed_accelerations
 
   !> External nodal forces at `time` (overwrites `external_force`).
   subroutine assemble_nodal_loads(model, time, external_force)
@@ -96,14 +118,16 @@ contains
         case (motion_velocity)
           target = value
         case (motion_acceleration)
-          ! replace the computed acceleration of this dof by the prescribed one
-          target = velocity(direction, node) + (value - acceleration(direction, node))*average_dt
+          ! the acceleration of this dof is already the prescribed one
+          target = velocity(direction, node)
         case (motion_displacement)
           target = (value - displacement(direction, node))/dt
         case default
           cycle
         end select
-        support_work = support_work + 0.5_wp*mass(node)*(target**2 - velocity(direction, node)**2)
+        ! impulse m (target - v) times the mean of v^{n-1/2} = v - a dt and v^{n+1/2} = target
+        support_work = support_work + 0.5_wp*mass(node)*(target - velocity(direction, node))* &
+                       (target + velocity(direction, node) - average_dt*acceleration(direction, node))
         velocity(direction, node) = target
       end associate
     end do

@@ -7,7 +7,8 @@ module explicit_solver
   use model, only: model_t
   use explicit_state, only: explicit_state_t
   use element_forces, only: compute_element_forces
-  use boundary_conditions, only: assemble_nodal_loads, load_work, impose_kinematic_conditions
+  use boundary_conditions, only: assemble_nodal_loads, load_work, impose_kinematic_conditions, &
+                                 hold_prescribed_accelerations
   use planar_rigid_walls, only: enforce_planar_walls
   use energy_balance, only: update_energy_totals, total_energy
   use run_output, only: output_plan_t, plan_output, write_due_output
@@ -47,6 +48,7 @@ contains
     call stop_phase(element_timer)
     call assemble_nodal_loads(model, 0.0_wp, state%external_force)
     call compute_accelerations(state)
+    call hold_prescribed_accelerations(model, 0.0_wp, state%acceleration)
     call select_time_step(model, state, is_first=.true.)
     call update_energy_totals(state)
     state%energy%initial_total = total_energy(state)
@@ -66,8 +68,8 @@ contains
                                        state%displacement, state%acceleration, state%mass, state%velocity, work)
       state%energy%external_work = state%energy%external_work + work
       if (size(model%walls) > 0) then
-        call enforce_planar_walls(model%walls, state%walls, state%time, step, state%coordinates, state%mass, &
-                                  state%velocity, work)
+        call enforce_planar_walls(model%walls, state%walls, state%time, step, 0.5_wp*(previous_step + step), &
+                                  state%coordinates, state%acceleration, state%mass, state%velocity, work)
         state%energy%rigid_wall = state%energy%rigid_wall + work
       end if
       call update_positions(state, step)
@@ -85,6 +87,7 @@ contains
       state%energy%external_work = state%energy%external_work + &
                                    0.5_wp*load_work(model, state%external_force, state%velocity, step)
       call compute_accelerations(state)
+      call hold_prescribed_accelerations(model, state%time, state%acceleration)
       call select_time_step(model, state, is_first=.false.)
       call check_state(model, state, error)
 

@@ -29,6 +29,8 @@ module explicit_state
   type :: wall_state_t
     real(wp) :: displacement = 0.0_wp        !< along the normal (moving walls)
     real(wp) :: speed = 0.0_wp               !< along the normal (moving walls)
+    real(wp) :: mass = 0.0_wp                !< of a moving wall (its kinetic energy is the model's)
+    real(wp) :: normal(3) = 0.0_wp           !< direction of its motion
     real(wp) :: force(3) = 0.0_wp            !< force on the wall in the last cycle
     real(wp) :: impulse(3) = 0.0_wp          !< impulse on the wall since the last rwforc sample
   end type wall_state_t

@@ -14,6 +14,7 @@ module job
   use results_file, only: results_file_t, open_results, close_results
   use run_summary, only: run_summary_t, status_normal, status_error
   use wall_clock, only: seconds_now
+  use file_system, only: make_directory
   use progress_report, only: format_duration
   use version, only: crashfree_version
   use, intrinsic :: iso_fortran_env, only: error_unit
@@ -54,6 +55,11 @@ contains
       return
     end if
     call set_up_explicit_state(model, state, error)
+    if (allocated(error)) then
+      write (error_unit, '(a)') "crashfree: "//error%message
+      return
+    end if
+    call make_directory(options%output_dir, error)
     if (allocated(error)) then
       write (error_unit, '(a)') "crashfree: "//error%message
       return
@@ -105,7 +111,7 @@ contains
     write (line, '(a,i0,a,i0,a,i0,a)') "model: ", size(model%node_ids), " nodes, ", size(model%solid_ids), &
       " solids in ", size(model%parts), " parts"
     write (*, '(a)') trim(line)
-    write (line, '(a,es12.5,a,es12.5)') "mass: ", state%physical_mass, ", first time step ", state%next_time_step
+    write (line, '(a,es12.5)') "mass: ", state%physical_mass
     write (*, '(a)') trim(line)
     if (state%added_mass > 0.0_wp) then
       write (line, '(a,es12.5,a,f0.3,a)') "mass scaling: added mass ", state%added_mass, " (", &

@@ -1,5 +1,6 @@
 """Elastic block in free vibration: total energy (kinetic + internal + hourglass) stays within
-0.5% of its initial value over 10,000 cycles."""
+0.5% of its initial value over 10,000 cycles. The initial velocity, v_i = V cos(pi X_i / L), has
+neither momentum nor angular momentum: the block only deforms."""
 import numpy as np
 import pytest
 
@@ -10,9 +11,8 @@ from deck_writer import block_mesh, fields, nodes_card, solids_card, write_deck
 def test_total_energy_is_conserved(tmp_path, run_deck, element_formulation):
     nodes, elements = block_mesh((4, 4, 4), (10.0, 10.0, 10.0), perturbation=0.15, seed=3)
     initial = ["*INITIAL_VELOCITY_NODE"]
-    for k, (x, y, z) in enumerate(nodes):
-        speed = 50.0 * np.sin(np.pi * z / 10.0)          # a shear and bending shape
-        initial.append(fields(k + 1, speed, 0.3 * speed, 0.0))
+    for k, position in enumerate(nodes):
+        initial.append(fields(k + 1, *[float(v) for v in 20.0 * np.cos(np.pi * position / 10.0)]))
     deck = write_deck(
         tmp_path / "vibration.k",
         "*CONTROL_TERMINATION\n" + fields(100.0, 10000),

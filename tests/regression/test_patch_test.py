@@ -28,7 +28,11 @@ def patch_deck(path, element_formulation, hourglass_type):
     motion = ["*BOUNDARY_PRESCRIBED_MOTION_NODE+"]
     for k in boundary:
         for direction in range(3):
-            motion.append(f"{k + 1:20d}{direction + 1:20d}{0:20d}{1:20d}{velocity[k, direction]:20.13e}")
+            # curve 1 is 1.0 scaled by the velocity; SF = 0 would read as the default 1.0, so a
+            # zero velocity uses curve 2, which is 0.0
+            value = velocity[k, direction]
+            curve, scale = (1, value) if value != 0.0 else (2, 1.0)
+            motion.append(f"{k + 1:20d}{direction + 1:20d}{0:20d}{curve:20d}{scale:20.13e}")
     deck = write_deck(
         path,
         "*TITLE\npatch test",
@@ -40,6 +44,7 @@ def patch_deck(path, element_formulation, hourglass_type):
         "*MAT_ELASTIC\n" + fields(1, 7.8e-6, 210.0, 0.3),
         "*HOURGLASS\n" + fields(1, hourglass_type, 0.1),
         "*DEFINE_CURVE\n" + fields(1) + "\n" + f"{0.0:20.6e}{1.0:20.6e}\n{10.0:20.6e}{1.0:20.6e}",
+        "*DEFINE_CURVE\n" + fields(2) + "\n" + f"{0.0:20.6e}{0.0:20.6e}\n{10.0:20.6e}{0.0:20.6e}",
         nodes_card(nodes),
         solids_card(elements),
         "\n".join(initial),

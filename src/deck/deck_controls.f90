@@ -1,0 +1,162 @@
+!> *TITLE and the *CONTROL_ keywords: termination, time step, hourglass and bulk-viscosity
+!> defaults, energy bookkeeping.
+module deck_controls
+  use kinds, only: wp
+  use error_handling, only: error_list_t
+  use deck_problems, only: problem_log_t
+  use deck_numbers, only: integer_text, real_text
+  use deck_lexer, only: deck_t
+  use deck_fields, only: card_t, next_line, require_card, get_integer, get_real, &
+                         card_problem, warn_if_set, line_title
+  use deck_input, only: deck_input_t
+  implicit none
+  private
+
+  public :: read_title, read_termination, read_time_step, read_hourglass_control
+  public :: read_bulk_viscosity, read_energy_control
+
+  integer, parameter :: standard_widths(8) = 10
+
+contains
+
+  !> *TITLE: the next line is the title.
+  subroutine read_title(deck, block, input)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(deck_input_t), intent(inout) :: input
+    integer :: line
+    line = 0
+    if (next_line(deck, block, line, .false.)) input%model%title = line_title(deck, line)
+  end subroutine read_title
+
+  !> *CONTROL_TERMINATION: ENDTIM ENDCYC DTMIN ENDENG ENDMAS NOSOL. Whether ENDTIM is usable
+  !> is checked once the whole deck is read (ENDCYC may stand in for it).
+  subroutine read_termination(deck, block, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    integer :: line
+    line = 0
+    if (.not. require_card(deck, block, line, standard_widths, card, log, &
+                           "card 1 (ENDTIM ENDCYC DTMIN ENDENG ENDMAS NOSOL)", "ENDTIM")) return
+    input%termination_line = line
+    call get_real(deck, card, 1, "ENDTIM", input%model%end_time, log)
+    call get_integer(deck, card, 2, "ENDCYC", input%model%end_cycle, log)
+    if (input%model%end_cycle < 0) call card_problem(deck, log, card, "ENDCYC", "must be "// &
+      ">= 0 (0: no cycle limit), found "//integer_text(input%model%end_cycle))
+    call warn_if_set(deck, card, 3, "DTMIN", "the run does not stop on a small time step", &
+                     warnings)
+    call warn_if_set(deck, card, 4, "ENDENG", "the run does not stop on an energy change", &
+                     warnings)
+    call warn_if_set(deck, card, 6, "NOSOL", "the solution always runs", warnings)
+  end subroutine read_termination
+
+  !> *CONTROL_TIMESTEP card 1: DTINIT TSSFAC ISDO TSLIMT DT2MS LCTM ERODE MS1ST (the optional
+  !> cards 2 and 3 are not read). TSSFAC 0 or blank means 0.9.
+  subroutine read_time_step(deck, block, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    integer :: line, limit_curve
+    line = 0
+    if (.not. require_card(deck, block, line, standard_widths, card, log, "card 1 (DTINIT "// &
+                           "TSSFAC ISDO TSLIMT DT2MS LCTM ERODE MS1ST)", "DTINIT")) return
+    associate (model => input%model)
+      call get_real(deck, card, 1, "DTINIT", model%initial_time_step, log)
+      call get_real(deck, card, 2, "TSSFAC", model%time_step_scale, log)
+      call get_real(deck, card, 5, "DT2MS", model%mass_scaled_time_step, log)
+      call get_integer(deck, card, 6, "LCTM", limit_curve, log)
+      if (card%failed) return
+      if (model%time_step_scale == 0.0_wp) model%time_step_scale = 0.9_wp
+      if (model%initial_time_step < 0.0_wp) call card_problem(deck, log, card, "DTINIT", &
+        "must be >= 0 (0: computed), found "//real_text(model%initial_time_step))
+      if (model%time_step_scale < 0.0_wp) call card_problem(deck, log, card, "TSSFAC", &
+        "a time-step scale curve (TSSFAC < 0) is not available; give a factor > 0")
+      if (limit_curve /= 0) call card_problem(deck, log, card, "LCTM", "a curve limiting "// &
+        "the time step is not available; leave LCTM blank")
+    end associate
+    call warn_if_set(deck, card, 3, "ISDO", "shells only", warnings)
+    call warn_if_set(deck, card, 4, "TSLIMT", "shells only", warnings)
+    call warn_if_set(deck, card, 7, "ERODE", "elements do not erode", warnings)
+    call warn_if_set(deck, card, 8, "MS1ST", "mass scaling is applied every cycle", warnings)
+  end subroutine read_time_step
+
+  !> *CONTROL_HOURGLASS: IHQ QH, the defaults of parts without their own *HOURGLASS type
+  !> (IHQ 0 or blank: 1; QH 0 or blank: 0.1).
+  subroutine read_hourglass_control(deck, block, input, log)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(card_t) :: card
+    integer :: line
+    line = 0
+    if (.not. require_card(deck, block, line, standard_widths, card, log, "card 1 (IHQ QH)", &
+                           "IHQ")) return
+    associate (model => input%model)
+      call get_integer(deck, card, 1, "IHQ", model%default_hourglass_type, log, default=1)
+      call get_real(deck, card, 2, "QH", model%default_hourglass_coefficient, log, default=0.1_wp)
+      if (model%default_hourglass_type == 0) model%default_hourglass_type = 1
+      if (model%default_hourglass_coefficient == 0.0_wp) &
+        model%default_hourglass_coefficient = 0.1_wp
+      if (card%failed) return
+      if (model%default_hourglass_type < 1 .or. model%default_hourglass_type > 10) &
+        call card_problem(deck, log, card, "IHQ", "hourglass type must be 1-10, found "// &
+                          integer_text(model%default_hourglass_type))
+      if (model%default_hourglass_coefficient < 0.0_wp) call card_problem(deck, log, card, &
+        "QH", "must be >= 0, found "//real_text(model%default_hourglass_coefficient))
+    end associate
+  end subroutine read_hourglass_control
+
+  !> *CONTROL_BULK_VISCOSITY: Q1 Q2 TYPE, the bulk-viscosity defaults (0 or blank: 1.5 and
+  !> 0.06). TYPE is not used: bulk viscosity acts on solids, which is LS-DYNA's default.
+  subroutine read_bulk_viscosity(deck, block, input, log)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(card_t) :: card
+    integer :: line
+    line = 0
+    if (.not. require_card(deck, block, line, standard_widths, card, log, "card 1 (Q1 Q2 TYPE)", &
+                           "Q1")) return
+    call get_real(deck, card, 1, "Q1", input%bulk_quadratic, log)
+    call get_real(deck, card, 2, "Q2", input%bulk_linear, log)
+    if (input%bulk_quadratic == 0.0_wp) input%bulk_quadratic = 1.5_wp
+    if (input%bulk_linear == 0.0_wp) input%bulk_linear = 0.06_wp
+    if (card%failed) return
+    if (input%bulk_quadratic < 0.0_wp) call card_problem(deck, log, card, "Q1", &
+      "must be >= 0, found "//real_text(input%bulk_quadratic))
+    if (input%bulk_linear < 0.0_wp) call card_problem(deck, log, card, "Q2", "must be >= 0, "// &
+                                                      "found "//real_text(input%bulk_linear))
+  end subroutine read_bulk_viscosity
+
+  !> *CONTROL_ENERGY: HGEN RWEN SLNTEN RYLEN ...; 1 = not in the energy balance, 2 = in it.
+  !> HGEN and RWEN are used; the others concern features crashfree does not have.
+  subroutine read_energy_control(deck, block, input, log)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(card_t) :: card
+    integer :: line, hourglass, wall
+    line = 0
+    if (.not. require_card(deck, block, line, standard_widths, card, log, "card 1 (HGEN RWEN "// &
+                           "SLNTEN RYLEN IRGEN MATEN DRLEN DISEN)", "HGEN")) return
+    call get_integer(deck, card, 1, "HGEN", hourglass, log, default=1)
+    call get_integer(deck, card, 2, "RWEN", wall, log, default=2)
+    if (card%failed) return
+    if (hourglass < 0 .or. hourglass > 2) call card_problem(deck, log, card, "HGEN", "must be "// &
+      "1 (not computed) or 2 (in the energy balance), found "//integer_text(hourglass))
+    if (wall < 0 .or. wall > 2) call card_problem(deck, log, card, "RWEN", "must be 1 (not "// &
+      "computed) or 2 (in the energy balance), found "//integer_text(wall))
+    input%model%hourglass_energy_in_balance = hourglass == 2
+    input%model%wall_energy_in_balance = wall /= 1
+  end subroutine read_energy_control
+end module deck_controls

@@ -1,0 +1,839 @@
+!> The consistency pass: every id resolved to an index, every list expanded per node, the
+!> mesh checked, and every problem listed at once, each at the card holding the reference
+!> (CalculiX's way: one run shows all mistakes, not one per run).
+module deck_cross_check
+  use kinds, only: wp
+  use error_handling, only: error_list_t, add_error
+  use model, only: model_t, spc_t, prescribed_motion_t, nodal_load_t, rigid_wall_t
+  use deck_problems, only: problem_log_t, report_problem, has_problems
+  use deck_numbers, only: integer_text, real_text
+  use deck_lexer, only: deck_t, line_location
+  use deck_fields, only: located_problem
+  use deck_input, only: deck_input_t, set_input_t, velocity_input_t, velocity_by_set, &
+                        velocity_by_node, velocity_generation
+  use deck_id_index, only: id_index_t, build_id_index, find_id, lower_bound
+  use deck_element_check, only: check_hexahedron, shape_inside_out, shape_flat
+  implicit none
+  private
+
+  public :: check_and_build
+
+  !> Sorted ids of everything that can be referenced.
+  type :: deck_indices_t
+    type(id_index_t) :: nodes, solids, parts, sections, materials, hourglasses, curves
+    type(id_index_t) :: node_sets, part_sets
+  end type deck_indices_t
+
+  character(len=1), parameter :: axis_names(3) = ["x", "y", "z"]
+
+contains
+
+  !> Resolve and check everything in `input` and build the final `model`.
+  subroutine check_and_build(deck, input, model, log, warnings)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(inout) :: input
+    type(model_t), intent(out) :: model
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(deck_indices_t) :: indices
+    logical :: mesh_resolved
+
+    call trim_to_counts(input)
+    call index_definitions(deck, input, indices, log)
+    call resolve_solids(deck, input, indices, mesh_resolved, log)
+    call resolve_parts(deck, input, indices, log)
+    call resolve_node_sets(deck, input, indices, log)
+    call resolve_part_sets(deck, input, indices, log)
+    call build_constraints(deck, input, indices, log)
+    call build_motions(deck, input, indices, log)
+    call build_loads(deck, input, indices, log)
+    call build_initial_velocities(deck, input, indices, log)
+    call build_walls(deck, input, indices, log)
+    call build_history_nodes(deck, input, indices, log, warnings)
+    call check_mesh(deck, input, mesh_resolved, log)
+    call check_controls(deck, input, log)
+    call set_effective_hourglass(input)
+    if (has_problems(log)) return
+    model = input%model
+  end subroutine check_and_build
+
+  !> Cut every list to what was read (the readers sized them from line counts).
+  subroutine trim_to_counts(input)
+    type(deck_input_t), intent(inout) :: input
+    associate (model => input%model)
+      model%node_ids = model%node_ids(1:input%node_count)
+      model%coordinates = model%coordinates(:, 1:input%node_count)
+      model%solid_ids = model%solid_ids(1:input%solid_count)
+      model%solid_part = model%solid_part(1:input%solid_count)
+      model%solid_nodes = model%solid_nodes(:, 1:input%solid_count)
+      model%parts = model%parts(1:input%part_count)
+      model%sections = model%sections(1:input%section_count)
+      model%materials = model%materials(1:input%material_count)
+      model%hourglasses = model%hourglasses(1:input%hourglass_count)
+      model%curves = model%curves(1:input%curve_count)
+      if (.not. allocated(model%title)) model%title = ""
+    end associate
+  end subroutine trim_to_counts
+
+  !> Sorted indices of all definitions; a duplicated id is reported at its second definition.
+  subroutine index_definitions(deck, input, indices, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(in) :: input
+    type(deck_indices_t), intent(out) :: indices
+    type(problem_log_t), intent(inout) :: log
+    integer :: k
+    associate (model => input%model)
+      call index_ids(deck, model%node_ids, input%node_lines, "NID", "node", indices%nodes, log)
+      call index_ids(deck, model%solid_ids, input%solid_lines, "EID", "element", indices%solids, &
+                     log)
+      call index_ids(deck, [(model%parts(k)%id, k=1, input%part_count)], input%part_lines, &
+                     "PID", "part", indices%parts, log)
+      call index_ids(deck, [(model%sections(k)%id, k=1, input%section_count)], &
+                     input%section_lines, "SECID", "section", indices%sections, log)
+      call index_ids(deck, [(model%materials(k)%id, k=1, input%material_count)], &
+                     input%material_lines, "MID", "material", indices%materials, log)
+      call index_ids(deck, [(model%hourglasses(k)%id, k=1, input%hourglass_count)], &
+                     input%hourglass_lines, "HGID", "hourglass", indices%hourglasses, log)
+      call index_ids(deck, [(model%curves(k)%id, k=1, input%curve_count)], input%curve_lines, &
+                     "LCID", "curve", indices%curves, log)
+    end associate
+    call index_ids(deck, [(input%node_sets(k)%id, k=1, input%node_set_count)], &
+                   [(input%node_sets(k)%line, k=1, input%node_set_count)], "SID", "node set", &
+                   indices%node_sets, log)
+    call index_ids(deck, [(input%part_sets(k)%id, k=1, input%part_set_count)], &
+                   [(input%part_sets(k)%line, k=1, input%part_set_count)], "SID", "part set", &
+                   indices%part_sets, log)
+  end subroutine index_definitions
+
+  subroutine index_ids(deck, ids, lines, field, noun, index, log)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: ids(:), lines(:)
+    character(len=*), intent(in) :: field, noun
+    type(id_index_t), intent(out) :: index
+    type(problem_log_t), intent(inout) :: log
+    integer :: k, first
+    call build_id_index(ids, index)
+    first = 1
+    do k = 2, size(index%ids)
+      if (index%ids(k) /= index%ids(k - 1)) then
+        first = k
+      else if (index%ids(k) > 0) then
+        call located_problem(deck, log, lines(index%positions(k)), field, noun//" id "// &
+          integer_text(index%ids(k))//" is defined twice (first at "// &
+          line_location(deck, lines(index%positions(first)))//")")
+      end if
+    end do
+  end subroutine index_ids
+
+  !> Element part ids and node ids to indices.
+  subroutine resolve_solids(deck, input, indices, resolved, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(inout) :: input
+    type(deck_indices_t), intent(in) :: indices
+    logical, intent(out) :: resolved
+    type(problem_log_t), intent(inout) :: log
+    integer :: element, corner, index
+    resolved = .true.
+    associate (model => input%model)
+      do element = 1, input%solid_count
+        index = find_id(indices%parts, model%solid_part(element))
+        if (index == 0) then
+          call located_problem(deck, log, input%solid_lines(element), "PID", "part "// &
+            integer_text(model%solid_part(element))//" of element "// &
+            integer_text(model%solid_ids(element))//" is not defined (no *PART with this PID)")
+        end if
+        model%solid_part(element) = index
+        do corner = 1, 8
+          index = find_id(indices%nodes, model%solid_nodes(corner, element))
+          if (index == 0) then
+            call located_problem(deck, log, input%solid_node_lines(element), &
+              "N"//achar(iachar("0") + corner), "node "// &
+              integer_text(model%solid_nodes(corner, element))//" of element "// &
+              integer_text(model%solid_ids(element))//" is not defined")
+            resolved = .false.
+          end if
+          model%solid_nodes(corner, element) = index
+        end do
+      end do
+    end associate
+  end subroutine resolve_solids
+
+  !> Part -> section, material and hourglass indices.
+  subroutine resolve_parts(deck, input, indices, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(inout) :: input
+    type(deck_indices_t), intent(in) :: indices
+    type(problem_log_t), intent(inout) :: log
+    integer :: k, line
+    character(len=:), allocatable :: part_name
+    do k = 1, input%part_count
+      associate (part => input%model%parts(k))
+        line = input%part_lines(k)
+        part_name = "part "//integer_text(part%id)
+        if (part%section_id == 0) then
+          call located_problem(deck, log, line, "SECID", part_name//" has no section (SECID "// &
+                               "is blank or 0)")
+        else
+          part%section = find_id(indices%sections, part%section_id)
+          if (part%section == 0) call located_problem(deck, log, line, "SECID", "section "// &
+            integer_text(part%section_id)//" of "//part_name//" is not defined")
+        end if
+        if (part%material_id == 0) then
+          call located_problem(deck, log, line, "MID", part_name//" has no material (MID is "// &
+                               "blank or 0)")
+        else
+          part%material = find_id(indices%materials, part%material_id)
+          if (part%material == 0) call located_problem(deck, log, line, "MID", "material "// &
+            integer_text(part%material_id)//" of "//part_name//" is not defined")
+        end if
+        if (part%hourglass_id > 0) then
+          part%hourglass = find_id(indices%hourglasses, part%hourglass_id)
+          if (part%hourglass == 0) call located_problem(deck, log, line, "HGID", "hourglass "// &
+            integer_text(part%hourglass_id)//" of "//part_name//" is not defined (no "// &
+            "*HOURGLASS with this HGID)")
+        end if
+      end associate
+    end do
+  end subroutine resolve_parts
+
+  !> Node set members (ids or ranges) to node indices, each node once.
+  subroutine resolve_node_sets(deck, input, indices, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(inout) :: input
+    type(deck_indices_t), intent(in) :: indices
+    type(problem_log_t), intent(inout) :: log
+    integer, allocatable :: seen(:), members(:)
+    integer :: set, count
+    allocate (seen(input%node_count), input%model%node_sets(input%node_set_count))
+    seen = 0
+    do set = 1, input%node_set_count
+      associate (given => input%node_sets(set))
+        if (given%generated) then
+          call generate_members(deck, given, indices%nodes, set, seen, members, count, log)
+        else
+          call list_members(deck, given, indices%nodes, "node", set, seen, members, count, log)
+        end if
+        input%model%node_sets(set)%id = given%id
+        input%model%node_sets(set)%title = given%title
+        input%model%node_sets(set)%nodes = members(1:count)
+      end associate
+    end do
+  end subroutine resolve_node_sets
+
+  !> Part set members to part indices, each part once.
+  subroutine resolve_part_sets(deck, input, indices, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(inout) :: input
+    type(deck_indices_t), intent(in) :: indices
+    type(problem_log_t), intent(inout) :: log
+    integer, allocatable :: seen(:), members(:)
+    integer :: set, count
+    allocate (seen(input%part_count), input%model%part_sets(input%part_set_count))
+    seen = 0
+    do set = 1, input%part_set_count
+      associate (given => input%part_sets(set))
+        call list_members(deck, given, indices%parts, "part", set, seen, members, count, log)
+        input%model%part_sets(set)%id = given%id
+        input%model%part_sets(set)%title = given%title
+        input%model%part_sets(set)%parts = members(1:count)
+      end associate
+    end do
+  end subroutine resolve_part_sets
+
+  !> Listed ids of a set to indices; `seen(i) == stamp` marks indices already taken.
+  subroutine list_members(deck, given, index, noun, stamp, seen, members, count, log)
+    type(deck_t), intent(in) :: deck
+    type(set_input_t), intent(in) :: given
+    type(id_index_t), intent(in) :: index
+    character(len=*), intent(in) :: noun
+    integer, intent(in) :: stamp
+    integer, intent(inout) :: seen(:)
+    integer, allocatable, intent(out) :: members(:)
+    integer, intent(out) :: count
+    type(problem_log_t), intent(inout) :: log
+    integer :: k, position
+    character(len=:), allocatable :: prefix
+    allocate (members(given%members%count))
+    count = 0
+    prefix = merge("NID", "PID", noun == "node")
+    do k = 1, given%members%count
+      position = find_id(index, given%members%ids(k))
+      if (position == 0) then
+        call located_problem(deck, log, given%members%lines(k), prefix// &
+          integer_text(given%members%fields(k)), noun//" "//integer_text(given%members%ids(k))// &
+          " of set "//integer_text(given%id)//" is not defined")
+      else if (seen(position) /= stamp) then
+        seen(position) = stamp
+        count = count + 1
+        members(count) = position
+      end if
+    end do
+  end subroutine list_members
+
+  !> Ranges of a generated node set: every defined node with an id in a range (LS-DYNA
+  !> numbering may have gaps); a range that holds no node at all is an error.
+  subroutine generate_members(deck, given, index, stamp, seen, members, count, log)
+    type(deck_t), intent(in) :: deck
+    type(set_input_t), intent(in) :: given
+    type(id_index_t), intent(in) :: index
+    integer, intent(in) :: stamp
+    integer, intent(inout) :: seen(:)
+    integer, allocatable, intent(out) :: members(:)
+    integer, intent(out) :: count
+    type(problem_log_t), intent(inout) :: log
+    integer :: range, k, first, last, found
+    allocate (members(size(seen)))
+    count = 0
+    do range = 1, given%members%count/2
+      first = given%members%ids(2*range - 1)
+      last = given%members%ids(2*range)
+      found = 0
+      do k = lower_bound(index, first), size(index%ids)
+        if (index%ids(k) > last) exit
+        found = found + 1
+        if (seen(index%positions(k)) == stamp) cycle
+        seen(index%positions(k)) = stamp
+        count = count + 1
+        members(count) = index%positions(k)
+      end do
+      if (found == 0) call located_problem(deck, log, given%members%lines(2*range - 1), &
+        "B"//integer_text((given%members%fields(2*range - 1) + 1)/2)//"BEG", "no node has an "// &
+        "id in "//integer_text(first)//"-"//integer_text(last)//" (set "// &
+        integer_text(given%id)//")")
+    end do
+  end subroutine generate_members
+
+  !> Node indices a condition applies to: one node, or a node set's members. False after
+  !> reporting an undefined id.
+  logical function target_nodes(deck, input, indices, target, is_set, line, nodes, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(in) :: input
+    type(deck_indices_t), intent(in) :: indices
+    integer, intent(in) :: target, line
+    logical, intent(in) :: is_set
+    integer, allocatable, intent(out) :: nodes(:)
+    type(problem_log_t), intent(inout) :: log
+    integer :: position
+    target_nodes = .false.
+    if (is_set) then
+      position = find_id(indices%node_sets, target)
+      if (position == 0) then
+        call located_problem(deck, log, line, "NSID", "node set "//integer_text(target)// &
+                             " is not defined (no *SET_NODE with this SID)")
+        return
+      end if
+      nodes = input%model%node_sets(position)%nodes
+    else
+      position = find_id(indices%nodes, target)
+      if (position == 0) then
+        call located_problem(deck, log, line, "NID", "node "//integer_text(target)// &
+                             " is not defined")
+        return
+      end if
+      nodes = [position]
+    end if
+    target_nodes = .true.
+  end function target_nodes
+
+  !> Node set `id` as node indices, where 0 means every node (LS-DYNA's NSID = 0).
+  logical function set_or_all(deck, input, indices, id, line, field, nodes, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(in) :: input
+    type(deck_indices_t), intent(in) :: indices
+    integer, intent(in) :: id, line
+    character(len=*), intent(in) :: field
+    integer, allocatable, intent(out) :: nodes(:)
+    type(problem_log_t), intent(inout) :: log
+    integer :: k, position
+    set_or_all = .true.
+    if (id == 0) then
+      nodes = [(k, k=1, input%node_count)]
+      return
+    end if
+    position = find_id(indices%node_sets, id)
+    if (position == 0) then
+      call located_problem(deck, log, line, field, "node set "//integer_text(id)// &
+                           " is not defined (no *SET_NODE with this SID)")
+      set_or_all = .false.
+      allocate (nodes(0))
+      return
+    end if
+    nodes = input%model%node_sets(position)%nodes
+  end function set_or_all
+
+  !> *BOUNDARY_SPC_* and *NODE TC codes merged into one spc_t per constrained node.
+  subroutine build_constraints(deck, input, indices, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(inout) :: input
+    type(deck_indices_t), intent(in) :: indices
+    type(problem_log_t), intent(inout) :: log
+    logical, allocatable :: fixed(:, :)
+    integer, allocatable :: nodes(:)
+    integer :: k, node, constrained
+    ! TC codes: 1 x, 2 y, 3 z, 4 xy, 5 yz, 6 zx, 7 xyz
+    logical, parameter :: by_code(3, 0:7) = reshape([.false., .false., .false., &
+      .true., .false., .false., .false., .true., .false., .false., .false., .true., &
+      .true., .true., .false., .false., .true., .true., .true., .false., .true., &
+      .true., .true., .true.], [3, 8])
+
+    allocate (fixed(3, input%node_count))
+    do node = 1, input%node_count
+      fixed(:, node) = by_code(:, input%node_constraints(node))
+    end do
+    do k = 1, input%spc_count
+      associate (spc => input%spcs(k))
+        if (.not. target_nodes(deck, input, indices, spc%target, spc%is_set, spc%line, nodes, &
+                               log)) cycle
+        do node = 1, size(nodes)
+          fixed(:, nodes(node)) = fixed(:, nodes(node)) .or. spc%fixed
+        end do
+      end associate
+    end do
+    allocate (input%model%spcs(count(any(fixed, dim=1))))
+    constrained = 0
+    do node = 1, input%node_count
+      if (.not. any(fixed(:, node))) cycle
+      constrained = constrained + 1
+      input%model%spcs(constrained) = spc_t(node=node, fixed=fixed(:, node))
+    end do
+  end subroutine build_constraints
+
+  !> One prescribed_motion_t per node and direction; two motions on one node and direction
+  !> contradict each other.
+  subroutine build_motions(deck, input, indices, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(inout) :: input
+    type(deck_indices_t), intent(in) :: indices
+    type(problem_log_t), intent(inout) :: log
+    type(prescribed_motion_t), allocatable :: motions(:)
+    integer, allocatable :: nodes(:), owner(:, :)
+    integer :: k, node, count, curve
+
+    allocate (owner(3, input%node_count), motions(0))
+    owner = 0
+    count = 0
+    do k = 1, input%motion_count
+      associate (given => input%motions(k))
+        curve = find_curve(deck, indices, given%curve_id, given%line, log)
+        if (.not. target_nodes(deck, input, indices, given%target, given%is_set, given%line, &
+                               nodes, log)) cycle
+        if (given%direction < 1 .or. given%direction > 3) cycle
+        call reserve_motions(motions, count + size(nodes))
+        do node = 1, size(nodes)
+          if (owner(given%direction, nodes(node)) /= 0) then
+            call located_problem(deck, log, given%line, merge("NSID", "NID ", given%is_set), &
+              "node "//integer_text(input%model%node_ids(nodes(node)))//" already has a "// &
+              "prescribed motion in "//axis_names(given%direction)//" (at "// &
+              line_location(deck, input%motions(owner(given%direction, nodes(node)))%line)//")")
+            cycle
+          end if
+          owner(given%direction, nodes(node)) = k
+          count = count + 1
+          motions(count) = prescribed_motion_t(node=nodes(node), direction=given%direction, &
+            kind=given%kind, curve=curve, scale=given%scale, birth=given%birth, &
+            death=given%death)
+        end do
+      end associate
+    end do
+    input%model%motions = motions(1:count)
+  end subroutine build_motions
+
+  subroutine reserve_motions(motions, needed)
+    type(prescribed_motion_t), allocatable, intent(inout) :: motions(:)
+    integer, intent(in) :: needed
+    type(prescribed_motion_t), allocatable :: larger(:)
+    if (needed <= size(motions)) return
+    allocate (larger(max(needed, 2*size(motions))))
+    larger(1:size(motions)) = motions
+    call move_alloc(larger, motions)
+  end subroutine reserve_motions
+
+  !> One nodal_load_t per node (loads on the same node add up, as in LS-DYNA).
+  subroutine build_loads(deck, input, indices, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(inout) :: input
+    type(deck_indices_t), intent(in) :: indices
+    type(problem_log_t), intent(inout) :: log
+    type(nodal_load_t), allocatable :: loads(:), larger(:)
+    integer, allocatable :: nodes(:)
+    integer :: k, node, count, curve
+
+    allocate (loads(input%load_count))
+    count = 0
+    do k = 1, input%load_count
+      associate (given => input%loads(k))
+        curve = find_curve(deck, indices, given%curve_id, given%line, log)
+        if (.not. target_nodes(deck, input, indices, given%target, given%is_set, given%line, &
+                               nodes, log)) cycle
+        if (count + size(nodes) > size(loads)) then
+          allocate (larger(max(count + size(nodes), 2*size(loads))))
+          larger(1:count) = loads(1:count)
+          call move_alloc(larger, loads)
+        end if
+        do node = 1, size(nodes)
+          count = count + 1
+          loads(count) = nodal_load_t(node=nodes(node), direction=given%direction, &
+                                      curve=curve, scale=given%scale)
+        end do
+      end associate
+    end do
+    input%model%loads = loads(1:count)
+  end subroutine build_loads
+
+  integer function find_curve(deck, indices, id, line, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_indices_t), intent(in) :: indices
+    integer, intent(in) :: id, line
+    type(problem_log_t), intent(inout) :: log
+    find_curve = 0
+    if (id <= 0) return      ! already reported by the reader
+    find_curve = find_id(indices%curves, id)
+    if (find_curve == 0) call located_problem(deck, log, line, "LCID", "curve "// &
+      integer_text(id)//" is not defined (no *DEFINE_CURVE with this LCID)")
+  end function find_curve
+
+  !> Initial velocities: *INITIAL_VELOCITY (by set) first, then _GENERATION, then _NODE, each
+  !> in deck order; a later, more specific definition overrides an earlier one.
+  subroutine build_initial_velocities(deck, input, indices, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(inout) :: input
+    type(deck_indices_t), intent(in) :: indices
+    type(problem_log_t), intent(inout) :: log
+    integer :: pass, k
+    integer, parameter :: order(3) = [velocity_by_set, velocity_generation, velocity_by_node]
+
+    allocate (input%model%initial_velocity(3, input%node_count))
+    input%model%initial_velocity = 0.0_wp
+    do pass = 1, 3
+      do k = 1, input%velocity_count
+        if (input%velocities(k)%kind /= order(pass)) cycle
+        select case (order(pass))
+        case (velocity_by_set)
+          call apply_set_velocity(deck, input, indices, input%velocities(k), log)
+        case (velocity_generation)
+          call apply_generated_velocity(deck, input, indices, input%velocities(k), log)
+        case (velocity_by_node)
+          call apply_node_velocity(deck, input, indices, input%velocities(k), log)
+        end select
+      end do
+    end do
+  end subroutine build_initial_velocities
+
+  subroutine apply_set_velocity(deck, input, indices, given, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(inout) :: input
+    type(deck_indices_t), intent(in) :: indices
+    type(velocity_input_t), intent(in) :: given
+    type(problem_log_t), intent(inout) :: log
+    integer, allocatable :: nodes(:), exempt(:)
+    logical, allocatable :: is_exempt(:)
+    integer :: k
+    if (.not. set_or_all(deck, input, indices, given%target, given%line, "NSID", nodes, log)) &
+      return
+    allocate (is_exempt(input%node_count))
+    is_exempt = .false.
+    if (given%exempt_set > 0) then
+      if (.not. set_or_all(deck, input, indices, given%exempt_set, given%line, "NSIDEX", &
+                           exempt, log)) return
+      is_exempt(exempt) = .true.
+      do k = 1, size(exempt)
+        input%model%initial_velocity(:, exempt(k)) = given%exempt_velocity
+      end do
+    end if
+    do k = 1, size(nodes)
+      if (.not. is_exempt(nodes(k))) input%model%initial_velocity(:, nodes(k)) = given%velocity
+    end do
+  end subroutine apply_set_velocity
+
+  subroutine apply_node_velocity(deck, input, indices, given, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(inout) :: input
+    type(deck_indices_t), intent(in) :: indices
+    type(velocity_input_t), intent(in) :: given
+    type(problem_log_t), intent(inout) :: log
+    integer, allocatable :: nodes(:)
+    if (.not. target_nodes(deck, input, indices, given%target, .false., given%line, nodes, &
+                           log)) return
+    input%model%initial_velocity(:, nodes(1)) = given%velocity
+  end subroutine apply_node_velocity
+
+  !> V + OMEGA n x (x - c) on the nodes of a part set (STYP 1), a part (2) or a node set (3).
+  subroutine apply_generated_velocity(deck, input, indices, given, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(inout) :: input
+    type(deck_indices_t), intent(in) :: indices
+    type(velocity_input_t), intent(in) :: given
+    type(problem_log_t), intent(inout) :: log
+    integer, allocatable :: nodes(:)
+    real(wp) :: centre(3), axis(3), length
+    integer :: k, first, second
+
+    centre = given%centre
+    axis = given%axis
+    if (given%axis_nodes(1) > 0) then
+      first = find_id(indices%nodes, given%axis_nodes(1))
+      second = find_id(indices%nodes, given%axis_nodes(2))
+      if (first == 0 .or. second == 0) then
+        call located_problem(deck, log, given%axis_line, trim(merge("NY", "NZ", first == 0)), &
+          "axis node "//integer_text(given%axis_nodes(merge(1, 2, first == 0)))//" is not "// &
+          "defined (NX = -999 makes NY and NZ node ids)")
+        return
+      end if
+      centre = input%model%coordinates(:, first)
+      axis = input%model%coordinates(:, second) - centre
+      length = norm2(axis)
+      if (length == 0.0_wp) then
+        call located_problem(deck, log, given%axis_line, "NZ", "axis nodes "// &
+          integer_text(given%axis_nodes(1))//" and "//integer_text(given%axis_nodes(2))// &
+          " are at the same place")
+        return
+      end if
+      axis = axis/length
+    end if
+    if (.not. generation_nodes(deck, input, indices, given, nodes, log)) return
+    do k = 1, size(nodes)
+      input%model%initial_velocity(:, nodes(k)) = given%velocity + given%omega* &
+        cross_product(axis, input%model%coordinates(:, nodes(k)) - centre)
+    end do
+  end subroutine apply_generated_velocity
+
+  !> Nodes of *INITIAL_VELOCITY_GENERATION's ID by STYP (ID 0: every node).
+  logical function generation_nodes(deck, input, indices, given, nodes, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(in) :: input
+    type(deck_indices_t), intent(in) :: indices
+    type(velocity_input_t), intent(in) :: given
+    integer, allocatable, intent(out) :: nodes(:)
+    type(problem_log_t), intent(inout) :: log
+    logical, allocatable :: chosen_part(:), chosen_node(:)
+    integer :: position, element, k
+    generation_nodes = .false.
+    if (given%target == 0 .or. given%target_type == 3) then
+      generation_nodes = set_or_all(deck, input, indices, given%target, given%line, "ID", &
+                                    nodes, log)
+      return
+    end if
+    allocate (chosen_part(input%part_count), chosen_node(input%node_count))
+    chosen_part = .false.
+    if (given%target_type == 2) then
+      position = find_id(indices%parts, given%target)
+      if (position == 0) then
+        call located_problem(deck, log, given%line, "ID", "part "//integer_text(given%target)// &
+                             " is not defined (STYP 2: ID is a part)")
+        return
+      end if
+      chosen_part(position) = .true.
+    else
+      position = find_id(indices%part_sets, given%target)
+      if (position == 0) then
+        call located_problem(deck, log, given%line, "ID", "part set "// &
+          integer_text(given%target)//" is not defined (STYP 1: ID is a part set)")
+        return
+      end if
+      chosen_part(input%model%part_sets(position)%parts) = .true.
+    end if
+    chosen_node = .false.
+    do element = 1, input%solid_count
+      k = input%model%solid_part(element)
+      if (k == 0) cycle
+      if (chosen_part(k)) chosen_node(pack(input%model%solid_nodes(:, element), &
+                                           input%model%solid_nodes(:, element) > 0)) = .true.
+    end do
+    nodes = pack([(k, k=1, input%node_count)], chosen_node)
+    generation_nodes = .true.
+  end function generation_nodes
+
+  !> Rigid walls: tracked nodes (NSID 0: all) without the exempted set, ids (walls without
+  !> _ID are numbered by their place among the walls, as LS-DYNA numbers them).
+  subroutine build_walls(deck, input, indices, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(inout) :: input
+    type(deck_indices_t), intent(in) :: indices
+    type(problem_log_t), intent(inout) :: log
+    integer, allocatable :: nodes(:), exempt(:)
+    logical, allocatable :: keep(:)
+    type(id_index_t) :: wall_index
+    integer :: k
+
+    allocate (input%model%walls(input%wall_count), keep(input%node_count))
+    do k = 1, input%wall_count
+      associate (given => input%walls(k))
+        if (.not. given%id_given) given%wall%id = k
+        if (.not. set_or_all(deck, input, indices, given%node_set, given%line, "NSID", nodes, &
+                             log)) cycle
+        if (given%exempt_set > 0) then
+          if (.not. set_or_all(deck, input, indices, given%exempt_set, given%line, "NSIDEX", &
+                               exempt, log)) cycle
+          keep = .false.
+          keep(nodes) = .true.
+          keep(exempt) = .false.
+          nodes = pack(nodes, keep(nodes))
+        end if
+        given%wall%nodes = nodes
+        input%model%walls(k) = given%wall
+      end associate
+    end do
+    call index_ids(deck, [(input%walls(k)%wall%id, k=1, input%wall_count)], &
+                   [(input%walls(k)%line, k=1, input%wall_count)], "RWID", &
+                   "rigid wall (walls without _ID are numbered 1, 2, ... in deck order)", &
+                   wall_index, log)
+    do k = 1, input%wall_count
+      if (.not. allocated(input%model%walls(k)%nodes)) allocate (input%model%walls(k)%nodes(0))
+    end do
+  end subroutine build_walls
+
+  !> *DATABASE_HISTORY_NODE(_SET): node indices in deck order, each node once.
+  subroutine build_history_nodes(deck, input, indices, log, warnings)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(inout) :: input
+    type(deck_indices_t), intent(in) :: indices
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    integer, allocatable :: nodes(:), members(:)
+    logical, allocatable :: taken(:)
+    integer :: k, position, count, member
+
+    allocate (taken(input%node_count), nodes(input%node_count))
+    taken = .false.
+    count = 0
+    do k = 1, input%history_requests%count
+      associate (request => input%history_requests)
+        if (request%fields(k) > 0) then
+          position = find_id(indices%nodes, request%ids(k))
+          if (position == 0) then
+            call located_problem(deck, log, request%lines(k), "ID"// &
+              integer_text(request%fields(k)), "node "//integer_text(request%ids(k))// &
+              " is not defined")
+          else if (.not. taken(position)) then
+            taken(position) = .true.
+            count = count + 1
+            nodes(count) = position
+          end if
+          cycle
+        end if
+        position = find_id(indices%node_sets, request%ids(k))
+        if (position == 0) then
+          call located_problem(deck, log, request%lines(k), "ID"// &
+            integer_text(-request%fields(k)), "node set "//integer_text(request%ids(k))// &
+            " is not defined")
+          cycle
+        end if
+      end associate
+      members = input%model%node_sets(position)%nodes
+      do member = 1, size(members)
+        if (taken(members(member))) cycle
+        taken(members(member)) = .true.
+        count = count + 1
+        nodes(count) = members(member)
+      end do
+    end do
+    input%model%output%history_nodes = nodes(1:count)
+    if (count > 0 .and. input%model%output%nodout_interval == 0.0_wp) call add_error(warnings, &
+      deck%files(1)%path//": *DATABASE_HISTORY_NODE: "//integer_text(count)//" history "// &
+      "nodes are given but *DATABASE_NODOUT has no interval (DT), so no nodout is written")
+  end subroutine build_history_nodes
+
+  !> At least one node and one element, and every element with a valid shape.
+  subroutine check_mesh(deck, input, resolved, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(in) :: input
+    logical, intent(in) :: resolved
+    type(problem_log_t), intent(inout) :: log
+    integer :: element, status, corner, part
+    real(wp) :: volume, corners(3, 8)
+    character(len=:), allocatable :: name
+
+    if (input%node_count == 0) call report_problem(log, deck%files(1)%path// &
+      ": *NODE: field NID: the deck defines no nodes")
+    if (input%solid_count == 0) call report_problem(log, deck%files(1)%path// &
+      ": *ELEMENT_SOLID: field EID: the deck defines no solid elements")
+    if (.not. resolved) return
+    associate (model => input%model)
+      do element = 1, input%solid_count
+        do corner = 1, 8
+          corners(:, corner) = model%coordinates(:, model%solid_nodes(corner, element))
+        end do
+        call check_hexahedron(corners, status, corner, volume)
+        if (status == 0) cycle
+        part = model%solid_part(element)
+        name = "element "//integer_text(model%solid_ids(element))
+        if (part > 0) name = name//" of part "//integer_text(model%parts(part)%id)
+        if (status == shape_inside_out) then
+          call located_problem(deck, log, input%solid_node_lines(element), "N1-N8", name// &
+            " is inside out: negative Jacobian at corner N"//integer_text(corner)//" (node "// &
+            integer_text(model%node_ids(model%solid_nodes(corner, element)))//"); number "// &
+            "N1-N4 counterclockwise as seen from the N5-N8 face")
+        else if (status == shape_flat) then
+          call located_problem(deck, log, input%solid_node_lines(element), "N1-N8", name// &
+            " has no volume ("//real_text(volume)//"): its nodes are collapsed or flat")
+        end if
+      end do
+    end associate
+  end subroutine check_mesh
+
+  !> ENDTIM (or ENDCYC) and the output intervals that depend on it.
+  subroutine check_controls(deck, input, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    associate (model => input%model)
+      if (input%termination_line == 0) then
+        call report_problem(log, deck%files(1)%path//": *CONTROL_TERMINATION: field ENDTIM: "// &
+          "the deck has no *CONTROL_TERMINATION, so the run has no end time")
+      else if (model%end_time < 0.0_wp .or. (model%end_time == 0.0_wp .and. &
+                                              model%end_cycle == 0)) then
+        call located_problem(deck, log, input%termination_line, "ENDTIM", "end time must be "// &
+          "> 0 (or give ENDCYC > 0), found "//real_text(model%end_time))
+      else if (model%end_time == 0.0_wp) then
+        model%end_time = huge(1.0_wp)    ! ENDCYC alone ends the run
+      end if
+      if (input%plot_count > 0) then
+        if (model%end_time > 0.0_wp .and. model%end_time < huge(1.0_wp)) then
+          model%output%state_interval = model%end_time/input%plot_count
+        else if (input%termination_line > 0) then
+          call located_problem(deck, log, input%plot_line, "NPLTC", "NPLTC sets the interval "// &
+            "to ENDTIM/NPLTC, which needs ENDTIM > 0")
+        end if
+      end if
+    end associate
+  end subroutine check_controls
+
+  !> Each part's effective hourglass and bulk-viscosity values (LS-DYNA's rules): the part's
+  !> *HOURGLASS where it gives a value, else *CONTROL_HOURGLASS IHQ/QH and
+  !> *CONTROL_BULK_VISCOSITY Q1/Q2, else LS-DYNA's defaults (IHQ 1, QM 0.1, Q1 1.5, Q2 0.06).
+  subroutine set_effective_hourglass(input)
+    type(deck_input_t), intent(inout) :: input
+    integer :: k
+    associate (model => input%model)
+      do k = 1, input%hourglass_count
+        associate (hourglass => model%hourglasses(k))
+          if (hourglass%coefficient == 0.0_wp) hourglass%coefficient = &
+            model%default_hourglass_coefficient
+          if (hourglass%bulk_quadratic == 0.0_wp) hourglass%bulk_quadratic = input%bulk_quadratic
+          if (hourglass%bulk_linear == 0.0_wp) hourglass%bulk_linear = input%bulk_linear
+        end associate
+      end do
+      do k = 1, input%part_count
+        associate (part => model%parts(k))
+          part%hourglass_type = model%default_hourglass_type
+          part%hourglass_coefficient = model%default_hourglass_coefficient
+          part%bulk_quadratic = input%bulk_quadratic
+          part%bulk_linear = input%bulk_linear
+          if (part%hourglass > 0) then
+            if (model%hourglasses(part%hourglass)%hourglass_type > 0) &
+              part%hourglass_type = model%hourglasses(part%hourglass)%hourglass_type
+            part%hourglass_coefficient = model%hourglasses(part%hourglass)%coefficient
+            part%bulk_quadratic = model%hourglasses(part%hourglass)%bulk_quadratic
+            part%bulk_linear = model%hourglasses(part%hourglass)%bulk_linear
+          end if
+        end associate
+      end do
+    end associate
+  end subroutine set_effective_hourglass
+
+  pure function cross_product(a, b) result(c)
+    real(wp), intent(in) :: a(3), b(3)
+    real(wp) :: c(3)
+    c = [a(2)*b(3) - a(3)*b(2), a(3)*b(1) - a(1)*b(3), a(1)*b(2) - a(2)*b(1)]
+  end function cross_product
+end module deck_cross_check

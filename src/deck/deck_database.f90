@@ -1,0 +1,128 @@
+!> *DATABASE_ keywords: output intervals and the nodes written to the nodout history.
+module deck_database
+  use kinds, only: wp
+  use error_handling, only: error_list_t
+  use deck_problems, only: problem_log_t
+  use deck_numbers, only: integer_text, real_text, digit
+  use deck_lexer, only: deck_t
+  use deck_keywords, only: keyword_t, keyword_glstat, keyword_matsum, keyword_nodout, &
+                           keyword_rwforc
+  use deck_fields, only: card_t, open_card, next_line, require_card, get_integer, get_real, &
+                         card_problem, warn_if_set, id_heading, line_problem
+  use deck_input, only: deck_input_t, append_id
+  implicit none
+  private
+
+  public :: read_plot_output, read_history_output, read_history_nodes
+
+  integer, parameter :: standard_widths(8) = 10
+
+contains
+
+  !> *DATABASE_BINARY_D3PLOT card 1: DT LCDT BEAM NPLTC PSETID (card 2, filtering, is not
+  !> read). NPLTC > 0 gives DT = ENDTIM/NPLTC once ENDTIM is known.
+  subroutine read_plot_output(deck, block, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    integer :: line, interval_curve
+    line = 0
+    if (.not. require_card(deck, block, line, standard_widths, card, log, &
+                           "card 1 (DT LCDT BEAM NPLTC PSETID)", "DT")) return
+    call get_real(deck, card, 1, "DT", input%model%output%state_interval, log)
+    call get_integer(deck, card, 2, "LCDT", interval_curve, log)
+    call get_integer(deck, card, 4, "NPLTC", input%plot_count, log)
+    input%plot_line = line
+    if (card%failed) return
+    call check_interval(deck, card, input%model%output%state_interval, interval_curve, log)
+    if (input%plot_count < 0) call card_problem(deck, log, card, "NPLTC", "must be >= 0, "// &
+                                                "found "//integer_text(input%plot_count))
+    call warn_if_set(deck, card, 5, "PSETID", "every part is written", warnings)
+  end subroutine read_plot_output
+
+  !> *DATABASE_GLSTAT / _MATSUM / _NODOUT / _RWFORC: DT BINARY LCUR IOOPT (NODOUT: OPTION1
+  !> OPTION2 for nodouthf). BINARY is not used: every history goes to results.h5.
+  subroutine read_history_output(deck, block, code, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block, code
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    integer :: line, interval_curve
+    real(wp) :: interval
+    line = 0
+    if (.not. require_card(deck, block, line, standard_widths, card, log, &
+                           "card 1 (DT BINARY LCUR IOOPT)", "DT")) return
+    call get_real(deck, card, 1, "DT", interval, log)
+    call get_integer(deck, card, 3, "LCUR", interval_curve, log)
+    if (card%failed) return
+    call check_interval(deck, card, interval, interval_curve, log)
+    select case (code)
+    case (keyword_glstat)
+      input%model%output%glstat_interval = interval
+    case (keyword_matsum)
+      input%model%output%matsum_interval = interval
+    case (keyword_nodout)
+      input%model%output%nodout_interval = interval
+      input%nodout_line = line
+      call warn_if_set(deck, card, 5, "OPTION1", "no high-frequency nodouthf output", warnings)
+    case (keyword_rwforc)
+      input%model%output%rwforc_interval = interval
+    end select
+  end subroutine read_history_output
+
+  subroutine check_interval(deck, card, interval, interval_curve, log)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(in) :: card
+    real(wp), intent(in) :: interval
+    integer, intent(in) :: interval_curve
+    type(problem_log_t), intent(inout) :: log
+    if (interval < 0.0_wp) call card_problem(deck, log, card, "DT", "output interval must "// &
+      "be >= 0 (0: no output), found "//real_text(interval))
+    if (interval_curve /= 0) call card_problem(deck, log, card, trim(merge("LCDT", "LCUR", &
+      deck%blocks(card%block)%name == "DATABASE_BINARY_D3PLOT")), "output intervals from a "// &
+      "curve are not available; give DT")
+  end subroutine check_interval
+
+  !> *DATABASE_HISTORY_NODE (ids 8 per line), _NODE_ID (one id and a heading per line) and
+  !> _NODE_SET (set ids 8 per line).
+  subroutine read_history_nodes(deck, block, keyword, by_set, input, log)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    logical, intent(in) :: by_set
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(card_t) :: card
+    integer :: line, k, id
+    character(len=:), allocatable :: heading
+
+    line = 0
+    do while (next_line(deck, block, line, .true.))
+      if (keyword%id) then
+        call id_heading(deck, block, line, "ID", id, heading, log)
+        if (id <= 0) then
+          call line_problem(deck, log, line, block, "ID", "node id must be > 0, found "// &
+                            integer_text(id))
+        else
+          call append_id(input%history_requests, id, line, 1)
+        end if
+        cycle
+      end if
+      call open_card(deck, block, line, standard_widths, card, log)
+      do k = 1, 8
+        call get_integer(deck, card, k, "ID"//digit(k), id, log)
+        if (id < 0) then
+          call card_problem(deck, log, card, "ID"//digit(k), "id must be > 0 (blank or 0 "// &
+                            "entries are skipped), found "//integer_text(id))
+        else if (id > 0) then
+          call append_id(input%history_requests, id, line, merge(-k, k, by_set))
+        end if
+      end do
+    end do
+  end subroutine read_history_nodes
+end module deck_database

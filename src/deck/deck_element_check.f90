@@ -1,0 +1,100 @@
+!> Shape check of a hexahedron in the reference configuration: the 8 corner Jacobians and the
+!> volume. An element numbered inside out (mirrored node order) gives negative corner
+!> Jacobians; a degenerate shape (wedge, tetrahedron written as a hexahedron) has collapsed
+!> corners with zero Jacobian, which is fine as long as the volume is positive.
+module deck_element_check
+  use kinds, only: wp
+  implicit none
+  private
+
+  public :: check_hexahedron
+
+  !> Results of `check_hexahedron`.
+  integer, parameter, public :: shape_valid = 0, shape_inside_out = 1, shape_flat = 2
+
+  ! Node k sits at (xi, eta, zeta) = (xi_sign(k), eta_sign(k), zeta_sign(k)); its neighbour
+  ! along each direction is the node with that sign flipped.
+  integer, parameter :: xi_sign(8) = [-1, 1, 1, -1, -1, 1, 1, -1]
+  integer, parameter :: eta_sign(8) = [-1, -1, 1, 1, -1, -1, 1, 1]
+  integer, parameter :: zeta_sign(8) = [-1, -1, -1, -1, 1, 1, 1, 1]
+  integer, parameter :: xi_neighbour(8) = [2, 1, 4, 3, 6, 5, 8, 7]
+  integer, parameter :: eta_neighbour(8) = [4, 3, 2, 1, 8, 7, 6, 5]
+  integer, parameter :: zeta_neighbour(8) = [5, 6, 7, 8, 1, 2, 3, 4]
+  !> The 12 edges, for the length scale of the tolerances.
+  integer, parameter :: edge_ends(2, 12) = reshape([1, 2, 2, 3, 3, 4, 4, 1, 5, 6, 6, 7, 7, 8, &
+                                                    8, 5, 1, 5, 2, 6, 3, 7, 4, 8], [2, 12])
+
+contains
+
+  !> Check the hexahedron with corner coordinates `x(3, 8)`. `status` is shape_valid,
+  !> shape_inside_out (`corner` = the corner with the most negative Jacobian) or shape_flat
+  !> (no positive volume). `volume`, exact for the trilinear shape (2x2x2 Gauss points), is
+  !> computed only for elements with a collapsed corner (0 otherwise).
+  pure subroutine check_hexahedron(x, status, corner, volume)
+    real(wp), intent(in) :: x(3, 8)
+    integer, intent(out) :: status, corner
+    real(wp), intent(out) :: volume
+    real(wp) :: tolerance, lowest, jacobian, scale
+    integer :: k
+
+    scale = 0.0_wp
+    do k = 1, 12
+      scale = max(scale, sum((x(:, edge_ends(2, k)) - x(:, edge_ends(1, k)))**2))
+    end do
+    tolerance = 1.0e-10_wp*sqrt(scale)**3
+    status = shape_valid
+    corner = 0
+    lowest = huge(1.0_wp)
+    do k = 1, 8
+      jacobian = triple_product(xi_sign(k)*(x(:, k) - x(:, xi_neighbour(k))), &
+                                eta_sign(k)*(x(:, k) - x(:, eta_neighbour(k))), &
+                                zeta_sign(k)*(x(:, k) - x(:, zeta_neighbour(k))))
+      if (jacobian < lowest) then
+        lowest = jacobian
+        corner = k
+      end if
+    end do
+    volume = 0.0_wp
+    if (lowest < -tolerance) then
+      status = shape_inside_out
+    else if (lowest <= tolerance) then
+      ! a collapsed corner: acceptable only when the element still has a volume
+      volume = gauss_volume(x)
+      if (volume <= tolerance) status = shape_flat
+    end if
+  end subroutine check_hexahedron
+
+  !> Volume of the trilinear hexahedron: det J summed over the 2x2x2 Gauss points (exact,
+  !> since det J is at most quadratic in each coordinate).
+  pure real(wp) function gauss_volume(x)
+    real(wp), intent(in) :: x(3, 8)
+    real(wp), parameter :: g = 0.577350269189625764509148780502_wp   ! 1/sqrt(3)
+    real(wp) :: point(3), derivative(3, 8), jacobian(3, 3)
+    integer :: i, j, l, k
+    gauss_volume = 0.0_wp
+    do i = -1, 1, 2
+      do j = -1, 1, 2
+        do l = -1, 1, 2
+          point = g*[real(i, wp), real(j, wp), real(l, wp)]
+          do k = 1, 8
+            derivative(1, k) = xi_sign(k)*(1.0_wp + eta_sign(k)*point(2))* &
+                               (1.0_wp + zeta_sign(k)*point(3))/8.0_wp
+            derivative(2, k) = eta_sign(k)*(1.0_wp + xi_sign(k)*point(1))* &
+                               (1.0_wp + zeta_sign(k)*point(3))/8.0_wp
+            derivative(3, k) = zeta_sign(k)*(1.0_wp + xi_sign(k)*point(1))* &
+                               (1.0_wp + eta_sign(k)*point(2))/8.0_wp
+          end do
+          jacobian = matmul(x, transpose(derivative))
+          gauss_volume = gauss_volume + triple_product(jacobian(:, 1), jacobian(:, 2), &
+                                                       jacobian(:, 3))
+        end do
+      end do
+    end do
+  end function gauss_volume
+
+  pure real(wp) function triple_product(a, b, c)
+    real(wp), intent(in) :: a(3), b(3), c(3)
+    triple_product = a(1)*(b(2)*c(3) - b(3)*c(2)) + a(2)*(b(3)*c(1) - b(1)*c(3)) + &
+                     a(3)*(b(1)*c(2) - b(2)*c(1))
+  end function triple_product
+end module deck_element_check

@@ -1,0 +1,394 @@
+!> The one field-reading routine family every keyword reader shares.
+!>
+!> A card is one data line split into fields; `get_integer`, `get_real` and `get_text` read
+!> field `k`, give blank fields their default, replace `&name` / `-&name` parameter references
+!> and report any problem as `file:line: *KEYWORD: field NAME: what is wrong`, then return the
+!> default so the reader can go on and list further problems.
+module deck_fields
+  use kinds, only: wp
+  use error_handling, only: error_list_t, add_error
+  use deck_problems, only: problem_log_t, report_problem
+  use deck_numbers, only: parse_integer, parse_real, number_ok, number_not_integral, &
+                          number_out_of_range, integer_text, real_text
+  use deck_columns, only: field_spans_t, split_fields
+  use deck_lexer, only: deck_t, line_location, find_parameter, trim_blanks, is_blank_line, &
+                        block_of_line
+  implicit none
+  private
+
+  public :: card_t, open_card, next_line, require_card, next_definition, get_integer, get_real
+  public :: get_text
+  public :: field_is_blank, card_problem, line_problem, line_title, id_heading, warn_if_set
+  public :: keyword_label, located_problem
+
+  !> One data line split into fields, and the block (keyword) it belongs to.
+  type :: card_t
+    integer :: line = 0
+    integer :: block = 0
+    type(field_spans_t) :: spans
+    logical :: failed = .false.     !< a field could not be read
+  end type card_t
+
+contains
+
+  !> Split line `line` of block `block` with the standard `widths` of its layout.
+  subroutine open_card(deck, block, line, widths, card, log)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block, line
+    integer, intent(in) :: widths(:)
+    type(card_t), intent(out) :: card
+    type(problem_log_t), intent(inout) :: log
+    card%line = line
+    card%block = block
+    call split_fields(deck%files(deck%line_file(line))%text(deck%line_first(line): &
+                      deck%line_last(line)), widths, deck%blocks(block)%format, card%spans)
+    if (card%spans%has_tab .and. .not. card%spans%free) then
+      call report_problem(log, line_location(deck, line)//": *"//keyword_label(deck, block)// &
+        ": the card holds a tab character; fixed columns need blanks (or separate the "// &
+        "fields with commas)", unreadable=.true.)
+      card%failed = .true.
+    end if
+  end subroutine open_card
+
+  !> Advance `line` to the next data line of `block` (skipping blank lines when
+  !> `skip_blank`); false at the end of the block.
+  logical function next_line(deck, block, line, skip_blank)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    integer, intent(inout) :: line
+    logical, intent(in) :: skip_blank
+    next_line = .false.
+    line = max(line, deck%blocks(block)%first_line - 1)
+    do while (line < deck%blocks(block)%last_line)
+      line = line + 1
+      if (skip_blank) then
+        if (is_blank_line(deck, line)) cycle
+      end if
+      next_line = .true.
+      return
+    end do
+  end function next_line
+
+  !> Advance to the next card of a definition and split it. When the block ends first, report
+  !> `field FIRST_FIELD: card LABEL is missing` at the last line read (the keyword line when
+  !> no card was read yet) and return false.
+  logical function require_card(deck, block, line, widths, card, log, label, first_field)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    integer, intent(inout) :: line
+    integer, intent(in) :: widths(:)
+    type(card_t), intent(out) :: card
+    type(problem_log_t), intent(inout) :: log
+    character(len=*), intent(in) :: label, first_field
+    integer :: previous
+    previous = max(line, deck%blocks(block)%keyword_line)
+    require_card = next_line(deck, block, line, .false.)
+    if (require_card) then
+      call open_card(deck, block, line, widths, card, log)
+    else
+      call line_problem(deck, log, previous, block, first_field, label// &
+        " is missing: the keyword ends after this line", unreadable=.true.)
+    end if
+  end function require_card
+
+  !> The next definition of a keyword whose definitions may repeat: with `has_title` a title
+  !> line and then the first card, otherwise just the first card. False at the end of the
+  !> block, or when the title is the last line (the missing card is then reported).
+  logical function next_definition(deck, block, has_title, line, widths, card, title, log, &
+                                   label, first_field)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    logical, intent(in) :: has_title
+    integer, intent(inout) :: line
+    integer, intent(in) :: widths(:)
+    type(card_t), intent(out) :: card
+    character(len=:), allocatable, intent(out) :: title
+    type(problem_log_t), intent(inout) :: log
+    character(len=*), intent(in) :: label, first_field
+    title = ""
+    next_definition = next_line(deck, block, line, .false.)
+    if (.not. next_definition) return
+    if (has_title) then
+      title = line_title(deck, line)
+      next_definition = require_card(deck, block, line, widths, card, log, label, first_field)
+    else
+      call open_card(deck, block, line, widths, card, log)
+    end if
+  end function next_definition
+
+  !> Integer field `k`; blank gives `default` (0 when absent).
+  subroutine get_integer(deck, card, k, name, value, log, default)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(inout) :: card
+    integer, intent(in) :: k
+    character(len=*), intent(in) :: name
+    integer, intent(out) :: value
+    type(problem_log_t), intent(inout) :: log
+    integer, intent(in), optional :: default
+    integer :: file, first, last, status, parameter
+    real(wp) :: real_value
+
+    value = 0
+    if (present(default)) value = default
+    call field_bounds(deck, card, k, file, first, last)
+    if (last < first) return
+    associate (text => deck%files(file)%text(first:last))
+      if (is_reference(text)) then
+        call resolve_reference(deck, card, name, text, parameter, log)
+        if (parameter == 0) return
+        select case (deck%parameters(parameter)%kind)
+        case ("I")
+          value = deck%parameters(parameter)%integer_value
+        case ("R")
+          real_value = deck%parameters(parameter)%real_value
+          if (real_value /= aint(real_value) .or. abs(real_value) > 2.0e9_wp) then
+            call reference_problem(deck, card, name, text, "holds "//real_text(real_value)// &
+                                   ", not an integer", log)
+            return
+          end if
+          value = nint(real_value)
+        case default
+          call reference_problem(deck, card, name, text, "is a character parameter, not "// &
+                                 "a number", log)
+          return
+        end select
+        if (text(1:1) == "-") value = -value
+        return
+      end if
+      call parse_integer(text, value, status)
+      if (status /= number_ok) then
+        select case (status)
+        case (number_not_integral)
+          call field_problem(deck, card, k, name, """"//text//""" is not an integer", log)
+        case (number_out_of_range)
+          call field_problem(deck, card, k, name, """"//text//""" is out of range", log)
+        case default
+          call field_problem(deck, card, k, name, """"//text//""" is not an integer", log)
+        end select
+        value = 0
+        if (present(default)) value = default
+      end if
+    end associate
+  end subroutine get_integer
+
+  !> Real field `k`; blank gives `default` (0 when absent).
+  subroutine get_real(deck, card, k, name, value, log, default)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(inout) :: card
+    integer, intent(in) :: k
+    character(len=*), intent(in) :: name
+    real(wp), intent(out) :: value
+    type(problem_log_t), intent(inout) :: log
+    real(wp), intent(in), optional :: default
+    integer :: file, first, last, status, parameter
+
+    value = 0.0_wp
+    if (present(default)) value = default
+    call field_bounds(deck, card, k, file, first, last)
+    if (last < first) return
+    associate (text => deck%files(file)%text(first:last))
+      if (is_reference(text)) then
+        call resolve_reference(deck, card, name, text, parameter, log)
+        if (parameter == 0) return
+        if (deck%parameters(parameter)%kind == "C") then
+          call reference_problem(deck, card, name, text, "is a character parameter, not "// &
+                                 "a number", log)
+          return
+        end if
+        value = deck%parameters(parameter)%real_value
+        if (text(1:1) == "-") value = -value
+        return
+      end if
+      call parse_real(text, value, status)
+      if (status /= number_ok) then
+        if (status == number_out_of_range) then
+          call field_problem(deck, card, k, name, """"//text//""" is out of range", log)
+        else
+          call field_problem(deck, card, k, name, """"//text//""" is not a number", log)
+        end if
+        value = 0.0_wp
+        if (present(default)) value = default
+      end if
+    end associate
+  end subroutine get_real
+
+  !> Text field `k`, trimmed; a `&name` reference to a C parameter is replaced by its value.
+  subroutine get_text(deck, card, k, name, value, log)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(inout) :: card
+    integer, intent(in) :: k
+    character(len=*), intent(in) :: name
+    character(len=:), allocatable, intent(out) :: value
+    type(problem_log_t), intent(inout) :: log
+    integer :: file, first, last, parameter
+    value = ""
+    call field_bounds(deck, card, k, file, first, last)
+    if (last < first) return
+    value = deck%files(file)%text(first:last)
+    if (value(1:1) == "&") then
+      call resolve_reference(deck, card, name, value, parameter, log)
+      if (parameter > 0) value = trim_blanks(deck%parameters(parameter)%text_value)
+    end if
+  end subroutine get_text
+
+  !> True when field `k` is blank (the field's default applies).
+  logical function field_is_blank(deck, card, k)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(in) :: card
+    integer, intent(in) :: k
+    integer :: file, first, last
+    call field_bounds(deck, card, k, file, first, last)
+    field_is_blank = last < first
+  end function field_is_blank
+
+  !> Add a warning when field `k` holds a value other than blank or zero: crashfree reads
+  !> the field but does not use it (`reason` says why).
+  subroutine warn_if_set(deck, card, k, name, reason, warnings)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(in) :: card
+    integer, intent(in) :: k
+    character(len=*), intent(in) :: name, reason
+    type(error_list_t), intent(inout) :: warnings
+    integer :: file, first, last, status
+    real(wp) :: value
+    call field_bounds(deck, card, k, file, first, last)
+    if (last < first) return
+    call parse_real(deck%files(file)%text(first:last), value, status)
+    if (status == number_ok .and. value == 0.0_wp) return
+    call add_error(warnings, line_location(deck, card%line)//": *"// &
+      keyword_label(deck, card%block)//": field "//name//": ignored ("//reason//")")
+  end subroutine warn_if_set
+
+  !> Report `field NAME: message` for the line of `card`.
+  subroutine card_problem(deck, log, card, name, message, unreadable)
+    type(deck_t), intent(in) :: deck
+    type(problem_log_t), intent(inout) :: log
+    type(card_t), intent(in) :: card
+    character(len=*), intent(in) :: name, message
+    logical, intent(in), optional :: unreadable
+    call line_problem(deck, log, card%line, card%block, name, message, unreadable)
+  end subroutine card_problem
+
+  !> Report `file:line: *KEYWORD: field NAME: message` for line `line` of block `block`.
+  subroutine line_problem(deck, log, line, block, name, message, unreadable)
+    type(deck_t), intent(in) :: deck
+    type(problem_log_t), intent(inout) :: log
+    integer, intent(in) :: line, block
+    character(len=*), intent(in) :: name, message
+    logical, intent(in), optional :: unreadable
+    call report_problem(log, line_location(deck, line)//": *"//keyword_label(deck, block)// &
+                        ": field "//name//": "//message, unreadable)
+  end subroutine line_problem
+
+  !> Report `file:line: *KEYWORD: field NAME: message` for line `line`, finding its keyword.
+  subroutine located_problem(deck, log, line, name, message)
+    type(deck_t), intent(in) :: deck
+    type(problem_log_t), intent(inout) :: log
+    integer, intent(in) :: line
+    character(len=*), intent(in) :: name, message
+    call line_problem(deck, log, line, block_of_line(deck, line), name, message)
+  end subroutine located_problem
+
+  !> The keyword of block `block` as the deck writes it (upper case, options included).
+  function keyword_label(deck, block) result(label)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    character(len=:), allocatable :: label
+    label = deck%blocks(block)%name
+  end function keyword_label
+
+  !> A whole line as a title (A80 heading), trimmed.
+  function line_title(deck, line) result(title)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: line
+    character(len=:), allocatable :: title
+    title = trim_blanks(deck%files(deck%line_file(line))%text(deck%line_first(line): &
+                                                                 deck%line_last(line)))
+  end function line_title
+
+  !> An `_ID` card: the id (I10) and the heading (the rest of the line).
+  subroutine id_heading(deck, block, line, name, id, heading, log)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block, line
+    character(len=*), intent(in) :: name
+    integer, intent(out) :: id
+    character(len=:), allocatable, intent(out) :: heading
+    type(problem_log_t), intent(inout) :: log
+    type(card_t) :: card
+    call open_card(deck, block, line, [10, 150], card, log)
+    call get_integer(deck, card, 1, name, id, log)
+    call get_text(deck, card, 2, "HEADING", heading, log)
+  end subroutine id_heading
+
+  !> File and text positions of field `k` of `card`, blanks trimmed (last < first: blank).
+  subroutine field_bounds(deck, card, k, file, first, last)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(in) :: card
+    integer, intent(in) :: k
+    integer, intent(out) :: file, first, last
+    integer :: offset, start, finish
+    file = deck%line_file(card%line)
+    first = 1
+    last = 0
+    if (k > card%spans%count) return
+    if (card%spans%last(k) < card%spans%first(k)) return
+    offset = deck%line_first(card%line) - 1
+    start = verify(deck%files(file)%text(offset + card%spans%first(k): &
+                   offset + card%spans%last(k)), " "//achar(9))
+    if (start == 0) return
+    finish = verify(deck%files(file)%text(offset + card%spans%first(k): &
+                    offset + card%spans%last(k)), " "//achar(9), back=.true.)
+    first = offset + card%spans%first(k) + start - 1
+    last = offset + card%spans%first(k) + finish - 1
+  end subroutine field_bounds
+
+  pure logical function is_reference(text)
+    character(len=*), intent(in) :: text
+    is_reference = text(1:1) == "&"
+    if (len(text) >= 2) is_reference = is_reference .or. text(1:2) == "-&"
+  end function is_reference
+
+  !> Index of the parameter `text` (`&name` or `-&name`) refers to; 0 after reporting it.
+  subroutine resolve_reference(deck, card, name, text, parameter, log)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(inout) :: card
+    character(len=*), intent(in) :: name, text
+    integer, intent(out) :: parameter
+    type(problem_log_t), intent(inout) :: log
+    integer :: ampersand
+    ampersand = index(text, "&")
+    parameter = find_parameter(deck, trim_blanks(text(ampersand + 1:)))
+    if (parameter == 0) call reference_problem(deck, card, name, text, "is not defined "// &
+                                               "(no *PARAMETER of that name)", log)
+  end subroutine resolve_reference
+
+  subroutine reference_problem(deck, card, name, text, message, log)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(inout) :: card
+    character(len=*), intent(in) :: name, text, message
+    type(problem_log_t), intent(inout) :: log
+    integer :: ampersand
+    ampersand = index(text, "&")
+    call card_problem(deck, log, card, name, "parameter "//text(ampersand:)//" "//message, &
+                      unreadable=.true.)
+    card%failed = .true.
+  end subroutine reference_problem
+
+  !> A field that cannot be read: name the field, show its text and where it was taken from.
+  subroutine field_problem(deck, card, k, name, message, log)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(inout) :: card
+    integer, intent(in) :: k
+    character(len=*), intent(in) :: name, message
+    type(problem_log_t), intent(inout) :: log
+    character(len=:), allocatable :: where
+    if (card%spans%free) then
+      where = " (entry "//integer_text(k)//" of the comma-separated card)"
+    else
+      where = " (columns "//integer_text(card%spans%column_first(k))//"-"// &
+              integer_text(card%spans%column_last(k))//")"
+    end if
+    call card_problem(deck, log, card, name, message//where, unreadable=.true.)
+    card%failed = .true.
+  end subroutine field_problem
+end module deck_fields

@@ -1,0 +1,182 @@
+!> What the keyword readers collect before the cross-check: the model with ids where indices
+!> will go, the deck lines every definition came from, and the loads and conditions as written
+!> (by node or by set) before they are expanded per node.
+module deck_input
+  use kinds, only: wp
+  use model, only: model_t, rigid_wall_t
+  use deck_keywords, only: keyword_count, keyword_node, keyword_element_solid, keyword_part, &
+    keyword_section_solid, keyword_section_solid_efg, keyword_mat_elastic, &
+    keyword_mat_plastic_kinematic, keyword_hourglass, keyword_define_curve, &
+    keyword_set_node_list, keyword_set_node_list_generate, keyword_set_part_list, &
+    keyword_spc_node, keyword_spc_set, keyword_motion_node, keyword_motion_set, &
+    keyword_load_node_point, keyword_load_node_set, keyword_initial_velocity, &
+    keyword_initial_velocity_node, keyword_initial_velocity_generation, keyword_rigidwall_planar
+  implicit none
+  private
+
+  public :: id_list_t, set_input_t, spc_input_t, motion_input_t, load_input_t
+  public :: velocity_input_t, wall_input_t, deck_input_t, prepare_input, append_id
+
+  !> How an initial velocity was given.
+  integer, parameter, public :: velocity_by_set = 1, velocity_by_node = 2, &
+                                velocity_generation = 3
+
+  !> Ids as written, with the line and field (1-8) each came from.
+  type :: id_list_t
+    integer :: count = 0
+    integer, allocatable :: ids(:), lines(:), fields(:)
+  end type id_list_t
+
+  !> One *SET_NODE_LIST(_GENERATE) or *SET_PART_LIST. For a generated set `members` holds
+  !> pairs (first id, last id) of the ranges.
+  type :: set_input_t
+    integer :: id = 0
+    character(len=:), allocatable :: title
+    integer :: line = 0
+    logical :: generated = .false.
+    type(id_list_t) :: members
+  end type set_input_t
+
+  !> *BOUNDARY_SPC_NODE/_SET line (or a *NODE TC code): `target` is a node or set id.
+  type :: spc_input_t
+    integer :: target = 0
+    logical :: is_set = .false.
+    logical :: fixed(3) = .false.
+    integer :: line = 0
+  end type spc_input_t
+
+  !> *BOUNDARY_PRESCRIBED_MOTION_NODE/_SET line.
+  type :: motion_input_t
+    integer :: target = 0
+    logical :: is_set = .false.
+    integer :: direction = 0, kind = 0, curve_id = 0
+    real(wp) :: scale = 1.0_wp, birth = 0.0_wp, death = 1.0e28_wp
+    integer :: line = 0
+  end type motion_input_t
+
+  !> *LOAD_NODE_POINT/_SET line.
+  type :: load_input_t
+    integer :: target = 0
+    logical :: is_set = .false.
+    integer :: direction = 0, curve_id = 0
+    real(wp) :: scale = 1.0_wp
+    integer :: line = 0
+  end type load_input_t
+
+  !> *INITIAL_VELOCITY (by node set), _NODE or _GENERATION definition.
+  type :: velocity_input_t
+    integer :: kind = velocity_by_set
+    integer :: target = 0             !< NSID, NID or ID (0: all nodes)
+    integer :: target_type = 1        !< STYP of _GENERATION: 1 part set, 2 part, 3 node set
+    integer :: exempt_set = 0         !< NSIDEX
+    real(wp) :: velocity(3) = 0.0_wp
+    real(wp) :: exempt_velocity(3) = 0.0_wp
+    real(wp) :: omega = 0.0_wp        !< angular velocity about the axis
+    real(wp) :: centre(3) = 0.0_wp    !< point on the axis
+    real(wp) :: axis(3) = 0.0_wp      !< unit axis direction
+    integer :: axis_nodes(2) = 0      !< NX = -999: NY, NZ are nodes on the axis
+    integer :: line = 0               !< first card
+    integer :: axis_line = 0          !< card with the axis
+  end type velocity_input_t
+
+  !> *RIGIDWALL_PLANAR definition; its node sets are resolved later.
+  type :: wall_input_t
+    type(rigid_wall_t) :: wall
+    integer :: node_set = 0, exempt_set = 0
+    logical :: id_given = .false.
+    integer :: line = 0               !< card 1 (NSID)
+  end type wall_input_t
+
+  !> Everything read, before ids are resolved. Arrays are sized from line counts and hold
+  !> `*_count` entries.
+  type :: deck_input_t
+    type(model_t) :: model
+    integer :: node_count = 0, solid_count = 0, part_count = 0, section_count = 0
+    integer :: material_count = 0, hourglass_count = 0, curve_count = 0
+    integer :: node_set_count = 0, part_set_count = 0, spc_count = 0, motion_count = 0
+    integer :: load_count = 0, velocity_count = 0, wall_count = 0
+    integer, allocatable :: node_lines(:), node_constraints(:)     !< TC code of each node
+    integer, allocatable :: solid_lines(:), solid_node_lines(:)   !< PID card, node card
+    integer, allocatable :: part_lines(:), section_lines(:), material_lines(:)
+    integer, allocatable :: hourglass_lines(:), curve_lines(:)
+    type(set_input_t), allocatable :: node_sets(:), part_sets(:)
+    type(spc_input_t), allocatable :: spcs(:)
+    type(motion_input_t), allocatable :: motions(:)
+    type(load_input_t), allocatable :: loads(:)
+    type(velocity_input_t), allocatable :: velocities(:)
+    type(wall_input_t), allocatable :: walls(:)
+    !> *DATABASE_HISTORY_NODE(_SET) requests in deck order; a node set id is stored with a
+    !> negative field number (-k for field IDk) so that nodes and sets keep their order.
+    type(id_list_t) :: history_requests
+    ! controls whose meaning depends on other keywords
+    integer :: termination_line = 0        !< *CONTROL_TERMINATION card (0: not given)
+    integer :: plot_count = 0              !< *DATABASE_BINARY_D3PLOT NPLTC
+    integer :: plot_line = 0
+    integer :: nodout_line = 0
+    real(wp) :: bulk_quadratic = 1.5_wp    !< *CONTROL_BULK_VISCOSITY Q1
+    real(wp) :: bulk_linear = 0.06_wp      !< *CONTROL_BULK_VISCOSITY Q2
+  end type deck_input_t
+
+contains
+
+  !> Allocate every list for at most the given numbers of data lines and blocks per keyword
+  !> (each definition takes at least one line, so these bound the counts).
+  subroutine prepare_input(lines, blocks, input)
+    integer, intent(in) :: lines(keyword_count), blocks(keyword_count)
+    type(deck_input_t), intent(out) :: input
+    integer :: n
+
+    n = lines(keyword_node)
+    allocate (input%model%node_ids(n), input%model%coordinates(3, n), input%node_lines(n), &
+              input%node_constraints(n))
+    n = lines(keyword_element_solid)
+    allocate (input%model%solid_ids(n), input%model%solid_part(n), input%model%solid_nodes(8, n), &
+              input%solid_lines(n), input%solid_node_lines(n))
+    n = lines(keyword_part)
+    allocate (input%model%parts(n), input%part_lines(n))
+    n = lines(keyword_section_solid) + lines(keyword_section_solid_efg)
+    allocate (input%model%sections(n), input%section_lines(n))
+    n = lines(keyword_mat_elastic) + lines(keyword_mat_plastic_kinematic)
+    allocate (input%model%materials(n), input%material_lines(n))
+    n = lines(keyword_hourglass)
+    allocate (input%model%hourglasses(n), input%hourglass_lines(n))
+    n = blocks(keyword_define_curve)
+    allocate (input%model%curves(n), input%curve_lines(n))
+    allocate (input%node_sets(blocks(keyword_set_node_list) + &
+                              blocks(keyword_set_node_list_generate)))
+    allocate (input%part_sets(blocks(keyword_set_part_list)))
+    allocate (input%spcs(lines(keyword_spc_node) + lines(keyword_spc_set)))
+    allocate (input%motions(lines(keyword_motion_node) + lines(keyword_motion_set)))
+    allocate (input%loads(lines(keyword_load_node_point) + lines(keyword_load_node_set)))
+    allocate (input%velocities(lines(keyword_initial_velocity) + &
+                               lines(keyword_initial_velocity_node) + &
+                               lines(keyword_initial_velocity_generation)))
+    allocate (input%walls(lines(keyword_rigidwall_planar)))
+  end subroutine prepare_input
+
+  !> Append one id with its origin, growing the list by doubling.
+  pure subroutine append_id(list, id, line, field)
+    type(id_list_t), intent(inout) :: list
+    integer, intent(in) :: id, line, field
+    integer, allocatable :: larger(:)
+    integer :: capacity
+    if (.not. allocated(list%ids)) then
+      allocate (list%ids(16), list%lines(16), list%fields(16))
+    else if (list%count == size(list%ids)) then
+      capacity = 2*size(list%ids)
+      allocate (larger(capacity))
+      larger(1:list%count) = list%ids(1:list%count)
+      call move_alloc(larger, list%ids)
+      allocate (larger(capacity))
+      larger(1:list%count) = list%lines(1:list%count)
+      call move_alloc(larger, list%lines)
+      allocate (larger(capacity))
+      larger(1:list%count) = list%fields(1:list%count)
+      call move_alloc(larger, list%fields)
+    end if
+    list%count = list%count + 1
+    list%ids(list%count) = id
+    list%lines(list%count) = line
+    list%fields(list%count) = field
+  end subroutine append_id
+end module deck_input

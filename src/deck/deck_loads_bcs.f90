@@ -1,0 +1,549 @@
+!> Boundary conditions, loads, initial velocities and rigid walls: *BOUNDARY_SPC_NODE/_SET,
+!> *BOUNDARY_PRESCRIBED_MOTION_NODE/_SET, *LOAD_NODE_POINT/_SET, *INITIAL_VELOCITY(_NODE,
+!> _GENERATION) and *RIGIDWALL_PLANAR. They are kept as written (by node or set id); the
+!> cross-check expands them per node.
+module deck_loads_bcs
+  use kinds, only: wp
+  use error_handling, only: error_list_t
+  use model, only: rigid_wall_t, motion_velocity, motion_acceleration, motion_displacement
+  use deck_problems, only: problem_log_t
+  use deck_numbers, only: integer_text, real_text
+  use deck_lexer, only: deck_t
+  use deck_keywords, only: keyword_t
+  use deck_fields, only: card_t, open_card, next_line, require_card, get_integer, get_real, &
+                         card_problem, warn_if_set, id_heading, line_problem
+  use deck_input, only: deck_input_t, velocity_input_t, velocity_by_set, velocity_by_node, &
+                        velocity_generation
+  implicit none
+  private
+
+  public :: read_spcs, read_motions, read_loads, read_initial_velocities
+  public :: read_initial_velocity_nodes, read_velocity_generations, read_planar_walls
+
+  integer, parameter :: standard_widths(8) = 10
+  character(len=*), parameter :: no_rotations = "solid nodes have no rotations"
+  character(len=*), parameter :: no_local_systems = "local coordinate systems are not "// &
+                                                    "available; leave it blank or 0"
+
+contains
+
+  !> *BOUNDARY_SPC_NODE / _SET: NID|NSID CID DOFX DOFY DOFZ DOFRX DOFRY DOFRZ per line.
+  subroutine read_spcs(deck, block, keyword, by_set, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    logical, intent(in) :: by_set
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    integer :: line, n, k, system, flag
+    logical :: fixed(6)
+    character(len=5), parameter :: names(6) = ["DOFX ", "DOFY ", "DOFZ ", "DOFRX", "DOFRY", "DOFRZ"]
+
+    line = 0
+    if (.not. skip_id_card(deck, block, keyword, line, log)) return
+    do while (next_line(deck, block, line, .true.))
+      call open_card(deck, block, line, standard_widths, card, log)
+      n = input%spc_count + 1
+      input%spc_count = n
+      associate (spc => input%spcs(n))
+        spc%is_set = by_set
+        spc%line = line
+        call read_target(deck, card, by_set, spc%target, log)
+        call get_integer(deck, card, 2, "CID", system, log)
+        if (system /= 0) call card_problem(deck, log, card, "CID", no_local_systems)
+        do k = 1, 6
+          call get_integer(deck, card, k + 2, trim(names(k)), flag, log)
+          if (flag /= 0 .and. flag /= 1) then
+            call card_problem(deck, log, card, trim(names(k)), "must be 0 (free) or 1 "// &
+                              "(fixed), found "//integer_text(flag))
+            flag = 0
+          end if
+          if (k > 3) call warn_if_set(deck, card, k + 2, trim(names(k)), no_rotations, warnings)
+          fixed(k) = flag == 1
+        end do
+        spc%fixed = fixed(1:3)
+      end associate
+    end do
+  end subroutine read_spcs
+
+  !> *BOUNDARY_PRESCRIBED_MOTION_NODE / _SET: NID|NSID DOF VAD LCID SF VID DEATH BIRTH.
+  subroutine read_motions(deck, block, keyword, by_set, input, log)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    logical, intent(in) :: by_set
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(card_t) :: card
+    integer :: line, n, vector
+
+    line = 0
+    if (.not. skip_id_card(deck, block, keyword, line, log)) return
+    do while (next_line(deck, block, line, .true.))
+      call open_card(deck, block, line, standard_widths, card, log)
+      n = input%motion_count + 1
+      input%motion_count = n
+      associate (motion => input%motions(n))
+        motion%is_set = by_set
+        motion%line = line
+        call read_target(deck, card, by_set, motion%target, log)
+        call get_integer(deck, card, 2, "DOF", motion%direction, log)
+        call get_integer(deck, card, 3, "VAD", motion%kind, log)
+        call get_integer(deck, card, 4, "LCID", motion%curve_id, log)
+        call get_real(deck, card, 5, "SF", motion%scale, log)
+        call get_integer(deck, card, 6, "VID", vector, log)
+        call get_real(deck, card, 7, "DEATH", motion%death, log)
+        call get_real(deck, card, 8, "BIRTH", motion%birth, log)
+        if (motion%scale == 0.0_wp) motion%scale = 1.0_wp
+        if (motion%death == 0.0_wp) motion%death = 1.0e28_wp
+        if (card%failed) cycle
+        call check_motion_direction(deck, card, motion%direction, log)
+        select case (motion%kind)
+        case (motion_velocity, motion_acceleration, motion_displacement)
+        case (3, 4)
+          call card_problem(deck, log, card, "VAD", integer_text(motion%kind)//" applies to "// &
+            "rigid bodies only; use 0 (velocity), 1 (acceleration) or 2 (displacement)")
+        case default
+          call card_problem(deck, log, card, "VAD", "must be 0 (velocity), 1 (acceleration) "// &
+                            "or 2 (displacement), found "//integer_text(motion%kind))
+        end select
+        call check_curve_given(deck, card, 4, motion%curve_id, log)
+        if (vector /= 0) call card_problem(deck, log, card, "VID", "vectors and local "// &
+          "coordinate systems are not available; use DOF 1, 2 or 3 with VID blank")
+        if (motion%death <= motion%birth) call card_problem(deck, log, card, "DEATH", &
+          "death time "//real_text(motion%death)//" must be later than the birth time "// &
+          real_text(motion%birth))
+      end associate
+    end do
+  end subroutine read_motions
+
+  !> DOF of a prescribed motion: 1-3 only, since solid nodes carry no rotations.
+  subroutine check_motion_direction(deck, card, direction, log)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(in) :: card
+    integer, intent(in) :: direction
+    type(problem_log_t), intent(inout) :: log
+    select case (direction)
+    case (1:3)
+    case (4, -4, 8, -8)
+      call card_problem(deck, log, card, "DOF", integer_text(direction)//" (motion along or "// &
+        "about a vector VID) is not available; use DOF 1, 2 or 3 (x, y, z)")
+    case (5:7, 9:11, -11:-9)
+      call card_problem(deck, log, card, "DOF", integer_text(direction)//" is a rotation, "// &
+        "but "//no_rotations//"; use DOF 1, 2 or 3 (x, y, z)")
+    case (12)
+      call card_problem(deck, log, card, "DOF", "12 (along segment normals) applies to "// &
+        "*BOUNDARY_PRESCRIBED_MOTION_SET_SEGMENT only; use DOF 1, 2 or 3")
+    case default
+      call card_problem(deck, log, card, "DOF", "must be 1, 2 or 3 (x, y, z translation), "// &
+                        "found "//integer_text(direction))
+    end select
+  end subroutine check_motion_direction
+
+  !> *LOAD_NODE_POINT / _SET: NID|NSID DOF LCID SF CID M1 M2 M3.
+  subroutine read_loads(deck, block, by_set, input, log)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    logical, intent(in) :: by_set
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(card_t) :: card
+    integer :: line, n, system
+
+    line = 0
+    do while (next_line(deck, block, line, .true.))
+      call open_card(deck, block, line, standard_widths, card, log)
+      n = input%load_count + 1
+      input%load_count = n
+      associate (load => input%loads(n))
+        load%is_set = by_set
+        load%line = line
+        call read_target(deck, card, by_set, load%target, log)
+        call get_integer(deck, card, 2, "DOF", load%direction, log)
+        call get_integer(deck, card, 3, "LCID", load%curve_id, log)
+        call get_real(deck, card, 4, "SF", load%scale, log)
+        call get_integer(deck, card, 5, "CID", system, log)
+        if (load%scale == 0.0_wp) load%scale = 1.0_wp
+        if (card%failed) cycle
+        select case (load%direction)
+        case (1:3)
+        case (4, 8)
+          call card_problem(deck, log, card, "DOF", integer_text(load%direction)//" (follower "// &
+            "force or moment) is not available; use DOF 1, 2 or 3 (x, y, z)")
+        case (5:7)
+          call card_problem(deck, log, card, "DOF", integer_text(load%direction)//" is a "// &
+            "moment, but "//no_rotations//"; use DOF 1, 2 or 3 (x, y, z)")
+        case default
+          call card_problem(deck, log, card, "DOF", "must be 1, 2 or 3 (force in x, y, z), "// &
+                            "found "//integer_text(load%direction))
+        end select
+        call check_curve_given(deck, card, 3, load%curve_id, log)
+        if (system /= 0) call card_problem(deck, log, card, "CID", no_local_systems)
+      end associate
+    end do
+  end subroutine read_loads
+
+  !> *INITIAL_VELOCITY: card 1 NSID NSIDEX BOXID IRIGID ICID, card 2 VX VY VZ VXR VYR VZR,
+  !> card 3 (when NSIDEX > 0) the velocities of the exempted nodes.
+  subroutine read_initial_velocities(deck, block, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    type(velocity_input_t) :: velocity
+    integer :: line, box, system
+
+    line = 0
+    do while (next_line(deck, block, line, .true.))
+      velocity = velocity_input_t(kind=velocity_by_set, line=line)
+      call open_card(deck, block, line, standard_widths, card, log)
+      call get_integer(deck, card, 1, "NSID", velocity%target, log)
+      call get_integer(deck, card, 2, "NSIDEX", velocity%exempt_set, log)
+      call get_integer(deck, card, 3, "BOXID", box, log)
+      call get_integer(deck, card, 5, "ICID", system, log)
+      call check_set_id(deck, card, 1, "NSID", velocity%target, log)
+      call check_set_id(deck, card, 2, "NSIDEX", velocity%exempt_set, log)
+      if (box /= 0) call card_problem(deck, log, card, "BOXID", "boxes (*DEFINE_BOX) are not "// &
+                                      "available; use a node set")
+      if (system /= 0) call card_problem(deck, log, card, "ICID", no_local_systems)
+      call warn_if_set(deck, card, 4, "IRIGID", "no rigid bodies", warnings)
+      if (.not. require_card(deck, block, line, standard_widths, card, log, &
+                             "card 2 (VX VY VZ VXR VYR VZR)", "VX")) exit
+      call read_vector(deck, card, 1, ["VX", "VY", "VZ"], velocity%velocity, log)
+      call warn_rotations(deck, card, 4, ["VXR", "VYR", "VZR"], warnings)
+      if (velocity%exempt_set > 0) then
+        if (.not. require_card(deck, block, line, standard_widths, card, log, "card 3 (VXE "// &
+                               "VYE VZE VXRE VYRE VZRE, read because NSIDEX > 0)", "VXE")) exit
+        call read_vector(deck, card, 1, ["VXE", "VYE", "VZE"], velocity%exempt_velocity, log)
+        call warn_rotations(deck, card, 4, ["VXRE", "VYRE", "VZRE"], warnings)
+      end if
+      call add_velocity(input, velocity)
+    end do
+  end subroutine read_initial_velocities
+
+  !> *INITIAL_VELOCITY_NODE: NID VX VY VZ VXR VYR VZR ICID per line.
+  subroutine read_initial_velocity_nodes(deck, block, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    type(velocity_input_t) :: velocity
+    integer :: line, system
+
+    line = 0
+    do while (next_line(deck, block, line, .true.))
+      velocity = velocity_input_t(kind=velocity_by_node, line=line)
+      call open_card(deck, block, line, standard_widths, card, log)
+      call read_target(deck, card, .false., velocity%target, log)
+      call read_vector(deck, card, 2, ["VX", "VY", "VZ"], velocity%velocity, log)
+      call warn_rotations(deck, card, 5, ["VXR", "VYR", "VZR"], warnings)
+      call get_integer(deck, card, 8, "ICID", system, log)
+      if (system /= 0) call card_problem(deck, log, card, "ICID", no_local_systems)
+      call add_velocity(input, velocity)
+    end do
+  end subroutine read_initial_velocity_nodes
+
+  !> *INITIAL_VELOCITY_GENERATION: card 1 ID STYP OMEGA VX VY VZ IVATN ICID, card 2 XC YC ZC
+  !> NX NY NZ PHASE IRIGID. The velocity is V + OMEGA n x (x - c): a rotation about the axis
+  !> through c along n plus a translation. NX = -999 makes NY and NZ two nodes on the axis.
+  subroutine read_velocity_generations(deck, block, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    type(velocity_input_t) :: velocity
+    integer :: line, system
+
+    line = 0
+    do while (next_line(deck, block, line, .true.))
+      velocity = velocity_input_t(kind=velocity_generation, line=line)
+      call open_card(deck, block, line, standard_widths, card, log)
+      call get_integer(deck, card, 1, "ID", velocity%target, log)
+      call get_integer(deck, card, 2, "STYP", velocity%target_type, log, default=1)
+      call get_real(deck, card, 3, "OMEGA", velocity%omega, log)
+      call read_vector(deck, card, 4, ["VX", "VY", "VZ"], velocity%velocity, log)
+      call get_integer(deck, card, 8, "ICID", system, log)
+      if (velocity%target_type == 0) velocity%target_type = 1
+      if (velocity%target_type < 1 .or. velocity%target_type > 3) call card_problem(deck, log, &
+        card, "STYP", "must be 1 (part set), 2 (part) or 3 (node set), found "// &
+        integer_text(velocity%target_type))
+      call check_set_id(deck, card, 1, "ID", velocity%target, log)
+      if (system /= 0) call card_problem(deck, log, card, "ICID", no_local_systems)
+      call warn_if_set(deck, card, 7, "IVATN", "no rigid bodies or constrained nodes", warnings)
+      if (.not. require_card(deck, block, line, standard_widths, card, log, &
+                             "card 2 (XC YC ZC NX NY NZ PHASE IRIGID)", "XC")) exit
+      velocity%axis_line = line
+      call read_vector(deck, card, 1, ["XC", "YC", "ZC"], velocity%centre, log)
+      call read_vector(deck, card, 4, ["NX", "NY", "NZ"], velocity%axis, log)
+      call warn_if_set(deck, card, 8, "IRIGID", "no rigid bodies", warnings)
+      if (.not. card%failed) call prepare_axis(deck, card, velocity, log)
+      call add_velocity(input, velocity)
+    end do
+  end subroutine read_velocity_generations
+
+  !> Normalise the rotation axis, or take its two nodes when NX = -999.
+  subroutine prepare_axis(deck, card, velocity, log)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(in) :: card
+    type(velocity_input_t), intent(inout) :: velocity
+    type(problem_log_t), intent(inout) :: log
+    real(wp) :: length
+    integer :: k
+    character(len=2), parameter :: names(2) = ["NY", "NZ"]
+    if (velocity%axis(1) == -999.0_wp) then
+      do k = 1, 2
+        if (velocity%axis(k + 1) <= 0.0_wp .or. velocity%axis(k + 1) /= aint(velocity%axis(k + 1)) &
+            .or. velocity%axis(k + 1) > 2.0e9_wp) then
+          call card_problem(deck, log, card, names(k), "with NX = -999, NY and NZ are node "// &
+                            "ids, found "//real_text(velocity%axis(k + 1)))
+          return
+        end if
+        velocity%axis_nodes(k) = nint(velocity%axis(k + 1))
+      end do
+      return
+    end if
+    length = norm2(velocity%axis)
+    if (length > 0.0_wp) then
+      velocity%axis = velocity%axis/length
+    else if (velocity%omega /= 0.0_wp) then
+      call card_problem(deck, log, card, "NX", "the rotation axis (NX NY NZ) has zero length "// &
+                        "but OMEGA is "//real_text(velocity%omega))
+    end if
+  end subroutine prepare_axis
+
+  !> *RIGIDWALL_PLANAR(_FINITE)(_MOVING)(_FORCES)(_ID): [RWID heading], card 1 NSID NSIDEX
+  !> BOXID OFFSET BIRTH DEATH RWKSF, card 2 XT YT ZT XH YH ZH FRIC WVEL, then the option cards
+  !> in the order FINITE, MOVING, FORCES.
+  subroutine read_planar_walls(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    integer :: line, n, box
+
+    line = 0
+    do while (next_line(deck, block, line, .false.))
+      n = input%wall_count + 1
+      input%wall_count = n
+      associate (entry => input%walls(n), wall => input%walls(n)%wall)
+        entry%id_given = keyword%id
+        wall%title = ""
+        if (keyword%id) then
+          call id_heading(deck, block, line, "RWID", wall%id, wall%title, log)
+          if (wall%id <= 0) call line_problem(deck, log, line, block, "RWID", "wall id must "// &
+                                              "be > 0, found "//integer_text(wall%id))
+          if (.not. require_card(deck, block, line, standard_widths, card, log, "card 1 (NSID "// &
+                                 "NSIDEX BOXID OFFSET BIRTH DEATH RWKSF)", "NSID")) exit
+        else
+          call open_card(deck, block, line, standard_widths, card, log)
+        end if
+        entry%line = line
+        call get_integer(deck, card, 1, "NSID", entry%node_set, log)
+        call get_integer(deck, card, 2, "NSIDEX", entry%exempt_set, log)
+        call get_integer(deck, card, 3, "BOXID", box, log)
+        call get_real(deck, card, 4, "OFFSET", wall%offset, log)
+        call get_real(deck, card, 5, "BIRTH", wall%birth, log)
+        call get_real(deck, card, 6, "DEATH", wall%death, log)
+        if (wall%death == 0.0_wp) wall%death = 1.0e20_wp
+        call check_set_id(deck, card, 1, "NSID", entry%node_set, log)
+        call check_set_id(deck, card, 2, "NSIDEX", entry%exempt_set, log)
+        if (box /= 0) call card_problem(deck, log, card, "BOXID", "boxes (*DEFINE_BOX) are "// &
+                                        "not available; use a node set")
+        if (wall%offset < 0.0_wp) call card_problem(deck, log, card, "OFFSET", "must be >= 0, "// &
+                                                    "found "//real_text(wall%offset))
+        if (wall%death <= wall%birth) call card_problem(deck, log, card, "DEATH", "death "// &
+          "time "//real_text(wall%death)//" must be later than the birth time "// &
+          real_text(wall%birth))
+        if (.not. require_card(deck, block, line, standard_widths, card, log, &
+                               "card 2 (XT YT ZT XH YH ZH FRIC WVEL)", "XT")) exit
+        call read_wall_plane(deck, card, entry%wall, log)
+        if (keyword%finite) then
+          if (.not. require_card(deck, block, line, standard_widths, card, log, "the FINITE "// &
+                                 "card (XHEV YHEV ZHEV LENL LENM)", "XHEV")) exit
+          call read_wall_edges(deck, card, entry%wall, log)
+        end if
+        if (keyword%moving) then
+          if (.not. require_card(deck, block, line, standard_widths, card, log, &
+                                 "the MOVING card (MASS V0)", "MASS")) exit
+          call read_wall_motion(deck, card, entry%wall, log)
+        end if
+        wall%forces_requested = keyword%forces
+        if (keyword%forces) then
+          if (.not. require_card(deck, block, line, standard_widths, card, log, &
+                                 "the FORCES card (SOFT SSID N1 N2 N3 N4)", "SOFT")) exit
+          call warn_if_set(deck, card, 1, "SOFT", "the wall force is not softened", warnings)
+        end if
+      end associate
+    end do
+  end subroutine read_planar_walls
+
+  !> Card 2: tail (a point of the wall) and head of the normal, friction.
+  subroutine read_wall_plane(deck, card, wall, log)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(inout) :: card
+    type(rigid_wall_t), intent(inout) :: wall
+    type(problem_log_t), intent(inout) :: log
+    real(wp) :: head(3), length
+    call read_vector(deck, card, 1, ["XT", "YT", "ZT"], wall%point, log)
+    call read_vector(deck, card, 4, ["XH", "YH", "ZH"], head, log)
+    call get_real(deck, card, 7, "FRIC", wall%friction, log)
+    if (card%failed) return
+    length = norm2(head - wall%point)
+    if (length == 0.0_wp) then
+      call card_problem(deck, log, card, "XH", "the normal from the tail (XT YT ZT) to the "// &
+                        "head (XH YH ZH) has zero length")
+    else
+      wall%normal = (head - wall%point)/length
+    end if
+    if (wall%friction < 0.0_wp .or. wall%friction > 1.0_wp) then
+      if (wall%friction == 2.0_wp .or. wall%friction == 3.0_wp) then
+        call card_problem(deck, log, card, "FRIC", "welding walls (FRIC 2 or 3) are not "// &
+                          "available; use a Coulomb coefficient 0-1")
+      else
+        call card_problem(deck, log, card, "FRIC", "must be a Coulomb coefficient 0-1, found "// &
+                          real_text(wall%friction))
+      end if
+    end if
+  end subroutine read_wall_plane
+
+  !> FINITE card: head of the edge vector l (its tail is XT YT ZT), lengths along l and m.
+  subroutine read_wall_edges(deck, card, wall, log)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(inout) :: card
+    type(rigid_wall_t), intent(inout) :: wall
+    type(problem_log_t), intent(inout) :: log
+    real(wp) :: head(3), edge(3), length
+    wall%finite = .true.
+    call read_vector(deck, card, 1, ["XHEV", "YHEV", "ZHEV"], head, log)
+    call get_real(deck, card, 4, "LENL", wall%length_l, log)
+    call get_real(deck, card, 5, "LENM", wall%length_m, log)
+    if (card%failed) return
+    ! only the part of l in the wall's plane matters
+    edge = head - wall%point
+    edge = edge - dot_product(edge, wall%normal)*wall%normal
+    length = norm2(edge)
+    if (length <= 1.0e-12_wp*max(norm2(head - wall%point), tiny(1.0_wp))) then
+      call card_problem(deck, log, card, "XHEV", "the edge vector l from (XT YT ZT) to "// &
+                        "(XHEV YHEV ZHEV) is zero or along the normal")
+    else
+      wall%edge_direction = edge/length
+    end if
+    if (wall%length_l < 0.0_wp) call card_problem(deck, log, card, "LENL", "must be >= 0, "// &
+                                                  "found "//real_text(wall%length_l))
+    if (wall%length_m < 0.0_wp) call card_problem(deck, log, card, "LENM", "must be >= 0, "// &
+                                                  "found "//real_text(wall%length_m))
+  end subroutine read_wall_edges
+
+  !> MOVING card: the wall's mass and initial speed along the normal.
+  subroutine read_wall_motion(deck, card, wall, log)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(inout) :: card
+    type(rigid_wall_t), intent(inout) :: wall
+    type(problem_log_t), intent(inout) :: log
+    wall%moving = .true.
+    call get_real(deck, card, 1, "MASS", wall%mass, log)
+    call get_real(deck, card, 2, "V0", wall%initial_speed, log)
+    if (.not. card%failed .and. wall%mass <= 0.0_wp) call card_problem(deck, log, card, &
+      "MASS", "a moving wall needs a mass > 0, found "//real_text(wall%mass))
+  end subroutine read_wall_motion
+
+  !> Skip the _ID card (ID, heading) when the keyword has it: spcs and motions have no id in
+  !> the model. False when the block is empty.
+  logical function skip_id_card(deck, block, keyword, line, log)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    integer, intent(inout) :: line
+    type(problem_log_t), intent(inout) :: log
+    integer :: id
+    character(len=:), allocatable :: heading
+    skip_id_card = .true.
+    if (.not. keyword%id) return
+    skip_id_card = next_line(deck, block, line, .false.)
+    if (skip_id_card) call id_heading(deck, block, line, "ID", id, heading, log)
+  end function skip_id_card
+
+  !> Field 1: a node id (> 0) or, for `by_set`, a node set id (> 0).
+  subroutine read_target(deck, card, by_set, target, log)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(inout) :: card
+    logical, intent(in) :: by_set
+    integer, intent(out) :: target
+    type(problem_log_t), intent(inout) :: log
+    if (by_set) then
+      call get_integer(deck, card, 1, "NSID", target, log)
+      if (target <= 0 .and. .not. card%failed) call card_problem(deck, log, card, "NSID", &
+        "node set id must be > 0, found "//integer_text(target))
+    else
+      call get_integer(deck, card, 1, "NID", target, log)
+      if (target <= 0 .and. .not. card%failed) call card_problem(deck, log, card, "NID", &
+        "node id must be > 0, found "//integer_text(target))
+    end if
+  end subroutine read_target
+
+  !> A set id field where 0 keeps LS-DYNA's meaning (all nodes, or none exempted).
+  subroutine check_set_id(deck, card, k, name, id, log)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(in) :: card
+    integer, intent(in) :: k
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: id
+    type(problem_log_t), intent(inout) :: log
+    if (id < 0 .and. .not. card%failed) call card_problem(deck, log, card, name, "must be "// &
+      ">= 0, found "//integer_text(id)//" (field "//integer_text(k)//")")
+  end subroutine check_set_id
+
+  !> A load curve id is required (LS-DYNA has no default curve).
+  subroutine check_curve_given(deck, card, k, curve_id, log)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(in) :: card
+    integer, intent(in) :: k, curve_id
+    type(problem_log_t), intent(inout) :: log
+    if (curve_id <= 0) call card_problem(deck, log, card, "LCID", "a load curve id > 0 is "// &
+      "required (field "//integer_text(k)//"), found "//integer_text(curve_id))
+  end subroutine check_curve_given
+
+  !> Three consecutive real fields from field `first`.
+  subroutine read_vector(deck, card, first, names, vector, log)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(inout) :: card
+    integer, intent(in) :: first
+    character(len=*), intent(in) :: names(3)
+    real(wp), intent(out) :: vector(3)
+    type(problem_log_t), intent(inout) :: log
+    integer :: k
+    do k = 1, 3
+      call get_real(deck, card, first + k - 1, trim(names(k)), vector(k), log)
+    end do
+  end subroutine read_vector
+
+  subroutine warn_rotations(deck, card, first, names, warnings)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(in) :: card
+    integer, intent(in) :: first
+    character(len=*), intent(in) :: names(3)
+    type(error_list_t), intent(inout) :: warnings
+    integer :: k
+    do k = 1, 3
+      call warn_if_set(deck, card, first + k - 1, trim(names(k)), no_rotations, warnings)
+    end do
+  end subroutine warn_rotations
+
+  subroutine add_velocity(input, velocity)
+    type(deck_input_t), intent(inout) :: input
+    type(velocity_input_t), intent(in) :: velocity
+    input%velocity_count = input%velocity_count + 1
+    input%velocities(input%velocity_count) = velocity
+  end subroutine add_velocity
+end module deck_loads_bcs

@@ -1,0 +1,109 @@
+!> Fully integrated selective-reduced hexahedron, ELFORM 2: the deviatoric part of the rate of
+!> deformation at the 2x2x2 Gauss points, its volumetric part from the element mean (mean
+!> dilatation / B-bar; Hughes, IJNME 15 (1980) 1413-1418; LS-DYNA Theory Manual, "Fully
+!> integrated brick elements"). The stress is updated at each point and the corner forces are
+!> the virtual work of the B-bar strain rate,
+!>   f_iI = sum_p detJ_p s_ij(p) dN_I/dx_j(p) + (mean(sigma_kk/3) - q) b_iI,
+!> with s the deviatoric stress, the mean taken over the element volume and
+!> b_iI = sum_p detJ_p dN_I/dx_i(p) (the exact volume derivatives: the 2x2x2 rule integrates
+!> them exactly). No hourglass control is needed. These kernels work point by point on a block;
+!> the block driver (solid_block) loops over the points.
+module hex8_full
+  use kinds, only: wp, block_size
+  implicit none
+  private
+
+  public :: point_velocity_gradient, add_deviatoric_point_forces, add_mean_stress_forces
+
+contains
+
+  !> Velocity gradient at one point, L_ij = sum_I v_iI dN_I/dx_j, stored row by row.
+  subroutine point_velocity_gradient(nel, dndx, dndy, dndz, vx, vy, vz, gradient)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: dndx(block_size, 8), dndy(block_size, 8), dndz(block_size, 8)
+    real(wp), intent(in) :: vx(block_size, 8), vy(block_size, 8), vz(block_size, 8)
+    real(wp), intent(out) :: gradient(block_size, 9)
+    real(wp) :: l11, l12, l13, l21, l22, l23, l31, l32, l33
+    integer :: node, i
+    do i = 1, nel
+      l11 = 0.0_wp; l12 = 0.0_wp; l13 = 0.0_wp
+      l21 = 0.0_wp; l22 = 0.0_wp; l23 = 0.0_wp
+      l31 = 0.0_wp; l32 = 0.0_wp; l33 = 0.0_wp
+      do node = 1, 8
+        l11 = l11 + vx(i, node)*dndx(i, node)
+        l12 = l12 + vx(i, node)*dndy(i, node)
+        l13 = l13 + vx(i, node)*dndz(i, node)
+        l21 = l21 + vy(i, node)*dndx(i, node)
+        l22 = l22 + vy(i, node)*dndy(i, node)
+        l23 = l23 + vy(i, node)*dndz(i, node)
+        l31 = l31 + vz(i, node)*dndx(i, node)
+        l32 = l32 + vz(i, node)*dndy(i, node)
+        l33 = l33 + vz(i, node)*dndz(i, node)
+      end do
+      gradient(i, 1) = l11
+      gradient(i, 2) = l12
+      gradient(i, 3) = l13
+      gradient(i, 4) = l21
+      gradient(i, 5) = l22
+      gradient(i, 6) = l23
+      gradient(i, 7) = l31
+      gradient(i, 8) = l32
+      gradient(i, 9) = l33
+    end do
+  end subroutine point_velocity_gradient
+
+  !> Adds the deviatoric stress forces of one point, detJ s_ij dN_I/dx_j, to the corner forces
+  !> and accumulates what the mean-stress term needs: the integral of sigma_kk/3 and the
+  !> volume derivatives b_iI = sum_p detJ dN_I/dx_i (both start from zero at the first point).
+  subroutine add_deviatoric_point_forces(nel, determinant, dndx, dndy, dndz, stress, corner_force, &
+                                         mean_stress_integral, bx, by, bz)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: determinant(block_size)
+    real(wp), intent(in) :: dndx(block_size, 8), dndy(block_size, 8), dndz(block_size, 8)
+    real(wp), intent(in) :: stress(block_size, 6)
+    real(wp), intent(inout) :: corner_force(block_size, 8, 3)
+    real(wp), intent(inout) :: mean_stress_integral(block_size)
+    real(wp), intent(inout) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8)
+    real(wp) :: mean, w, s11, s22, s33, s12, s23, s31
+    integer :: node, i
+    do i = 1, nel
+      w = determinant(i)
+      mean = (stress(i, 1) + stress(i, 2) + stress(i, 3))/3.0_wp
+      mean_stress_integral(i) = mean_stress_integral(i) + w*mean
+      s11 = w*(stress(i, 1) - mean)
+      s22 = w*(stress(i, 2) - mean)
+      s33 = w*(stress(i, 3) - mean)
+      s12 = w*stress(i, 4)
+      s23 = w*stress(i, 5)
+      s31 = w*stress(i, 6)
+      do node = 1, 8
+        corner_force(i, node, 1) = corner_force(i, node, 1) + s11*dndx(i, node) + s12*dndy(i, node) &
+                                   + s31*dndz(i, node)
+        corner_force(i, node, 2) = corner_force(i, node, 2) + s12*dndx(i, node) + s22*dndy(i, node) &
+                                   + s23*dndz(i, node)
+        corner_force(i, node, 3) = corner_force(i, node, 3) + s31*dndx(i, node) + s23*dndy(i, node) &
+                                   + s33*dndz(i, node)
+        bx(i, node) = bx(i, node) + w*dndx(i, node)
+        by(i, node) = by(i, node) + w*dndy(i, node)
+        bz(i, node) = bz(i, node) + w*dndz(i, node)
+      end do
+    end do
+  end subroutine add_deviatoric_point_forces
+
+  !> Adds the forces of a uniform mean stress (volume-averaged sigma_kk/3 minus the bulk
+  !> viscosity), mean_stress b_iI.
+  subroutine add_mean_stress_forces(nel, bx, by, bz, mean_stress, corner_force)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8)
+    real(wp), intent(in) :: mean_stress(block_size)
+    real(wp), intent(inout) :: corner_force(block_size, 8, 3)
+    integer :: node, i
+    do i = 1, nel
+      do node = 1, 8
+        corner_force(i, node, 1) = corner_force(i, node, 1) + mean_stress(i)*bx(i, node)
+        corner_force(i, node, 2) = corner_force(i, node, 2) + mean_stress(i)*by(i, node)
+        corner_force(i, node, 3) = corner_force(i, node, 3) + mean_stress(i)*bz(i, node)
+      end do
+    end do
+  end subroutine add_mean_stress_forces
+end module hex8_full

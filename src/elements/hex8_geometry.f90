@@ -1,0 +1,283 @@
+!> Geometry of the 8-node hexahedron on a block of elements: exact volume derivatives (the
+!> uniform-strain B matrix), mean velocity gradient, face areas, centre Jacobian and the
+!> natural derivatives at the 2x2x2 Gauss points.
+!>
+!> Node numbering is LS-DYNA's: nodes 1-4 the bottom face counterclockwise seen from the top,
+!> nodes 5-8 the top face above them; natural coordinates (xi, eta, zeta) of the nodes are
+!> `node_xi`, `node_eta`, `node_zeta`. All arrays have the element (lane) index first and every
+!> loop over it runs `do i = 1, nel`, so the compiler vectorizes across elements.
+!>
+!> Reference: D.P. Flanagan and T. Belytschko, "A uniform strain hexahedron and quadrilateral
+!> with orthogonal hourglass control", IJNME 17 (1981) 679-706, eqs. (14)-(16) and Appendix:
+!> b_iI = dV/dx_iI = integral of dN_I/dx_i over the element, evaluated in closed form.
+module hex8_geometry
+  use kinds, only: wp, block_size
+  implicit none
+  private
+
+  public :: hex8_volume_derivatives, hex8_velocity_gradient, hex8_largest_face_area
+  public :: hex8_gauss_natural_derivatives, hex8_point_derivatives, deformation_increments
+
+  !> Natural coordinates of the eight nodes.
+  real(wp), parameter, public :: node_xi(8) = [-1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp]
+  real(wp), parameter, public :: node_eta(8) = [-1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp]
+  real(wp), parameter, public :: node_zeta(8) = [-1.0_wp, -1.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, 1.0_wp, 1.0_wp]
+
+  !> The six faces, each as four corner nodes in order around the face.
+  integer, parameter, public :: hex8_faces(4, 6) = reshape([1, 2, 3, 4, 5, 6, 7, 8, 1, 2, 6, 5, &
+                                                            2, 3, 7, 6, 3, 4, 8, 7, 4, 1, 5, 8], [4, 6])
+
+  ! The volume derivative of node 1 is a fixed bilinear form in the coordinates of nodes 2, 3,
+  ! 4, 5, 6 and 8 (Flanagan & Belytschko 1981, Appendix); every other node uses the same form
+  ! on its own neighbours. For node I the element nodes playing the roles of nodes 1..8 of the
+  ! node-1 formula are (derived from the rotations of the cube and checked symbolically against
+  ! dV/dx_I for every node and component):
+  !   node 1: 1 2 3 4 5 6 7 8    node 2: 2 1 5 6 3 4 8 7    node 3: 3 4 1 2 7 8 5 6
+  !   node 4: 4 3 7 8 1 2 6 5    node 5: 5 6 2 1 8 7 3 4    node 6: 6 5 8 7 2 1 4 3
+  !   node 7: 7 8 4 3 6 5 1 2    node 8: 8 7 6 5 4 3 2 1
+  ! The y and z components follow from the x component by the cyclic permutations (y,z) ->
+  ! (z,x) -> (x,y).
+
+contains
+
+  !> Exact volume derivatives b_iI = dV/dx_iI of each element and its exact volume
+  !> V = sum_I x_I b_xI (the volume is linear in the x coordinates alone, so this is exact;
+  !> it equals the 2x2x2 Gauss volume). Node I uses the node-1 form on the nodes of its role
+  !> list (see above), written out so that the lane loop vectorizes with every coordinate in a
+  !> register.
+  subroutine hex8_volume_derivatives(nel, x, y, z, bx, by, bz, volume)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
+    real(wp), intent(out) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8)
+    real(wp), intent(out) :: volume(block_size)
+    real(wp), parameter :: twelfth = 1.0_wp/12.0_wp
+    real(wp) :: x1, x2, x3, x4, x5, x6, x7, x8, y1, y2, y3, y4, y5, y6, y7, y8
+    real(wp) :: z1, z2, z3, z4, z5, z6, z7, z8
+    integer :: i
+
+    do i = 1, nel
+      x1 = x(i, 1); x2 = x(i, 2); x3 = x(i, 3); x4 = x(i, 4); x5 = x(i, 5); x6 = x(i, 6); x7 = x(i, 7); x8 = x(i, 8)
+      y1 = y(i, 1); y2 = y(i, 2); y3 = y(i, 3); y4 = y(i, 4); y5 = y(i, 5); y6 = y(i, 6); y7 = y(i, 7); y8 = y(i, 8)
+      z1 = z(i, 1); z2 = z(i, 2); z3 = z(i, 3); z4 = z(i, 4); z5 = z(i, 5); z6 = z(i, 6); z7 = z(i, 7); z8 = z(i, 8)
+      bx(i, 1) = twelfth*volume_form(y2, y3, y4, y5, y6, y8, z2, z3, z4, z5, z6, z8)
+      bx(i, 2) = twelfth*volume_form(y1, y5, y6, y3, y4, y7, z1, z5, z6, z3, z4, z7)
+      bx(i, 3) = twelfth*volume_form(y4, y1, y2, y7, y8, y6, z4, z1, z2, z7, z8, z6)
+      bx(i, 4) = twelfth*volume_form(y3, y7, y8, y1, y2, y5, z3, z7, z8, z1, z2, z5)
+      bx(i, 5) = twelfth*volume_form(y6, y2, y1, y8, y7, y4, z6, z2, z1, z8, z7, z4)
+      bx(i, 6) = twelfth*volume_form(y5, y8, y7, y2, y1, y3, z5, z8, z7, z2, z1, z3)
+      bx(i, 7) = twelfth*volume_form(y8, y4, y3, y6, y5, y2, z8, z4, z3, z6, z5, z2)
+      bx(i, 8) = twelfth*volume_form(y7, y6, y5, y4, y3, y1, z7, z6, z5, z4, z3, z1)
+      by(i, 1) = twelfth*volume_form(z2, z3, z4, z5, z6, z8, x2, x3, x4, x5, x6, x8)
+      by(i, 2) = twelfth*volume_form(z1, z5, z6, z3, z4, z7, x1, x5, x6, x3, x4, x7)
+      by(i, 3) = twelfth*volume_form(z4, z1, z2, z7, z8, z6, x4, x1, x2, x7, x8, x6)
+      by(i, 4) = twelfth*volume_form(z3, z7, z8, z1, z2, z5, x3, x7, x8, x1, x2, x5)
+      by(i, 5) = twelfth*volume_form(z6, z2, z1, z8, z7, z4, x6, x2, x1, x8, x7, x4)
+      by(i, 6) = twelfth*volume_form(z5, z8, z7, z2, z1, z3, x5, x8, x7, x2, x1, x3)
+      by(i, 7) = twelfth*volume_form(z8, z4, z3, z6, z5, z2, x8, x4, x3, x6, x5, x2)
+      by(i, 8) = twelfth*volume_form(z7, z6, z5, z4, z3, z1, x7, x6, x5, x4, x3, x1)
+      bz(i, 1) = twelfth*volume_form(x2, x3, x4, x5, x6, x8, y2, y3, y4, y5, y6, y8)
+      bz(i, 2) = twelfth*volume_form(x1, x5, x6, x3, x4, x7, y1, y5, y6, y3, y4, y7)
+      bz(i, 3) = twelfth*volume_form(x4, x1, x2, x7, x8, x6, y4, y1, y2, y7, y8, y6)
+      bz(i, 4) = twelfth*volume_form(x3, x7, x8, x1, x2, x5, y3, y7, y8, y1, y2, y5)
+      bz(i, 5) = twelfth*volume_form(x6, x2, x1, x8, x7, x4, y6, y2, y1, y8, y7, y4)
+      bz(i, 6) = twelfth*volume_form(x5, x8, x7, x2, x1, x3, y5, y8, y7, y2, y1, y3)
+      bz(i, 7) = twelfth*volume_form(x8, x4, x3, x6, x5, x2, y8, y4, y3, y6, y5, y2)
+      bz(i, 8) = twelfth*volume_form(x7, x6, x5, x4, x3, x1, y7, y6, y5, y4, y3, y1)
+      volume(i) = x1*bx(i, 1) + x2*bx(i, 2) + x3*bx(i, 3) + x4*bx(i, 4) + x5*bx(i, 5) + x6*bx(i, 6) &
+                  + x7*bx(i, 7) + x8*bx(i, 8)
+    end do
+  end subroutine hex8_volume_derivatives
+
+  !> Twelve times dV/dx_1 written with the roles of nodes 2..8 (node 7 does not appear):
+  !> the cyclic permutations (y,z), (z,x), (x,y) give the x, y and z components.
+  elemental function volume_form(a2, a3, a4, a5, a6, a8, c2, c3, c4, c5, c6, c8) result(value)
+    real(wp), intent(in) :: a2, a3, a4, a5, a6, a8, c2, c3, c4, c5, c6, c8
+    real(wp) :: value
+    value = a2*((c6 - c3) - (c4 - c5)) + a3*(c2 - c4) + a4*((c3 - c8) - (c5 - c2)) &
+            + a5*((c8 - c6) - (c2 - c4)) + a6*(c5 - c2) + a8*(c4 - c5)
+  end function volume_form
+
+  !> Mean velocity gradient over the element, L_ij = (1/V) sum_I v_iI b_jI, stored row by row:
+  !> gradient(:, 3*(i-1)+j) = dv_i/dx_j, with b and V taken on the configuration x + shift v
+  !> (shift = -dt/2 gives the mid-step configuration from x(n+1) and v(n+1/2)). For a velocity
+  !> field linear in the coordinates of that configuration it is exact
+  !> (sum_I x_jI b_kI = V delta_jk). Also returns the exact volume of that configuration.
+  subroutine hex8_velocity_gradient(nel, shift, x, y, z, vx, vy, vz, gradient, volume)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: shift
+    real(wp), intent(in) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
+    real(wp), intent(in) :: vx(block_size, 8), vy(block_size, 8), vz(block_size, 8)
+    real(wp), intent(out) :: gradient(block_size, 9)
+    real(wp), intent(out) :: volume(block_size)
+    real(wp) :: shifted_x(block_size, 8), shifted_y(block_size, 8), shifted_z(block_size, 8)
+    real(wp) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8)
+    real(wp) :: l11, l12, l13, l21, l22, l23, l31, l32, l33, inverse_volume
+    integer :: node, i
+
+    do i = 1, nel
+      do node = 1, 8
+        shifted_x(i, node) = x(i, node) + shift*vx(i, node)
+        shifted_y(i, node) = y(i, node) + shift*vy(i, node)
+        shifted_z(i, node) = z(i, node) + shift*vz(i, node)
+      end do
+    end do
+    call hex8_volume_derivatives(nel, shifted_x, shifted_y, shifted_z, bx, by, bz, volume)
+    do i = 1, nel
+      l11 = 0.0_wp; l12 = 0.0_wp; l13 = 0.0_wp
+      l21 = 0.0_wp; l22 = 0.0_wp; l23 = 0.0_wp
+      l31 = 0.0_wp; l32 = 0.0_wp; l33 = 0.0_wp
+      do node = 1, 8
+        l11 = l11 + vx(i, node)*bx(i, node)
+        l12 = l12 + vx(i, node)*by(i, node)
+        l13 = l13 + vx(i, node)*bz(i, node)
+        l21 = l21 + vy(i, node)*bx(i, node)
+        l22 = l22 + vy(i, node)*by(i, node)
+        l23 = l23 + vy(i, node)*bz(i, node)
+        l31 = l31 + vz(i, node)*bx(i, node)
+        l32 = l32 + vz(i, node)*by(i, node)
+        l33 = l33 + vz(i, node)*bz(i, node)
+      end do
+      ! An inverted element (V <= 0) is reported by the caller; only keep the division finite.
+      inverse_volume = 1.0_wp/sign(max(abs(volume(i)), tiny(1.0_wp)), volume(i))
+      gradient(i, 1) = l11*inverse_volume
+      gradient(i, 2) = l12*inverse_volume
+      gradient(i, 3) = l13*inverse_volume
+      gradient(i, 4) = l21*inverse_volume
+      gradient(i, 5) = l22*inverse_volume
+      gradient(i, 6) = l23*inverse_volume
+      gradient(i, 7) = l31*inverse_volume
+      gradient(i, 8) = l32*inverse_volume
+      gradient(i, 9) = l33*inverse_volume
+    end do
+  end subroutine hex8_velocity_gradient
+
+  !> Area of the largest face of each element. A face's area is the magnitude of its vector
+  !> area, (1/2) |(x_3 - x_1) x (x_4 - x_2)|, which is exact for a plane face and the projected
+  !> area for a warped one. LS-DYNA's characteristic length of a hexahedron is V / this area.
+  subroutine hex8_largest_face_area(nel, x, y, z, area)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
+    real(wp), intent(out) :: area(block_size)
+    real(wp) :: largest_squared, ax, ay, az, cx, cy, cz
+    integer :: face, i, n1, n2, n3, n4
+
+    do i = 1, nel
+      largest_squared = 0.0_wp
+      do face = 1, 6
+        n1 = hex8_faces(1, face)
+        n2 = hex8_faces(2, face)
+        n3 = hex8_faces(3, face)
+        n4 = hex8_faces(4, face)
+        ax = x(i, n3) - x(i, n1)
+        ay = y(i, n3) - y(i, n1)
+        az = z(i, n3) - z(i, n1)
+        cx = x(i, n4) - x(i, n2)
+        cy = y(i, n4) - y(i, n2)
+        cz = z(i, n4) - z(i, n2)
+        largest_squared = max(largest_squared, (ay*cz - az*cy)**2 + (az*cx - ax*cz)**2 + (ax*cy - ay*cx)**2)
+      end do
+      area(i) = 0.5_wp*sqrt(largest_squared)
+    end do
+  end subroutine hex8_largest_face_area
+
+  !> Derivatives of the shape functions with respect to (xi, eta, zeta) at the eight Gauss
+  !> points of the 2x2x2 rule (+-1/sqrt(3), weights 1; point p sits in the octant of node p):
+  !> natural_derivatives(I, a, p) = dN_I/dxi_a at point p.
+  pure subroutine hex8_gauss_natural_derivatives(natural_derivatives)
+    real(wp), intent(out) :: natural_derivatives(8, 3, 8)
+    real(wp) :: g, xi, eta, zeta
+    integer :: point, node
+    g = 1.0_wp/sqrt(3.0_wp)
+    do point = 1, 8
+      xi = g*node_xi(point)
+      eta = g*node_eta(point)
+      zeta = g*node_zeta(point)
+      do node = 1, 8
+        natural_derivatives(node, 1, point) = 0.125_wp*node_xi(node)*(1.0_wp + node_eta(node)*eta) &
+                                              *(1.0_wp + node_zeta(node)*zeta)
+        natural_derivatives(node, 2, point) = 0.125_wp*node_eta(node)*(1.0_wp + node_xi(node)*xi) &
+                                              *(1.0_wp + node_zeta(node)*zeta)
+        natural_derivatives(node, 3, point) = 0.125_wp*node_zeta(node)*(1.0_wp + node_xi(node)*xi) &
+                                              *(1.0_wp + node_eta(node)*eta)
+      end do
+    end do
+  end subroutine hex8_gauss_natural_derivatives
+
+  !> Shape function derivatives dN_I/dx at one integration point of each element, from the
+  !> natural derivatives at that point (natural(I, a) = dN_I/dxi_a), and det J. Elements with
+  !> det J <= 0 get finite (meaningless) derivatives; the caller reports them.
+  subroutine hex8_point_derivatives(nel, natural, x, y, z, dndx, dndy, dndz, determinant)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: natural(8, 3)
+    real(wp), intent(in) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
+    real(wp), intent(out) :: dndx(block_size, 8), dndy(block_size, 8), dndz(block_size, 8)
+    real(wp), intent(out) :: determinant(block_size)
+    real(wp) :: j11, j12, j13, j21, j22, j23, j31, j32, j33
+    real(wp) :: i11, i12, i13, i21, i22, i23, i31, i32, i33, inverse_determinant
+    integer :: node, i
+
+    do i = 1, nel
+      ! J_ka = dx_k/dxi_a
+      j11 = 0.0_wp; j12 = 0.0_wp; j13 = 0.0_wp
+      j21 = 0.0_wp; j22 = 0.0_wp; j23 = 0.0_wp
+      j31 = 0.0_wp; j32 = 0.0_wp; j33 = 0.0_wp
+      do node = 1, 8
+        j11 = j11 + x(i, node)*natural(node, 1)
+        j12 = j12 + x(i, node)*natural(node, 2)
+        j13 = j13 + x(i, node)*natural(node, 3)
+        j21 = j21 + y(i, node)*natural(node, 1)
+        j22 = j22 + y(i, node)*natural(node, 2)
+        j23 = j23 + y(i, node)*natural(node, 3)
+        j31 = j31 + z(i, node)*natural(node, 1)
+        j32 = j32 + z(i, node)*natural(node, 2)
+        j33 = j33 + z(i, node)*natural(node, 3)
+      end do
+      ! i_ak = (J^-1)_ak from the cofactors
+      i11 = j22*j33 - j23*j32
+      i12 = j13*j32 - j12*j33
+      i13 = j12*j23 - j13*j22
+      i21 = j23*j31 - j21*j33
+      i22 = j11*j33 - j13*j31
+      i23 = j13*j21 - j11*j23
+      i31 = j21*j32 - j22*j31
+      i32 = j12*j31 - j11*j32
+      i33 = j11*j22 - j12*j21
+      determinant(i) = j11*i11 + j12*i21 + j13*i31
+      inverse_determinant = 1.0_wp/sign(max(abs(determinant(i)), tiny(1.0_wp)), determinant(i))
+      ! dN_I/dx_k = sum_a dN_I/dxi_a (J^-1)_ak
+      do node = 1, 8
+        dndx(i, node) = (natural(node, 1)*i11 + natural(node, 2)*i21 + natural(node, 3)*i31)*inverse_determinant
+        dndy(i, node) = (natural(node, 1)*i12 + natural(node, 2)*i22 + natural(node, 3)*i32)*inverse_determinant
+        dndz(i, node) = (natural(node, 1)*i13 + natural(node, 2)*i23 + natural(node, 3)*i33)*inverse_determinant
+      end do
+    end do
+  end subroutine hex8_point_derivatives
+
+  !> Strain and spin increments of a step from a velocity gradient (row by row, see
+  !> hex8_velocity_gradient): strain_increment = sym(L) dt in TENSOR components (xx, yy, zz, xy,
+  !> yz, zx), with its volumetric part replaced by volumetric_rate dt / 3 (the element mean, for
+  !> the selective-reduced element; pass tr L itself to keep it); spin_increment = axial vector
+  !> of skw(L) dt, w = (W32, W13, W21) dt.
+  subroutine deformation_increments(nel, time_step, gradient, volumetric_rate, strain_increment, spin_increment)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: time_step
+    real(wp), intent(in) :: gradient(block_size, 9), volumetric_rate(block_size)
+    real(wp), intent(out) :: strain_increment(block_size, 6), spin_increment(block_size, 3)
+    real(wp) :: half_step, volumetric_correction
+    integer :: i
+    half_step = 0.5_wp*time_step
+    do i = 1, nel
+      volumetric_correction = (volumetric_rate(i) - (gradient(i, 1) + gradient(i, 5) + gradient(i, 9))) &
+                              *time_step/3.0_wp
+      strain_increment(i, 1) = gradient(i, 1)*time_step + volumetric_correction
+      strain_increment(i, 2) = gradient(i, 5)*time_step + volumetric_correction
+      strain_increment(i, 3) = gradient(i, 9)*time_step + volumetric_correction
+      strain_increment(i, 4) = (gradient(i, 2) + gradient(i, 4))*half_step
+      strain_increment(i, 5) = (gradient(i, 6) + gradient(i, 8))*half_step
+      strain_increment(i, 6) = (gradient(i, 7) + gradient(i, 3))*half_step
+      spin_increment(i, 1) = (gradient(i, 8) - gradient(i, 6))*half_step
+      spin_increment(i, 2) = (gradient(i, 3) - gradient(i, 7))*half_step
+      spin_increment(i, 3) = (gradient(i, 4) - gradient(i, 2))*half_step
+    end do
+  end subroutine deformation_increments
+end module hex8_geometry

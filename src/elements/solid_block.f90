@@ -1,0 +1,548 @@
+!> Blocks of hexahedral solid elements of one part and the per-cycle element work on them:
+!> kinematics, objective stress update through the material dispatch, bulk viscosity, corner
+!> forces (stress divergence + hourglass control + bulk viscosity), energies and time step.
+!>
+!> A block holds at most `block_size` elements of one part (hence one material, section and
+!> hourglass setting) with all per-element arrays lane-first, so every kernel below runs its
+!> innermost loop over the elements of the block. The solver calls, per cycle and per block,
+!> `compute_solid_block` (blocks are independent, so they can be spread over threads) and
+!> gathers the corner forces to the nodes itself.
+!>
+!> Time centring: coordinates are x(n+1), velocities v(n+1/2). The velocity gradient is taken
+!> at the mid-step configuration x(n+1/2) = x(n+1) - dt/2 v(n+1/2) (second-order strain
+!> increments; a rigid rotation then gives D = 0 exactly and, with the orthogonal incremental
+!> rotation, the exact rotation of the stress); forces, volume and time step use x(n+1).
+!> Internal energy is integrated by the midpoint rule, V(n+1/2) (sigma(n) + sigma(n+1))/2 : D dt,
+!> with sigma(n) rotated to the end of the step, plus the bulk viscosity work -q tr D V dt.
+module solid_block
+  use kinds, only: wp, block_size
+  use model, only: model_t, material_t, formulation_fe
+  use material_dispatch, only: material_history_count, initialize_material_history, update_material_block, &
+                               rotate_material_history, material_wave_modulus, material_plastic_strain
+  use objective_rotation, only: incremental_rotation, rotate_symmetric_tensors
+  use hex8_geometry, only: hex8_volume_derivatives, hex8_velocity_gradient, hex8_largest_face_area, &
+                           hex8_gauss_natural_derivatives, hex8_point_derivatives, deformation_increments
+  use hex8_one_point, only: one_point_stress_forces, hourglass_shape_vectors, hourglass_viscous_forces, &
+                            hourglass_stiffness_forces
+  use hex8_full, only: point_velocity_gradient, add_deviatoric_point_forces, add_mean_stress_forces
+  use element_time_step, only: bulk_viscosity_pressure, solid_element_time_steps
+  implicit none
+  private
+
+  public :: build_solid_blocks, solid_block_corner_masses, solid_block_time_steps, compute_solid_block
+  public :: solid_block_element_results
+
+  !> ELFORM values this module implements.
+  integer, parameter, public :: formulation_one_point = 1, formulation_selective_reduced = 2
+
+  !> Up to `block_size` hexahedra of one part and their state. Lane i describes model solid
+  !> `elements(i)`; lanes beyond `element_count` are unused.
+  type, public :: solid_block_t
+    integer :: element_count = 0                 !< 1..block_size
+    integer :: part = 0                          !< index into model%parts
+    integer :: material = 0                      !< index into model%materials
+    integer :: formulation = 1                   !< ELFORM 1 (one point) or 2 (selective-reduced)
+    integer :: hourglass_type = 1                !< effective IHQ (1-5)
+    real(wp) :: hourglass_coefficient = 0.1_wp   !< QM
+    real(wp) :: bulk_quadratic = 1.5_wp          !< Q1
+    real(wp) :: bulk_linear = 0.06_wp            !< Q2
+    integer :: elements(block_size) = 0          !< model solid index of each lane
+    integer :: nodes(block_size, 8) = 0          !< node indices of each corner
+    real(wp) :: density(block_size) = 0.0_wp     !< effective density (raised by mass scaling)
+    real(wp) :: reference_volume(block_size) = 0.0_wp   !< exact initial volume
+    real(wp) :: internal_energy(block_size) = 0.0_wp    !< cumulative, bulk viscosity work included
+    real(wp) :: hourglass_energy(block_size) = 0.0_wp   !< cumulative work of the hourglass forces
+    real(wp) :: volume(block_size) = 0.0_wp             !< current volume (end of the last step)
+    real(wp) :: bulk_viscosity(block_size) = 0.0_wp     !< q of the last step
+    integer :: point_count = 1                   !< integration points: 1 (ELFORM 1) or 8 (ELFORM 2)
+    integer :: material_law = 0                  !< law of the material (material_t%law)
+    !> Cauchy stress (block_size, 6, point_count), order xx, yy, zz, xy, yz, zx.
+    real(wp), allocatable :: stress(:, :, :)
+    !> Material history (block_size, material_history_count, point_count), the law's layout.
+    real(wp), allocatable :: history(:, :, :)
+    !> Volume of each integration point (block_size, point_count), for averaging.
+    real(wp), allocatable :: point_volume(:, :)
+    !> Accumulated generalized hourglass forces Q (block_size, 3, 4) of the stiffness forms
+    !> (IHQ 4, 5); (block_size, 3, 0) otherwise.
+    real(wp), allocatable :: hourglass_force(:, :, :)
+  end type solid_block_t
+
+contains
+
+  !> Group the model's solids into blocks: parts in model order, the solids of each part in
+  !> input order, at most block_size per block. Only parts discretised with finite elements
+  !> (formulation_fe) get blocks; EFG and rigid parts are handled elsewhere. Sets every field,
+  !> density = material density, exact reference volumes, zero stress, energies and history.
+  subroutine build_solid_blocks(model, blocks)
+    type(model_t), intent(in) :: model
+    type(solid_block_t), allocatable, intent(out) :: blocks(:)
+    integer :: part, solid, block_count, solid_count, count_in_part, lane, current
+    integer, allocatable :: part_block_count(:)
+
+    solid_count = 0
+    if (allocated(model%solid_part)) solid_count = size(model%solid_part)
+    if (.not. allocated(model%parts)) then
+      allocate (blocks(0))
+      return
+    end if
+    allocate (part_block_count(size(model%parts)))
+    do part = 1, size(model%parts)
+      count_in_part = 0
+      if (model%parts(part)%formulation == formulation_fe) count_in_part = count(model%solid_part == part)
+      part_block_count(part) = (count_in_part + block_size - 1)/block_size
+    end do
+    block_count = sum(part_block_count)
+    allocate (blocks(block_count))
+
+    current = 0
+    do part = 1, size(model%parts)
+      if (part_block_count(part) == 0) cycle
+      lane = block_size
+      do solid = 1, solid_count
+        if (model%solid_part(solid) /= part) cycle
+        if (lane == block_size) then
+          current = current + 1
+          call start_block(model, part, blocks(current))
+          lane = 0
+        end if
+        lane = lane + 1
+        blocks(current)%element_count = lane
+        blocks(current)%elements(lane) = solid
+        blocks(current)%nodes(lane, :) = model%solid_nodes(:, solid)
+      end do
+    end do
+    do current = 1, block_count
+      call finish_block(model, blocks(current))
+    end do
+  end subroutine build_solid_blocks
+
+  !> Part-level settings of a new block.
+  subroutine start_block(model, part, block)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: part
+    type(solid_block_t), intent(inout) :: block
+    block%part = part
+    block%material = model%parts(part)%material
+    block%material_law = model%materials(block%material)%law
+    block%formulation = formulation_one_point
+    if (model%parts(part)%section > 0 .and. allocated(model%sections)) then
+      if (model%sections(model%parts(part)%section)%element_formulation == formulation_selective_reduced) &
+        block%formulation = formulation_selective_reduced
+    end if
+    ! IHQ 1-5 are implemented; anything else falls back to LS-DYNA's type 1.
+    block%hourglass_type = model%parts(part)%hourglass_type
+    if (block%hourglass_type < 1 .or. block%hourglass_type > 5) block%hourglass_type = 1
+    block%hourglass_coefficient = model%parts(part)%hourglass_coefficient
+    block%bulk_quadratic = model%parts(part)%bulk_quadratic
+    block%bulk_linear = model%parts(part)%bulk_linear
+  end subroutine start_block
+
+  !> Allocate the state of a filled block and set its reference geometry.
+  subroutine finish_block(model, block)
+    type(model_t), intent(in) :: model
+    type(solid_block_t), intent(inout) :: block
+    real(wp) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
+    real(wp) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8)
+    real(wp) :: dndx(block_size, 8), dndy(block_size, 8), dndz(block_size, 8)
+    real(wp) :: natural(8, 3, 8)
+    integer :: nel, point, history_count
+
+    nel = block%element_count
+    block%point_count = merge(8, 1, block%formulation == formulation_selective_reduced)
+    history_count = material_history_count(model%materials(block%material))
+    allocate (block%stress(block_size, 6, block%point_count), source=0.0_wp)
+    allocate (block%history(block_size, history_count, block%point_count), source=0.0_wp)
+    allocate (block%point_volume(block_size, block%point_count), source=0.0_wp)
+    if (block%formulation == formulation_one_point .and. block%hourglass_type >= 4) then
+      allocate (block%hourglass_force(block_size, 3, 4), source=0.0_wp)
+    else
+      allocate (block%hourglass_force(block_size, 3, 0))
+    end if
+    do point = 1, block%point_count
+      call initialize_material_history(model%materials(block%material), nel, block%history(:, :, point))
+    end do
+
+    block%density(1:nel) = model%materials(block%material)%density
+    call gather_coordinates(nel, block%nodes, model%coordinates, x, y, z)
+    call hex8_volume_derivatives(nel, x, y, z, bx, by, bz, block%reference_volume)
+    block%volume(1:nel) = block%reference_volume(1:nel)
+    if (block%point_count == 1) then
+      block%point_volume(1:nel, 1) = block%reference_volume(1:nel)
+    else
+      call hex8_gauss_natural_derivatives(natural)
+      do point = 1, 8
+        call hex8_point_derivatives(nel, natural(:, :, point), x, y, z, dndx, dndy, dndz, &
+                                    block%point_volume(:, point))
+      end do
+    end if
+  end subroutine finish_block
+
+  !> Corner masses density * reference volume / 8 (lanes beyond element_count zero).
+  subroutine solid_block_corner_masses(block, corner_mass)
+    type(solid_block_t), intent(in) :: block
+    real(wp), intent(out) :: corner_mass(block_size, 8)
+    integer :: node, nel
+    nel = block%element_count
+    corner_mass = 0.0_wp
+    do node = 1, 8
+      corner_mass(1:nel, node) = 0.125_wp*block%density(1:nel)*block%reference_volume(1:nel)
+    end do
+  end subroutine solid_block_corner_masses
+
+  !> Stable time step of each element at the given configuration, without bulk viscosity
+  !> (no rates are known here) and without TSSFAC; lanes beyond element_count get huge.
+  subroutine solid_block_time_steps(block, material, coordinates, element_time_step)
+    type(solid_block_t), intent(in) :: block
+    type(material_t), intent(in) :: material
+    real(wp), intent(in) :: coordinates(:, :)
+    real(wp), intent(out) :: element_time_step(block_size)
+    real(wp) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
+    real(wp) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8)
+    real(wp) :: volume(block_size), area(block_size), wave_modulus(block_size), rest(block_size)
+    integer :: nel
+    nel = block%element_count
+    element_time_step = huge(1.0_wp)
+    call gather_coordinates(nel, block%nodes, coordinates, x, y, z)
+    call hex8_volume_derivatives(nel, x, y, z, bx, by, bz, volume)
+    call hex8_largest_face_area(nel, x, y, z, area)
+    call material_wave_modulus(material, nel, wave_modulus)
+    rest(1:nel) = 0.0_wp
+    call solid_element_time_steps(nel, block%bulk_quadratic, block%bulk_linear, volume, area, wave_modulus, &
+                                  block%density, rest, element_time_step)
+  end subroutine solid_block_time_steps
+
+  !> One cycle of element work on a block: strain increments from x(n+1) and v(n+1/2), stress
+  !> and material state update, energies, corner forces on x(n+1), stable time step.
+  !> corner_force(i, I, k) is the internal force on corner I of lane i in direction k (the solver
+  !> uses a = (f_ext - sum of corner forces) / m); lanes beyond element_count are zero.
+  !> critical_time_step / critical_element: smallest stable element step (no TSSFAC) and the
+  !> model solid index of its element. inverted_element: 0, or the model solid index of the
+  !> first element whose volume (ELFORM 2: any Gauss point Jacobian) is <= 0; the state of the
+  !> block is then not meaningful and the solver should stop. Allocates nothing.
+  subroutine compute_solid_block(block, material, coordinates, velocities, dt, corner_force, &
+                                 critical_time_step, critical_element, inverted_element)
+    type(solid_block_t), intent(inout) :: block
+    type(material_t), intent(in) :: material
+    real(wp), intent(in) :: coordinates(:, :)
+    real(wp), intent(in) :: velocities(:, :)
+    real(wp), intent(in) :: dt
+    real(wp), intent(out) :: corner_force(block_size, 8, 3)
+    real(wp), intent(out) :: critical_time_step
+    integer, intent(out) :: critical_element
+    integer, intent(out) :: inverted_element
+    real(wp) :: element_time_step(block_size)
+    logical :: inverted(block_size)
+    integer :: nel, i, lane
+
+    nel = block%element_count
+    ! The kernels write lanes 1..nel only; the rest stay zero (huge for the time step).
+    corner_force(nel + 1:, :, :) = 0.0_wp
+    element_time_step(nel + 1:) = huge(1.0_wp)
+    inverted = .false.
+    if (block%formulation == formulation_selective_reduced) then
+      call compute_selective_reduced(block, material, coordinates, velocities, dt, corner_force, &
+                                     element_time_step, inverted)
+    else
+      call compute_one_point(block, material, coordinates, velocities, dt, corner_force, &
+                             element_time_step, inverted)
+    end if
+
+    critical_time_step = huge(1.0_wp)
+    critical_element = 0
+    inverted_element = 0
+    lane = 0
+    do i = 1, nel
+      if (element_time_step(i) < critical_time_step) then
+        critical_time_step = element_time_step(i)
+        lane = i
+      end if
+    end do
+    if (lane > 0) critical_element = block%elements(lane)
+    do i = 1, nel
+      if (inverted(i)) then
+        inverted_element = block%elements(i)
+        exit
+      end if
+    end do
+  end subroutine compute_solid_block
+
+  !> ELFORM 1: Flanagan-Belytschko uniform strain hexahedron with hourglass control.
+  subroutine compute_one_point(block, material, coordinates, velocities, dt, corner_force, &
+                               element_time_step, inverted)
+    type(solid_block_t), intent(inout) :: block
+    type(material_t), intent(in) :: material
+    real(wp), intent(in) :: coordinates(:, :), velocities(:, :)
+    real(wp), intent(in) :: dt
+    real(wp), intent(inout) :: corner_force(block_size, 8, 3)
+    real(wp), intent(inout) :: element_time_step(block_size)
+    logical, intent(inout) :: inverted(block_size)
+    real(wp) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
+    real(wp) :: vx(block_size, 8), vy(block_size, 8), vz(block_size, 8)
+    real(wp) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8)
+    real(wp) :: gamma(block_size, 8, 4)
+    real(wp) :: gradient(block_size, 9), rotation(block_size, 9)
+    real(wp) :: strain_increment(block_size, 6), spin_increment(block_size, 3), old_stress(block_size, 6)
+    real(wp) :: volume_mid(block_size), volume(block_size), volumetric_rate(block_size)
+    real(wp) :: wave_modulus(block_size), density(block_size), sound_speed(block_size)
+    real(wp) :: bulk_viscosity(block_size), energy_increment(block_size), area(block_size)
+    real(wp) :: hourglass_volume(block_size), gradient_norm_squared(block_size)
+    integer :: nel, i
+
+    nel = block%element_count
+    call gather_coordinates(nel, block%nodes, coordinates, x, y, z)
+    call gather_coordinates(nel, block%nodes, velocities, vx, vy, vz)
+
+    ! Kinematics at the mid-step configuration x(n+1/2) = x(n+1) - dt/2 v(n+1/2).
+    call hex8_velocity_gradient(nel, -0.5_wp*dt, x, y, z, vx, vy, vz, gradient, volume_mid)
+    do i = 1, nel
+      volumetric_rate(i) = gradient(i, 1) + gradient(i, 5) + gradient(i, 9)
+    end do
+    call deformation_increments(nel, dt, gradient, volumetric_rate, strain_increment, spin_increment)
+
+    ! Objective rotation of the state, then the constitutive update.
+    call incremental_rotation(nel, spin_increment, rotation)
+    call rotate_symmetric_tensors(nel, rotation, block%stress(:, :, 1))
+    old_stress(1:nel, :) = block%stress(1:nel, :, 1)
+    call rotate_material_history(material, nel, rotation, block%history(:, :, 1))
+    call update_material_block(material, nel, dt, strain_increment, block%stress(:, :, 1), &
+                               block%history(:, :, 1), wave_modulus)
+
+    ! End-of-step geometry, bulk viscosity, energy and stress forces.
+    call hex8_volume_derivatives(nel, x, y, z, bx, by, bz, volume)
+    call current_density_and_speed(nel, block%density, block%reference_volume, volume, wave_modulus, &
+                                   density, sound_speed, inverted)
+    call bulk_viscosity_pressure(nel, block%bulk_quadratic, block%bulk_linear, density, sound_speed, volume, &
+                                 volumetric_rate, bulk_viscosity)
+    call add_internal_energy(nel, dt, volume_mid, old_stress, block%stress(:, :, 1), strain_increment, &
+                             bulk_viscosity, volumetric_rate, block%internal_energy)
+    call one_point_stress_forces(nel, bx, by, bz, block%stress(:, :, 1), bulk_viscosity, corner_force)
+
+    ! Hourglass control.
+    call hourglass_shape_vectors(nel, block%hourglass_type, x, y, z, bx, by, bz, volume, gamma, &
+                                 hourglass_volume, gradient_norm_squared)
+    if (block%hourglass_type >= 4) then
+      call hourglass_stiffness_forces(nel, block%hourglass_coefficient, dt, wave_modulus, hourglass_volume, &
+                                      gradient_norm_squared, rotation, gamma, vx, vy, vz, &
+                                      block%hourglass_force, corner_force, energy_increment)
+    else
+      call hourglass_viscous_forces(nel, block%hourglass_coefficient, dt, density, sound_speed, &
+                                    hourglass_volume, gamma, vx, vy, vz, corner_force, energy_increment)
+    end if
+    do i = 1, nel
+      block%hourglass_energy(i) = block%hourglass_energy(i) + energy_increment(i)
+    end do
+
+    call hex8_largest_face_area(nel, x, y, z, area)
+    call solid_element_time_steps(nel, block%bulk_quadratic, block%bulk_linear, volume, area, wave_modulus, &
+                                  block%density, volumetric_rate, element_time_step)
+    block%volume(1:nel) = volume(1:nel)
+    block%point_volume(1:nel, 1) = volume(1:nel)
+    block%bulk_viscosity(1:nel) = bulk_viscosity(1:nel)
+  end subroutine compute_one_point
+
+  !> ELFORM 2: selective-reduced 2x2x2 hexahedron (deviatoric at the points, volumetric from
+  !> the element mean).
+  subroutine compute_selective_reduced(block, material, coordinates, velocities, dt, corner_force, &
+                                       element_time_step, inverted)
+    type(solid_block_t), intent(inout) :: block
+    type(material_t), intent(in) :: material
+    real(wp), intent(in) :: coordinates(:, :), velocities(:, :)
+    real(wp), intent(in) :: dt
+    real(wp), intent(inout) :: corner_force(block_size, 8, 3)
+    real(wp), intent(inout) :: element_time_step(block_size)
+    logical, intent(inout) :: inverted(block_size)
+    real(wp) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
+    real(wp) :: xm(block_size, 8), ym(block_size, 8), zm(block_size, 8)
+    real(wp) :: vx(block_size, 8), vy(block_size, 8), vz(block_size, 8)
+    real(wp) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8)
+    real(wp) :: dndx(block_size, 8), dndy(block_size, 8), dndz(block_size, 8)
+    real(wp) :: natural(8, 3, 8)
+    real(wp) :: gradient(block_size, 9, 8), mid_determinant(block_size, 8), rotation(block_size, 9)
+    real(wp) :: strain_increment(block_size, 6), spin_increment(block_size, 3), old_stress(block_size, 6)
+    real(wp) :: volume_mid(block_size), volume(block_size), volumetric_rate(block_size)
+    real(wp) :: wave_modulus(block_size), density(block_size), sound_speed(block_size)
+    real(wp) :: bulk_viscosity(block_size), area(block_size), mean_stress(block_size)
+    real(wp) :: stress_work(block_size), zero_viscosity(block_size)
+    integer :: nel, i, point
+
+    nel = block%element_count
+    call hex8_gauss_natural_derivatives(natural)
+    call gather_coordinates(nel, block%nodes, coordinates, x, y, z)
+    call gather_coordinates(nel, block%nodes, velocities, vx, vy, vz)
+
+    ! Point velocity gradients at the mid-step configuration and the element mean dilatation.
+    call shifted_configuration(nel, -0.5_wp*dt, vx, vy, vz, x, y, z, xm, ym, zm)
+    volume_mid(1:nel) = 0.0_wp
+    volumetric_rate(1:nel) = 0.0_wp
+    do point = 1, 8
+      call hex8_point_derivatives(nel, natural(:, :, point), xm, ym, zm, dndx, dndy, dndz, &
+                                  mid_determinant(:, point))
+      call point_velocity_gradient(nel, dndx, dndy, dndz, vx, vy, vz, gradient(:, :, point))
+      do i = 1, nel
+        volume_mid(i) = volume_mid(i) + mid_determinant(i, point)
+        volumetric_rate(i) = volumetric_rate(i) + mid_determinant(i, point) &
+                             *(gradient(i, 1, point) + gradient(i, 5, point) + gradient(i, 9, point))
+      end do
+    end do
+    do i = 1, nel
+      volumetric_rate(i) = volumetric_rate(i)/sign(max(abs(volume_mid(i)), tiny(1.0_wp)), volume_mid(i))
+    end do
+
+    ! Stress update and deviatoric forces point by point at x(n+1).
+    corner_force(1:nel, :, :) = 0.0_wp
+    bx(1:nel, :) = 0.0_wp
+    by(1:nel, :) = 0.0_wp
+    bz(1:nel, :) = 0.0_wp
+    mean_stress(1:nel) = 0.0_wp
+    zero_viscosity(1:nel) = 0.0_wp
+    do point = 1, 8
+      call deformation_increments(nel, dt, gradient(:, :, point), volumetric_rate, strain_increment, &
+                                  spin_increment)
+      call incremental_rotation(nel, spin_increment, rotation)
+      call rotate_symmetric_tensors(nel, rotation, block%stress(:, :, point))
+      old_stress(1:nel, :) = block%stress(1:nel, :, point)
+      call rotate_material_history(material, nel, rotation, block%history(:, :, point))
+      call update_material_block(material, nel, dt, strain_increment, block%stress(:, :, point), &
+                                 block%history(:, :, point), wave_modulus)
+      stress_work(1:nel) = 0.0_wp
+      call add_internal_energy(nel, dt, mid_determinant(:, point), old_stress, block%stress(:, :, point), &
+                               strain_increment, zero_viscosity, volumetric_rate, stress_work)
+      block%internal_energy(1:nel) = block%internal_energy(1:nel) + stress_work(1:nel)
+      call hex8_point_derivatives(nel, natural(:, :, point), x, y, z, dndx, dndy, dndz, &
+                                  block%point_volume(:, point))
+      call add_deviatoric_point_forces(nel, block%point_volume(:, point), dndx, dndy, dndz, &
+                                       block%stress(:, :, point), corner_force, mean_stress, bx, by, bz)
+    end do
+
+    volume(1:nel) = 0.0_wp
+    do point = 1, 8
+      do i = 1, nel
+        volume(i) = volume(i) + block%point_volume(i, point)
+        inverted(i) = inverted(i) .or. block%point_volume(i, point) <= 0.0_wp
+      end do
+    end do
+    call current_density_and_speed(nel, block%density, block%reference_volume, volume, wave_modulus, &
+                                   density, sound_speed, inverted)
+    call bulk_viscosity_pressure(nel, block%bulk_quadratic, block%bulk_linear, density, sound_speed, volume, &
+                                 volumetric_rate, bulk_viscosity)
+    do i = 1, nel
+      block%internal_energy(i) = block%internal_energy(i) - volume_mid(i)*bulk_viscosity(i)*volumetric_rate(i)*dt
+      mean_stress(i) = mean_stress(i)/sign(max(abs(volume(i)), tiny(1.0_wp)), volume(i)) - bulk_viscosity(i)
+    end do
+    call add_mean_stress_forces(nel, bx, by, bz, mean_stress, corner_force)
+
+    call hex8_largest_face_area(nel, x, y, z, area)
+    call solid_element_time_steps(nel, block%bulk_quadratic, block%bulk_linear, volume, area, wave_modulus, &
+                                  block%density, volumetric_rate, element_time_step)
+    block%volume(1:nel) = volume(1:nel)
+    block%bulk_viscosity(1:nel) = bulk_viscosity(1:nel)
+  end subroutine compute_selective_reduced
+
+  !> x(i, I) = coordinates(1, nodes(i, I)) etc. for lanes 1..nel (also used for velocities).
+  subroutine gather_coordinates(nel, nodes, coordinates, x, y, z)
+    integer, intent(in) :: nel
+    integer, intent(in) :: nodes(block_size, 8)
+    real(wp), intent(in) :: coordinates(:, :)
+    real(wp), intent(out) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
+    integer :: node, i, global
+    do i = 1, nel
+      do node = 1, 8
+        global = nodes(i, node)
+        x(i, node) = coordinates(1, global)
+        y(i, node) = coordinates(2, global)
+        z(i, node) = coordinates(3, global)
+      end do
+    end do
+  end subroutine gather_coordinates
+
+  !> shifted = x + factor v on every corner (the mid-step configuration for factor = -dt/2).
+  subroutine shifted_configuration(nel, factor, vx, vy, vz, x, y, z, shifted_x, shifted_y, shifted_z)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: factor
+    real(wp), intent(in) :: vx(block_size, 8), vy(block_size, 8), vz(block_size, 8)
+    real(wp), intent(in) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
+    real(wp), intent(out) :: shifted_x(block_size, 8), shifted_y(block_size, 8), shifted_z(block_size, 8)
+    integer :: node, i
+    do i = 1, nel
+      do node = 1, 8
+        shifted_x(i, node) = x(i, node) + factor*vx(i, node)
+        shifted_y(i, node) = y(i, node) + factor*vy(i, node)
+        shifted_z(i, node) = z(i, node) + factor*vz(i, node)
+      end do
+    end do
+  end subroutine shifted_configuration
+
+  !> Current density rho_block V0 / V, wave speed sqrt(rho c^2 / rho_block), and the inverted
+  !> flag V <= 0 (the density is then kept finite and positive).
+  subroutine current_density_and_speed(nel, block_density, reference_volume, volume, wave_modulus, &
+                                       density, sound_speed, inverted)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: block_density(block_size), reference_volume(block_size), volume(block_size)
+    real(wp), intent(in) :: wave_modulus(block_size)
+    real(wp), intent(out) :: density(block_size), sound_speed(block_size)
+    logical, intent(inout) :: inverted(block_size)
+    integer :: i
+    do i = 1, nel
+      inverted(i) = inverted(i) .or. volume(i) <= 0.0_wp
+      density(i) = block_density(i)*reference_volume(i)/max(volume(i), tiny(1.0_wp))
+      sound_speed(i) = sqrt(max(wave_modulus(i), 0.0_wp)/max(block_density(i), tiny(1.0_wp)))
+    end do
+  end subroutine current_density_and_speed
+
+  !> energy += V (sigma_old + sigma_new)/2 : de - V q tr(D) dt, with tensor shear components
+  !> in de (hence the factor 2 on the shear terms).
+  subroutine add_internal_energy(nel, dt, volume, old_stress, new_stress, strain_increment, bulk_viscosity, &
+                                 volumetric_rate, energy)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: dt
+    real(wp), intent(in) :: volume(block_size), old_stress(block_size, 6), new_stress(block_size, 6)
+    real(wp), intent(in) :: strain_increment(block_size, 6), bulk_viscosity(block_size)
+    real(wp), intent(in) :: volumetric_rate(block_size)
+    real(wp), intent(inout) :: energy(block_size)
+    real(wp) :: work
+    integer :: i
+    do i = 1, nel
+      work = 0.5_wp*((old_stress(i, 1) + new_stress(i, 1))*strain_increment(i, 1) &
+                     + (old_stress(i, 2) + new_stress(i, 2))*strain_increment(i, 2) &
+                     + (old_stress(i, 3) + new_stress(i, 3))*strain_increment(i, 3)) &
+             + (old_stress(i, 4) + new_stress(i, 4))*strain_increment(i, 4) &
+             + (old_stress(i, 5) + new_stress(i, 5))*strain_increment(i, 5) &
+             + (old_stress(i, 6) + new_stress(i, 6))*strain_increment(i, 6)
+      energy(i) = energy(i) + volume(i)*(work - bulk_viscosity(i)*volumetric_rate(i)*dt)
+    end do
+  end subroutine add_internal_energy
+
+  !> Element stress (volume average over the integration points) into column elements(i) of
+  !> stress(6, solids), and the effective plastic strain (mean over the points, 0 for elastic
+  !> laws) into plastic_strain(elements(i)).
+  subroutine solid_block_element_results(block, stress, plastic_strain)
+    type(solid_block_t), intent(in) :: block
+    real(wp), intent(inout) :: stress(:, :)
+    real(wp), intent(inout) :: plastic_strain(:)
+    real(wp) :: point_plastic_strain(block_size), mean_plastic_strain(block_size)
+    real(wp) :: average(block_size, 6), total_volume(block_size)
+    integer :: nel, i, point, component
+
+    nel = block%element_count
+    average(1:nel, :) = 0.0_wp
+    total_volume(1:nel) = 0.0_wp
+    mean_plastic_strain(1:nel) = 0.0_wp
+    do point = 1, block%point_count
+      do component = 1, 6
+        average(1:nel, component) = average(1:nel, component) &
+                                    + block%point_volume(1:nel, point)*block%stress(1:nel, component, point)
+      end do
+      total_volume(1:nel) = total_volume(1:nel) + block%point_volume(1:nel, point)
+    end do
+    if (size(block%history, 2) > 0) then
+      do point = 1, block%point_count
+        call material_plastic_strain(block%material_law, nel, block%history(:, :, point), point_plastic_strain)
+        mean_plastic_strain(1:nel) = mean_plastic_strain(1:nel) + point_plastic_strain(1:nel)/block%point_count
+      end do
+    end if
+    do i = 1, nel
+      stress(:, block%elements(i)) = average(i, :)/sign(max(abs(total_volume(i)), tiny(1.0_wp)), total_volume(i))
+      plastic_strain(block%elements(i)) = mean_plastic_strain(i)
+    end do
+  end subroutine solid_block_element_results
+end module solid_block

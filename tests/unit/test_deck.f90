@@ -1,0 +1,732 @@
+!> Unit tests of the keyword deck reader: parsed values for every supported form, and the
+!> exact `file:line: *KEYWORD: field NAME` of every kind of bad input.
+!>
+!> Decks are written to a fresh directory under /tmp; line numbers in the expected messages
+!> are those of the lines written (the base deck below is numbered in its comments).
+program test_deck
+  use kinds, only: wp
+  use testing, only: test_suite_t, check, check_close, finish_suite
+  use error_handling, only: error_t, error_list_t
+  use model, only: model_t, formulation_fe, law_elastic, law_plastic_kinematic, &
+                   motion_displacement, motion_velocity
+  use deck_reader, only: read_deck
+  implicit none
+
+  integer, parameter :: line_length = 200
+  type(test_suite_t) :: suite
+  character(len=:), allocatable :: directory
+
+  suite%name = "deck"
+  directory = make_directory()
+  call test_fixed_format()
+  call test_free_format_parameters_include()
+  call test_long_format()
+  call test_two_line_elements_and_degenerate()
+  call test_hourglass_rules()
+  call test_curve_sets_and_conditions()
+  call test_initial_velocity_generation()
+  call test_rigid_walls_and_output()
+  call test_unknown_keywords()
+  call test_syntax_errors()
+  call test_missing_cards()
+  call test_reference_errors()
+  call test_duplicates()
+  call test_material_limits()
+  call test_controls_and_mesh_errors()
+  call test_field_meanings()
+  call execute_command_line("rm -rf "//directory)
+  call finish_suite(suite)
+
+contains
+
+  ! ---------------------------------------------------------------- decks used by the tests
+
+  !> A valid one-element deck in fixed format. Line numbers:
+  !>  1 *KEYWORD  2 *TITLE  3 title  4 *CONTROL_TERMINATION  5 card  6 *NODE  7-14 nodes
+  !>  15 *ELEMENT_SOLID  16 element  17 *PART  18 heading  19 card  20 *SECTION_SOLID  21 card
+  !>  22 *MAT_ELASTIC  23 card ... then `extra` lines from 24, then *END.
+  function cube_deck(extra) result(lines)
+    character(len=*), intent(in), optional :: extra(:)
+    character(len=line_length), allocatable :: lines(:)
+    character(len=line_length) :: base(23)
+    base(1) = "*KEYWORD"
+    base(2) = "*TITLE"
+    base(3) = "unit cube"
+    base(4) = "*CONTROL_TERMINATION"
+    base(5) = fixed(["1.0"], 10)
+    base(6) = "*NODE"
+    base(7) = node_line(1, 0.0_wp, 0.0_wp, 0.0_wp)
+    base(8) = node_line(2, 1.0_wp, 0.0_wp, 0.0_wp)
+    base(9) = node_line(3, 1.0_wp, 1.0_wp, 0.0_wp)
+    base(10) = node_line(4, 0.0_wp, 1.0_wp, 0.0_wp)
+    base(11) = node_line(5, 0.0_wp, 0.0_wp, 1.0_wp)
+    base(12) = node_line(6, 1.0_wp, 0.0_wp, 1.0_wp)
+    base(13) = node_line(7, 1.0_wp, 1.0_wp, 1.0_wp)
+    base(14) = node_line(8, 0.0_wp, 1.0_wp, 1.0_wp)
+    base(15) = "*ELEMENT_SOLID"
+    base(16) = fixed(["1", "1", "1", "2", "3", "4", "5", "6", "7", "8"], 8)
+    base(17) = "*PART"
+    base(18) = "the cube"
+    base(19) = fixed(["1", "1", "1"], 10)
+    base(20) = "*SECTION_SOLID"
+    base(21) = fixed(["1", "1"], 10)
+    base(22) = "*MAT_ELASTIC"
+    base(23) = fixed(["1     ", "7.8e-6", "210.0 ", "0.3   "], 10)
+    if (present(extra)) then
+      lines = [base, extra, text_line("*END")]
+    else
+      lines = [base, text_line("*END")]
+    end if
+  end function cube_deck
+
+  !> The cube deck with line `number` replaced.
+  function replaced(number, text, extra) result(lines)
+    integer, intent(in) :: number
+    character(len=*), intent(in) :: text
+    character(len=*), intent(in), optional :: extra(:)
+    character(len=line_length), allocatable :: lines(:)
+    lines = cube_deck(extra)
+    lines(number) = text
+  end function replaced
+
+  function node_line(id, x, y, z) result(line)
+    integer, intent(in) :: id
+    real(wp), intent(in) :: x, y, z
+    character(len=line_length) :: line
+    write (line, '(i8,3f16.4)') id, x, y, z
+  end function node_line
+
+  !> Fields right-aligned in columns of `width`.
+  function fixed(fields, width) result(line)
+    character(len=*), intent(in) :: fields(:)
+    integer, intent(in) :: width
+    character(len=line_length) :: line
+    integer :: k
+    line = ""
+    do k = 1, size(fields)
+      line((k - 1)*width + 1:k*width) = adjustr(fields(k)(1:min(len(fields(k)), width)))
+    end do
+  end function fixed
+
+  function text_line(text) result(line)
+    character(len=*), intent(in) :: text
+    character(len=line_length) :: line(1)
+    line(1) = text
+  end function text_line
+
+  function make_directory() result(path)
+    character(len=:), allocatable :: path
+    real :: random
+    integer :: clock
+    character(len=40) :: name
+    call random_seed()
+    call random_number(random)
+    call system_clock(clock)
+    write (name, '("/tmp/crashfree_test_deck_",i0,"_",i0)') clock, int(random*1.0e6)
+    path = trim(name)
+    call execute_command_line("mkdir -p "//path//"/sub/nested")
+  end function make_directory
+
+  subroutine write_file(name, lines)
+    character(len=*), intent(in) :: name
+    character(len=*), intent(in) :: lines(:)
+    integer :: unit, k
+    open (newunit=unit, file=directory//"/"//name, status="replace", action="write")
+    do k = 1, size(lines)
+      write (unit, '(a)') trim(lines(k))
+    end do
+    close (unit)
+  end subroutine write_file
+
+  !> Read `lines` as deck `name`; a test fails when the deck is rejected.
+  subroutine read_good(name, lines, model, warnings, ignore_unknown)
+    character(len=*), intent(in) :: name
+    character(len=*), intent(in) :: lines(:)
+    type(model_t), intent(out) :: model
+    type(error_list_t), intent(out) :: warnings
+    logical, intent(in), optional :: ignore_unknown
+    type(error_t), allocatable :: error
+    logical :: ignore
+    ignore = .false.
+    if (present(ignore_unknown)) ignore = ignore_unknown
+    call write_file(name, lines)
+    call read_deck(directory//"/"//name, model, warnings, error, ignore)
+    if (allocated(error)) then
+      call check(suite, name//" is accepted", .false., error%message)
+    else
+      call check(suite, name//" is accepted", .true.)
+    end if
+  end subroutine read_good
+
+  !> Read `lines` as deck `name`; it must be rejected with a message holding every `expected`
+  !> text (in which `@` stands for the deck's path and `#` for the test directory).
+  subroutine read_bad(name, lines, expected, message_lines)
+    character(len=*), intent(in) :: name
+    character(len=*), intent(in) :: lines(:)
+    character(len=*), intent(in) :: expected(:)
+    integer, intent(in), optional :: message_lines
+    type(model_t) :: model
+    type(error_list_t) :: warnings
+    type(error_t), allocatable :: error
+    character(len=:), allocatable :: wanted
+    integer :: k, at
+    call write_file(name, lines)
+    call read_deck(directory//"/"//name, model, warnings, error, .false.)
+    if (.not. allocated(error)) then
+      call check(suite, name//" is rejected", .false., "the deck was accepted")
+      return
+    end if
+    do k = 1, size(expected)
+      wanted = trim(expected(k))
+      at = index(wanted, "@")
+      if (at > 0) wanted = wanted(:at - 1)//directory//"/"//name//wanted(at + 1:)
+      at = index(wanted, "@")
+      if (at > 0) wanted = wanted(:at - 1)//directory//"/"//name//wanted(at + 1:)
+      at = index(wanted, "#")
+      if (at > 0) wanted = wanted(:at - 1)//directory//wanted(at + 1:)
+      call check(suite, name//": "//wanted, index(error%message, wanted) > 0, &
+                 "message was:"//new_line("a")//error%message)
+    end do
+    if (present(message_lines)) call check(suite, name//": "//trim(count_text(message_lines))// &
+      " problems listed", count_lines(error%message) == message_lines, &
+      "message was:"//new_line("a")//error%message)
+  end subroutine read_bad
+
+  integer function count_lines(text)
+    character(len=*), intent(in) :: text
+    integer :: k
+    count_lines = 1
+    do k = 1, len(text)
+      if (text(k:k) == new_line("a")) count_lines = count_lines + 1
+    end do
+  end function count_lines
+
+  function count_text(value) result(text)
+    integer, intent(in) :: value
+    character(len=12) :: text
+    write (text, '(i0)') value
+  end function count_text
+
+  ! ---------------------------------------------------------------- values read
+
+  subroutine test_fixed_format()
+    type(model_t) :: model
+    type(error_list_t) :: warnings
+    call read_good("fixed.k", cube_deck(), model, warnings)
+    if (.not. allocated(model%node_ids)) return
+    call check(suite, "fixed: 8 nodes", size(model%node_ids) == 8)
+    call check_close(suite, "fixed: node 7 coordinates", model%coordinates(:, 7), &
+                     [1.0_wp, 1.0_wp, 1.0_wp], thr=0.0_wp)
+    call check(suite, "fixed: one solid", size(model%solid_ids) == 1)
+    call check(suite, "fixed: solid node indices", all(model%solid_nodes(:, 1) == [1, 2, 3, 4, &
+                                                                                  5, 6, 7, 8]))
+    call check(suite, "fixed: part index", model%solid_part(1) == 1)
+    call check(suite, "fixed: part references", model%parts(1)%section == 1 .and. &
+               model%parts(1)%material == 1 .and. model%parts(1)%hourglass == 0)
+    call check(suite, "fixed: part title", model%parts(1)%title == "the cube")
+    call check(suite, "fixed: formulation", model%parts(1)%formulation == formulation_fe)
+    call check(suite, "fixed: title", model%title == "unit cube")
+    call check(suite, "fixed: deck path", model%deck_path == directory//"/fixed.k")
+    call check_close(suite, "fixed: end time", model%end_time, 1.0_wp, thr=0.0_wp)
+    call check_close(suite, "fixed: TSSFAC default", model%time_step_scale, 0.9_wp, thr=0.0_wp)
+    call check(suite, "fixed: elastic law", model%materials(1)%law == law_elastic)
+    call check_close(suite, "fixed: density", model%materials(1)%density, 7.8e-6_wp, rel=1e-15_wp)
+    call check_close(suite, "fixed: E", model%materials(1)%youngs_modulus, 210.0_wp, thr=0.0_wp)
+    call check(suite, "fixed: section ELFORM", model%sections(1)%element_formulation == 1)
+    call check(suite, "fixed: default hourglass", model%parts(1)%hourglass_type == 1)
+    call check_close(suite, "fixed: default QM", model%parts(1)%hourglass_coefficient, 0.1_wp, &
+                     thr=0.0_wp)
+    call check_close(suite, "fixed: default Q1", model%parts(1)%bulk_quadratic, 1.5_wp, thr=0.0_wp)
+    call check_close(suite, "fixed: default Q2", model%parts(1)%bulk_linear, 0.06_wp, thr=0.0_wp)
+    call check(suite, "fixed: empty lists allocated", size(model%spcs) == 0 .and. &
+               size(model%motions) == 0 .and. size(model%loads) == 0 .and. &
+               size(model%walls) == 0 .and. size(model%node_sets) == 0 .and. &
+               size(model%part_sets) == 0 .and. size(model%curves) == 0 .and. &
+               size(model%hourglasses) == 0 .and. size(model%output%history_nodes) == 0)
+    call check(suite, "fixed: initial velocity zero", all(shape(model%initial_velocity) == &
+               [3, 8]) .and. all(model%initial_velocity == 0.0_wp))
+    call check(suite, "fixed: no warnings", warnings%count == 0)
+  end subroutine test_fixed_format
+
+  !> Comma cards, lower-case keywords, parameters (R and I, `&`, `-&`), _TITLE options,
+  !> blank fields with defaults, nested includes by relative path, *END ending an include.
+  subroutine test_free_format_parameters_include()
+    type(model_t) :: model
+    type(error_list_t) :: warnings
+    call write_file("sub/mesh.k", [character(len=line_length) :: &
+      "$ nodes and elements, included from ../free.k", &
+      "*node", &
+      "1,0,0,0", "2,&len,0,0", "3,&len,&len,0", "4,0,&len,0", &
+      "*include", &
+      "nested/top.k", &
+      "*element_solid", &
+      "10,&part,1,2,3,4,5,6,7,8", &
+      "*END", &
+      "*NODE", &
+      "99,5,5,5"])
+    call write_file("sub/nested/top.k", [character(len=line_length) :: &
+      "*NODE", "5,0,0,&len", "6,&len,0,&len", "7,&len,&len,&len", "8,0,&len,&len"])
+    call read_good("free.k", [character(len=line_length) :: &
+      "*keyword", &
+      "$ comment before the parameters", &
+      "*PARAMETER", &
+      "R len      2.5       I part    3", &
+      "*Control_Termination", &
+      "&len,,,", &
+      "*include", &
+      "sub/mesh.k", &
+      "*PART", &
+      "", &
+      "&part,4,2", &
+      "*SECTION_SOLID_TITLE", &
+      "fully integrated", &
+      "4,2", &
+      "*MAT_PLASTIC_KINEMATIC_TITLE", &
+      "steel", &
+      "2,7.8e-6,210.,0.3,0.25,2.1,-&beta", &
+      "40.,5.,,", &
+      "*PARAMETER", &
+      "R beta     -1.0", &
+      "*end"], model, warnings)
+    if (.not. allocated(model%node_ids)) return
+    call check(suite, "free: 8 nodes, *END ends the include only", size(model%node_ids) == 8)
+    call check_close(suite, "free: parameter in a node", model%coordinates(:, 7), &
+                     [2.5_wp, 2.5_wp, 2.5_wp], thr=0.0_wp)
+    call check(suite, "free: element from include", model%solid_ids(1) == 10 .and. &
+               model%parts(model%solid_part(1))%id == 3)
+    call check(suite, "free: nested include nodes", model%node_ids(5) == 5)
+    call check_close(suite, "free: ENDTIM from parameter", model%end_time, 2.5_wp, thr=0.0_wp)
+    call check(suite, "free: blank part heading", model%parts(1)%title == "")
+    call check(suite, "free: section title and ELFORM", model%sections(1)%title == &
+               "fully integrated" .and. model%sections(1)%element_formulation == 2)
+    call check(suite, "free: material title and law", model%materials(1)%title == "steel" .and. &
+               model%materials(1)%law == law_plastic_kinematic)
+    call check_close(suite, "free: SIGY", model%materials(1)%yield_stress, 0.25_wp, thr=0.0_wp)
+    call check_close(suite, "free: -&beta", model%materials(1)%hardening_beta, 1.0_wp, thr=0.0_wp)
+    call check_close(suite, "free: SRC SRP", [model%materials(1)%rate_c, &
+                     model%materials(1)%rate_p], [40.0_wp, 5.0_wp], thr=0.0_wp)
+    call check_close(suite, "free: blank FS", model%materials(1)%failure_strain, 0.0_wp, thr=0.0_wp)
+    call check(suite, "free: title blank when no *TITLE", model%title == "")
+  end subroutine test_free_format_parameters_include
+
+  !> *KEYWORD LONG=Y (20-column fields everywhere), the per-keyword `+` suffix and the I10
+  !> `%` suffix.
+  subroutine test_long_format()
+    type(model_t) :: model
+    type(error_list_t) :: warnings
+    character(len=line_length), allocatable :: lines(:)
+    integer :: k
+    allocate (lines(0))    ! (keeps gfortran 12 from a false "used uninitialized" warning)
+    lines = cube_deck()
+    lines(1) = "*KEYWORD LONG=Y"
+    lines(5) = fixed(["0.5"], 20)
+    do k = 7, 14
+      lines(k) = long_node(lines(k))
+    end do
+    lines(16) = fixed(["1", "1", "1", "2", "3", "4", "5", "6", "7", "8"], 20)
+    lines(19) = fixed(["1", "1", "1"], 20)
+    lines(21) = fixed(["1", "1"], 20)
+    lines(23) = fixed(["1     ", "7.8e-6", "210.0 ", "0.3   "], 20)
+    call read_good("long.k", lines, model, warnings)
+    if (allocated(model%node_ids)) then
+      call check_close(suite, "long: ENDTIM", model%end_time, 0.5_wp, thr=0.0_wp)
+      call check_close(suite, "long: node 7", model%coordinates(:, 7), [1.0_wp, 1.0_wp, 1.0_wp], &
+                       thr=0.0_wp)
+      call check_close(suite, "long: PR", model%materials(1)%poissons_ratio, 0.3_wp, thr=0.0_wp)
+    end if
+    lines = cube_deck()
+    lines(6) = "*NODE +"     ! text after a blank is a comment; "+" must be attached
+    lines(6) = "*NODE+"
+    do k = 7, 14
+      lines(k) = long_node(lines(k))
+    end do
+    call read_good("long_suffix.k", lines, model, warnings)
+    if (allocated(model%node_ids)) call check_close(suite, "long suffix: node 2", &
+      model%coordinates(:, 2), [1.0_wp, 0.0_wp, 0.0_wp], thr=0.0_wp)
+    lines = cube_deck()
+    lines(6) = "*node%"
+    do k = 7, 14
+      write (lines(k), '(i10,3f16.4,i10)') k - 6, model%coordinates(:, k - 6), merge(7, 0, k == 7)
+    end do
+    call read_good("i10_suffix.k", lines, model, warnings)
+    if (allocated(model%node_ids)) then
+      call check_close(suite, "I10: node 7", model%coordinates(:, 7), [1.0_wp, 1.0_wp, 1.0_wp], &
+                       thr=0.0_wp)
+      call check(suite, "I10: TC 7 of node 1", size(model%spcs) == 1 .and. all(model%spcs%node &
+                 == [1]))
+    end if
+  end subroutine test_long_format
+
+  function long_node(standard) result(line)
+    character(len=*), intent(in) :: standard
+    character(len=line_length) :: line
+    character(len=16) :: fields(4)
+    ! (assigned one by one: gfortran 12 mishandles typed constructors of unequal substrings)
+    fields(1) = standard(1:8)
+    fields(2) = standard(9:24)
+    fields(3) = standard(25:40)
+    fields(4) = standard(41:56)
+    line = fixed(fields, 20)
+  end function long_node
+
+  !> The two-line (ten nodes) element layout, a wedge and a tetrahedron written with repeated
+  !> nodes, and numbers packed without blanks between fixed fields.
+  subroutine test_two_line_elements_and_degenerate()
+    type(model_t) :: model
+    type(error_list_t) :: warnings
+    character(len=line_length), allocatable :: lines(:)
+    allocate (lines(0))    ! (keeps gfortran 12 from a false "used uninitialized" warning)
+    lines = cube_deck([character(len=line_length) :: &
+      "*ELEMENT_SOLID", &
+      fixed(["2", "1"], 8), &
+      fixed(["1", "2", "3", "4", "5", "6", "7", "8", "0", " "], 8), &
+      fixed(["3", "1"], 8), &
+      fixed(["1", "2", "4", "4", "5", "6", "8", "8"], 8), &
+      "*ELEMENT_SOLID", &
+      fixed(["4", "1", "1", "2", "4", "5", "5", "5", "5", "5"], 8), &
+      "*NODE", &
+      "      20-1.5000000000000 2.0000000000000-3.000000000000"])
+    call read_good("two_line.k", lines, model, warnings)
+    if (.not. allocated(model%solid_ids)) return
+    call check(suite, "two-line: 4 elements", size(model%solid_ids) == 4)
+    call check(suite, "two-line: nodes", all(model%solid_nodes(:, 2) == [1, 2, 3, 4, 5, 6, 7, 8]))
+    call check(suite, "wedge nodes", all(model%solid_nodes(:, 3) == [1, 2, 4, 4, 5, 6, 8, 8]))
+    call check_close(suite, "packed node fields", model%coordinates(:, 9), &
+                     [-1.5_wp, 2.0_wp, -3.0_wp], thr=0.0_wp)
+  end subroutine test_two_line_elements_and_degenerate
+
+  !> Effective hourglass values by LS-DYNA's rules.
+  subroutine test_hourglass_rules()
+    type(model_t) :: model
+    type(error_list_t) :: warnings
+    call read_good("hourglass.k", cube_deck([character(len=line_length) :: &
+      "*CONTROL_HOURGLASS", &
+      fixed(["4   ", "0.05"], 10), &
+      "*CONTROL_BULK_VISCOSITY", &
+      "1.2,0.05", &
+      "*HOURGLASS", &
+      fixed(["7  ", "0  ", "   ", "   ", "2.0"], 10), &
+      fixed(["8   ", "5   ", "0.12"], 10), &
+      "*PART", "with HGID 7", fixed(["2", "1", "1", "0", "7"], 10), &
+      "*PART", "no HGID", fixed(["3", "1", "1"], 10), &
+      "*PART", "with HGID 8", fixed(["4", "1", "1", "0", "8"], 10)]), model, warnings)
+    if (.not. allocated(model%parts)) return
+    call check(suite, "hourglass: part 1 control type", model%parts(1)%hourglass_type == 4)
+    call check_close(suite, "hourglass: part 1 control values", [model%parts(1)% &
+      hourglass_coefficient, model%parts(1)%bulk_quadratic, model%parts(1)%bulk_linear], &
+      [0.05_wp, 1.2_wp, 0.05_wp], thr=0.0_wp)
+    call check(suite, "hourglass: IHQ 0 takes the control type", model%parts(2)%hourglass_type == 4)
+    call check_close(suite, "hourglass: HGID 7 values", [model%parts(2)%hourglass_coefficient, &
+      model%parts(2)%bulk_quadratic, model%parts(2)%bulk_linear], [0.05_wp, 2.0_wp, 0.05_wp], &
+      thr=0.0_wp)
+    call check(suite, "hourglass: HGID 8 type", model%parts(4)%hourglass_type == 5 .and. &
+               model%parts(4)%hourglass == 2)
+    call check_close(suite, "hourglass: HGID 8 QM", model%parts(4)%hourglass_coefficient, &
+                     0.12_wp, thr=0.0_wp)
+    call check(suite, "hourglass: no HGID", model%parts(3)%hourglass_type == 4 .and. &
+               model%parts(3)%hourglass == 0)
+  end subroutine test_hourglass_rules
+
+  !> Curve scale and offset, set generation, SPCs (with *NODE TC), motions, loads, history.
+  subroutine test_curve_sets_and_conditions()
+    type(model_t) :: model
+    type(error_list_t) :: warnings
+    call read_good("conditions.k", replaced(14, trim(node_line(8, 0.0_wp, 1.0_wp, 1.0_wp))// &
+      "       3", [character(len=line_length) :: &
+      "*DEFINE_CURVE_TITLE", "ramp", fixed(["5  ", "0  ", "2.0", "3.0", "1.0", "0.5"], 10), &
+      fixed(["0.0", "1.0"], 20), fixed(["1.0", "2.0"], 20), &
+      "*SET_NODE_LIST_GENERATE", fixed(["1"], 10), fixed(["1 ", "3 ", "7 ", "50"], 10), &
+      "*SET_NODE_LIST", "2", "5,6,0,5", &
+      "*SET_PART_LIST", "3", "1", &
+      "*BOUNDARY_SPC_SET_ID", "         1base", "2,0,1,1,1", &
+      "*BOUNDARY_SPC_NODE", "1,0,0,0,1", &
+      "*BOUNDARY_PRESCRIBED_MOTION_SET", "1,3,2,5,-2.0", &
+      "*BOUNDARY_PRESCRIBED_MOTION_NODE", "8,1,,5,,,0.0,0.0", &
+      "*LOAD_NODE_SET", "2,2,5,", &
+      "*DATABASE_HISTORY_NODE_SET", "1", &
+      "*DATABASE_HISTORY_NODE", fixed(["8", "1"], 10), &
+      "*DATABASE_NODOUT", "1.0e-3"]), model, warnings)
+    if (.not. allocated(model%curves)) return
+    call check(suite, "curve: id and title", model%curves(1)%id == 5 .and. &
+               model%curves(1)%title == "ramp")
+    call check_close(suite, "curve: SFA*(A+OFFA)", model%curves(1)%abscissa, [2.0_wp, 4.0_wp], &
+                     thr=0.0_wp)
+    call check_close(suite, "curve: SFO*(O+OFFO)", model%curves(1)%ordinate, [4.5_wp, 7.5_wp], &
+                     thr=0.0_wp)
+    call check(suite, "generate: ranges with gaps", size(model%node_sets(1)%nodes) == 5 .and. &
+               all(model%node_sets(1)%nodes == [1, 2, 3, 7, 8]))
+    call check(suite, "list: blank, 0 and repeated ids", all(model%node_sets(2)%nodes == [5, 6]))
+    call check(suite, "part set", all(model%part_sets(1)%parts == [1]))
+    call check(suite, "spc: merged per node", size(model%spcs) == 4)
+    call check(suite, "spc: node 1 from SPC_NODE", model%spcs(1)%node == 1 .and. &
+               all(model%spcs(1)%fixed .eqv. [.false., .false., .true.]))
+    call check(suite, "spc: node 5 from set", model%spcs(2)%node == 5 .and. &
+               all(model%spcs(2)%fixed))
+    call check(suite, "spc: node 8 from TC 3", model%spcs(4)%node == 8 .and. &
+               all(model%spcs(4)%fixed .eqv. [.false., .false., .true.]))
+    call check(suite, "motions: set of 5 plus 1 node", size(model%motions) == 6)
+    call check(suite, "motion: displacement in z", model%motions(1)%kind == motion_displacement &
+               .and. model%motions(1)%direction == 3 .and. model%motions(1)%curve == 1)
+    call check_close(suite, "motion: SF", model%motions(1)%scale, -2.0_wp, thr=0.0_wp)
+    call check(suite, "motion: velocity default VAD", model%motions(6)%kind == motion_velocity &
+               .and. model%motions(6)%node == 8)
+    call check_close(suite, "motion: SF blank and DEATH 0", [model%motions(6)%scale, &
+                     model%motions(6)%death], [1.0_wp, 1.0e28_wp], thr=0.0_wp)
+    call check(suite, "loads: per node of set 2", size(model%loads) == 2 .and. &
+               all(model%loads%node == [5, 6]) .and. all(model%loads%direction == 2))
+    call check(suite, "history: set then nodes, once each", &
+               all(model%output%history_nodes == [1, 2, 3, 7, 8]))
+    call check_close(suite, "nodout interval", model%output%nodout_interval, 1.0e-3_wp, thr=0.0_wp)
+  end subroutine test_curve_sets_and_conditions
+
+  !> *INITIAL_VELOCITY (all nodes, exempted set), _GENERATION rotation and _NODE, in that
+  !> order of precedence.
+  subroutine test_initial_velocity_generation()
+    type(model_t) :: model
+    type(error_list_t) :: warnings
+    call read_good("velocity.k", cube_deck([character(len=line_length) :: &
+      "*SET_NODE_LIST", "1", "5,6,7,8", &
+      "*SET_NODE_LIST", "2", "2", &
+      "*SET_NODE_LIST", "4", "3,4", &
+      "*INITIAL_VELOCITY", "0,2", "1.0,0.0,0.0", "0.0,-1.0,0.0", &
+      "*INITIAL_VELOCITY_GENERATION", &
+      "1,3,2.0,0.0,0.0,10.0", "0.0,0.0,0.0,0.0,0.0,1.0", &
+      "4,3,1.0,0.0,0.0,5.0", "0.0,0.0,0.0,-999,2,3", &
+      "*INITIAL_VELOCITY_NODE", "7,0,0,-3"]), model, warnings)
+    if (.not. allocated(model%initial_velocity)) return
+    call check_close(suite, "velocity: all nodes", model%initial_velocity(:, 1), &
+                     [1.0_wp, 0.0_wp, 0.0_wp], thr=0.0_wp)
+    call check_close(suite, "velocity: exempted node", model%initial_velocity(:, 2), &
+                     [0.0_wp, -1.0_wp, 0.0_wp], thr=0.0_wp)
+    ! node 6 at (1, 0, 1): 2 z x (1, 0, 1) = (0, 2, 0), plus (0, 0, 10)
+    call check_close(suite, "generation: rotation plus translation", &
+                     model%initial_velocity(:, 6), [0.0_wp, 2.0_wp, 10.0_wp], thr=1.0e-15_wp)
+    ! node 8 at (0, 1, 1): 2 z x (0, 1, 1) = (-2, 0, 0), plus (0, 0, 10)
+    call check_close(suite, "generation: second node", model%initial_velocity(:, 8), &
+                     [-2.0_wp, 0.0_wp, 10.0_wp], thr=1.0e-15_wp)
+    ! axis through nodes 2 (1, 0, 0) and 3 (1, 1, 0): node 3 is on it, node 4 at (0, 1, 0)
+    ! moves with 1 y x (-1, 1, 0) = (0, 0, 1)
+    call check_close(suite, "generation: axis nodes, node on the axis", &
+                     model%initial_velocity(:, 3), [0.0_wp, 0.0_wp, 5.0_wp], thr=1.0e-15_wp)
+    call check_close(suite, "generation: axis nodes, node off the axis", &
+                     model%initial_velocity(:, 4), [0.0_wp, 0.0_wp, 6.0_wp], thr=1.0e-15_wp)
+    call check_close(suite, "velocity: _NODE wins", model%initial_velocity(:, 7), &
+                     [0.0_wp, 0.0_wp, -3.0_wp], thr=0.0_wp)
+  end subroutine test_initial_velocity_generation
+
+  !> Rigid walls with every option, and the output intervals.
+  subroutine test_rigid_walls_and_output()
+    type(model_t) :: model
+    type(error_list_t) :: warnings
+    call read_good("walls.k", cube_deck([character(len=line_length) :: &
+      "*SET_NODE_LIST", "1", "1,2", &
+      "*RIGIDWALL_PLANAR_MOVING_FORCES_FINITE_ID", "12,the floor", &
+      "0,1,,,,", "0,0,-1,0,0,2,0.3", "5,0,-1,100,50", "20.0,-3.0", "0,0", &
+      "*RIGIDWALL_PLANAR", "1", "0,0,0,1,0,0", &
+      "*CONTROL_ENERGY", "2,1", &
+      "*DATABASE_BINARY_D3PLOT", fixed(["   ", "   ", "   ", "10 "], 10), &
+      "*DATABASE_GLSTAT", "1.0e-4", "*DATABASE_MATSUM", "2.0e-4", &
+      "*DATABASE_RWFORC", "3.0e-4"]), model, warnings)
+    if (.not. allocated(model%walls)) return
+    call check(suite, "walls: two", size(model%walls) == 2)
+    associate (wall => model%walls(1))
+      call check(suite, "wall: id and title", wall%id == 12 .and. wall%title == "the floor")
+      call check(suite, "wall: NSID 0 minus NSIDEX", size(wall%nodes) == 6 .and. &
+                 all(wall%nodes == [3, 4, 5, 6, 7, 8]))
+      call check_close(suite, "wall: unit normal", wall%normal, [0.0_wp, 0.0_wp, 1.0_wp], &
+                       thr=0.0_wp)
+      call check_close(suite, "wall: point", wall%point, [0.0_wp, 0.0_wp, -1.0_wp], thr=0.0_wp)
+      call check_close(suite, "wall: friction", wall%friction, 0.3_wp, thr=0.0_wp)
+      call check(suite, "wall: options", wall%finite .and. wall%moving .and. wall%forces_requested)
+      call check_close(suite, "wall: edge", wall%edge_direction, [1.0_wp, 0.0_wp, 0.0_wp], &
+                       thr=0.0_wp)
+      call check_close(suite, "wall: edge lengths", [wall%length_l, wall%length_m], &
+                       [100.0_wp, 50.0_wp], thr=0.0_wp)
+      call check_close(suite, "wall: mass and V0", [wall%mass, wall%initial_speed], &
+                       [20.0_wp, -3.0_wp], thr=0.0_wp)
+      call check_close(suite, "wall: DEATH 0 means never", wall%death, 1.0e20_wp, thr=0.0_wp)
+    end associate
+    call check(suite, "wall 2: numbered, set 1", model%walls(2)%id == 2 .and. &
+               all(model%walls(2)%nodes == [1, 2]) .and. .not. model%walls(2)%moving)
+    call check_close(suite, "d3plot: ENDTIM/NPLTC", model%output%state_interval, 0.1_wp, &
+                     rel=1.0e-15_wp)
+    call check_close(suite, "history intervals", [model%output%glstat_interval, &
+                     model%output%matsum_interval, model%output%rwforc_interval], &
+                     [1.0e-4_wp, 2.0e-4_wp, 3.0e-4_wp], thr=0.0_wp)
+    call check(suite, "energy: HGEN 2, RWEN 1", model%hourglass_energy_in_balance .and. &
+               .not. model%wall_energy_in_balance)
+  end subroutine test_rigid_walls_and_output
+
+  !> An unknown keyword is an error; with ignore_unknown a warning.
+  subroutine test_unknown_keywords()
+    type(model_t) :: model
+    type(error_list_t) :: warnings
+    call read_bad("unknown.k", cube_deck([character(len=line_length) :: "*NODDE", "9,0,0,0"]), &
+      [character(len=120) :: "@:24: *NODDE: unknown keyword (did you mean *NODE?)"])
+    call read_good("ignored.k", cube_deck([character(len=line_length) :: "*CONTACT_AUTOMATIC", &
+                   "1,2"]), model, warnings, ignore_unknown=.true.)
+    call check(suite, "ignore_unknown: one warning", warnings%count == 1)
+    if (warnings%count > 0) call check(suite, "ignore_unknown: warning text", &
+      index(warnings%text, "fixed.k") == 0 .and. index(warnings%text, &
+      "ignored.k:24: *CONTACT_AUTOMATIC: unknown keyword skipped") > 0, warnings%text)
+  end subroutine test_unknown_keywords
+
+  !> Letters in numbers, undefined parameters, tabs, a keyword not in column 1.
+  subroutine test_syntax_errors()
+    call read_bad("letter.k", replaced(9, "       3             1.0         1.0x0             0.0"), &
+      [character(len=120) :: "@:9: *NODE: field Y: ""1.0x0"" is not a number (columns 25-40)"])
+    call read_bad("letter_comma.k", replaced(21, "1,one"), &
+      [character(len=120) :: "@:21: *SECTION_SOLID: field ELFORM: ""one"" is not an integer "// &
+      "(entry 2 of the comma-separated card)"])
+    call read_bad("not_integral.k", replaced(16, fixed(["1.5", "1  "], 8)), &
+      [character(len=120) :: "@:16: *ELEMENT_SOLID: field EID: ""1.5"" is not an integer"])
+    call read_bad("parameter.k", replaced(5, "&tend"), &
+      [character(len=120) :: "@:5: *CONTROL_TERMINATION: field ENDTIM: parameter &tend is "// &
+      "not defined"])
+    call read_bad("tab.k", replaced(21, "         1"//achar(9)//"1"), &
+      [character(len=120) :: "@:21: *SECTION_SOLID: the card holds a tab character"])
+    call read_bad("column.k", replaced(20, " *SECTION_SOLID"), &
+      [character(len=120) :: "@:20: a keyword must start in column 1"])
+    call read_bad("bad_parameter.k", cube_deck([character(len=line_length) :: "*PARAMETER", &
+      "X name    1.0"]), [character(len=120) :: "@:25: *PARAMETER: field PRMR1: ""X name"" "// &
+      "must start with its type letter"])
+  end subroutine test_syntax_errors
+
+  !> Keywords that end before a required card.
+  subroutine test_missing_cards()
+    call read_bad("mat003_one_card.k", cube_deck([character(len=line_length) :: &
+      "*MAT_PLASTIC_KINEMATIC", "2,7.8e-6,210.,0.3,0.25,2.1,0.0"]), &
+      [character(len=120) :: "@:25: *MAT_PLASTIC_KINEMATIC: field SRC: card 2 (SRC SRP FS VP) "// &
+      "is missing"])
+    call read_bad("part_no_card.k", cube_deck([character(len=line_length) :: "*PART", &
+      "a part without its data card"]), [character(len=120) :: "@:25: *PART: field PID: the "// &
+      "data card (PID SECID MID EOSID HGID GRAV ADPOPT TMID) after the heading line is missing"])
+    call read_bad("termination_no_card.k", replaced(5, "$ no card", [character(len=line_length) &
+      :: "*DATABASE_GLSTAT", "1.0e-3"]), [character(len=120) :: "@:4: *CONTROL_TERMINATION: "// &
+      "field ENDTIM: card 1 (ENDTIM ENDCYC DTMIN ENDENG ENDMAS NOSOL) is missing"])
+    call read_bad("two_line_missing.k", cube_deck([character(len=line_length) :: &
+      "*ELEMENT_SOLID", fixed(["2", "1"], 8)]), [character(len=120) :: "@:25: *ELEMENT_SOLID: "// &
+      "field N1: the node card (N1-N8) of element 2 is missing"])
+    call read_bad("curve_no_points.k", cube_deck([character(len=line_length) :: &
+      "*DEFINE_CURVE", "3"]), [character(len=120) :: "@:25: *DEFINE_CURVE: field A: the curve "// &
+      "has no points"])
+    call read_bad("include_missing.k", cube_deck([character(len=line_length) :: "*INCLUDE", &
+      "sub/no_such_file.k"]), [character(len=120) :: "@:25: *INCLUDE: field FILENAME: cannot "// &
+      "open ""#/sub/no_such_file.k"""])
+  end subroutine test_missing_cards
+
+  !> Cross-reference errors: all listed at once, each at the card holding the reference.
+  subroutine test_reference_errors()
+    character(len=line_length), allocatable :: lines(:)
+    allocate (lines(0))    ! (keeps gfortran 12 from a false "used uninitialized" warning)
+    lines = replaced(16, fixed(["1 ", "1 ", "1 ", "2 ", "99", "4 ", "5 ", "6 ", "7 ", "8 "], 8), &
+      [character(len=line_length) :: &
+      "*PART", "no material", fixed(["2", "1"], 10), &
+      "*PART", "bad references", fixed(["3 ", "9 ", "7 ", "0 ", "11"], 10), &
+      "*BOUNDARY_PRESCRIBED_MOTION_NODE", "1,1,0,9", &
+      "*BOUNDARY_SPC_SET", "5,0,1,1,1", &
+      "*ELEMENT_SOLID", fixed(["2 ", "42", "1 ", "2 ", "3 ", "4 ", "5 ", "6 ", "7 ", "8 "], 8), &
+      "*SET_NODE_LIST", "4", "1,77", &
+      "*DATABASE_HISTORY_NODE", "1,0,88"])
+    call read_bad("references.k", lines, [character(len=120) :: &
+      "@:16: *ELEMENT_SOLID: field N3: node 99 of element 1 is not defined", &
+      "@:26: *PART: field MID: part 2 has no material (MID is blank or 0)", &
+      "@:29: *PART: field SECID: section 9 of part 3 is not defined", &
+      "@:29: *PART: field MID: material 7 of part 3 is not defined", &
+      "@:29: *PART: field HGID: hourglass 11 of part 3 is not defined", &
+      "@:31: *BOUNDARY_PRESCRIBED_MOTION_NODE: field LCID: curve 9 is not defined", &
+      "@:33: *BOUNDARY_SPC_SET: field NSID: node set 5 is not defined", &
+      "@:35: *ELEMENT_SOLID: field PID: part 42 of element 2 is not defined", &
+      "@:38: *SET_NODE_LIST: field NID2: node 77 of set 4 is not defined", &
+      "@:40: *DATABASE_HISTORY_NODE: field ID3: node 88 is not defined"], message_lines=10)
+  end subroutine test_reference_errors
+
+  subroutine test_duplicates()
+    call read_bad("duplicates.k", replaced(10, node_line(3, 0.0_wp, 1.0_wp, 0.0_wp), &
+      [character(len=line_length) :: &
+      "*ELEMENT_SOLID", fixed(["1", "1", "1", "2", "3", "4", "5", "6", "7", "8"], 8), &
+      "*PART", "again", fixed(["1", "1", "1"], 10), &
+      "*SECTION_SOLID", "1,2", &
+      "*MAT_ELASTIC", "1,1.0,1.0,0.2", &
+      "*DEFINE_CURVE", "6", "0,0", "*DEFINE_CURVE", "6", "0,0", &
+      "*SET_NODE_LIST", "3", "1", "*SET_NODE_LIST_GENERATE", "3", "1,2", &
+      "*SET_PART_LIST", "3", "1"]), [character(len=120) :: &
+      "@:10: *NODE: field NID: node id 3 is defined twice (first at @:9)", &
+      "@:25: *ELEMENT_SOLID: field EID: element id 1 is defined twice (first at @:16)", &
+      "@:28: *PART: field PID: part id 1 is defined twice (first at @:19)", &
+      "@:30: *SECTION_SOLID: field SECID: section id 1 is defined twice", &
+      "@:32: *MAT_ELASTIC: field MID: material id 1 is defined twice", &
+      "@:37: *DEFINE_CURVE: field LCID: curve id 6 is defined twice (first at @:34)", &
+      "@:43: *SET_NODE_LIST_GENERATE: field SID: node set id 3 is defined twice"])
+  end subroutine test_duplicates
+
+  !> Physically impossible material values.
+  subroutine test_material_limits()
+    call read_bad("materials.k", replaced(23, fixed(["1  ", "0.0", "0.0", "0.5"], 10), &
+      [character(len=line_length) :: &
+      "*MAT_PLASTIC_KINEMATIC", "2,1.0,-5.0,-1.0,-0.1,-1.0,1.5", "-1.0,,,2", &
+      "*MAT_003", "3,1.0,100.0,0.3,1.0,100.0,0.5", "10.0,0.0", &
+      "*MAT_ELASTIC", "4,1.0,,0.3"]), [character(len=120) :: &
+      "@:23: *MAT_ELASTIC: field RO: density must be > 0, found 0.0", &
+      "@:23: *MAT_ELASTIC: field E: Young's modulus must be > 0, found 0.0", &
+      "@:23: *MAT_ELASTIC: field PR: Poisson's ratio must lie in (-1, 0.5), found 0.5", &
+      "@:25: *MAT_PLASTIC_KINEMATIC: field E: Young's modulus must be > 0, found -5.0", &
+      "@:25: *MAT_PLASTIC_KINEMATIC: field PR: Poisson's ratio must lie in (-1, 0.5), found -1.0", &
+      "@:25: *MAT_PLASTIC_KINEMATIC: field SIGY: yield stress must be >= 0, found -0.1", &
+      "@:25: *MAT_PLASTIC_KINEMATIC: field ETAN: tangent modulus must be >= 0, found -1.0", &
+      "@:25: *MAT_PLASTIC_KINEMATIC: field BETA: hardening parameter must lie in [0, 1]", &
+      "@:26: *MAT_PLASTIC_KINEMATIC: field SRC: Cowper-Symonds C must be >= 0", &
+      "@:26: *MAT_PLASTIC_KINEMATIC: field VP: must be 0 (scale the yield stress) or 1", &
+      "@:28: *MAT_003: field ETAN: tangent modulus must be smaller than E = 100.0", &
+      "@:29: *MAT_003: field SRP: Cowper-Symonds rate effects need both SRC and SRP > 0", &
+      "@:31: *MAT_ELASTIC: field E: Young's modulus must be > 0, found 0.0 (the field is blank)"])
+  end subroutine test_material_limits
+
+  !> ENDTIM, no nodes or elements, inside-out and flat elements.
+  subroutine test_controls_and_mesh_errors()
+    character(len=line_length), allocatable :: lines(:)
+    allocate (lines(0))    ! (keeps gfortran 12 from a false "used uninitialized" warning)
+    call read_bad("endtim.k", replaced(5, fixed(["0.0"], 10)), [character(len=120) :: &
+      "@:5: *CONTROL_TERMINATION: field ENDTIM: end time must be > 0 (or give ENDCYC > 0), "// &
+      "found 0.0"])
+    lines = cube_deck()
+    call read_bad("no_termination.k", [lines(1:3), lines(6:)], [character(len=120) :: &
+      "@: *CONTROL_TERMINATION: field ENDTIM: the deck has no *CONTROL_TERMINATION"])
+    call read_bad("no_mesh.k", [lines(1:5), lines(17:)], [character(len=120) :: &
+      "@: *NODE: field NID: the deck defines no nodes", &
+      "@: *ELEMENT_SOLID: field EID: the deck defines no solid elements"])
+    call read_bad("inside_out.k", replaced(16, fixed(["1", "1", "1", "4", "3", "2", "5", "8", &
+      "7", "6"], 8)), [character(len=120) :: "@:16: *ELEMENT_SOLID: field N1-N8: element 1 of "// &
+      "part 1 is inside out: negative Jacobian at corner N"])
+    call read_bad("flat.k", replaced(16, fixed(["1", "1", "1", "2", "3", "4", "1", "2", "3", &
+      "4"], 8)), [character(len=120) :: "@:16: *ELEMENT_SOLID: field N1-N8: element 1 of part "// &
+      "1 has no volume"])
+  end subroutine test_controls_and_mesh_errors
+
+  !> Values with no LS-DYNA meaning, and features crashfree does not have, name their field.
+  subroutine test_field_meanings()
+    call read_bad("fields.k", cube_deck([character(len=line_length) :: &
+      "*DEFINE_CURVE", "1", "0,0", "1,1", "0.5,2", &
+      "*BOUNDARY_PRESCRIBED_MOTION_NODE", "1,14,0,1", "2,5,0,1", "3,1,7,1", &
+      "*LOAD_NODE_POINT", "4,8,1", &
+      "*BOUNDARY_SPC_NODE", "5,0,2", &
+      "*SECTION_SOLID", "7,41", &
+      "*SECTION_SOLID", "8,7", &
+      "*NODE", trim(node_line(9, 2.0_wp, 0.0_wp, 0.0_wp))//"      12", &
+      "*RIGIDWALL_PLANAR_MOVING", "0", "0,0,0,0,0,0", "0.0"]), [character(len=120) :: &
+      "@:28: *DEFINE_CURVE: field A: abscissa 0.5 is smaller than the previous one, 1.0", &
+      "@:30: *BOUNDARY_PRESCRIBED_MOTION_NODE: field DOF: must be 1, 2 or 3 (x, y, z "// &
+      "translation), found 14", &
+      "@:31: *BOUNDARY_PRESCRIBED_MOTION_NODE: field DOF: 5 is a rotation", &
+      "@:32: *BOUNDARY_PRESCRIBED_MOTION_NODE: field VAD: must be 0 (velocity), 1 "// &
+      "(acceleration) or 2 (displacement), found 7", &
+      "@:34: *LOAD_NODE_POINT: field DOF: 8 (follower force or moment) is not available", &
+      "@:36: *BOUNDARY_SPC_NODE: field DOFX: must be 0 (free) or 1 (fixed), found 2", &
+      "@:38: *SECTION_SOLID: field ELFORM: meshfree sections are not available yet", &
+      "@:40: *SECTION_SOLID: field ELFORM: element formulation 7 is not available", &
+      "@:42: *NODE: field TC: translational constraint code must be 0-7", &
+      "@:45: *RIGIDWALL_PLANAR_MOVING: field XH: the normal from the tail (XT YT ZT) to the "// &
+      "head (XH YH ZH) has zero length", &
+      "@:46: *RIGIDWALL_PLANAR_MOVING: field MASS: a moving wall needs a mass > 0"])
+  end subroutine test_field_meanings
+end program test_deck

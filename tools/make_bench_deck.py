@@ -1,0 +1,52 @@
+#!/usr/bin/env python3
+"""Write the benchmark deck: a block of one-point hexahedra (elastic-plastic) thrown at a rigid
+wall, so that the elements deform plastically while the cycles are timed.
+
+    python3 tools/make_bench_deck.py OUT.k [--cells 50 50 40] [--cycles 200]
+"""
+import argparse
+
+import numpy as np
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("output")
+    parser.add_argument("--cells", type=int, nargs=3, default=[50, 50, 40])
+    parser.add_argument("--cycles", type=int, default=200)
+    parser.add_argument("--size", type=float, default=1.0, help="cell edge in mm")
+    options = parser.parse_args()
+    nx, ny, nz = options.cells
+    h = options.size
+    rng = np.random.default_rng(11)
+    x, y, z = np.meshgrid(np.arange(nx + 1) * h, np.arange(ny + 1) * h, np.arange(nz + 1) * h, indexing="ij")
+    nodes = np.stack([x, y, z], axis=-1)
+    nodes[1:-1, 1:-1, 1:-1] += rng.uniform(-0.1 * h, 0.1 * h, (nx - 1, ny - 1, nz - 1, 3))
+    nodes = nodes.reshape(-1, 3)
+    index = np.arange((nx + 1) * (ny + 1) * (nz + 1)).reshape(nx + 1, ny + 1, nz + 1) + 1
+    corners = [index[:-1, :-1, :-1], index[1:, :-1, :-1], index[1:, 1:, :-1], index[:-1, 1:, :-1],
+               index[:-1, :-1, 1:], index[1:, :-1, 1:], index[1:, 1:, 1:], index[:-1, 1:, 1:]]
+    elements = np.stack([c.reshape(-1) for c in corners], axis=1)
+
+    with open(options.output, "w") as deck:
+        deck.write("*KEYWORD\n*TITLE\nbenchmark block: %d one-point hexahedra\n" % len(elements))
+        deck.write("*CONTROL_TERMINATION\n%10.3f%10d\n" % (1.0, options.cycles))
+        deck.write("*DATABASE_BINARY_D3PLOT\n%10.3f\n*DATABASE_GLSTAT\n%10.3f\n" % (10.0, 10.0))
+        deck.write("*PART\nblock\n%10d%10d%10d%10d%10d\n" % (1, 1, 1, 0, 1))
+        deck.write("*SECTION_SOLID\n%10d%10d\n" % (1, 1))
+        deck.write("*MAT_PLASTIC_KINEMATIC\n%10d%10s%10s%10s%10s%10s%10s\n%10s%10s\n"
+                   % (1, "7.85e-6", "210.0", "0.3", "0.2", "1.0", "1.0", "0.0", "0.0"))
+        deck.write("*HOURGLASS\n%10d%10d%10s\n" % (1, 1, "0.1"))
+        deck.write("*INITIAL_VELOCITY\n%10d\n%10s%10s%10s\n" % (0, "0.0", "0.0", "-200.0"))
+        deck.write("*RIGIDWALL_PLANAR\n%10d\n%10s%10s%10s%10s%10s%10s\n" % (0, "0.0", "0.0", "0.0", "0.0", "0.0", "1.0"))
+        deck.write("*NODE\n")
+        np.savetxt(deck, np.column_stack([np.arange(1, len(nodes) + 1), nodes, np.zeros((len(nodes), 2))]),
+                   fmt="%8d%16.9e%16.9e%16.9e%8d%8d")
+        deck.write("*ELEMENT_SOLID\n")
+        np.savetxt(deck, np.column_stack([np.arange(1, len(elements) + 1), np.ones(len(elements), int), elements]),
+                   fmt="%8d" * 10)
+        deck.write("*END\n")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# make test: release build, Fortran unit tests in the checked (debug) build, then the pytest
+# regression tests on the release binary. The last line adds both up: "N passed, N failed".
+set -u
+jobs=$(nproc 2>/dev/null || echo 2)
+make --no-print-directory -j"$jobs" all || { echo "0 passed, 1 failed"; exit 1; }
+
+echo "== unit tests (MODE=debug: -std=f2008 -fcheck=all -ffpe-trap=invalid,zero,overflow) =="
+unit_log=$(mktemp)
+make --no-print-directory -j"$jobs" MODE=debug unit 2>&1 | tee "$unit_log"
+unit_line=$(grep -E '^unit: [0-9]+ passed, [0-9]+ failed' "$unit_log" | tail -n 1)
+unit_passed=0
+unit_failed=1
+if [ -n "$unit_line" ]; then
+  unit_passed=$(echo "$unit_line" | sed -E 's/^unit: ([0-9]+) passed.*/\1/')
+  unit_failed=$(echo "$unit_line" | sed -E 's/.* ([0-9]+) failed.*/\1/')
+fi
+rm -f "$unit_log"
+
+echo "== regression tests (pytest on results.h5) =="
+regression_log=$(mktemp)
+${PYTHON:-python3} -m pytest -q -p no:cacheprovider tests/regression 2>&1 | tee "$regression_log"
+summary=$(grep -E ' in [0-9.]+s' "$regression_log" | tail -n 1)
+count() { echo "$summary" | grep -oE "[0-9]+ $1" | grep -oE '^[0-9]+' | awk '{s += $1} END {print s + 0}'; }
+regression_passed=$(count passed)
+regression_failed=$(( $(count failed) + $(count errors?) ))
+if [ "$regression_passed" -eq 0 ]; then regression_failed=$((regression_failed + 1)); fi
+rm -f "$regression_log"
+
+passed=$((unit_passed + regression_passed))
+failed=$((unit_failed + regression_failed))
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]
