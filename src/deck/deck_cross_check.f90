@@ -132,17 +132,19 @@ contains
     type(deck_indices_t), intent(in) :: indices
     logical, intent(out) :: resolved
     type(problem_log_t), intent(inout) :: log
-    integer :: element, corner, index
+    integer, allocatable :: unknown_part(:)
+    integer :: element, corner, index, missing
     resolved = .true.
+    allocate (unknown_part(input%solid_count))
+    missing = 0
     associate (model => input%model)
       do element = 1, input%solid_count
         index = find_id(indices%parts, model%solid_part(element))
         if (index == 0) then
-          call located_problem(deck, log, input%solid_lines(element), "PID", "part "// &
-            integer_text(model%solid_part(element))//" of element "// &
-            integer_text(model%solid_ids(element))//" is not defined (no *PART with this PID)")
+          missing = missing + 1
+          unknown_part(missing) = element
         end if
-        model%solid_part(element) = index
+        if (index > 0) model%solid_part(element) = index
         do corner = 1, 8
           index = find_id(indices%nodes, model%solid_nodes(corner, element))
           if (index == 0) then
@@ -155,8 +157,38 @@ contains
           model%solid_nodes(corner, element) = index
         end do
       end do
+      call report_unknown_parts(deck, input, unknown_part(1:missing), log)
+      model%solid_part(unknown_part(1:missing)) = 0
     end associate
   end subroutine resolve_solids
+
+  !> One message per undefined part id, at its first element, with the number of elements
+  !> naming it (a mesh include without its *PART would otherwise fill the report).
+  subroutine report_unknown_parts(deck, input, elements, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(in) :: input
+    integer, intent(in) :: elements(:)
+    type(problem_log_t), intent(inout) :: log
+    type(id_index_t) :: by_part
+    integer :: k, first, element
+    character(len=:), allocatable :: others
+    call build_id_index(input%model%solid_part(elements), by_part)
+    first = 1
+    do k = 1, size(elements)
+      if (k < size(elements)) then
+        if (by_part%ids(k + 1) == by_part%ids(k)) cycle
+      end if
+      element = elements(by_part%positions(first))
+      others = ""
+      if (k - first == 1) others = "; 1 more element names it"
+      if (k - first > 1) others = "; "//integer_text(k - first)//" more elements name it"
+      call located_problem(deck, log, input%solid_lines(element), "PID", "part "// &
+        integer_text(input%model%solid_part(element))//" of element "// &
+        integer_text(input%model%solid_ids(element))//" is not defined (no *PART with this "// &
+        "PID)"//others)
+      first = k + 1
+    end do
+  end subroutine report_unknown_parts
 
   !> Part -> section, material and hourglass indices.
   subroutine resolve_parts(deck, input, indices, log)
@@ -740,7 +772,7 @@ contains
     logical, intent(in) :: resolved
     type(problem_log_t), intent(inout) :: log
     integer :: element, status, corner, part
-    real(wp) :: volume, corners(3, 8)
+    real(wp) :: corners(3, 8)
     character(len=:), allocatable :: name
 
     if (input%node_count == 0) call report_problem(log, deck%files(1)%path// &
@@ -753,7 +785,7 @@ contains
         do corner = 1, 8
           corners(:, corner) = model%coordinates(:, model%solid_nodes(corner, element))
         end do
-        call check_hexahedron(corners, status, corner, volume)
+        call check_hexahedron(corners, status, corner)
         if (status == 0) cycle
         part = model%solid_part(element)
         name = "element "//integer_text(model%solid_ids(element))
@@ -765,7 +797,7 @@ contains
             "N1-N4 counterclockwise as seen from the N5-N8 face")
         else if (status == shape_flat) then
           call located_problem(deck, log, input%solid_node_lines(element), "N1-N8", name// &
-            " has no volume ("//real_text(volume)//"): its nodes are collapsed or flat")
+            " has no volume: its nodes are collapsed or lie in one plane")
         end if
       end do
     end associate

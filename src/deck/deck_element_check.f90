@@ -20,28 +20,29 @@ module deck_element_check
   integer, parameter :: xi_neighbour(8) = [2, 1, 4, 3, 6, 5, 8, 7]
   integer, parameter :: eta_neighbour(8) = [4, 3, 2, 1, 8, 7, 6, 5]
   integer, parameter :: zeta_neighbour(8) = [5, 6, 7, 8, 1, 2, 3, 4]
-  !> The 12 edges, for the length scale of the tolerances.
-  integer, parameter :: edge_ends(2, 12) = reshape([1, 2, 2, 3, 3, 4, 4, 1, 5, 6, 6, 7, 7, 8, &
-                                                    8, 5, 1, 5, 2, 6, 3, 7, 4, 8], [2, 12])
 
 contains
 
   !> Check the hexahedron with corner coordinates `x(3, 8)`. `status` is shape_valid,
   !> shape_inside_out (`corner` = the corner with the most negative Jacobian) or shape_flat
-  !> (no positive volume). `volume`, exact for the trilinear shape (2x2x2 Gauss points), is
-  !> computed only for elements with a collapsed corner (0 otherwise).
-  pure subroutine check_hexahedron(x, status, corner, volume)
-    real(wp), intent(in) :: x(3, 8)
+  !> (a collapsed corner and no positive volume).
+  pure subroutine check_hexahedron(corners, status, corner)
+    real(wp), intent(in) :: corners(3, 8)
     integer, intent(out) :: status, corner
-    real(wp), intent(out) :: volume
-    real(wp) :: tolerance, lowest, jacobian, scale
+    real(wp) :: x(3, 8), tolerance, lowest, jacobian, extent, volume
     integer :: k
 
-    scale = 0.0_wp
-    do k = 1, 12
-      scale = max(scale, sum((x(:, edge_ends(2, k)) - x(:, edge_ends(1, k)))**2))
+    ! Work relative to node 1 and in units of the element's size: the tolerances are then
+    ! plain numbers and no product can overflow, whatever the units of the deck.
+    do k = 1, 8
+      x(:, k) = corners(:, k) - corners(:, 1)
     end do
-    tolerance = 1.0e-10_wp*sqrt(scale)**3
+    extent = maxval(abs(x))
+    status = shape_flat
+    corner = 1
+    if (extent == 0.0_wp) return
+    x = x/extent
+    tolerance = 1.0e-10_wp
     status = shape_valid
     corner = 0
     lowest = huge(1.0_wp)
@@ -54,7 +55,6 @@ contains
         corner = k
       end if
     end do
-    volume = 0.0_wp
     if (lowest < -tolerance) then
       status = shape_inside_out
     else if (lowest <= tolerance) then

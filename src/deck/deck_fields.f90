@@ -17,7 +17,7 @@ module deck_fields
   private
 
   public :: card_t, open_card, next_line, require_card, next_definition, get_integer, get_real
-  public :: get_text
+  public :: get_text, has_data
   public :: field_is_blank, card_problem, line_problem, line_title, id_heading, warn_if_set
   public :: keyword_label, located_problem
 
@@ -93,7 +93,8 @@ contains
 
   !> The next definition of a keyword whose definitions may repeat: with `has_title` a title
   !> line and then the first card, otherwise just the first card. False at the end of the
-  !> block, or when the title is the last line (the missing card is then reported).
+  !> block, or when the title is the last line or the keyword has no line at all (the missing
+  !> card is then reported).
   logical function next_definition(deck, block, has_title, line, widths, card, title, log, &
                                    label, first_field)
     type(deck_t), intent(in) :: deck
@@ -106,6 +107,10 @@ contains
     type(problem_log_t), intent(inout) :: log
     character(len=*), intent(in) :: label, first_field
     title = ""
+    if (line == 0) then
+      next_definition = has_data(deck, block, log, label, first_field)
+      if (.not. next_definition) return
+    end if
     next_definition = next_line(deck, block, line, .false.)
     if (.not. next_definition) return
     if (has_title) then
@@ -115,6 +120,18 @@ contains
       call open_card(deck, block, line, widths, card, log)
     end if
   end function next_definition
+
+  !> True when `block` has at least one data line; otherwise report `field FIRST_FIELD: LABEL
+  !> is missing` at the keyword line, for keywords that are meaningless without a card.
+  logical function has_data(deck, block, log, label, first_field)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(problem_log_t), intent(inout) :: log
+    character(len=*), intent(in) :: label, first_field
+    has_data = deck%blocks(block)%last_line >= deck%blocks(block)%first_line
+    if (.not. has_data) call line_problem(deck, log, deck%blocks(block)%keyword_line, block, &
+      first_field, label//" is missing: the keyword has no cards", unreadable=.true.)
+  end function has_data
 
   !> Integer field `k`; blank gives `default` (0 when absent).
   subroutine get_integer(deck, card, k, name, value, log, default)
@@ -202,7 +219,8 @@ contains
       call parse_real(text, value, status)
       if (status /= number_ok) then
         if (status == number_out_of_range) then
-          call field_problem(deck, card, k, name, """"//text//""" is out of range", log)
+          call field_problem(deck, card, k, name, """"//text//""" is out of range (magnitudes "// &
+                             "must stay below 1e100)", log)
         else
           call field_problem(deck, card, k, name, """"//text//""" is not a number", log)
         end if

@@ -10,8 +10,8 @@ module deck_loads_bcs
   use deck_numbers, only: integer_text, real_text
   use deck_lexer, only: deck_t
   use deck_keywords, only: keyword_t
-  use deck_fields, only: card_t, open_card, next_line, require_card, get_integer, get_real, &
-                         card_problem, warn_if_set, id_heading, line_problem
+  use deck_fields, only: card_t, open_card, next_line, require_card, has_data, get_integer, &
+                         get_real, card_problem, warn_if_set, id_heading, line_problem
   use deck_input, only: deck_input_t, velocity_input_t, velocity_by_set, velocity_by_node, &
                         velocity_generation
   implicit none
@@ -198,6 +198,7 @@ contains
     integer :: line, box, system
 
     line = 0
+    if (.not. has_data(deck, block, log, "card 1 (NSID NSIDEX BOXID IRIGID ICID)", "NSID")) return
     do while (next_line(deck, block, line, .true.))
       velocity = velocity_input_t(kind=velocity_by_set, line=line)
       call open_card(deck, block, line, standard_widths, card, log)
@@ -263,6 +264,7 @@ contains
     integer :: line, system
 
     line = 0
+    if (.not. has_data(deck, block, log, "card 1 (ID STYP OMEGA VX VY VZ IVATN ICID)", "ID")) return
     do while (next_line(deck, block, line, .true.))
       velocity = velocity_input_t(kind=velocity_generation, line=line)
       call open_card(deck, block, line, standard_widths, card, log)
@@ -333,6 +335,8 @@ contains
     integer :: line, n, box
 
     line = 0
+    if (.not. has_data(deck, block, log, "card 1 (NSID NSIDEX BOXID OFFSET BIRTH DEATH RWKSF)", &
+                       "NSID")) return
     do while (next_line(deck, block, line, .false.))
       n = input%wall_count + 1
       input%wall_count = n

@@ -3,7 +3,8 @@
 !> List-directed reads accept "1 2" as 1 and "1,2" as 1, so every field is checked character by
 !> character here instead. Reals take Fortran's forms, as LS-DYNA reads them: `1.5`, `-.5`,
 !> `2e3`, `2.0D+3`, and `1.0-3` (exponent without its letter). Most values are converted
-!> directly (exact and fast); long mantissas fall back to an internal read.
+!> directly (exact and fast); long mantissas fall back to an internal read. Magnitudes of 1e100
+!> and more are out of range.
 module deck_numbers
   use kinds, only: wp
   use, intrinsic :: iso_fortran_env, only: int64
@@ -144,9 +145,11 @@ contains
       status = number_ok
       return
     end if
-    ! decimal magnitude of the value: guards the conversion against overflow traps
+    ! Decimal magnitude of the value. Values of 1e100 and more are refused: no input quantity is
+    ! near that (LS-DYNA's "never" is 1e20 or 1e28), and products of a few inputs (scale times
+    ! offset, speed times distance) then stay far from overflow.
     magnitude = exponent + significant
-    if (magnitude > 300) then
+    if (magnitude > 100) then
       status = number_out_of_range
       return
     end if

@@ -7,8 +7,8 @@ module deck_parts_sections
   use deck_numbers, only: integer_text, real_text
   use deck_lexer, only: deck_t
   use deck_keywords, only: keyword_t
-  use deck_fields, only: card_t, next_line, require_card, next_definition, get_integer, &
-                         get_real, card_problem, warn_if_set, line_title
+  use deck_fields, only: card_t, next_line, require_card, next_definition, has_data, &
+                         get_integer, get_real, card_problem, warn_if_set, line_title
   use deck_input, only: deck_input_t
   implicit none
   private
@@ -31,6 +31,7 @@ contains
     character(len=:), allocatable :: title
 
     line = 0
+    if (.not. has_data(deck, block, log, "the heading line and the data card", "PID")) return
     do while (next_line(deck, block, line, .false.))
       title = line_title(deck, line)
       if (.not. require_card(deck, block, line, standard_widths, card, log, "the data card "// &

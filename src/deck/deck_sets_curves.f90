@@ -76,11 +76,7 @@ contains
 
     read_set_header = next_definition(deck, block, keyword%title, line, standard_widths, card, &
                                       set%title, log, "card 1 (SID DA1 DA2 DA3 DA4 SOLVER)", "SID")
-    if (.not. read_set_header) then
-      if (line == 0) call card_problem(deck, log, card_t(line=deck%blocks(block)%keyword_line, &
-        block=block), "SID", "card 1 (SID DA1 DA2 DA3 DA4 SOLVER) is missing", unreadable=.true.)
-      return
-    end if
+    if (.not. read_set_header) return
     set%line = line
     call get_integer(deck, card, 1, "SID", set%id, log)
     call get_text(deck, card, 6, "SOLVER", solver, log)
@@ -167,12 +163,7 @@ contains
 
     line = 0
     if (.not. next_definition(deck, block, keyword%title, line, standard_widths, card, title, log, &
-                              "card 1 (LCID SIDR SFA SFO OFFA OFFO DATTYP LCINT)", "LCID")) then
-      if (line == 0) call card_problem(deck, log, card_t(line=deck%blocks(block)%keyword_line, &
-        block=block), "LCID", "card 1 (LCID SIDR SFA SFO OFFA OFFO DATTYP LCINT) is missing", &
-        unreadable=.true.)
-      return
-    end if
+                              "card 1 (LCID SIDR SFA SFO OFFA OFFO DATTYP LCINT)", "LCID")) return
     n = input%curve_count + 1
     input%curve_count = n
     input%curve_lines(n) = line

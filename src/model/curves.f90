@@ -7,7 +7,8 @@ module curves
   public :: curve_t, curve_value, curve_slope
 
   !> One curve with its scale and offset factors already applied to the stored points:
-  !> stored abscissa = SFA * A + OFFA, stored ordinate = SFO * O + OFFO (LS-DYNA's convention).
+  !> stored abscissa = SFA * (A + OFFA), stored ordinate = SFO * (O + OFFO) (LS-DYNA's rule:
+  !> the offset is added before scaling).
   type :: curve_t
     integer :: id = 0
     character(len=:), allocatable :: title

@@ -248,7 +248,7 @@ contains
     call check(suite, "fixed: no warnings", warnings%count == 0)
   end subroutine test_fixed_format
 
-  !> Comma cards, lower-case keywords, parameters (R and I, `&`, `-&`), _TITLE options,
+  !> Comma cards, lower-case keywords, parameters (R, I and C, `&`, `-&`), _TITLE options,
   !> blank fields with defaults, nested includes by relative path, *END ending an include.
   subroutine test_free_format_parameters_include()
     type(model_t) :: model
@@ -273,8 +273,10 @@ contains
       "R len      2.5       I part    3", &
       "*Control_Termination", &
       "&len,,,", &
+      "*PARAMETER", &
+      "C meshfile,sub/mesh.k", &
       "*include", &
-      "sub/mesh.k", &
+      "&meshfile", &
       "*PART", &
       "", &
       "&part,4,2", &
@@ -580,6 +582,8 @@ contains
       "(entry 2 of the comma-separated card)"])
     call read_bad("not_integral.k", replaced(16, fixed(["1.5", "1  "], 8)), &
       [character(len=120) :: "@:16: *ELEMENT_SOLID: field EID: ""1.5"" is not an integer"])
+    call read_bad("out_of_range.k", replaced(8, "2,1e200,0,0"), &
+      [character(len=120) :: "@:8: *NODE: field X: ""1e200"" is out of range"])
     call read_bad("parameter.k", replaced(5, "&tend"), &
       [character(len=120) :: "@:5: *CONTROL_TERMINATION: field ENDTIM: parameter &tend is "// &
       "not defined"])
@@ -604,6 +608,9 @@ contains
     call read_bad("termination_no_card.k", replaced(5, "$ no card", [character(len=line_length) &
       :: "*DATABASE_GLSTAT", "1.0e-3"]), [character(len=120) :: "@:4: *CONTROL_TERMINATION: "// &
       "field ENDTIM: card 1 (ENDTIM ENDCYC DTMIN ENDENG ENDMAS NOSOL) is missing"])
+    call read_bad("section_no_card.k", replaced(21, "$ the card is missing"), &
+      [character(len=120) :: "@:20: *SECTION_SOLID: field SECID: card 1 (SECID ELFORM AET) is "// &
+      "missing: the keyword has no cards"])
     call read_bad("two_line_missing.k", cube_deck([character(len=line_length) :: &
       "*ELEMENT_SOLID", fixed(["2", "1"], 8)]), [character(len=120) :: "@:25: *ELEMENT_SOLID: "// &
       "field N1: the node card (N1-N8) of element 2 is missing"])
@@ -627,7 +634,8 @@ contains
       "*BOUNDARY_SPC_SET", "5,0,1,1,1", &
       "*ELEMENT_SOLID", fixed(["2 ", "42", "1 ", "2 ", "3 ", "4 ", "5 ", "6 ", "7 ", "8 "], 8), &
       "*SET_NODE_LIST", "4", "1,77", &
-      "*DATABASE_HISTORY_NODE", "1,0,88"])
+      "*DATABASE_HISTORY_NODE", "1,0,88", &
+      "*ELEMENT_SOLID", fixed(["3 ", "42", "1 ", "2 ", "3 ", "4 ", "5 ", "6 ", "7 ", "8 "], 8)])
     call read_bad("references.k", lines, [character(len=120) :: &
       "@:16: *ELEMENT_SOLID: field N3: node 99 of element 1 is not defined", &
       "@:26: *PART: field MID: part 2 has no material (MID is blank or 0)", &
@@ -636,7 +644,8 @@ contains
       "@:29: *PART: field HGID: hourglass 11 of part 3 is not defined", &
       "@:31: *BOUNDARY_PRESCRIBED_MOTION_NODE: field LCID: curve 9 is not defined", &
       "@:33: *BOUNDARY_SPC_SET: field NSID: node set 5 is not defined", &
-      "@:35: *ELEMENT_SOLID: field PID: part 42 of element 2 is not defined", &
+      "@:35: *ELEMENT_SOLID: field PID: part 42 of element 2 is not defined (no *PART with "// &
+      "this PID); 1 more element names it", &
       "@:38: *SET_NODE_LIST: field NID2: node 77 of set 4 is not defined", &
       "@:40: *DATABASE_HISTORY_NODE: field ID3: node 88 is not defined"], message_lines=10)
   end subroutine test_reference_errors
