@@ -14,6 +14,7 @@ module hex8_full
   private
 
   public :: point_velocity_gradient, add_deviatoric_point_forces, add_mean_stress_forces
+  public :: add_point_stress_power, corner_force_power
 
 contains
 
@@ -83,9 +84,14 @@ contains
                                    + s23*dndz(i, node)
         corner_force(i, node, 3) = corner_force(i, node, 3) + s31*dndx(i, node) + s23*dndy(i, node) &
                                    + s33*dndz(i, node)
-        bx(i, node) = bx(i, node) + w*dndx(i, node)
-        by(i, node) = by(i, node) + w*dndy(i, node)
-        bz(i, node) = bz(i, node) + w*dndz(i, node)
+      end do
+    end do
+    ! (a separate lane loop: one loop with both would be too large to vectorize)
+    do i = 1, nel
+      do node = 1, 8
+        bx(i, node) = bx(i, node) + determinant(i)*dndx(i, node)
+        by(i, node) = by(i, node) + determinant(i)*dndy(i, node)
+        bz(i, node) = bz(i, node) + determinant(i)*dndz(i, node)
       end do
     end do
   end subroutine add_deviatoric_point_forces
@@ -106,4 +112,48 @@ contains
       end do
     end do
   end subroutine add_mean_stress_forces
+
+  !> Accumulates what the power of the B-bar forces of one point needs, for a velocity field
+  !> whose gradient at the point is `gradient` (row by row): detJ s : L into `deviatoric_power`,
+  !> detJ sigma_kk/3 into `mean_stress_integral` and detJ tr L into `trace_integral`. The
+  !> power of the element's forces is then deviatoric_power + (mean_stress_integral / V - q)
+  !> trace_integral (see the module comment).
+  subroutine add_point_stress_power(nel, determinant, gradient, stress, deviatoric_power, &
+                                    mean_stress_integral, trace_integral)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: determinant(block_size), gradient(block_size, 9), stress(block_size, 6)
+    real(wp), intent(inout) :: deviatoric_power(block_size), mean_stress_integral(block_size)
+    real(wp), intent(inout) :: trace_integral(block_size)
+    real(wp) :: mean, trace
+    integer :: i
+    do i = 1, nel
+      mean = (stress(i, 1) + stress(i, 2) + stress(i, 3))/3.0_wp
+      trace = gradient(i, 1) + gradient(i, 5) + gradient(i, 9)
+      deviatoric_power(i) = deviatoric_power(i) + determinant(i)*(stress(i, 1)*gradient(i, 1) &
+                            + stress(i, 2)*gradient(i, 5) + stress(i, 3)*gradient(i, 9) &
+                            + stress(i, 4)*(gradient(i, 2) + gradient(i, 4)) &
+                            + stress(i, 5)*(gradient(i, 6) + gradient(i, 8)) &
+                            + stress(i, 6)*(gradient(i, 7) + gradient(i, 3)) - mean*trace)
+      mean_stress_integral(i) = mean_stress_integral(i) + determinant(i)*mean
+      trace_integral(i) = trace_integral(i) + determinant(i)*trace
+    end do
+  end subroutine add_point_stress_power
+
+  !> Power of the corner forces against the corner velocities, sum_I f_I . v_I.
+  subroutine corner_force_power(nel, corner_force, vx, vy, vz, power)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: corner_force(block_size, 8, 3)
+    real(wp), intent(in) :: vx(block_size, 8), vy(block_size, 8), vz(block_size, 8)
+    real(wp), intent(out) :: power(block_size)
+    real(wp) :: sum_of_products
+    integer :: node, i
+    do i = 1, nel
+      sum_of_products = 0.0_wp
+      do node = 1, 8
+        sum_of_products = sum_of_products + corner_force(i, node, 1)*vx(i, node) &
+                          + corner_force(i, node, 2)*vy(i, node) + corner_force(i, node, 3)*vz(i, node)
+      end do
+      power(i) = sum_of_products
+    end do
+  end subroutine corner_force_power
 end module hex8_full

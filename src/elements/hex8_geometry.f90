@@ -8,14 +8,14 @@
 !> loop over it runs `do i = 1, nel`, so the compiler vectorizes across elements.
 !>
 !> Reference: D.P. Flanagan and T. Belytschko, "A uniform strain hexahedron and quadrilateral
-!> with orthogonal hourglass control", IJNME 17 (1981) 679-706, eqs. (14)-(16) and Appendix:
-!> b_iI = dV/dx_iI = integral of dN_I/dx_i over the element, evaluated in closed form.
+!> with orthogonal hourglass control", IJNME 17 (1981) 679-706: the mean gradient
+!> b_iI = integral of dN_I/dx_i over the element equals dV/dx_iI and has a closed form.
 module hex8_geometry
   use kinds, only: wp, block_size
   implicit none
   private
 
-  public :: hex8_volume_derivatives, hex8_velocity_gradient, hex8_largest_face_area
+  public :: hex8_volume_derivatives, hex8_volume, hex8_velocity_gradient, hex8_largest_face_area
   public :: hex8_gauss_natural_derivatives, hex8_point_derivatives, deformation_increments
 
   !> Natural coordinates of the eight nodes.
@@ -28,7 +28,7 @@ module hex8_geometry
                                                             2, 3, 7, 6, 3, 4, 8, 7, 4, 1, 5, 8], [4, 6])
 
   ! The volume derivative of node 1 is a fixed bilinear form in the coordinates of nodes 2, 3,
-  ! 4, 5, 6 and 8 (Flanagan & Belytschko 1981, Appendix); every other node uses the same form
+  ! 4, 5, 6 and 8 (Flanagan & Belytschko 1981 give it); every other node uses the same form
   ! on its own neighbours. For node I the element nodes playing the roles of nodes 1..8 of the
   ! node-1 formula are (derived from the rotations of the cube and checked symbolically against
   ! dV/dx_I for every node and component):
@@ -87,6 +87,33 @@ contains
                   + x7*bx(i, 7) + x8*bx(i, 8)
     end do
   end subroutine hex8_volume_derivatives
+
+  !> The trilinear "volume" V = sum_I x_I b_xI of eight points given as x, y, z (for the
+  !> element's nodes its volume; for the nodal velocities the cubic coefficient of the volume
+  !> along the step, see solid_block).
+  subroutine hex8_volume(nel, x, y, z, volume)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
+    real(wp), intent(out) :: volume(block_size)
+    real(wp), parameter :: twelfth = 1.0_wp/12.0_wp
+    real(wp) :: x1, x2, x3, x4, x5, x6, x7, x8, y1, y2, y3, y4, y5, y6, y7, y8
+    real(wp) :: z1, z2, z3, z4, z5, z6, z7, z8
+    integer :: i
+
+    do i = 1, nel
+      x1 = x(i, 1); x2 = x(i, 2); x3 = x(i, 3); x4 = x(i, 4); x5 = x(i, 5); x6 = x(i, 6); x7 = x(i, 7); x8 = x(i, 8)
+      y1 = y(i, 1); y2 = y(i, 2); y3 = y(i, 3); y4 = y(i, 4); y5 = y(i, 5); y6 = y(i, 6); y7 = y(i, 7); y8 = y(i, 8)
+      z1 = z(i, 1); z2 = z(i, 2); z3 = z(i, 3); z4 = z(i, 4); z5 = z(i, 5); z6 = z(i, 6); z7 = z(i, 7); z8 = z(i, 8)
+      volume(i) = twelfth*(x1*volume_form(y2, y3, y4, y5, y6, y8, z2, z3, z4, z5, z6, z8) &
+                           + x2*volume_form(y1, y5, y6, y3, y4, y7, z1, z5, z6, z3, z4, z7) &
+                           + x3*volume_form(y4, y1, y2, y7, y8, y6, z4, z1, z2, z7, z8, z6) &
+                           + x4*volume_form(y3, y7, y8, y1, y2, y5, z3, z7, z8, z1, z2, z5) &
+                           + x5*volume_form(y6, y2, y1, y8, y7, y4, z6, z2, z1, z8, z7, z4) &
+                           + x6*volume_form(y5, y8, y7, y2, y1, y3, z5, z8, z7, z2, z1, z3) &
+                           + x7*volume_form(y8, y4, y3, y6, y5, y2, z8, z4, z3, z6, z5, z2) &
+                           + x8*volume_form(y7, y6, y5, y4, y3, y1, z7, z6, z5, z4, z3, z1))
+    end do
+  end subroutine hex8_volume
 
   !> Twelve times dV/dx_1 written with the roles of nodes 2..8 (node 7 does not appear):
   !> the cyclic permutations (y,z), (z,x), (x,y) give the x, y and z components.

@@ -1,33 +1,34 @@
 !> One-point (uniform strain) hexahedron, ELFORM 1: corner forces from the element stress and
-!> the hourglass control forces, on a block of elements.
+!> the hourglass control forces, on a block of elements (Flanagan & Belytschko, IJNME 17 (1981)
+!> 679-706; LS-DYNA Theory Manual, "Solid elements" and "Hourglass control").
 !>
-!> Stress divergence (Flanagan & Belytschko 1981, eq. 20): f_iI = (sigma_ij - q delta_ij) b_jI
-!> with b the exact volume derivatives at the end-of-step configuration and q the bulk
-!> viscosity. Sum over I vanishes (sum_I b_jI = 0) and so does the moment
-!> (sum_I x_kI b_jI = V delta_jk with sigma symmetric).
+!> Stress divergence: f_iI = (sigma_ij - q delta_ij) b_jI with b the exact volume derivatives at
+!> the end-of-step configuration and q the bulk viscosity. The sum over I vanishes
+!> (sum_I b_jI = 0) and so does the moment (sum_I x_kI b_jI = V delta_jk, sigma symmetric).
 !>
-!> Hourglass control (LS-DYNA Theory Manual, section "Hourglass control" of the solid elements;
-!> Flanagan & Belytschko 1981, section 4). With the base vectors h_alpha (alpha = 1..4; eta zeta,
-!> zeta xi, xi eta, xi eta zeta at the nodes) the shape vectors are
-!>   IHQ 1      gamma_alpha = h_alpha                          (LS-DYNA standard, Kosloff-Frazier)
+!> Hourglass control. With the base vectors h_alpha (alpha = 1..4: eta zeta, zeta xi, xi eta,
+!> xi eta zeta at the nodes) the shape vectors are
+!>   IHQ 1      gamma_alpha = h_alpha                               (LS-DYNA standard form)
 !>   IHQ 2, 4   gamma_alphaI = h_alphaI - (h_alpha . x_i) dN_I/dx_i(0)  (one-point Jacobian at
 !>              the element centre; "volume" V0 = 8 det J(0))
 !>   IHQ 3, 5   gamma_alphaI = h_alphaI - (h_alpha . x_i) b_iI / V      (exact volume)
-!> For IHQ 2-5, sum_I gamma_alphaI x_jI = 0 and sum_I gamma_alphaI = 0, so a velocity field
-!> linear in the coordinates has zero hourglass velocity q_ialpha = sum_I v_iI gamma_alphaI,
-!> and the hourglass forces f_iI = sum_alpha Q_ialpha gamma_alphaI carry neither resultant nor
-!> moment. IHQ 1 passes neither test on a distorted element (it is only orthogonal to linear
-!> fields on parallelepipeds).
+!> For IHQ 2-5, sum_I gamma_alphaI x_jI = 0 and sum_I gamma_alphaI = 0 (Flanagan & Belytschko's
+!> orthogonality), so a velocity field linear in the coordinates has zero hourglass velocity
+!> q_ialpha = sum_I v_iI gamma_alphaI, and the hourglass forces f_iI = sum_alpha Q_ialpha
+!> gamma_alphaI carry neither resultant nor moment. IHQ 1 has no resultant, but it is orthogonal
+!> to linear fields only on parallelepipeds, so on distorted elements it resists uniform strain
+!> and its forces have a moment.
 !>   viscous (IHQ 1, 2, 3):   Q_ialpha = a_h q_ialpha,  a_h = QM rho c V^(2/3) / 4
-!>                            (the LS-DYNA Theory Manual's scaling of the viscous form)
+!>                            (the scaling of the LS-DYNA Theory Manual's viscous form)
 !>   stiffness (IHQ 4, 5):    Q_ialpha(n+1) = R Q_ialpha(n) + k dt q_ialpha,
 !>                            k = QM (lambda + 2 mu) (b_iI b_iI) / (3 V)
-!> The stiffness k is QM times the one-eighth share of the element's highest-mode stiffness in
-!> the eigenvalue bound of Flanagan & Belytschko (1981): omega_max^2 = 8 (lambda + 2 mu)
-!> b_iI b_iI / (3 rho V^2), i.e. (rho V / 8) omega_max^2 = (lambda + 2 mu) b_iI b_iI / (3 V).
-!> For a cube of side h, k = QM (lambda + 2 mu) h / 2. The accumulated Q rotate with the
-!> element (R the incremental rotation of the spin). Hourglass energy is the work
-!> sum Q_ialpha q_ialpha dt (mid-step force for the stiffness form).
+!> For the stiffness we use QM times (rho V / 8) omega^2 with the uniform-strain estimate of the
+!> highest frequency omega^2 = 8 (lambda + 2 mu) b_iI b_iI / (3 rho V^2) (Flanagan & Belytschko's
+!> bound has this form; for a cube of side h it gives omega = 2c/h, the critical step h/c), so
+!> that k = QM (lambda + 2 mu) h / 2 for a cube; the Theory Manual gives the (lambda + 2 mu)
+!> scaling but we have not checked LS-DYNA's constant against it. The accumulated Q rotate with
+!> the element (R the incremental rotation of the spin). Hourglass energy is the work of the
+!> hourglass forces (solid_block integrates it in the central-difference sense).
 !> rho is the current density (mass / current volume), c = sqrt((lambda + 2 mu) / rho_block).
 module hex8_one_point
   use kinds, only: wp, block_size
@@ -36,8 +37,8 @@ module hex8_one_point
   implicit none
   private
 
-  public :: one_point_stress_forces, hourglass_shape_vectors, hourglass_viscous_forces
-  public :: hourglass_stiffness_forces
+  public :: one_point_corner_forces, hourglass_shape_vectors, hourglass_viscous_forces
+  public :: hourglass_stiffness_forces, one_point_force_powers, previous_hourglass_velocities, hourglass_power
 
   !> Hourglass base vectors h_alpha(I) (rows: eta zeta, zeta xi, xi eta, xi eta zeta).
   real(wp), parameter, public :: hourglass_base(8, 4) = reshape([ &
@@ -46,29 +47,241 @@ module hex8_one_point
 
 contains
 
-  !> Corner forces of the uniform stress (sigma - q I) of each element, overwriting
-  !> corner_force(:, I, i) = sum_j (sigma_ij - q delta_ij) b_jI.
-  subroutine one_point_stress_forces(nel, bx, by, bz, stress, bulk_viscosity, corner_force)
+  !> Corner forces of each element, overwriting lanes 1..nel:
+  !>   corner_force(:, I, i) = sum_j (sigma_ij - q delta_ij) b_jI + sum_alpha Q_ialpha gamma_alphaI
+  !> (stress divergence with bulk viscosity, plus the generalized hourglass forces Q stored as
+  !> generalized(:, i + 3 (alpha - 1))). Written in one pass, as the corner forces go to memory.
+  subroutine one_point_corner_forces(nel, bx, by, bz, stress, bulk_viscosity, gamma, generalized, corner_force)
     integer, intent(in) :: nel
     real(wp), intent(in) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8)
     real(wp), intent(in) :: stress(block_size, 6), bulk_viscosity(block_size)
+    real(wp), intent(in) :: gamma(block_size, 8, 4), generalized(block_size, 12)
     real(wp), intent(inout) :: corner_force(block_size, 8, 3)
-    real(wp) :: s11, s22, s33, s12, s23, s31
-    integer :: node, i
-    do i = 1, nel
-      s11 = stress(i, 1) - bulk_viscosity(i)
-      s22 = stress(i, 2) - bulk_viscosity(i)
-      s33 = stress(i, 3) - bulk_viscosity(i)
-      s12 = stress(i, 4)
-      s23 = stress(i, 5)
-      s31 = stress(i, 6)
-      do node = 1, 8
-        corner_force(i, node, 1) = s11*bx(i, node) + s12*by(i, node) + s31*bz(i, node)
-        corner_force(i, node, 2) = s12*bx(i, node) + s22*by(i, node) + s23*bz(i, node)
-        corner_force(i, node, 3) = s31*bx(i, node) + s23*by(i, node) + s33*bz(i, node)
+    ! Voigt position of stress row `component`, columns x, y, z
+    integer, parameter :: row(3, 3) = reshape([1, 4, 6, 4, 2, 5, 6, 5, 3], [3, 3])
+    real(wp) :: sx, sy, sz, g1, g2, g3, g4
+    integer :: node, i, component
+    ! one component at a time keeps the lane loop small enough to vectorize
+    do component = 1, 3
+      do i = 1, nel
+        sx = stress(i, row(1, component))
+        sy = stress(i, row(2, component))
+        sz = stress(i, row(3, component))
+        if (component == 1) sx = sx - bulk_viscosity(i)
+        if (component == 2) sy = sy - bulk_viscosity(i)
+        if (component == 3) sz = sz - bulk_viscosity(i)
+        g1 = generalized(i, component)
+        g2 = generalized(i, component + 3)
+        g3 = generalized(i, component + 6)
+        g4 = generalized(i, component + 9)
+        do node = 1, 8
+          corner_force(i, node, component) = sx*bx(i, node) + sy*by(i, node) + sz*bz(i, node) &
+                                             + g1*gamma(i, node, 1) + g2*gamma(i, node, 2) &
+                                             + g3*gamma(i, node, 3) + g4*gamma(i, node, 4)
+        end do
       end do
     end do
-  end subroutine one_point_stress_forces
+  end subroutine one_point_corner_forces
+
+  !> Power against v(n+1/2) of the stress-divergence forces (sigma - q I) b of this call
+  !> (new_power, b at x(n+1)) and of the previous call (old_power, with the previous stress and
+  !> q and b at x(n) = x(n+1) - dt v). The sums G = sum_I v_I (x) b_I at x(n) need no second
+  !> geometry: along x(s) = x(n+1) - s dt v the volume derivatives are quadratic in s, and the
+  !> identity sum_I v_jI b_kI(v) = V(v) delta_jk (b and V of the "velocity hexahedron") gives
+  !>   G(n) = 2 G(n+1/2) - G(n+1) + dt^2 V(v) I / 2,   V(n) = V(n+1) - dt tr G(n+1/2) - dt^3 V(v) / 4
+  !> with G(n+1/2) = V(n+1/2) L(n+1/2) from the mid-step kinematics. G(n) (row by row) and V(n)
+  !> are returned for the hourglass power of the previous call.
+  subroutine one_point_force_powers(nel, time_step, bx, by, bz, volume, vx, vy, vz, mid_gradient, mid_volume, &
+                                    velocity_volume, old_stress, old_bulk_viscosity, new_stress, &
+                                    new_bulk_viscosity, old_gradient_sum, old_volume, old_power, new_power)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: time_step
+    real(wp), intent(in) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8), volume(block_size)
+    real(wp), intent(in) :: vx(block_size, 8), vy(block_size, 8), vz(block_size, 8)
+    real(wp), intent(in) :: mid_gradient(block_size, 9), mid_volume(block_size), velocity_volume(block_size)
+    real(wp), intent(in) :: old_stress(block_size, 6), old_bulk_viscosity(block_size)
+    real(wp), intent(in) :: new_stress(block_size, 6), new_bulk_viscosity(block_size)
+    real(wp), intent(out) :: old_gradient_sum(block_size, 9), old_volume(block_size)
+    real(wp), intent(out) :: old_power(block_size), new_power(block_size)
+    real(wp) :: g11, g12, g13, g21, g22, g23, g31, g32, g33, diagonal
+    real(wp) :: o11, o12, o13, o21, o22, o23, o31, o32, o33
+    integer :: node, i
+    do i = 1, nel
+      g11 = 0.0_wp; g12 = 0.0_wp; g13 = 0.0_wp
+      g21 = 0.0_wp; g22 = 0.0_wp; g23 = 0.0_wp
+      g31 = 0.0_wp; g32 = 0.0_wp; g33 = 0.0_wp
+      do node = 1, 8
+        g11 = g11 + vx(i, node)*bx(i, node)
+        g12 = g12 + vx(i, node)*by(i, node)
+        g13 = g13 + vx(i, node)*bz(i, node)
+        g21 = g21 + vy(i, node)*bx(i, node)
+        g22 = g22 + vy(i, node)*by(i, node)
+        g23 = g23 + vy(i, node)*bz(i, node)
+        g31 = g31 + vz(i, node)*bx(i, node)
+        g32 = g32 + vz(i, node)*by(i, node)
+        g33 = g33 + vz(i, node)*bz(i, node)
+      end do
+      new_power(i) = (new_stress(i, 1) - new_bulk_viscosity(i))*g11 + (new_stress(i, 2) - new_bulk_viscosity(i))*g22 &
+                     + (new_stress(i, 3) - new_bulk_viscosity(i))*g33 + new_stress(i, 4)*(g12 + g21) &
+                     + new_stress(i, 5)*(g23 + g32) + new_stress(i, 6)*(g31 + g13)
+      diagonal = 0.5_wp*time_step**2*velocity_volume(i)
+      o11 = 2.0_wp*mid_volume(i)*mid_gradient(i, 1) - g11 + diagonal
+      o12 = 2.0_wp*mid_volume(i)*mid_gradient(i, 2) - g12
+      o13 = 2.0_wp*mid_volume(i)*mid_gradient(i, 3) - g13
+      o21 = 2.0_wp*mid_volume(i)*mid_gradient(i, 4) - g21
+      o22 = 2.0_wp*mid_volume(i)*mid_gradient(i, 5) - g22 + diagonal
+      o23 = 2.0_wp*mid_volume(i)*mid_gradient(i, 6) - g23
+      o31 = 2.0_wp*mid_volume(i)*mid_gradient(i, 7) - g31
+      o32 = 2.0_wp*mid_volume(i)*mid_gradient(i, 8) - g32
+      o33 = 2.0_wp*mid_volume(i)*mid_gradient(i, 9) - g33 + diagonal
+      old_power(i) = (old_stress(i, 1) - old_bulk_viscosity(i))*o11 + (old_stress(i, 2) - old_bulk_viscosity(i))*o22 &
+                     + (old_stress(i, 3) - old_bulk_viscosity(i))*o33 + old_stress(i, 4)*(o12 + o21) &
+                     + old_stress(i, 5)*(o23 + o32) + old_stress(i, 6)*(o31 + o13)
+      old_gradient_sum(i, 1) = o11
+      old_gradient_sum(i, 2) = o12
+      old_gradient_sum(i, 3) = o13
+      old_gradient_sum(i, 4) = o21
+      old_gradient_sum(i, 5) = o22
+      old_gradient_sum(i, 6) = o23
+      old_gradient_sum(i, 7) = o31
+      old_gradient_sum(i, 8) = o32
+      old_gradient_sum(i, 9) = o33
+      old_volume(i) = volume(i) - time_step*mid_volume(i)*(mid_gradient(i, 1) + mid_gradient(i, 5) + mid_gradient(i, 9)) &
+                      - 0.25_wp*time_step**3*velocity_volume(i)
+    end do
+  end subroutine one_point_force_powers
+
+  !> Hourglass velocities q_ialpha = sum_I v_iI gamma_alphaI(n) with the shape vectors of the
+  !> previous configuration x(n) = x(n+1) - dt v, for the power of the previous call's hourglass
+  !> forces, without forming gamma(n): with p = h_alpha . x(n) and h_alpha . v,
+  !>   IHQ 1      q = h_alpha . v
+  !>   IHQ 3, 5   q = h_alpha . v - G(n) p / V(n)          (G(n), V(n) from one_point_force_powers)
+  !>   IHQ 2, 4   q = h_alpha . v - Jv (8 J(n))^-1 p,  Jv_ia = sum_I v_iI xi_aI, 8 J(n)_ka = sum_I x_kI(n) xi_aI
+  subroutine previous_hourglass_velocities(nel, hourglass_type, time_step, x, y, z, vx, vy, vz, &
+                                           old_gradient_sum, old_volume, velocity)
+    integer, intent(in) :: nel, hourglass_type
+    real(wp), intent(in) :: time_step
+    real(wp), intent(in) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
+    real(wp), intent(in) :: vx(block_size, 8), vy(block_size, 8), vz(block_size, 8)
+    real(wp), intent(in) :: old_gradient_sum(block_size, 9), old_volume(block_size)
+    real(wp), intent(out) :: velocity(block_size, 12)
+    real(wp) :: mapping(block_size, 9)
+    real(wp) :: hvx, hvy, hvz, px, py, pz
+    real(wp) :: j11, j12, j13, j21, j22, j23, j31, j32, j33, i11, i12, i13, i21, i22, i23, i31, i32, i33
+    real(wp) :: v11, v12, v13, v21, v22, v23, v31, v32, v33, scale, xn, yn, zn
+    integer :: node, mode, i
+
+    ! the 3 x 3 map from p to the correction of q, row by row
+    select case (hourglass_type)
+    case (2, 4)
+      do i = 1, nel
+        j11 = 0.0_wp; j12 = 0.0_wp; j13 = 0.0_wp; j21 = 0.0_wp; j22 = 0.0_wp; j23 = 0.0_wp
+        j31 = 0.0_wp; j32 = 0.0_wp; j33 = 0.0_wp
+        v11 = 0.0_wp; v12 = 0.0_wp; v13 = 0.0_wp; v21 = 0.0_wp; v22 = 0.0_wp; v23 = 0.0_wp
+        v31 = 0.0_wp; v32 = 0.0_wp; v33 = 0.0_wp
+        do node = 1, 8
+          xn = x(i, node) - time_step*vx(i, node)
+          yn = y(i, node) - time_step*vy(i, node)
+          zn = z(i, node) - time_step*vz(i, node)
+          j11 = j11 + xn*node_xi(node)
+          j12 = j12 + xn*node_eta(node)
+          j13 = j13 + xn*node_zeta(node)
+          j21 = j21 + yn*node_xi(node)
+          j22 = j22 + yn*node_eta(node)
+          j23 = j23 + yn*node_zeta(node)
+          j31 = j31 + zn*node_xi(node)
+          j32 = j32 + zn*node_eta(node)
+          j33 = j33 + zn*node_zeta(node)
+          v11 = v11 + vx(i, node)*node_xi(node)
+          v12 = v12 + vx(i, node)*node_eta(node)
+          v13 = v13 + vx(i, node)*node_zeta(node)
+          v21 = v21 + vy(i, node)*node_xi(node)
+          v22 = v22 + vy(i, node)*node_eta(node)
+          v23 = v23 + vy(i, node)*node_zeta(node)
+          v31 = v31 + vz(i, node)*node_xi(node)
+          v32 = v32 + vz(i, node)*node_eta(node)
+          v33 = v33 + vz(i, node)*node_zeta(node)
+        end do
+        i11 = j22*j33 - j23*j32
+        i12 = j13*j32 - j12*j33
+        i13 = j12*j23 - j13*j22
+        i21 = j23*j31 - j21*j33
+        i22 = j11*j33 - j13*j31
+        i23 = j13*j21 - j11*j23
+        i31 = j21*j32 - j22*j31
+        i32 = j12*j31 - j11*j32
+        i33 = j11*j22 - j12*j21
+        scale = j11*i11 + j12*i21 + j13*i31
+        scale = 1.0_wp/sign(max(abs(scale), tiny(1.0_wp)), scale)
+        mapping(i, 1) = (v11*i11 + v12*i21 + v13*i31)*scale
+        mapping(i, 2) = (v11*i12 + v12*i22 + v13*i32)*scale
+        mapping(i, 3) = (v11*i13 + v12*i23 + v13*i33)*scale
+        mapping(i, 4) = (v21*i11 + v22*i21 + v23*i31)*scale
+        mapping(i, 5) = (v21*i12 + v22*i22 + v23*i32)*scale
+        mapping(i, 6) = (v21*i13 + v22*i23 + v23*i33)*scale
+        mapping(i, 7) = (v31*i11 + v32*i21 + v33*i31)*scale
+        mapping(i, 8) = (v31*i12 + v32*i22 + v33*i32)*scale
+        mapping(i, 9) = (v31*i13 + v32*i23 + v33*i33)*scale
+      end do
+    case (3, 5)
+      do i = 1, nel
+        scale = 1.0_wp/sign(max(abs(old_volume(i)), tiny(1.0_wp)), old_volume(i))
+        mapping(i, 1) = old_gradient_sum(i, 1)*scale
+        mapping(i, 2) = old_gradient_sum(i, 2)*scale
+        mapping(i, 3) = old_gradient_sum(i, 3)*scale
+        mapping(i, 4) = old_gradient_sum(i, 4)*scale
+        mapping(i, 5) = old_gradient_sum(i, 5)*scale
+        mapping(i, 6) = old_gradient_sum(i, 6)*scale
+        mapping(i, 7) = old_gradient_sum(i, 7)*scale
+        mapping(i, 8) = old_gradient_sum(i, 8)*scale
+        mapping(i, 9) = old_gradient_sum(i, 9)*scale
+      end do
+    case default
+      mapping(1:nel, :) = 0.0_wp
+    end select
+
+    do mode = 1, 4
+      do i = 1, nel
+        hvx = 0.0_wp
+        hvy = 0.0_wp
+        hvz = 0.0_wp
+        px = 0.0_wp
+        py = 0.0_wp
+        pz = 0.0_wp
+        do node = 1, 8
+          hvx = hvx + hourglass_base(node, mode)*vx(i, node)
+          hvy = hvy + hourglass_base(node, mode)*vy(i, node)
+          hvz = hvz + hourglass_base(node, mode)*vz(i, node)
+          px = px + hourglass_base(node, mode)*x(i, node)
+          py = py + hourglass_base(node, mode)*y(i, node)
+          pz = pz + hourglass_base(node, mode)*z(i, node)
+        end do
+        ! p = h . x(n) = h . x(n+1) - dt h . v
+        px = px - time_step*hvx
+        py = py - time_step*hvy
+        pz = pz - time_step*hvz
+        velocity(i, 3*mode - 2) = hvx - (mapping(i, 1)*px + mapping(i, 2)*py + mapping(i, 3)*pz)
+        velocity(i, 3*mode - 1) = hvy - (mapping(i, 4)*px + mapping(i, 5)*py + mapping(i, 6)*pz)
+        velocity(i, 3*mode) = hvz - (mapping(i, 7)*px + mapping(i, 8)*py + mapping(i, 9)*pz)
+      end do
+    end do
+  end subroutine previous_hourglass_velocities
+
+  !> sum_k generalized(:, k) velocity(:, k): the power of hourglass forces.
+  subroutine hourglass_power(nel, generalized, velocity, power)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: generalized(block_size, 12), velocity(block_size, 12)
+    real(wp), intent(out) :: power(block_size)
+    real(wp) :: total
+    integer :: k, i
+    do i = 1, nel
+      total = 0.0_wp
+      do k = 1, 12
+        total = total + generalized(i, k)*velocity(i, k)
+      end do
+      power(i) = total
+    end do
+  end subroutine hourglass_power
 
   !> Hourglass shape vectors gamma(:, I, alpha) of the chosen type at the configuration x, y, z
   !> (see the module comment), the volume that scales the hourglass coefficient and the sum
@@ -238,59 +451,38 @@ contains
     end do
   end subroutine hourglass_velocities
 
-  !> corner_force(:, I, i) += sum_alpha generalized(:, i + 3 (alpha - 1)) gamma(:, I, alpha)
-  subroutine add_generalized_forces(nel, gamma, generalized, corner_force)
+  !> Viscous forms (IHQ 1-3): generalized hourglass forces Q_ialpha = a_h q_ialpha with
+  !> a_h = QM rho c V^(2/3) / 4, and their power a_h |q|^2 against the velocities.
+  subroutine hourglass_viscous_forces(nel, coefficient, density, sound_speed, hourglass_volume, &
+                                      gamma, vx, vy, vz, generalized, power)
     integer, intent(in) :: nel
-    real(wp), intent(in) :: gamma(block_size, 8, 4), generalized(block_size, 12)
-    real(wp), intent(inout) :: corner_force(block_size, 8, 3)
-    integer :: node, component, i
-    do component = 1, 3
-      do i = 1, nel
-        do node = 1, 8
-          corner_force(i, node, component) = corner_force(i, node, component) &
-                                             + generalized(i, component)*gamma(i, node, 1) &
-                                             + generalized(i, component + 3)*gamma(i, node, 2) &
-                                             + generalized(i, component + 6)*gamma(i, node, 3) &
-                                             + generalized(i, component + 9)*gamma(i, node, 4)
-        end do
-      end do
-    end do
-  end subroutine add_generalized_forces
-
-  !> Viscous forms (IHQ 1-3): adds a_h sum_alpha q_ialpha gamma_alphaI to the corner forces with
-  !> a_h = QM rho c V^(2/3) / 4 and returns the hourglass work a_h |q|^2 dt of the step.
-  subroutine hourglass_viscous_forces(nel, coefficient, time_step, density, sound_speed, hourglass_volume, &
-                                      gamma, vx, vy, vz, corner_force, energy_increment)
-    integer, intent(in) :: nel
-    real(wp), intent(in) :: coefficient, time_step
+    real(wp), intent(in) :: coefficient
     real(wp), intent(in) :: density(block_size), sound_speed(block_size), hourglass_volume(block_size)
     real(wp), intent(in) :: gamma(block_size, 8, 4)
     real(wp), intent(in) :: vx(block_size, 8), vy(block_size, 8), vz(block_size, 8)
-    real(wp), intent(inout) :: corner_force(block_size, 8, 3)
-    real(wp), intent(out) :: energy_increment(block_size)
-    real(wp) :: velocity(block_size, 12)
+    real(wp), intent(out) :: generalized(block_size, 12)
+    real(wp), intent(out) :: power(block_size)
     real(wp) :: viscosity, squared
     integer :: k, i
 
-    call hourglass_velocities(nel, gamma, vx, vy, vz, velocity)
+    call hourglass_velocities(nel, gamma, vx, vy, vz, generalized)
     do i = 1, nel
       viscosity = 0.25_wp*coefficient*density(i)*sound_speed(i)*abs(hourglass_volume(i))**(2.0_wp/3.0_wp)
       squared = 0.0_wp
       do k = 1, 12
-        squared = squared + velocity(i, k)**2
-        velocity(i, k) = viscosity*velocity(i, k)
+        squared = squared + generalized(i, k)**2
+        generalized(i, k) = viscosity*generalized(i, k)
       end do
-      energy_increment(i) = viscosity*squared*time_step
+      power(i) = viscosity*squared
     end do
-    call add_generalized_forces(nel, gamma, velocity, corner_force)
   end subroutine hourglass_viscous_forces
 
-  !> Stiffness forms (IHQ 4, 5): rotates the accumulated generalized forces Q with the element,
-  !> adds k dt q, adds sum_alpha Q_ialpha gamma_alphaI to the corner forces and returns the work
-  !> of the mid-step force, (Q_rotated + Q_new)/2 . q dt.
+  !> Stiffness forms (IHQ 4, 5): rotates the accumulated generalized forces Q with the element
+  !> and adds k dt q; returns the power Q . q of the new forces. `hourglass_force` (the block
+  !> state, (block_size, 3, 4) seen as (block_size, 12)) then holds the generalized forces of the
+  !> corner-force kernel.
   subroutine hourglass_stiffness_forces(nel, coefficient, time_step, wave_modulus, hourglass_volume, &
-                                        gradient_norm_squared, rotation, gamma, vx, vy, vz, &
-                                        hourglass_force, corner_force, energy_increment)
+                                        gradient_norm_squared, rotation, gamma, vx, vy, vz, hourglass_force, power)
     integer, intent(in) :: nel
     real(wp), intent(in) :: coefficient, time_step
     real(wp), intent(in) :: wave_modulus(block_size), hourglass_volume(block_size)
@@ -298,10 +490,9 @@ contains
     real(wp), intent(in) :: gamma(block_size, 8, 4)
     real(wp), intent(in) :: vx(block_size, 8), vy(block_size, 8), vz(block_size, 8)
     real(wp), intent(inout) :: hourglass_force(block_size, 12)
-    real(wp), intent(inout) :: corner_force(block_size, 8, 3)
-    real(wp), intent(out) :: energy_increment(block_size)
+    real(wp), intent(out) :: power(block_size)
     real(wp) :: velocity(block_size, 12)
-    real(wp) :: stiffness_step, work
+    real(wp) :: stiffness_step, total
     integer :: k, i
 
     call hourglass_velocities(nel, gamma, vx, vy, vz, velocity)
@@ -309,14 +500,12 @@ contains
     do i = 1, nel
       stiffness_step = coefficient*wave_modulus(i)*gradient_norm_squared(i)*time_step &
                        /(3.0_wp*sign(max(abs(hourglass_volume(i)), tiny(1.0_wp)), hourglass_volume(i)))
-      work = 0.0_wp
+      total = 0.0_wp
       do k = 1, 12
-        ! work of (Q_rotated + Q_new) / 2 = Q_rotated + k dt q / 2
-        work = work + (hourglass_force(i, k) + 0.5_wp*stiffness_step*velocity(i, k))*velocity(i, k)
         hourglass_force(i, k) = hourglass_force(i, k) + stiffness_step*velocity(i, k)
+        total = total + hourglass_force(i, k)*velocity(i, k)
       end do
-      energy_increment(i) = work*time_step
+      power(i) = total
     end do
-    call add_generalized_forces(nel, gamma, hourglass_force, corner_force)
   end subroutine hourglass_stiffness_forces
 end module hex8_one_point

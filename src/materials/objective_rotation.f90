@@ -93,8 +93,8 @@ contains
     real(wp), intent(inout) :: vectors(block_size, 3, count)
     real(wp) :: a1, a2, a3
     integer :: i, k
-    do i = 1, nel
-      do k = 1, count
+    do k = 1, count
+      do i = 1, nel
         a1 = vectors(i, 1, k)
         a2 = vectors(i, 2, k)
         a3 = vectors(i, 3, k)

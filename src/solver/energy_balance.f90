@@ -24,11 +24,14 @@ contains
     type(explicit_state_t), intent(inout) :: state
     integer :: chunk_count, chunk, first, last, node, b
     real(wp) :: partial(4, max(1, (state%node_count + chunk_size - 1)/chunk_size)), velocity(3), next_velocity(3)
-    real(wp) :: half_step, average_step
+    real(wp) :: half_step, average_step, step_correction
 
     chunk_count = (state%node_count + chunk_size - 1)/chunk_size
     half_step = 0.5_wp*state%time_step
     average_step = 0.5_wp*(state%time_step + state%next_time_step)
+    ! the elements book the newest forces' work with the step just taken; the kinetic energy
+    ! above uses the mean of that step and the next (see solid_block)
+    step_correction = 0.25_wp*(state%next_time_step - state%time_step)
     !$omp parallel do schedule(static) default(shared) private(chunk, first, last, node, velocity, next_velocity)
     do chunk = 1, chunk_count
       first = (chunk - 1)*chunk_size + 1
@@ -59,34 +62,41 @@ contains
     state%energy%hourglass = 0.0_wp
     do b = 1, size(state%blocks)
       associate (block => state%blocks(b))
-        state%energy%internal = state%energy%internal + sum(block%internal_energy(1:block%element_count))
-        state%energy%hourglass = state%energy%hourglass + sum(block%hourglass_energy(1:block%element_count))
+        state%energy%internal = state%energy%internal + sum(block%internal_energy(1:block%element_count)) &
+                                + step_correction*sum(block%force_power(1:block%element_count))
+        state%energy%hourglass = state%energy%hourglass + sum(block%hourglass_energy(1:block%element_count)) &
+                                 + step_correction*sum(block%hourglass_power(1:block%element_count))
       end associate
     end do
   end subroutine update_energy_totals
 
-  !> Kinetic, internal and hourglass energy of each part (indexed like model%parts). A node's
-  !> kinetic energy is shared among parts in proportion to the mass each element gives it.
+  !> Kinetic, internal and hourglass energy of each part (indexed like model%parts), measured
+  !> as the totals are. A node's kinetic energy is shared among parts in proportion to the
+  !> mass each element gives it.
   subroutine part_energies(state, part_count, kinetic, internal, hourglass)
     type(explicit_state_t), intent(in) :: state
     integer, intent(in) :: part_count
     real(wp), intent(out) :: kinetic(part_count), internal(part_count), hourglass(part_count)
     integer :: b, corner, lane, node
-    real(wp) :: velocity(3), half_step
+    real(wp) :: velocity(3), next_velocity(3), average_step, step_correction
     kinetic = 0.0_wp
     internal = 0.0_wp
     hourglass = 0.0_wp
-    half_step = 0.5_wp*state%time_step
+    average_step = 0.5_wp*(state%time_step + state%next_time_step)
+    step_correction = 0.25_wp*(state%next_time_step - state%time_step)
     do b = 1, size(state%blocks)
       associate (block => state%blocks(b))
-        internal(block%part) = internal(block%part) + sum(block%internal_energy(1:block%element_count))
-        hourglass(block%part) = hourglass(block%part) + sum(block%hourglass_energy(1:block%element_count))
+        internal(block%part) = internal(block%part) + sum(block%internal_energy(1:block%element_count)) &
+                               + step_correction*sum(block%force_power(1:block%element_count))
+        hourglass(block%part) = hourglass(block%part) + sum(block%hourglass_energy(1:block%element_count)) &
+                                + step_correction*sum(block%hourglass_power(1:block%element_count))
         do corner = 1, 8
           do lane = 1, block%element_count
             node = block%nodes(lane, corner)
-            velocity = state%velocity(:, node) + half_step*state%acceleration(:, node)
+            velocity = state%velocity(:, node)
+            next_velocity = velocity + average_step*state%acceleration(:, node)
             kinetic(block%part) = kinetic(block%part) + &
-                                  0.5_wp*state%corner_mass(lane, corner, b)*dot_product(velocity, velocity)
+                                  0.5_wp*state%corner_mass(lane, corner, b)*dot_product(velocity, next_velocity)
           end do
         end do
       end associate

@@ -86,7 +86,7 @@ contains
     type(model_t), intent(in) :: model
     type(solid_block_t), allocatable :: blocks(:)
     real(wp), allocatable :: corner_force(:, :, :, :)
-    real(wp) :: critical, smallest, seconds, work
+    real(wp) :: critical, smallest, work, cycle_seconds(cycles), per_element, fastest, median
     integer :: b, cycle_index, critical_element, inverted, node
     integer(int64) :: start, finish, rate
 
@@ -100,22 +100,46 @@ contains
                              -1.0_wp*coordinates(3, node)]*1000.0_wp
     end do
     work = 0.0_wp
-    call system_clock(start, rate)
     do cycle_index = 1, cycles
       coordinates = coordinates + time_step*velocities
       smallest = huge(1.0_wp)
+      call system_clock(start, rate)
       do b = 1, size(blocks)
         call compute_solid_block(blocks(b), model%materials(1), coordinates, velocities, time_step, &
                                  corner_force(:, :, :, b), critical, critical_element, inverted)
         smallest = min(smallest, critical)
       end do
+      call system_clock(finish)
+      cycle_seconds(cycle_index) = real(finish - start, wp)/real(rate, wp)
       work = work + smallest
     end do
-    call system_clock(finish)
-    seconds = real(finish - start, wp)/real(rate, wp)
-    write (output_unit, '(a,i0,a,i0,a,f8.1,a,es10.3,a,f8.5,a)') "  ELFORM ", model%sections(1)%element_formulation, &
-      " IHQ ", model%parts(1)%hourglass_type, ": ", 1.0e9_wp*seconds/(real(cycles, wp)*size(model%solid_part)), &
-      " ns/element/call   (check: dt ", work/cycles, ", max plastic strain ", maxval(blocks(1)%history(:, 1, :)), ")"
+    ! The machine may be shared: report the fastest cycle and the median.
+    per_element = 1.0e9_wp/size(model%solid_part)
+    fastest = minval(cycle_seconds)*per_element
+    median = median_of(cycle_seconds)*per_element
+    write (output_unit, '(a,i0,a,i0,a,f7.1,a,f7.1,a,es10.3,a,f8.5,a)') "  ELFORM ", &
+      model%sections(1)%element_formulation, " IHQ ", model%parts(1)%hourglass_type, ": ", fastest, &
+      " ns/element/call (fastest cycle), ", median, " (median)   [dt ", work/cycles, &
+      ", max plastic strain ", maxval(blocks(1)%history(:, 1, :)), "]"
     deallocate (velocities)
   end subroutine run_variant
+
+  !> Median of a short array (insertion sort of a copy).
+  function median_of(values) result(median)
+    real(wp), intent(in) :: values(:)
+    real(wp) :: median, sorted(size(values)), key
+    integer :: i, j
+    sorted = values
+    do i = 2, size(sorted)
+      key = sorted(i)
+      j = i - 1
+      do while (j >= 1)
+        if (sorted(j) <= key) exit
+        sorted(j + 1) = sorted(j)
+        j = j - 1
+      end do
+      sorted(j + 1) = key
+    end do
+    median = sorted((size(sorted) + 1)/2)
+  end function median_of
 end program bench_solid_kernels
