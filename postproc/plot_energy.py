@@ -66,8 +66,14 @@ def plot_energy(results_path, output_path, title: str | None = None) -> dict:
     energies.legend(loc="best")
     energies.set_title(title or run.get("title") or Path(results_path).name)
 
-    ratio.plot(time, cr.energy_ratio_history(glstat), color="black")
+    ratio_history = cr.energy_ratio_history(glstat)
+    ratio.plot(time, ratio_history, color="black")
     ratio.axhline(1.0, color="gray", linestyle="--", linewidth=0.8)
+    # at least +-2 % around 1, so that a perfect balance does not zoom into round-off
+    low = min(0.98, float(min(ratio_history.min(), 1.0)) - 0.005)
+    high = max(1.02, float(max(ratio_history.max(), 1.0)) + 0.005)
+    ratio.set_ylim(low, high)
+    ratio.ticklabel_format(axis="y", useOffset=False)
     ratio.set_xlabel("time")
     ratio.set_ylabel("energy ratio")
     ratio.grid(True, alpha=0.3)

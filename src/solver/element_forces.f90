@@ -1,6 +1,8 @@
-!> The element step of the time loop: every block computes its corner forces (in parallel,
-!> each block writing only its own slice), then every node gathers its corners in a fixed
-!> order. No atomics, no thread-dependent summation order: bit-identical for any `ncpu`.
+!> The element step of the time loop. Blocks are coloured so that the blocks of one colour
+!> share no node: the blocks of a colour compute their corner forces in parallel and add them
+!> straight into the nodal forces; colours follow one another. Each node receives its
+!> contributions in a fixed order (colour, then lane and corner), so the sum is bit-identical
+!> for any `ncpu`, with no atomics and no per-corner force array in memory.
 module element_forces
   use kinds, only: wp, block_size
   use model, only: model_t
@@ -19,45 +21,43 @@ contains
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(inout) :: state
     real(wp), intent(in) :: dt
-    integer :: b
+    real(wp) :: block_force(block_size, 8, 3)
+    integer :: colour, k, b, node
 
-    !$omp parallel do schedule(dynamic, 4) default(shared) private(b)
-    do b = 1, size(state%blocks)
-      call compute_solid_block(state%blocks(b), model%materials(state%blocks(b)%material), &
-                               state%coordinates, state%velocity, dt, state%corner_force(:, :, :, b), &
-                               state%block_time_step(b), state%block_critical_element(b), &
-                               state%block_inverted_element(b))
+    !$omp parallel do schedule(static) default(shared) private(node)
+    do node = 1, state%node_count
+      state%internal_force(:, node) = 0.0_wp
     end do
     !$omp end parallel do
-    call gather_corner_forces(state%node_count, state%node_corners%offsets, state%node_corners%corners, &
-                              state%corner_force, state%internal_force)
+    do colour = 1, size(state%block_colors%offsets) - 1
+      !$omp parallel do schedule(dynamic, 2) default(shared) private(k, b, block_force)
+      do k = state%block_colors%offsets(colour), state%block_colors%offsets(colour + 1) - 1
+        b = state%block_colors%corners(k)
+        call compute_solid_block(state%blocks(b), model%materials(state%blocks(b)%material), &
+                                 state%coordinates, state%velocity, dt, block_force, &
+                                 state%block_time_step(b), state%block_critical_element(b), &
+                                 state%block_inverted_element(b))
+        call add_block_forces(state%blocks(b)%element_count, state%blocks(b)%nodes, block_force, &
+                              state%internal_force)
+      end do
+      !$omp end parallel do
+    end do
   end subroutine compute_element_forces
 
-  !> internal_force(:, node) = sum of the node's corner forces, in slot order.
-  subroutine gather_corner_forces(node_count, offsets, slots, corner_force, internal_force)
-    integer, intent(in) :: node_count
-    integer, intent(in) :: offsets(:), slots(:)
-    real(wp), intent(in) :: corner_force(*)
-    real(wp), intent(out) :: internal_force(3, node_count)
-    integer, parameter :: component_stride = 8*block_size
-    integer :: node, k, slot
-    real(wp) :: fx, fy, fz
-
-    !$omp parallel do schedule(static) default(shared) private(node, k, slot, fx, fy, fz)
-    do node = 1, node_count
-      fx = 0.0_wp
-      fy = 0.0_wp
-      fz = 0.0_wp
-      do k = offsets(node), offsets(node + 1) - 1
-        slot = slots(k)
-        fx = fx + corner_force(slot)
-        fy = fy + corner_force(slot + component_stride)
-        fz = fz + corner_force(slot + 2*component_stride)
+  !> internal_force(:, node) += the block's corner forces, corner by corner, lane by lane.
+  subroutine add_block_forces(element_count, nodes, block_force, internal_force)
+    integer, intent(in) :: element_count
+    integer, intent(in) :: nodes(block_size, 8)
+    real(wp), intent(in) :: block_force(block_size, 8, 3)
+    real(wp), intent(inout) :: internal_force(:, :)
+    integer :: corner, lane, node
+    do corner = 1, 8
+      do lane = 1, element_count
+        node = nodes(lane, corner)
+        internal_force(1, node) = internal_force(1, node) + block_force(lane, corner, 1)
+        internal_force(2, node) = internal_force(2, node) + block_force(lane, corner, 2)
+        internal_force(3, node) = internal_force(3, node) + block_force(lane, corner, 3)
       end do
-      internal_force(1, node) = fx
-      internal_force(2, node) = fy
-      internal_force(3, node) = fz
     end do
-    !$omp end parallel do
-  end subroutine gather_corner_forces
+  end subroutine add_block_forces
 end module element_forces

@@ -3,7 +3,7 @@
 module explicit_setup
   use kinds, only: wp, block_size
   use error_handling, only: error_t, make_error
-  use gather_list, only: build_gather_list
+  use gather_list, only: gather_list_t, build_gather_list
   use model, only: model_t
   use solid_block, only: solid_block_t, build_solid_blocks, solid_block_corner_masses, &
                          solid_block_time_steps
@@ -13,7 +13,7 @@ module explicit_setup
   implicit none
   private
 
-  public :: set_up_explicit_state, corner_slot_to_mass_index
+  public :: set_up_explicit_state
 
 contains
 
@@ -42,16 +42,15 @@ contains
 
     call build_solid_blocks(model, state%blocks)
     block_count = size(state%blocks)
-    allocate (state%corner_force(block_size, 8, 3, block_count), state%corner_mass(block_size, 8, block_count), &
+    allocate (state%corner_mass(block_size, 8, block_count), &
               state%block_time_step(block_count), state%block_critical_element(block_count), &
               state%block_inverted_element(block_count))
-    state%corner_force = 0.0_wp
     state%block_time_step = huge(1.0_wp)
     state%block_critical_element = 0
     state%block_inverted_element = 0
 
     call scale_masses(model, state)
-    call build_node_corner_list(state)
+    call colour_blocks(state)
     call lump_nodal_masses(state)
     call initialise_wall_states(model%walls, state%walls)
     if (sum(state%mass) <= 0.0_wp) then
@@ -88,54 +87,86 @@ contains
     end do
   end subroutine scale_masses
 
-  !> Node -> corner list. A slot is the position of the x component of one corner force in
-  !> `corner_force(block_size, 8, 3, blocks)` viewed as one array; y and z follow at
-  !> +8*block_size and +16*block_size.
-  subroutine build_node_corner_list(state)
+  !> Greedy colouring of the blocks: a block takes the lowest colour that no block sharing a
+  !> node with it has taken. Within a colour, blocks stay in index order.
+  subroutine colour_blocks(state)
     type(explicit_state_t), intent(inout) :: state
-    integer, allocatable :: slot_node(:)
-    integer :: b, corner, lane
+    type(gather_list_t) :: node_blocks
+    integer, allocatable :: slot_node(:), colour(:), taken_by(:), count_of(:), blocks(:)
+    integer :: block_count, b, corner, lane, node, k, other, chosen, colour_count
 
-    allocate (slot_node(block_size*24*size(state%blocks)))
+    block_count = size(state%blocks)
+    ! node -> blocks touching it (a slot is one corner of one lane of one block)
+    allocate (slot_node(block_size*8*block_count))
     slot_node = 0
-    do b = 1, size(state%blocks)
+    do b = 1, block_count
       do corner = 1, 8
         do lane = 1, state%blocks(b)%element_count
-          slot_node(force_slot(lane, corner, b)) = state%blocks(b)%nodes(lane, corner)
+          slot_node(corner_slot(lane, corner, b)) = state%blocks(b)%nodes(lane, corner)
         end do
       end do
     end do
-    call build_gather_list(state%node_count, slot_node, state%node_corners)
-  end subroutine build_node_corner_list
+    call build_gather_list(state%node_count, slot_node, node_blocks)
 
-  !> Lumped nodal masses: each node gathers its corner masses in slot order.
+    allocate (colour(block_count), taken_by(block_count + 1))
+    taken_by = 0
+    colour_count = 0
+    do b = 1, block_count
+      do corner = 1, 8
+        do lane = 1, state%blocks(b)%element_count
+          node = state%blocks(b)%nodes(lane, corner)
+          do k = node_blocks%offsets(node), node_blocks%offsets(node + 1) - 1
+            other = (node_blocks%corners(k) - 1)/(block_size*8) + 1
+            if (other < b) taken_by(colour(other)) = b
+          end do
+        end do
+      end do
+      chosen = 1
+      do while (taken_by(chosen) == b)
+        chosen = chosen + 1
+      end do
+      colour(b) = chosen
+      colour_count = max(colour_count, chosen)
+    end do
+
+    ! colour -> blocks, as a CSR list
+    allocate (count_of(colour_count + 1), blocks(block_count))
+    count_of = 0
+    do b = 1, block_count
+      count_of(colour(b) + 1) = count_of(colour(b) + 1) + 1
+    end do
+    count_of(1) = 1
+    do k = 1, colour_count
+      count_of(k + 1) = count_of(k + 1) + count_of(k)
+    end do
+    state%block_colors%offsets = count_of
+    do b = 1, block_count
+      blocks(count_of(colour(b))) = b
+      count_of(colour(b)) = count_of(colour(b)) + 1
+    end do
+    call move_alloc(blocks, state%block_colors%corners)
+  end subroutine colour_blocks
+
+  !> Lumped nodal masses: each block adds its corner masses to its nodes (serially, in block,
+  !> corner and lane order).
   subroutine lump_nodal_masses(state)
     type(explicit_state_t), intent(inout) :: state
-    integer :: b, node, k
-    real(wp), allocatable :: flat_mass(:)
+    integer :: b, corner, lane, node
 
+    state%mass = 0.0_wp
     do b = 1, size(state%blocks)
       call solid_block_corner_masses(state%blocks(b), state%corner_mass(:, :, b))
-    end do
-    flat_mass = reshape(state%corner_mass, [size(state%corner_mass)])
-    do node = 1, state%node_count
-      state%mass(node) = 0.0_wp
-      do k = state%node_corners%offsets(node), state%node_corners%offsets(node + 1) - 1
-        state%mass(node) = state%mass(node) + flat_mass(corner_slot_to_mass_index(state%node_corners%corners(k)))
+      do corner = 1, 8
+        do lane = 1, state%blocks(b)%element_count
+          node = state%blocks(b)%nodes(lane, corner)
+          state%mass(node) = state%mass(node) + state%corner_mass(lane, corner, b)
+        end do
       end do
     end do
   end subroutine lump_nodal_masses
 
-  pure integer function force_slot(lane, corner, block)
+  pure integer function corner_slot(lane, corner, block)
     integer, intent(in) :: lane, corner, block
-    force_slot = lane + (corner - 1)*block_size + (block - 1)*block_size*24
-  end function force_slot
-
-  !> Position in `corner_mass(block_size, 8, blocks)` of the corner whose force slot is `slot`.
-  pure integer function corner_slot_to_mass_index(slot)
-    integer, intent(in) :: slot
-    integer :: block_offset
-    block_offset = (slot - 1)/(block_size*24)
-    corner_slot_to_mass_index = slot - block_offset*block_size*16
-  end function corner_slot_to_mass_index
+    corner_slot = lane + (corner - 1)*block_size + (block - 1)*block_size*8
+  end function corner_slot
 end module explicit_setup

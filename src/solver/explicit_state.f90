@@ -1,9 +1,11 @@
 !> Everything that changes during an explicit run, in structure-of-arrays form.
 !>
-!> Nodal arrays are `(3, nodes)`; element data lives in blocks (`solid_block_t`) whose kernels
-!> write one force per element corner into `corner_force(:, :, :, block)`. The gather list then
-!> sums the corners of each node in a fixed order, which keeps results bit-identical for any
-!> thread count.
+!> Nodal arrays are `(3, nodes)`; element data lives in blocks (`solid_block_t`). Blocks are
+!> coloured so that no two blocks of one colour share a node: the blocks of a colour run in
+!> parallel and add their corner forces straight into the nodal forces, colour after colour.
+!> Every node then receives its contributions in the same order whatever the thread count,
+!> so results are bit-identical for any `ncpu`, without atomics and without a per-corner force
+!> array to write and read back.
 module explicit_state
   use kinds, only: wp, block_size
   use gather_list, only: gather_list_t
@@ -56,12 +58,11 @@ module explicit_state
     logical, allocatable :: fixed(:, :)                  !< SPC per dof
     ! element blocks and their corner forces
     type(solid_block_t), allocatable :: blocks(:)
-    real(wp), allocatable :: corner_force(:, :, :, :)    !< (block_size, 8, 3, blocks)
     real(wp), allocatable :: corner_mass(:, :, :)        !< (block_size, 8, blocks)
     real(wp), allocatable :: block_time_step(:)          !< per block, from its kernel
     integer, allocatable :: block_critical_element(:)
     integer, allocatable :: block_inverted_element(:)
-    type(gather_list_t) :: node_corners                  !< node -> (lane, corner, block) slots
+    type(gather_list_t) :: block_colors                  !< colour -> blocks (same CSR form as a gather list)
     ! walls
     type(wall_state_t), allocatable :: walls(:)
     ! bookkeeping
