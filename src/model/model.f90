@@ -40,11 +40,23 @@ module model
     real(wp) :: rate_formulation = 0.0_wp   !< VP: 0 scale yield stress, 1 viscoplastic
   end type material_t
 
-  !> One solid section (*SECTION_SOLID).
+  !> EFG kernels (ISPLINE) and boundary treatments (IEBT) and domain integrations (IDIM).
+  integer, parameter, public :: kernel_cubic_box = 0, kernel_cubic_sphere = 2
+  integer, parameter, public :: boundary_full_transformation = 1, boundary_coupled = 3
+  integer, parameter, public :: integration_local_boundary = 1, integration_gauss = 2
+
+  !> One solid section (*SECTION_SOLID, *SECTION_SOLID_EFG).
   type :: section_t
     integer :: id = 0
     character(len=:), allocatable :: title
-    integer :: element_formulation = 1     !< ELFORM: 1 one-point, 2 fully integrated S/R
+    integer :: element_formulation = 1     !< ELFORM: 1 one-point, 2 fully integrated S/R, 41 EFG
+    ! EFG card (ELFORM 41), meaningful only for meshfree sections
+    real(wp) :: support_scale(3) = 1.01_wp !< DX, DY, DZ: normalized support (> 1)
+    integer :: kernel = kernel_cubic_box   !< ISPLINE: 0 cubic spline, box; 2 cubic spline, sphere
+    integer :: dilation_basis = 0          !< IDILA (0: from the nodes sharing an element)
+    real(wp) :: kernel_tolerance = 0.0_wp  !< TOLDEF: 0 Lagrangian kernel (the only one built)
+    integer :: boundary_treatment = boundary_coupled        !< IEBT: 3 coupled FE/EFG, 1 full transformation
+    integer :: domain_integration = integration_local_boundary !< IDIM: 1 local boundary (SCNI), 2 Gauss 2x2x2
   end type section_t
 
   !> One hourglass / bulk-viscosity definition (*HOURGLASS).
