@@ -35,6 +35,7 @@ module run_output
     real(wp) :: last_rwforc_time = 0.0_wp
     ! work arrays for the element results of a state, allocated once
     real(wp), allocatable :: solid_stress(:, :), solid_plastic_strain(:)
+    real(wp), allocatable :: node_velocity(:, :)     !< integer-step velocities of a state
     real(wp), allocatable :: part_kinetic(:), part_internal(:), part_hourglass(:)
   end type output_plan_t
 
@@ -96,6 +97,7 @@ contains
       end do
     end if
     allocate (plan%solid_stress(6, size(model%solid_ids)), plan%solid_plastic_strain(size(model%solid_ids)))
+    allocate (plan%node_velocity(3, size(model%node_ids)))
     allocate (plan%part_kinetic(size(model%parts)), plan%part_internal(size(model%parts)), &
               plan%part_hourglass(size(model%parts)))
   end subroutine plan_output
@@ -212,8 +214,8 @@ contains
     do b = 1, size(state%blocks)
       call solid_block_element_results(state%blocks(b), plan%solid_stress, plan%solid_plastic_strain)
     end do
-    call write_state(results, state%time, state%displacement, &
-                     state%velocity + 0.5_wp*state%time_step*state%acceleration, plan%solid_stress, &
+    plan%node_velocity = state%velocity + 0.5_wp*state%time_step*state%acceleration
+    call write_state(results, state%time, state%displacement, plan%node_velocity, plan%solid_stress, &
                      plan%solid_plastic_strain, error)
   end subroutine write_current_state
 end module run_output
