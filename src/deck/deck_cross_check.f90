@@ -4,7 +4,8 @@
 module deck_cross_check
   use kinds, only: wp
   use error_handling, only: error_list_t, add_error
-  use model, only: model_t, spc_t, prescribed_motion_t, nodal_load_t, rigid_wall_t
+  use model, only: model_t, spc_t, prescribed_motion_t, nodal_load_t, rigid_wall_t, &
+                   formulation_fe, formulation_efg
   use deck_problems, only: problem_log_t, report_problem, has_problems
   use deck_numbers, only: integer_text, real_text
   use deck_lexer, only: deck_t, line_location
@@ -13,6 +14,7 @@ module deck_cross_check
                         velocity_by_node, velocity_generation
   use deck_id_index, only: id_index_t, build_id_index, find_id, lower_bound
   use deck_element_check, only: check_hexahedron, shape_inside_out, shape_flat
+  use deck_efg_cards, only: elform_efg
   implicit none
   private
 
@@ -190,7 +192,8 @@ contains
     end do
   end subroutine report_unknown_parts
 
-  !> Part -> section, material and hourglass indices.
+  !> Part -> section, material and hourglass indices, and the part's formulation from its
+  !> section (ELFORM 41: EFG, otherwise finite elements).
   subroutine resolve_parts(deck, input, indices, log)
     type(deck_t), intent(in) :: deck
     type(deck_input_t), intent(inout) :: input
@@ -209,6 +212,11 @@ contains
           part%section = find_id(indices%sections, part%section_id)
           if (part%section == 0) call located_problem(deck, log, line, "SECID", "section "// &
             integer_text(part%section_id)//" of "//part_name//" is not defined")
+        end if
+        part%formulation = formulation_fe
+        if (part%section > 0) then
+          if (input%model%sections(part%section)%element_formulation == elform_efg) &
+            part%formulation = formulation_efg
         end if
         if (part%material_id == 0) then
           call located_problem(deck, log, line, "MID", part_name//" has no material (MID is "// &
@@ -765,7 +773,8 @@ contains
       "nodes are given but *DATABASE_NODOUT has no interval (DT), so no nodout is written")
   end subroutine build_history_nodes
 
-  !> At least one node and one element, and every element with a valid shape.
+  !> At least one node and one element, every element with a valid shape, and the elements
+  !> of EFG parts proper hexahedra.
   subroutine check_mesh(deck, input, resolved, log)
     type(deck_t), intent(in) :: deck
     type(deck_input_t), intent(in) :: input
@@ -785,11 +794,16 @@ contains
         do corner = 1, 8
           corners(:, corner) = model%coordinates(:, model%solid_nodes(corner, element))
         end do
-        call check_hexahedron(corners, status, corner)
-        if (status == 0) cycle
         part = model%solid_part(element)
         name = "element "//integer_text(model%solid_ids(element))
         if (part > 0) name = name//" of part "//integer_text(model%parts(part)%id)
+        if (part > 0) then
+          if (model%parts(part)%formulation == formulation_efg) call check_efg_cell(deck, &
+            model%solid_nodes(:, element), model%node_ids, input%solid_node_lines(element), &
+            name, log)
+        end if
+        call check_hexahedron(corners, status, corner)
+        if (status == 0) cycle
         if (status == shape_inside_out) then
           call located_problem(deck, log, input%solid_node_lines(element), "N1-N8", name// &
             " is inside out: negative Jacobian at corner N"//integer_text(corner)//" (node "// &
@@ -802,6 +816,27 @@ contains
       end do
     end associate
   end subroutine check_mesh
+
+  !> A background cell of an EFG part needs 8 distinct nodes: the support sizes, the sub-cell
+  !> split and the face integration all assume a proper hexahedron, so a wedge or tetrahedron
+  !> written with repeated nodes is an error naming the element and the corners that repeat.
+  subroutine check_efg_cell(deck, nodes, node_ids, line, name, log)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: nodes(8), node_ids(:), line
+    character(len=*), intent(in) :: name
+    type(problem_log_t), intent(inout) :: log
+    integer :: first, second
+    do second = 2, 8
+      do first = 1, second - 1
+        if (nodes(first) /= nodes(second)) cycle
+        call located_problem(deck, log, line, "N1-N8", name//" repeats node "// &
+          integer_text(node_ids(nodes(first)))//" (N"//integer_text(first)//" and N"// &
+          integer_text(second)//"): the background cells of an EFG part (ELFORM 41) must be "// &
+          "proper hexahedra with 8 distinct nodes")
+        return
+      end do
+    end do
+  end subroutine check_efg_cell
 
   !> ENDTIM (or ENDCYC) and the output intervals that depend on it.
   subroutine check_controls(deck, input, log)

@@ -17,7 +17,7 @@ module deck_fields
   private
 
   public :: card_t, open_card, next_line, require_card, next_definition, get_integer, get_real
-  public :: get_text, has_data
+  public :: get_text, has_data, card_is_empty
   public :: field_is_blank, card_problem, line_problem, line_title, id_heading, warn_if_set
   public :: keyword_label, located_problem
 
@@ -258,6 +258,23 @@ contains
     call field_bounds(deck, card, k, file, first, last)
     field_is_blank = last < first
   end function field_is_blank
+
+  !> True when every field of `card` is blank or a number equal to zero: a card that sets
+  !> nothing (such as the unconditional user-element cards some writers add to a keyword).
+  logical function card_is_empty(deck, card)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(in) :: card
+    integer :: k, file, first, last, status
+    real(wp) :: value
+    card_is_empty = .false.
+    do k = 1, card%spans%count
+      call field_bounds(deck, card, k, file, first, last)
+      if (last < first) cycle
+      call parse_real(deck%files(file)%text(first:last), value, status)
+      if (status /= number_ok .or. value /= 0.0_wp) return
+    end do
+    card_is_empty = .true.
+  end function card_is_empty
 
   !> Add a warning when field `k` holds a value other than blank or zero: crashfree reads
   !> the field but does not use it (`reason` says why).

@@ -1,4 +1,4 @@
-!> *PART, *SECTION_SOLID and *HOURGLASS: what each part is made of and how it is integrated.
+!> *PART, *SECTION_SOLID(_EFG) and *HOURGLASS: what each part is made of and how it is integrated.
 module deck_parts_sections
   use kinds, only: wp
   use error_handling, only: error_list_t
@@ -7,8 +7,11 @@ module deck_parts_sections
   use deck_numbers, only: integer_text, real_text
   use deck_lexer, only: deck_t
   use deck_keywords, only: keyword_t
-  use deck_fields, only: card_t, next_line, require_card, next_definition, has_data, &
-                         get_integer, get_real, card_problem, warn_if_set, line_title
+  use deck_fields, only: card_t, open_card, next_line, require_card, next_definition, &
+                         has_data, get_integer, get_real, card_problem, warn_if_set, line_title, &
+                         card_is_empty, field_is_blank
+  use deck_efg_cards, only: read_efg_card, read_efg_options_card, elform_efg, &
+                            elform_adaptive_efg
   use deck_input, only: deck_input_t
   implicit none
   private
@@ -68,8 +71,18 @@ contains
     end do
   end subroutine read_parts
 
-  !> *SECTION_SOLID (and *SECTION_SOLID_EFG): SECID ELFORM AET, one card per section
-  !> (a title line before it with _TITLE). ELFORM 1 and 2 are available.
+  !> *SECTION_SOLID and *SECTION_SOLID_EFG (with _TITLE: a title line before card 1).
+  !>
+  !> Card 1 is SECID ELFORM AET. ELFORM 1 and 2 are finite elements; ELFORM 41 is the meshfree
+  !> (EFG) solid and is followed by the EFG card (DX DY DZ ISPLINE IDILA IEBT IDIM TOLDEF), as
+  !> is ELFORM 42, which is rejected. Where the cards of one section end:
+  !> * *SECTION_SOLID repeats its sections until the next keyword: card 1, plus the EFG card
+  !>   when ELFORM is 41 or 42. Card 3 is never read here, since an optional card inside a
+  !>   repeating set could not be told from the next section's card 1.
+  !> * *SECTION_SOLID_EFG holds one section, as in LS-DYNA: card 1 (ELFORM must be 41), the EFG
+  !>   card, and an optional card 3 (IPS STIME IKEN SF CMID IBR DS ECUT). Further cards are
+  !>   accepted only when they set nothing (the user-element cards that pydyna writes for
+  !>   every section); any other further card is an error.
   subroutine read_solid_sections(deck, block, keyword, meshfree_keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
@@ -79,36 +92,107 @@ contains
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
-    integer :: line, n, formulation
+    integer :: line, n, id, formulation
+    logical :: follows_efg_card
     character(len=:), allocatable :: title
 
     line = 0
+    follows_efg_card = .false.
     do while (next_definition(deck, block, keyword%title, line, standard_widths, card, title, &
                               log, "card 1 (SECID ELFORM AET)", "SECID"))
+      call get_integer(deck, card, 1, "SECID", id, log)
+      if (follows_efg_card .and. id == 0 .and. .not. card%failed) then
+        call card_problem(deck, log, card, "SECID", "section id must be > 0, found 0 (this "// &
+          "card follows an EFG card; card 3, IPS STIME IKEN SF CMID IBR DS ECUT, is read only "// &
+          "under *SECTION_SOLID_EFG)")
+        follows_efg_card = .false.
+        cycle
+      end if
+      call get_integer(deck, card, 2, "ELFORM", formulation, log, default=1)
       n = input%section_count + 1
       input%section_count = n
       input%section_lines(n) = line
-      associate (section => input%model%sections(n))
-        section%title = title
-        call get_integer(deck, card, 1, "SECID", section%id, log)
-        call get_integer(deck, card, 2, "ELFORM", formulation, log, default=1)
-        section%element_formulation = formulation
-        if (card%failed) cycle
-        if (section%id <= 0) call card_problem(deck, log, card, "SECID", "section id must "// &
-                                               "be > 0, found "//integer_text(section%id))
-        if (meshfree_keyword .or. formulation == 41 .or. formulation == 42) then
-          call card_problem(deck, log, card, "ELFORM", "meshfree sections are not "// &
-            "available yet (ELFORM "//integer_text(formulation)//"); use ELFORM 1 or 2")
-          exit     ! the EFG cards that follow are not sections
-        end if
-        if (formulation /= 1 .and. formulation /= 2) call card_problem(deck, log, card, &
-          "ELFORM", "element formulation "//integer_text(formulation)//" is not "// &
-          "available; crashfree has ELFORM 1 (one-point, constant stress) and 2 (fully "// &
-          "integrated, selective reduced)")
-      end associate
+      input%model%sections(n)%id = id
+      input%model%sections(n)%title = title
+      input%model%sections(n)%element_formulation = formulation
+      if (.not. card%failed) then
+        if (id <= 0) call card_problem(deck, log, card, "SECID", "section id must be > 0, "// &
+                                       "found "//integer_text(id))
+        call check_solid_formulation(deck, log, card, formulation, field_is_blank(deck, card, &
+                                     2), meshfree_keyword)
+      end if
       call warn_if_set(deck, card, 3, "AET", "ambient elements are not available", warnings)
+      follows_efg_card = meshfree_keyword .or. formulation == elform_efg .or. &
+                         formulation == elform_adaptive_efg
+      if (follows_efg_card) then
+        if (.not. require_card(deck, block, line, standard_widths, card, log, "the EFG card "// &
+            "(DX DY DZ ISPLINE IDILA IEBT IDIM TOLDEF) of section "//integer_text(id), "DX")) exit
+        call read_efg_card(deck, card, input%model%sections(n), log, warnings)
+      end if
+      if (meshfree_keyword) then
+        call read_efg_closing_cards(deck, block, line, log)
+        exit
+      end if
     end do
   end subroutine read_solid_sections
+
+  !> ELFORM of a solid section: 1 and 2 (finite elements) and 41 (EFG); 41 only under
+  !> *SECTION_SOLID_EFG.
+  subroutine check_solid_formulation(deck, log, card, formulation, blank, meshfree_keyword)
+    type(deck_t), intent(in) :: deck
+    type(problem_log_t), intent(inout) :: log
+    type(card_t), intent(in) :: card
+    integer, intent(in) :: formulation
+    logical, intent(in) :: blank             !< ELFORM was blank (LS-DYNA's default, 1)
+    logical, intent(in) :: meshfree_keyword
+    character(len=:), allocatable :: reason
+    if (meshfree_keyword) then
+      if (formulation == elform_efg) return
+      select case (formulation)
+      case (elform_adaptive_efg)
+        reason = "; adaptive EFG (ELFORM 42) is not available"
+      case (1, 2)
+        reason = " (a finite element formulation: use *SECTION_SOLID)"
+        if (blank) reason = " (the field is blank, which means 1)"
+      case default
+        reason = ""
+      end select
+      call card_problem(deck, log, card, "ELFORM", "*SECTION_SOLID_EFG needs ELFORM 41 "// &
+        "(meshfree EFG solid), found "//integer_text(formulation)//reason)
+      return
+    end if
+    select case (formulation)
+    case (1, 2, elform_efg)
+    case (elform_adaptive_efg)
+      call card_problem(deck, log, card, "ELFORM", "adaptive EFG (ELFORM 42, 4-node "// &
+        "background cells) is not available; use ELFORM 41 (EFG solid on hexahedral cells)")
+    case default
+      call card_problem(deck, log, card, "ELFORM", "element formulation "// &
+        integer_text(formulation)//" is not available; crashfree has ELFORM 1 (one-point, "// &
+        "constant stress), 2 (fully integrated, selective reduced) and 41 (meshfree EFG)")
+    end select
+  end subroutine check_solid_formulation
+
+  !> The cards of *SECTION_SOLID_EFG after the EFG card: the optional card 3, then only
+  !> cards that set nothing.
+  subroutine read_efg_closing_cards(deck, block, line, log)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    integer, intent(inout) :: line
+    type(problem_log_t), intent(inout) :: log
+    type(card_t) :: card
+    if (.not. next_line(deck, block, line, .false.)) return
+    call open_card(deck, block, line, standard_widths, card, log)
+    call read_efg_options_card(deck, card, log)
+    do while (next_line(deck, block, line, .false.))
+      call open_card(deck, block, line, standard_widths, card, log)
+      if (card_is_empty(deck, card)) cycle
+      call card_problem(deck, log, card, "SECID", "*SECTION_SOLID_EFG holds one section "// &
+        "(card 1, the EFG card and the optional card 3); give the next section its own "// &
+        "*SECTION_SOLID_EFG", unreadable=.true.)
+      exit
+    end do
+  end subroutine read_efg_closing_cards
 
   !> *HOURGLASS: HGID IHQ QM IBQ Q1 Q2 QB/VDC QW, one card per definition. Values are kept as
   !> written (blank = 0); the cross-check turns IHQ 0 and blank QM, Q1, Q2 into the global

@@ -7,8 +7,10 @@ program test_deck
   use kinds, only: wp
   use testing, only: test_suite_t, check, check_close, finish_suite
   use error_handling, only: error_t, error_list_t
-  use model, only: model_t, formulation_fe, law_elastic, law_plastic_kinematic, &
-                   motion_displacement, motion_velocity
+  use model, only: model_t, formulation_fe, formulation_efg, law_elastic, law_plastic_kinematic, &
+                   motion_displacement, motion_velocity, kernel_cubic_box, kernel_cubic_sphere, &
+                   boundary_coupled, boundary_full_transformation, integration_local_boundary, &
+                   integration_gauss
   use deck_reader, only: read_deck
   implicit none
 
@@ -34,6 +36,11 @@ program test_deck
   call test_material_limits()
   call test_controls_and_mesh_errors()
   call test_field_meanings()
+  call test_efg_section_keyword()
+  call test_efg_in_solid_section_sets()
+  call test_efg_card_errors()
+  call test_efg_card_structure()
+  call test_efg_cells()
   call execute_command_line("rm -rf "//directory)
   call finish_suite(suite)
 
@@ -78,6 +85,16 @@ contains
       lines = [base, text_line("*END")]
     end if
   end function cube_deck
+
+  !> The cube deck without its *SECTION_SOLID (lines 20 and 21 become comments), so that the
+  !> sections given in `extra` start at line 24.
+  function deck_with_sections(extra) result(lines)
+    character(len=*), intent(in) :: extra(:)
+    character(len=line_length), allocatable :: lines(:)
+    lines = cube_deck(extra)
+    lines(20) = "$ the sections follow *MAT_ELASTIC, from line 24"
+    lines(21) = "$"
+  end function deck_with_sections
 
   !> The cube deck with line `number` replaced.
   function replaced(number, text, extra) result(lines)
@@ -719,7 +736,7 @@ contains
       "*BOUNDARY_PRESCRIBED_MOTION_NODE", "1,14,0,1", "2,5,0,1", "3,1,7,1", &
       "*LOAD_NODE_POINT", "4,8,1", &
       "*BOUNDARY_SPC_NODE", "5,0,2", &
-      "*SECTION_SOLID", "7,41", &
+      "*SECTION_SOLID", "7,43", &
       "*SECTION_SOLID", "8,7", &
       "*NODE", trim(node_line(9, 2.0_wp, 0.0_wp, 0.0_wp))//"      12", &
       "*RIGIDWALL_PLANAR_MOVING", "0", "0,0,0,0,0,0", "0.0"]), [character(len=120) :: &
@@ -731,11 +748,234 @@ contains
       "(acceleration) or 2 (displacement), found 7", &
       "@:34: *LOAD_NODE_POINT: field DOF: 8 (follower force or moment) is not available", &
       "@:36: *BOUNDARY_SPC_NODE: field DOFX: must be 0 (free) or 1 (fixed), found 2", &
-      "@:38: *SECTION_SOLID: field ELFORM: meshfree sections are not available yet", &
+      "@:38: *SECTION_SOLID: field ELFORM: element formulation 43 is not available", &
       "@:40: *SECTION_SOLID: field ELFORM: element formulation 7 is not available", &
       "@:42: *NODE: field TC: translational constraint code must be 0-7", &
       "@:45: *RIGIDWALL_PLANAR_MOVING: field XH: the normal from the tail (XT YT ZT) to the "// &
       "head (XH YH ZH) has zero length", &
       "@:46: *RIGIDWALL_PLANAR_MOVING: field MASS: a moving wall needs a mass > 0"])
   end subroutine test_field_meanings
+  ! ---------------------------------------------------------------- meshfree (EFG) sections
+
+  !> *SECTION_SOLID_EFG_TITLE with every field of the EFG card and card 3 given, then a
+  !> *SECTION_SOLID_EFG of blank fields, without card 3 but with the empty user-element cards
+  !> pydyna writes.
+  subroutine test_efg_section_keyword()
+    type(model_t) :: model
+    type(error_list_t) :: warnings
+    call read_good("efg_keyword.k", deck_with_sections([character(len=line_length) :: &
+      "*SECTION_SOLID_EFG_TITLE", &
+      "meshfree block", &
+      fixed(["1 ", "41"], 10), &
+      fixed(["1.2", "1.3", "1.4", "2  ", "0  ", "1  ", "2  ", "0.0"], 10), &
+      fixed(["0      ", "1.0E+20", "0      ", "0.0    ", "0      ", "1      ", "0.01   ", &
+             "1.0e-2 "], 10)]), model, warnings)
+    if (allocated(model%sections)) then
+      associate (section => model%sections(1))
+        call check(suite, "efg keyword: one section, title, ELFORM 41", size(model%sections) == &
+                   1 .and. section%title == "meshfree block" .and. section%element_formulation &
+                   == 41)
+        call check_close(suite, "efg keyword: DX DY DZ", section%support_scale, [1.2_wp, &
+                         1.3_wp, 1.4_wp], thr=0.0_wp)
+        call check(suite, "efg keyword: ISPLINE 2, spherical", section%kernel == &
+                   kernel_cubic_sphere)
+        call check(suite, "efg keyword: IDILA 0", section%dilation_basis == 0)
+        call check(suite, "efg keyword: IEBT 1", section%boundary_treatment == &
+                   boundary_full_transformation)
+        call check(suite, "efg keyword: IDIM 2", section%domain_integration == integration_gauss)
+        call check_close(suite, "efg keyword: TOLDEF 0", section%kernel_tolerance, 0.0_wp, &
+                         thr=0.0_wp)
+      end associate
+      call check(suite, "efg keyword: part is EFG", model%parts(1)%formulation == &
+                 formulation_efg)
+      call check(suite, "efg keyword: DY, DZ of a sphere warned", warnings%count == 2 .and. &
+        index(warnings%text, "efg_keyword.k:27: *SECTION_SOLID_EFG_TITLE: field DZ: ignored "// &
+        "(a spherical support (ISPLINE 2) has one radius, scaled by DX)") > 0, warnings%text)
+    end if
+    call read_good("efg_defaults.k", deck_with_sections([character(len=line_length) :: &
+      "*SECTION_SOLID_EFG", &
+      "1,41", &
+      "", &
+      "", &
+      fixed(["  ", "  ", "0 ", "0 "], 10), &
+      "", &
+      fixed(["0.0"], 10)]), model, warnings)
+    if (.not. allocated(model%sections)) return
+    associate (section => model%sections(1))
+      call check_close(suite, "efg defaults: DX DY DZ 1.01", section%support_scale, &
+                       [1.01_wp, 1.01_wp, 1.01_wp], thr=0.0_wp)
+      call check(suite, "efg defaults: ISPLINE 0, box", section%kernel == kernel_cubic_box)
+      call check(suite, "efg defaults: IDILA 0", section%dilation_basis == 0)
+      call check(suite, "efg defaults: IEBT 3", section%boundary_treatment == boundary_coupled)
+      call check(suite, "efg defaults: IDIM 1", section%domain_integration == &
+                 integration_local_boundary)
+      call check_close(suite, "efg defaults: TOLDEF 0", section%kernel_tolerance, 0.0_wp, &
+                       thr=0.0_wp)
+    end associate
+    call check(suite, "efg defaults: part is EFG", model%parts(1)%formulation == formulation_efg)
+  end subroutine test_efg_section_keyword
+
+  !> ELFORM 41 inside repeating *SECTION_SOLID sets: the EFG card follows card 1, and the next
+  !> line is the next section (with _TITLE, its title). DX 0 means 1.01.
+  subroutine test_efg_in_solid_section_sets()
+    type(model_t) :: model
+    type(error_list_t) :: warnings
+    integer :: k
+    call read_good("efg_sets.k", deck_with_sections([character(len=line_length) :: &
+      "*SECTION_SOLID", &
+      "1,41", &
+      fixed(["0.0"], 10), &
+      "2,2", &
+      "3,41", &
+      "1.5,0,1.2,0,,1,2,0", &
+      "4,1", &
+      "*SECTION_SOLID_TITLE", &
+      "meshfree", &
+      fixed(["5 ", "41"], 10), &
+      fixed(["1.3", "   ", "   ", "2  "], 10), &
+      "finite elements", &
+      fixed(["6", "2"], 10), &
+      "*PART", "fe", fixed(["2", "2", "1"], 10), &
+      "*PART", "efg", fixed(["3", "3", "1"], 10), &
+      "*PART", "efg titled", fixed(["4", "5", "1"], 10), &
+      "*PART", "fe titled", fixed(["5", "6", "1"], 10)]), model, warnings)
+    if (.not. allocated(model%sections)) return
+    call check(suite, "efg sets: six sections", size(model%sections) == 6)
+    if (size(model%sections) /= 6) return
+    call check(suite, "efg sets: ids", all([(model%sections(k)%id, k=1, 6)] == [1, 2, 3, 4, 5, &
+                                                                                6]))
+    call check(suite, "efg sets: ELFORM", all([(model%sections(k)%element_formulation, k=1, &
+                                                6)] == [41, 2, 41, 1, 41, 2]))
+    call check_close(suite, "efg sets: DX 0 means 1.01", model%sections(1)%support_scale, &
+                     [1.01_wp, 1.01_wp, 1.01_wp], thr=0.0_wp)
+    call check(suite, "efg sets: blank IEBT IDIM", model%sections(1)%boundary_treatment == &
+               boundary_coupled .and. model%sections(1)%domain_integration == &
+               integration_local_boundary)
+    call check_close(suite, "efg sets: DY 0 means 1.01", model%sections(3)%support_scale, &
+                     [1.5_wp, 1.01_wp, 1.2_wp], thr=0.0_wp)
+    call check(suite, "efg sets: IEBT 1, IDIM 2", model%sections(3)%boundary_treatment == &
+               boundary_full_transformation .and. model%sections(3)%domain_integration == &
+               integration_gauss)
+    call check(suite, "efg sets: titles", model%sections(5)%title == "meshfree" .and. &
+               model%sections(6)%title == "finite elements")
+    call check(suite, "efg sets: titled section kernel", model%sections(5)%kernel == &
+               kernel_cubic_sphere)
+    call check(suite, "efg sets: blank DY DZ of a sphere, no warning", warnings%count == 0)
+    call check(suite, "efg sets: part formulations", all([(model%parts(k)%formulation, k=1, &
+               5)] == [formulation_efg, formulation_fe, formulation_efg, formulation_efg, &
+               formulation_fe]))
+  end subroutine test_efg_in_solid_section_sets
+
+  !> Every value of the EFG card and card 3 that crashfree does not have names its field, and
+  !> ELFORM must fit the keyword.
+  subroutine test_efg_card_errors()
+    call read_bad("efg_fields.k", deck_with_sections([character(len=line_length) :: &
+      "*SECTION_SOLID_EFG", &
+      "1,41", &
+      "1.0,0.5,-2,1,1,2,3,0.01", &
+      "1,5.0,1,0.1,7,2,0.02,0.5", &
+      "*SECTION_SOLID_EFG", &
+      "2,1", &
+      "1.1", &
+      "*SECTION_SOLID", &
+      "3,42", &
+      "1.1", &
+      "4,41", &
+      "1.1,,,3,2,0,0,-0.5", &
+      "5,1", &
+      "*SECTION_SOLID_EFG", &
+      "6", &
+      "1.1"]), [character(len=260) :: &
+      "@:26: *SECTION_SOLID_EFG: field DX: DX must be greater than 1: at 1.0 a vertex weight "// &
+      "vanishes on the cell's far corner; found 1.0 (blank or 0 means 1.01)", &
+      "@:26: *SECTION_SOLID_EFG: field DY: DY must be greater than 1: at 1.0 a vertex weight "// &
+      "vanishes on the cell's far corner; found 0.5", &
+      "@:26: *SECTION_SOLID_EFG: field DZ: DZ must be greater than 1: at 1.0 a vertex weight "// &
+      "vanishes on the cell's far corner; found -2.0", &
+      "@:26: *SECTION_SOLID_EFG: field ISPLINE: the quadratic spline kernel (ISPLINE 1) is "// &
+      "not available; use 0 (cubic spline, box support) or 2 (cubic spline, spherical support)", &
+      "@:26: *SECTION_SOLID_EFG: field IDILA: IDILA 1 (support size from the surrounding "// &
+      "nodes) is not available", &
+      "@:26: *SECTION_SOLID_EFG: field IEBT: essential boundary treatment 2 is not available; "// &
+      "crashfree has IEBT 3 (coupled FE/EFG, the default for a blank field) and 1 (full "// &
+      "transformation)", &
+      "@:26: *SECTION_SOLID_EFG: field IDIM: domain integration 3 is not available; crashfree "// &
+      "has IDIM 1 (local boundary integration, the default for a blank field) and 2", &
+      "@:26: *SECTION_SOLID_EFG: field TOLDEF: semi-Lagrangian and Eulerian kernels (TOLDEF "// &
+      "/= 0) are not available; use 0 (found 0.01)", &
+      "@:27: *SECTION_SOLID_EFG: field IPS: pressure smoothing is not available; leave IPS "// &
+      "blank or 0, found 1", &
+      "@:27: *SECTION_SOLID_EFG: field STIME: the switch from stabilized to standard EFG "// &
+      "belongs to stabilized EFG integration (IDIM -1), which is not available; leave STIME "// &
+      "blank (1e20), found 5.0", &
+      "@:27: *SECTION_SOLID_EFG: field IKEN: the maximum-entropy approximation is not "// &
+      "available: crashfree uses moving least squares (IKEN 0), found 1", &
+      "@:27: *SECTION_SOLID_EFG: field SF: EFG fracture (crack initiation at the failure "// &
+      "strain SF) is not available; leave SF blank or 0, found 0.1", &
+      "@:27: *SECTION_SOLID_EFG: field CMID: EFG fracture (the cohesive material CMID) is not "// &
+      "available; leave CMID blank, found 7", &
+      "@:27: *SECTION_SOLID_EFG: field IBR: crack branching belongs to EFG fracture, which is "// &
+      "not available; leave IBR blank or 1, found 2", &
+      "@:27: *SECTION_SOLID_EFG: field DS: the support of the displacement jump belongs to EFG "// &
+      "fracture, which is not available; leave DS blank (0.01), found 0.02", &
+      "@:27: *SECTION_SOLID_EFG: field ECUT: the smallest crack-cut distance belongs to EFG "// &
+      "fracture, which is not available; leave ECUT blank (0.01), found 0.5", &
+      "@:29: *SECTION_SOLID_EFG: field ELFORM: *SECTION_SOLID_EFG needs ELFORM 41 (meshfree "// &
+      "EFG solid), found 1 (a finite element formulation: use *SECTION_SOLID)", &
+      "@:32: *SECTION_SOLID: field ELFORM: adaptive EFG (ELFORM 42, 4-node background cells) "// &
+      "is not available; use ELFORM 41", &
+      "@:35: *SECTION_SOLID: field ISPLINE: must be 0 (cubic spline, box support) or 2 (cubic "// &
+      "spline, spherical support), found 3", &
+      "@:35: *SECTION_SOLID: field IDILA: must be 0 (support size from the background "// &
+      "elements), found 2", &
+      "@:35: *SECTION_SOLID: field IEBT: essential boundary treatment 0 is not available; "// &
+      "crashfree has IEBT 3 (coupled FE/EFG, the default for a blank field) and 1 (full "// &
+      "transformation); 0 is not a default here: leave the field blank", &
+      "@:35: *SECTION_SOLID: field IDIM: domain integration 0 is not available; crashfree has "// &
+      "IDIM 1 (local boundary integration, the default for a blank field) and 2 (2x2x2 Gauss "// &
+      "points per cell, for comparison); 0 is not a default here: leave the field blank", &
+      "@:35: *SECTION_SOLID: field TOLDEF: semi-Lagrangian and Eulerian kernels (TOLDEF /= 0) "// &
+      "are not available; use 0 (found -0.5)", &
+      "@:38: *SECTION_SOLID_EFG: field ELFORM: *SECTION_SOLID_EFG needs ELFORM 41 (meshfree "// &
+      "EFG solid), found 1 (the field is blank, which means 1)"], message_lines=24)
+  end subroutine test_efg_card_errors
+
+  !> Where the cards of an EFG section end: a missing EFG card, card 3 inside a *SECTION_SOLID
+  !> set, and a second section under one *SECTION_SOLID_EFG.
+  subroutine test_efg_card_structure()
+    call read_bad("efg_no_card.k", deck_with_sections([character(len=line_length) :: &
+      "*SECTION_SOLID_EFG", "1,41"]), [character(len=200) :: "@:25: *SECTION_SOLID_EFG: field "// &
+      "DX: the EFG card (DX DY DZ ISPLINE IDILA IEBT IDIM TOLDEF) of section 1 is missing: the "// &
+      "keyword ends after this line"], message_lines=1)
+    call read_bad("efg_no_card_in_set.k", deck_with_sections([character(len=line_length) :: &
+      "*SECTION_SOLID", "1,2", "2,41"]), [character(len=200) :: "@:26: *SECTION_SOLID: field "// &
+      "DX: the EFG card (DX DY DZ ISPLINE IDILA IEBT IDIM TOLDEF) of section 2 is missing"], &
+      message_lines=1)
+    call read_bad("efg_card3_in_set.k", deck_with_sections([character(len=line_length) :: &
+      "*SECTION_SOLID", "1,41", "1.1", fixed(["0      ", "1.0E+20"], 10)]), &
+      [character(len=200) :: "@:27: *SECTION_SOLID: field SECID: section id must be > 0, found "// &
+      "0 (this card follows an EFG card; card 3, IPS STIME IKEN SF CMID IBR DS ECUT, is read "// &
+      "only under *SECTION_SOLID_EFG)"], message_lines=1)
+    call read_bad("efg_two_sections.k", deck_with_sections([character(len=line_length) :: &
+      "*SECTION_SOLID_EFG_TITLE", "first", "1,41", "1.1", "0", "second", "2,41", "1.1"]), &
+      [character(len=200) :: "@:29: *SECTION_SOLID_EFG_TITLE: field SECID: *SECTION_SOLID_EFG "// &
+      "holds one section (card 1, the EFG card and the optional card 3); give the next section "// &
+      "its own *SECTION_SOLID_EFG"], message_lines=1)
+  end subroutine test_efg_card_structure
+
+  !> The background cells of an EFG part must have 8 distinct nodes; FE parts may hold
+  !> degenerate hexahedra.
+  subroutine test_efg_cells()
+    character(len=line_length), allocatable :: lines(:)
+    allocate (lines(0))    ! (keeps gfortran 12 from a false "used uninitialized" warning)
+    lines = deck_with_sections([character(len=line_length) :: &
+      "*SECTION_SOLID", "1,41", "1.2", "2,1", &
+      "*PART", "fe part", fixed(["2", "2", "1"], 10), &
+      "*ELEMENT_SOLID", fixed(["2", "2", "1", "2", "3", "3", "5", "6", "7", "7"], 8)])
+    lines(16) = fixed(["1", "1", "1", "2", "3", "3", "5", "6", "7", "7"], 8)
+    call read_bad("efg_wedge.k", lines, &
+      [character(len=200) :: "@:16: *ELEMENT_SOLID: field N1-N8: element 1 of part 1 repeats "// &
+      "node 3 (N3 and N4): the background cells of an EFG part (ELFORM 41) must be proper "// &
+      "hexahedra with 8 distinct nodes"], message_lines=1)
+  end subroutine test_efg_cells
 end program test_deck
