@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
-"""Write the benchmark deck: a block of one-point hexahedra (elastic-plastic) thrown at a rigid
-wall, so that the elements deform plastically while the cycles are timed.
+"""Write a benchmark deck: a block of one-point hexahedra (elastic-plastic) thrown at a rigid
+wall, so that the elements deform plastically while the cycles are timed. With --efg-cells N the
+first N layers of cells along x form a second part with the meshfree (EFG) section, sharing
+nodes with the FE part (a coupled model).
 
-    python3 tools/make_bench_deck.py OUT.k [--cells 50 50 40] [--cycles 200]
+    python3 tools/make_bench_deck.py OUT.k [--cells 50 50 40] [--cycles 200] [--efg-cells N]
 """
 import argparse
 
@@ -15,6 +17,8 @@ def main():
     parser.add_argument("--cells", type=int, nargs=3, default=[50, 50, 40])
     parser.add_argument("--cycles", type=int, default=200)
     parser.add_argument("--size", type=float, default=1.0, help="cell edge in mm")
+    parser.add_argument("--efg-cells", type=int, default=0, help="layers of cells along x that are EFG")
+    parser.add_argument("--support", type=float, default=1.2, help="normalized EFG support DX = DY = DZ")
     options = parser.parse_args()
     nx, ny, nz = options.cells
     h = options.size
@@ -27,6 +31,8 @@ def main():
     corners = [index[:-1, :-1, :-1], index[1:, :-1, :-1], index[1:, 1:, :-1], index[:-1, 1:, :-1],
                index[:-1, :-1, 1:], index[1:, :-1, 1:], index[1:, 1:, 1:], index[:-1, 1:, 1:]]
     elements = np.stack([c.reshape(-1) for c in corners], axis=1)
+    layer = np.broadcast_to(np.arange(nx)[:, None, None], (nx, ny, nz)).reshape(-1)
+    parts = np.where(layer < options.efg_cells, 2, 1)
 
     with open(options.output, "w") as deck:
         deck.write("*KEYWORD\n*TITLE\nbenchmark block: %d one-point hexahedra\n" % len(elements))
@@ -34,6 +40,11 @@ def main():
         deck.write("*DATABASE_BINARY_D3PLOT\n%10.3f\n*DATABASE_GLSTAT\n%10.3f\n" % (10.0, 10.0))
         deck.write("*PART\nblock\n%10d%10d%10d%10d%10d\n" % (1, 1, 1, 0, 1))
         deck.write("*SECTION_SOLID\n%10d%10d\n" % (1, 1))
+        if options.efg_cells > 0:
+            deck.write("*PART\nmeshfree layers\n%10d%10d%10d%10d%10d\n" % (2, 2, 1, 0, 1))
+            support = "%10.3f" % options.support
+            deck.write("*SECTION_SOLID_EFG\n%10d%10d\n%s%s%s%10d%10d%10d%10d%10s\n"
+                       % (2, 41, support, support, support, 0, 0, 3, 1, "0.0"))
         deck.write("*MAT_PLASTIC_KINEMATIC\n%10d%10s%10s%10s%10s%10s%10s\n%10s%10s\n"
                    % (1, "7.85e-6", "210.0", "0.3", "0.2", "1.0", "1.0", "0.0", "0.0"))
         deck.write("*HOURGLASS\n%10d%10d%10s\n" % (1, 1, "0.1"))
@@ -43,8 +54,7 @@ def main():
         np.savetxt(deck, np.column_stack([np.arange(1, len(nodes) + 1), nodes, np.zeros((len(nodes), 2))]),
                    fmt="%8d%16.9e%16.9e%16.9e%8d%8d")
         deck.write("*ELEMENT_SOLID\n")
-        np.savetxt(deck, np.column_stack([np.arange(1, len(elements) + 1), np.ones(len(elements), int), elements]),
-                   fmt="%8d" * 10)
+        np.savetxt(deck, np.column_stack([np.arange(1, len(elements) + 1), parts, elements]), fmt="%8d" * 10)
         deck.write("*END\n")
 
 

@@ -8,10 +8,11 @@ module element_forces
   use model, only: model_t
   use solid_block, only: compute_solid_block
   use explicit_state, only: explicit_state_t
+  use efg_forces, only: compute_efg_forces, add_efg_forces
   implicit none
   private
 
-  public :: compute_element_forces
+  public :: compute_element_forces, compute_meshfree_forces
 
 contains
 
@@ -43,6 +44,20 @@ contains
       !$omp end parallel do
     end do
   end subroutine compute_element_forces
+
+  !> Forces of the meshfree parts, added after the finite elements' (a Gamma node shared with
+  !> an FE part receives both, always in this order).
+  subroutine compute_meshfree_forces(model, state, dt)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(inout) :: state
+    real(wp), intent(in) :: dt
+    integer :: k
+    do k = 1, size(state%efg)
+      call compute_efg_forces(model%materials(state%efg(k)%geometry%material), state%efg(k), &
+                              state%displacement, state%velocity, dt)
+      call add_efg_forces(state%efg(k), state%internal_force)
+    end do
+  end subroutine compute_meshfree_forces
 
   !> internal_force(:, node) += the block's corner forces, corner by corner, lane by lane.
   subroutine add_block_forces(element_count, nodes, block_force, internal_force)

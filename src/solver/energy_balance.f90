@@ -22,7 +22,7 @@ contains
   !> section 6.2.3).
   subroutine update_energy_totals(state)
     type(explicit_state_t), intent(inout) :: state
-    integer :: chunk_count, chunk, first, last, node, b
+    integer :: chunk_count, chunk, first, last, node, b, k
     real(wp) :: partial(4, max(1, (state%node_count + chunk_size - 1)/chunk_size)), velocity(3), next_velocity(3)
     real(wp) :: half_step, average_step, step_correction
 
@@ -68,6 +68,14 @@ contains
                                  + step_correction*sum(block%hourglass_power(1:block%element_count))
       end associate
     end do
+    do k = 1, size(state%efg)
+      do b = 1, size(state%efg(k)%blocks)
+        associate (block => state%efg(k)%blocks(b))
+          state%energy%internal = state%energy%internal + sum(block%internal_energy(1:block%point_count)) &
+                                  + step_correction*sum(block%force_power(1:block%point_count))
+        end associate
+      end do
+    end do
   end subroutine update_energy_totals
 
   !> Kinetic, internal and hourglass energy of each part (indexed like model%parts), measured
@@ -77,7 +85,7 @@ contains
     type(explicit_state_t), intent(in) :: state
     integer, intent(in) :: part_count
     real(wp), intent(out) :: kinetic(part_count), internal(part_count), hourglass(part_count)
-    integer :: b, corner, lane, node
+    integer :: b, k, corner, lane, node
     real(wp) :: velocity(3), next_velocity(3), average_step, step_correction
     kinetic = 0.0_wp
     internal = 0.0_wp
@@ -98,6 +106,21 @@ contains
             kinetic(block%part) = kinetic(block%part) + &
                                   0.5_wp*state%corner_mass(lane, corner, b)*dot_product(velocity, next_velocity)
           end do
+        end do
+      end associate
+    end do
+    do k = 1, size(state%efg)
+      associate (efg => state%efg(k), part => state%efg(k)%geometry%part)
+        do b = 1, size(efg%blocks)
+          internal(part) = internal(part) + sum(efg%blocks(b)%internal_energy(1:efg%blocks(b)%point_count)) &
+                           + step_correction*sum(efg%blocks(b)%force_power(1:efg%blocks(b)%point_count))
+        end do
+        do lane = 1, size(efg%geometry%mass_node)
+          node = efg%geometry%mass_node(lane)
+          velocity = state%velocity(:, node)
+          next_velocity = velocity + average_step*state%acceleration(:, node)
+          kinetic(part) = kinetic(part) + 0.5_wp*efg%density*efg%geometry%mass_volume(lane)* &
+                          dot_product(velocity, next_velocity)
         end do
       end associate
     end do

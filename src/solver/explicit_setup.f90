@@ -4,7 +4,10 @@ module explicit_setup
   use kinds, only: wp, block_size
   use error_handling, only: error_t, make_error
   use gather_list, only: gather_list_t, build_gather_list
-  use model, only: model_t
+  use model, only: model_t, formulation_efg
+  use efg_part, only: efg_part_t
+  use efg_setup, only: build_efg_part
+  use efg_forces, only: set_up_efg_solver
   use solid_block, only: solid_block_t, build_solid_blocks, solid_block_corner_masses, &
                          solid_block_time_steps
   use explicit_state, only: explicit_state_t
@@ -52,6 +55,8 @@ contains
     call scale_masses(model, state)
     call colour_blocks(state)
     call lump_nodal_masses(state)
+    call set_up_meshfree_parts(model, state, error)
+    if (allocated(error)) return
     call initialise_wall_states(model%walls, state%walls)
     if (sum(state%mass) <= 0.0_wp) then
       call make_error(error, "model: the elements give no mass (check densities and element volumes)")
@@ -164,6 +169,40 @@ contains
       end do
     end do
   end subroutine lump_nodal_masses
+
+  !> Shape functions, smoothed gradients and row-sum masses of every EFG part (formulation
+  !> sections 2-5), once, on the undeformed mesh.
+  subroutine set_up_meshfree_parts(model, state, error)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(inout) :: state
+    type(error_t), allocatable, intent(out) :: error
+    type(efg_part_t) :: geometry
+    integer :: part, count, k
+
+    allocate (state%is_particle(state%node_count))
+    state%is_particle = .false.
+    count = 0
+    do part = 1, size(model%parts)
+      if (model%parts(part)%formulation == formulation_efg) count = count + 1
+    end do
+    allocate (state%efg(count))
+    count = 0
+    do part = 1, size(model%parts)
+      if (model%parts(part)%formulation /= formulation_efg) cycle
+      count = count + 1
+      call build_efg_part(model, part, geometry, error)
+      if (allocated(error)) return
+      call set_up_efg_solver(model, geometry, state%efg(count))
+      associate (efg => state%efg(count))
+        do k = 1, size(efg%geometry%mass_node)
+          state%mass(efg%geometry%mass_node(k)) = state%mass(efg%geometry%mass_node(k)) + &
+                                                  efg%density*efg%geometry%mass_volume(k)
+        end do
+        state%physical_mass = state%physical_mass + efg%density*sum(efg%geometry%mass_volume)
+        state%is_particle(efg%geometry%particles) = .true.
+      end associate
+    end do
+  end subroutine set_up_meshfree_parts
 
   pure integer function corner_slot(lane, corner, block)
     integer, intent(in) :: lane, corner, block

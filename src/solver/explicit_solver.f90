@@ -6,7 +6,7 @@ module explicit_solver
   use error_handling, only: error_t, make_error
   use model, only: model_t
   use explicit_state, only: explicit_state_t
-  use element_forces, only: compute_element_forces
+  use element_forces, only: compute_element_forces, compute_meshfree_forces
   use boundary_conditions, only: assemble_nodal_loads, load_work, impose_kinematic_conditions, &
                                  hold_prescribed_accelerations
   use planar_rigid_walls, only: enforce_planar_walls
@@ -35,7 +35,7 @@ contains
     type(history_set_t) :: histories
     type(output_plan_t) :: plan
     type(progress_t) :: progress
-    type(phase_timer_t) :: element_timer, output_timer
+    type(phase_timer_t) :: element_timer, meshfree_timer, output_timer
     type(error_t), allocatable :: output_error
     real(wp) :: previous_step, step, work
     logical :: finished, wrote_state
@@ -46,6 +46,9 @@ contains
     call start_phase(element_timer)
     call compute_element_forces(model, state, 0.0_wp)
     call stop_phase(element_timer)
+    call start_phase(meshfree_timer)
+    call compute_meshfree_forces(model, state, 0.0_wp)
+    call stop_phase(meshfree_timer)
     call assemble_nodal_loads(model, 0.0_wp, state%external_force)
     call compute_accelerations(state)
     call hold_prescribed_accelerations(model, 0.0_wp, state%acceleration)
@@ -69,7 +72,8 @@ contains
       state%energy%external_work = state%energy%external_work + work
       if (size(model%walls) > 0) then
         call enforce_planar_walls(model%walls, state%walls, state%time, step, 0.5_wp*(previous_step + step), &
-                                  state%coordinates, state%acceleration, state%mass, state%velocity, work)
+                                  state%coordinates, state%acceleration, state%mass, state%is_particle, &
+                                  state%velocity, work)
         state%energy%rigid_wall = state%energy%rigid_wall + work
       end if
       call update_positions(state, step)
@@ -83,6 +87,9 @@ contains
       call start_phase(element_timer)
       call compute_element_forces(model, state, step)
       call stop_phase(element_timer)
+      call start_phase(meshfree_timer)
+      call compute_meshfree_forces(model, state, step)
+      call stop_phase(meshfree_timer)
       call assemble_nodal_loads(model, state%time, state%external_force)
       state%energy%external_work = state%energy%external_work + &
                                    0.5_wp*load_work(model, state%external_force, state%velocity, step)
@@ -104,6 +111,7 @@ contains
     summary%end_time = state%time
     summary%cycles = state%cycle
     summary%fe_solid_s = element_timer%seconds
+    summary%efg_s = meshfree_timer%seconds
     summary%output_s = output_timer%seconds
   end subroutine run_explicit
 
@@ -154,7 +162,7 @@ contains
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(inout) :: state
     logical, intent(in) :: is_first
-    integer :: b, critical
+    integer :: b, k, critical
     real(wp) :: smallest
     smallest = huge(1.0_wp)
     critical = 0
@@ -163,6 +171,15 @@ contains
         smallest = state%block_time_step(b)
         critical = state%block_critical_element(b)
       end if
+    end do
+    ! meshfree integration points follow the FE rule of their background cell
+    do k = 1, size(state%efg)
+      do b = 1, size(state%efg(k)%blocks)
+        if (state%efg(k)%block_time_step(b) < smallest) then
+          smallest = state%efg(k)%block_time_step(b)
+          critical = state%efg(k)%geometry%point_cell(state%efg(k)%block_critical_point(b))
+        end if
+      end do
     end do
     state%next_time_step = model%time_step_scale*smallest
     state%controlling_element = critical
@@ -176,7 +193,7 @@ contains
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(in) :: state
     type(error_t), allocatable, intent(out) :: error
-    integer :: b, element
+    integer :: b, k, element, point
     character(len=256) :: text
     do b = 1, size(state%blocks)
       element = state%block_inverted_element(b)
@@ -185,6 +202,18 @@ contains
         " (part ", model%parts(model%solid_part(element))%id, ") at time ", state%time, ", cycle ", state%cycle
       call make_error(error, trim(text))
       return
+    end do
+    do k = 1, size(state%efg)
+      do b = 1, size(state%efg(k)%blocks)
+        point = state%efg(k)%block_inverted_point(b)
+        if (point == 0) cycle
+        element = state%efg(k)%geometry%point_cell(point)
+        write (text, '(a,i0,a,i0,a,es12.5,a,i0)') "negative volume at an integration point of meshfree part ", &
+          model%parts(state%efg(k)%geometry%part)%id, " (background cell ", model%solid_ids(element), &
+          ") at time ", state%time, ", cycle ", state%cycle
+        call make_error(error, trim(text))
+        return
+      end do
     end do
     if (.not. (state%next_time_step > 0.0_wp .and. state%next_time_step < huge(1.0_wp))) then
       element = state%controlling_element

@@ -10,6 +10,7 @@ module explicit_state
   use kinds, only: wp, block_size
   use gather_list, only: gather_list_t
   use solid_block, only: solid_block_t
+  use efg_forces, only: efg_solver_t
   implicit none
   private
 
@@ -63,6 +64,9 @@ module explicit_state
     integer, allocatable :: block_critical_element(:)
     integer, allocatable :: block_inverted_element(:)
     type(gather_list_t) :: block_colors                  !< colour -> blocks (same CSR form as a gather list)
+    ! meshfree parts: their interior particles carry generalized displacements
+    type(efg_solver_t), allocatable :: efg(:)
+    logical, allocatable :: is_particle(:)               !< interior particle of an EFG part
     ! walls
     type(wall_state_t), allocatable :: walls(:)
     ! bookkeeping

@@ -106,13 +106,26 @@ contains
     type(explicit_state_t), intent(in) :: state
     type(run_summary_t), intent(inout) :: summary
     character(len=200) :: line
-    summary%fe_elements = size(model%solid_ids)
+    integer :: k
+    summary%fe_elements = sum(state%blocks%element_count)
     summary%dofs_total = 3*size(model%node_ids)
+    summary%efg_particles = 0
+    summary%dofs_efg = 0
+    do k = 1, size(state%efg)
+      summary%efg_particles = summary%efg_particles + size(state%efg(k)%geometry%particles)
+      summary%dofs_efg = summary%dofs_efg + 3*size(state%efg(k)%geometry%mass_node)
+    end do
     write (line, '(a,i0,a,i0,a,i0,a)') "model: ", size(model%node_ids), " nodes, ", size(model%solid_ids), &
       " solids in ", size(model%parts), " parts"
     write (*, '(a)') trim(line)
     write (line, '(a,es12.5)') "mass: ", state%physical_mass
     write (*, '(a)') trim(line)
+    if (size(state%efg) > 0) then
+      write (line, '(a,i0,a,i0,a,f0.1,a,f0.3,a)') "meshfree: ", size(state%efg), " EFG part(s), ", &
+        summary%efg_particles, " interior particles, ", 100.0_wp*real(summary%dofs_efg, wp)/real(summary%dofs_total, wp), &
+        "% of the dofs; set-up ", sum(state%efg%geometry%setup_seconds), " s"
+      write (*, '(a)') trim(line)
+    end if
     if (state%added_mass > 0.0_wp) then
       write (line, '(a,es12.5,a,f0.3,a)') "mass scaling: added mass ", state%added_mass, " (", &
         100.0_wp*state%added_mass/state%physical_mass, "% of the physical mass)"

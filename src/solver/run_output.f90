@@ -12,6 +12,7 @@ module run_output
   use history_buffer, only: history_set_t, add_history_series, append_history_row
   use energy_balance, only: update_energy_totals, part_energies, total_energy, energy_ratio
   use solid_block, only: solid_block_element_results
+  use efg_forces, only: efg_point_results, transform_to_physical
   use results_file, only: results_file_t, write_state, write_histories
   implicit none
   private
@@ -35,7 +36,9 @@ module run_output
     real(wp) :: last_rwforc_time = 0.0_wp
     ! work arrays for the element results of a state, allocated once
     real(wp), allocatable :: solid_stress(:, :), solid_plastic_strain(:)
-    real(wp), allocatable :: node_velocity(:, :)     !< integer-step velocities of a state
+    real(wp), allocatable :: node_velocity(:, :)     !< physical integer-step velocities of a state
+    real(wp), allocatable :: node_displacement(:, :) !< physical displacements of a state
+    real(wp), allocatable :: generalized_velocity(:, :) !< integer-step solver velocities (work array)
     real(wp), allocatable :: part_kinetic(:), part_internal(:), part_hourglass(:)
   end type output_plan_t
 
@@ -97,7 +100,8 @@ contains
       end do
     end if
     allocate (plan%solid_stress(6, size(model%solid_ids)), plan%solid_plastic_strain(size(model%solid_ids)))
-    allocate (plan%node_velocity(3, size(model%node_ids)))
+    allocate (plan%node_velocity(3, size(model%node_ids)), plan%node_displacement(3, size(model%node_ids)), &
+              plan%generalized_velocity(3, size(model%node_ids)))
     allocate (plan%part_kinetic(size(model%parts)), plan%part_internal(size(model%parts)), &
               plan%part_hourglass(size(model%parts)))
   end subroutine plan_output
@@ -149,7 +153,7 @@ contains
     logical, intent(in) :: last
     logical, intent(out) :: wrote_state
     type(error_t), allocatable, intent(out) :: error
-    logical :: glstat_due, matsum_due
+    logical :: glstat_due, matsum_due, nodout_due, states_due
     integer :: k
 
     wrote_state = .false.
@@ -169,18 +173,20 @@ contains
                                 plan%part_internal(k), plan%part_hourglass(k)])
       end do
     end if
-    if (clock_due(plan%nodout, state%time, last)) then
+    nodout_due = clock_due(plan%nodout, state%time, last)
+    states_due = clock_due(plan%states, state%time, last)
+    if (nodout_due .or. states_due) call physical_node_fields(state, plan)
+    if (nodout_due) then
       do k = 1, size(plan%nodout_series)
         associate (node => model%output%history_nodes(k))
           call append_history_row(histories%series(plan%nodout_series(k)), [state%time, &
-            state%displacement(:, node), state%velocity(:, node) + 0.5_wp*state%time_step*state%acceleration(:, node), &
-            state%acceleration(:, node)])
+            plan%node_displacement(:, node), plan%node_velocity(:, node), state%acceleration(:, node)])
         end associate
       end do
     end if
     if (clock_due(plan%rwforc, state%time, last)) call record_wall_forces(state, plan, histories)
-    if (clock_due(plan%states, state%time, last)) then
-      call write_current_state(state, plan, results, error)
+    if (states_due) then
+      call write_current_state(model, state, plan, results, error)
       if (allocated(error)) return
       call write_histories(results, histories, error)
       wrote_state = .true.
@@ -205,17 +211,37 @@ contains
     plan%last_rwforc_time = state%time
   end subroutine record_wall_forces
 
-  subroutine write_current_state(state, plan, results, error)
+  !> Physical nodal displacements and integer-step velocities: the solver's values, with the
+  !> interior particles of meshfree parts transformed (eq. 16) so that the output shows the
+  !> real deformed shape.
+  subroutine physical_node_fields(state, plan)
+    type(explicit_state_t), intent(in) :: state
+    type(output_plan_t), intent(inout) :: plan
+    integer :: k
+    plan%generalized_velocity = state%velocity + 0.5_wp*state%time_step*state%acceleration
+    plan%node_displacement = state%displacement
+    plan%node_velocity = plan%generalized_velocity
+    do k = 1, size(state%efg)
+      call transform_to_physical(state%efg(k), state%displacement, plan%node_displacement)
+      call transform_to_physical(state%efg(k), plan%generalized_velocity, plan%node_velocity)
+    end do
+  end subroutine physical_node_fields
+
+  subroutine write_current_state(model, state, plan, results, error)
+    type(model_t), intent(in) :: model
     type(explicit_state_t), intent(in) :: state
     type(output_plan_t), intent(inout) :: plan
     type(results_file_t), intent(inout) :: results
     type(error_t), allocatable, intent(out) :: error
-    integer :: b
+    integer :: b, k
     do b = 1, size(state%blocks)
       call solid_block_element_results(state%blocks(b), plan%solid_stress, plan%solid_plastic_strain)
     end do
-    plan%node_velocity = state%velocity + 0.5_wp*state%time_step*state%acceleration
-    call write_state(results, state%time, state%displacement, plan%node_velocity, plan%solid_stress, &
+    do k = 1, size(state%efg)
+      call efg_point_results(model%materials(state%efg(k)%geometry%material), state%efg(k), plan%solid_stress, &
+                             plan%solid_plastic_strain)
+    end do
+    call write_state(results, state%time, plan%node_displacement, plan%node_velocity, plan%solid_stress, &
                      plan%solid_plastic_strain, error)
   end subroutine write_current_state
 end module run_output

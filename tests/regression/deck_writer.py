@@ -94,3 +94,10 @@ def write_deck(path, *blocks):
     text = "*KEYWORD\n" + "\n".join(blocks) + "\n*END\n"
     path.write_text(text)
     return path
+
+
+def efg_section(section_id, support=1.01, kernel=0, boundary_treatment=3, integration=1):
+    """*SECTION_SOLID_EFG (ELFORM 41) with its EFG card: DX = DY = DZ = support, ISPLINE = kernel
+    (0 cubic spline box support, 2 spherical), IDILA 0, IEBT, IDIM, TOLDEF 0."""
+    return ("*SECTION_SOLID_EFG\n" + fields(section_id, 41) + "\n" +
+            fields(float(support), float(support), float(support), kernel, 0, boundary_treatment, integration, 0.0))

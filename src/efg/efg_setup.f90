@@ -1,0 +1,386 @@
+!> Set-up of one meshfree (EFG) part: everything the explicit update needs, computed once on the
+!> undeformed background mesh (Lagrangian kernel; formulation sections 1-5, Wang et al. 2009).
+!>
+!> Steps: nodes, Gamma nodes, particles and supports (efg_supports) -> bins over the supports
+!> (efg_neighbour_search) -> per background cell, independently and in parallel: the coupled
+!> shape functions (efg_shape_functions) at the sub-cell face points, the smoothed gradients
+!> (efg_smoothed_gradient), the row-sum mass shares (efg_mass) and the transformation rows of the
+!> particles the cell owns (efg_transformation) -> assembly in cell order (so the result does not
+!> depend on the thread count) -> checks (moment residuals at round-off, positive masses).
+!> Every step is linear in the number of cells. See docs/efg.md.
+module efg_setup
+  use kinds, only: wp
+  use error_handling, only: error_t, make_error
+  use wall_clock, only: seconds_now
+  use model, only: model_t, formulation_efg, kernel_cubic_box, kernel_cubic_sphere, boundary_full_transformation, &
+                   boundary_coupled, integration_local_boundary, integration_gauss
+  use efg_part, only: efg_part_t
+  use efg_cell_geometry, only: subcell_volumes, largest_face_area
+  use efg_supports, only: part_supports_t, build_part_supports
+  use efg_neighbour_search, only: particle_grid_t, build_particle_grid
+  use efg_shape_functions, only: cell_shape_context_t, prepare_cell_context
+  use efg_smoothed_gradient, only: cell_smoothed_gradients, cell_gauss_gradients
+  use efg_mass, only: cell_mass_volumes
+  use efg_transformation, only: particle_transformation_row
+  implicit none
+  private
+
+  public :: build_efg_part
+
+  !> Largest |M alpha - b| accepted as round-off. It is about 1e-15 when the support rule of
+  !> formulation section 2 holds; anything near this bound means a particle needed by b does not
+  !> cover the point.
+  real(wp), parameter, public :: moment_residual_tolerance = 1.0e-9_wp
+
+  !> What one background cell contributes, kept until the cells are assembled in order.
+  type :: cell_result_t
+    real(wp) :: point_volume(8) = 0.0_wp
+    real(wp) :: point_length = 0.0_wp
+    integer :: pair_count(8) = 0
+    integer, allocatable :: pair_node(:)
+    real(wp), allocatable :: pair_gradient(:, :)
+    integer, allocatable :: mass_node(:)
+    real(wp), allocatable :: mass_volume(:)
+    integer :: row_count = 0                       !< particles whose transformation row is here
+    integer, allocatable :: row_particle(:)
+    integer, allocatable :: row_length(:)
+    integer, allocatable :: row_node(:)
+    real(wp), allocatable :: row_value(:)
+    integer :: singular_points = 0
+    real(wp) :: worst_residual = 0.0_wp
+  end type cell_result_t
+
+contains
+
+  !> Build the precomputed data `efg` of part `part` (an index into model%parts whose formulation
+  !> is EFG). On failure `error` names the part and, where it applies, the element or node and the
+  !> likely cause; `efg` is then still filled as far as it was built.
+  subroutine build_efg_part(model, part, efg, error)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: part
+    type(efg_part_t), intent(out) :: efg
+    type(error_t), allocatable, intent(out) :: error
+    type(part_supports_t) :: supports
+    type(particle_grid_t) :: grid
+    type(cell_result_t), allocatable :: results(:)
+    real(wp) :: started
+    integer :: k, domain_integration
+
+    started = seconds_now()
+    call check_section(model, part, error)
+    if (allocated(error)) return
+    associate (section => model%sections(model%parts(part)%section))
+      efg%part = part
+      efg%material = model%parts(part)%material
+      call build_part_supports(model, part, section%support_scale, section%kernel, &
+                               section%boundary_treatment == boundary_full_transformation, supports)
+      if (size(supports%cells) == 0) then
+        call make_error(error, "EFG part "//text(model%parts(part)%id)//" has no solid elements")
+        return
+      end if
+      domain_integration = section%domain_integration
+    end associate
+    efg%gamma_nodes = supports%gamma_nodes
+    efg%particles = supports%particles
+    call build_particle_grid(supports%particle_coordinates, supports%particle_radius, grid)
+
+    ! cells are independent; each writes only its own result
+    allocate (results(size(supports%cells)))
+    !$omp parallel do schedule(dynamic, 4)
+    do k = 1, size(supports%cells)
+      call process_cell(model, supports, grid, domain_integration, supports%cells(k), results(k))
+    end do
+    !$omp end parallel do
+
+    call assemble(supports, results, efg)
+    call check_results(model, part, supports, results, efg, error)
+    efg%setup_seconds = seconds_now() - started
+  end subroutine build_efg_part
+
+  !> Everything one cell contributes: points, pairs, mass shares and transformation rows.
+  subroutine process_cell(model, supports, grid, domain_integration, cell, result)
+    type(model_t), intent(in) :: model
+    type(part_supports_t), intent(in) :: supports
+    type(particle_grid_t), intent(in) :: grid
+    integer, intent(in) :: domain_integration, cell
+    type(cell_result_t), intent(inout) :: result
+    type(cell_shape_context_t) :: context
+    real(wp), allocatable :: gradients(:, :, :), mass_volume(:), row_value(:)
+    integer, allocatable :: row_node(:)
+    real(wp) :: volumes(8)
+    integer :: n, g, k, pair, vertex, particle, row_count, total
+
+    call prepare_cell_context(supports, grid, model%coordinates, model%solid_nodes(:, cell), cell, context)
+    n = context%node_count
+    volumes = subcell_volumes(context%vertices)
+    result%point_length = sum(volumes)/largest_face_area(context%vertices)
+    ! an inverted or degenerate cell is reported by the caller; nothing else is computed for it
+    if (any(volumes <= 0.0_wp)) then
+      result%point_volume = volumes
+      allocate (result%pair_node(0), result%pair_gradient(3, 0), result%mass_node(0), result%mass_volume(0))
+      allocate (result%row_particle(0), result%row_length(0), result%row_node(0), result%row_value(0))
+      return
+    end if
+
+    allocate (gradients(3, n, 8))
+    if (domain_integration == integration_gauss) then
+      call cell_gauss_gradients(context, gradients, result%point_volume, result%singular_points, &
+                                result%worst_residual)
+    else
+      result%point_volume = volumes
+      call cell_smoothed_gradients(context, volumes, gradients, result%singular_points, result%worst_residual)
+    end if
+    ! pairs: every local node whose gradient is not exactly zero, in ascending node order
+    do g = 1, 8
+      result%pair_count(g) = count(any(gradients(:, 1:n, g) /= 0.0_wp, dim=1))
+    end do
+    allocate (result%pair_node(sum(result%pair_count)), result%pair_gradient(3, sum(result%pair_count)))
+    pair = 0
+    do g = 1, 8
+      do k = 1, n
+        if (all(gradients(:, k, g) == 0.0_wp)) cycle
+        pair = pair + 1
+        result%pair_node(pair) = context%nodes(k)
+        result%pair_gradient(:, pair) = gradients(:, k, g)
+      end do
+    end do
+
+    allocate (mass_volume(n))
+    call cell_mass_volumes(context, domain_integration, volumes, mass_volume, result%singular_points, &
+                           result%worst_residual)
+    result%mass_node = pack(context%nodes(1:n), mass_volume /= 0.0_wp)
+    result%mass_volume = pack(mass_volume, mass_volume /= 0.0_wp)
+
+    ! transformation rows of the particles this cell owns
+    row_count = 0
+    do vertex = 1, 8
+      particle = supports%particle_of_node(model%solid_nodes(vertex, cell))
+      if (particle == 0) cycle
+      if (supports%owner_cell(particle) == cell) row_count = row_count + 1
+    end do
+    result%row_count = row_count
+    allocate (result%row_particle(row_count), result%row_length(row_count))
+    allocate (row_node(n*max(row_count, 1)), row_value(n*max(row_count, 1)))
+    row_count = 0
+    total = 0
+    do vertex = 1, 8
+      particle = supports%particle_of_node(model%solid_nodes(vertex, cell))
+      if (particle == 0) cycle
+      if (supports%owner_cell(particle) /= cell) cycle
+      if (any(result%row_particle(1:row_count) == particle)) cycle
+      row_count = row_count + 1
+      result%row_particle(row_count) = particle
+      call particle_transformation_row(context, vertex, row_node(total + 1:), row_value(total + 1:), &
+                                       result%row_length(row_count), result%singular_points, result%worst_residual)
+      total = total + result%row_length(row_count)
+    end do
+    result%row_count = row_count
+    result%row_node = row_node(1:total)
+    result%row_value = row_value(1:total)
+  end subroutine process_cell
+
+  !> Concatenate the cells' contributions in cell order.
+  subroutine assemble(supports, results, efg)
+    type(part_supports_t), intent(in) :: supports
+    type(cell_result_t), intent(in) :: results(:)
+    type(efg_part_t), intent(inout) :: efg
+    integer, allocatable :: part_node(:), row_start(:), row_length(:), row_cell(:)
+    integer :: cell_count, point_count, pair_count, k, g, point, pair, first, j, particle, r, start
+
+    cell_count = size(results)
+    point_count = 8*cell_count
+    pair_count = 0
+    do k = 1, cell_count
+      pair_count = pair_count + sum(results(k)%pair_count)
+    end do
+    allocate (efg%point_cell(point_count), efg%point_volume(point_count), efg%point_length(point_count))
+    allocate (efg%point_offsets(point_count + 1), efg%pair_node(pair_count), efg%pair_gradient(3, pair_count))
+    point = 0
+    pair = 0
+    efg%point_offsets(1) = 1
+    do k = 1, cell_count
+      first = pair + 1
+      pair = pair + sum(results(k)%pair_count)
+      efg%pair_node(first:pair) = results(k)%pair_node
+      efg%pair_gradient(:, first:pair) = results(k)%pair_gradient
+      do g = 1, 8
+        point = point + 1
+        efg%point_cell(point) = supports%cells(k)
+        efg%point_volume(point) = results(k)%point_volume(g)
+        efg%point_length(point) = results(k)%point_length
+        efg%point_offsets(point + 1) = efg%point_offsets(point) + results(k)%pair_count(g)
+      end do
+    end do
+
+    ! row-sum mass shares, every node of the part once, ascending
+    allocate (part_node(maxval(supports%nodes)))
+    part_node = 0
+    do j = 1, size(supports%nodes)
+      part_node(supports%nodes(j)) = j
+    end do
+    efg%mass_node = supports%nodes
+    allocate (efg%mass_volume(size(supports%nodes)))
+    efg%mass_volume = 0.0_wp
+    do k = 1, cell_count
+      do j = 1, size(results(k)%mass_node)
+        associate (local => part_node(results(k)%mass_node(j)))
+          efg%mass_volume(local) = efg%mass_volume(local) + results(k)%mass_volume(j)
+        end associate
+      end do
+    end do
+
+    ! transformation rows in particle order
+    allocate (row_start(size(supports%particles)), row_length(size(supports%particles)))
+    allocate (row_cell(size(supports%particles)))
+    row_length = 0
+    row_cell = 0
+    row_start = 0
+    do k = 1, cell_count
+      start = 1
+      do r = 1, results(k)%row_count
+        particle = results(k)%row_particle(r)
+        row_cell(particle) = k
+        row_start(particle) = start
+        row_length(particle) = results(k)%row_length(r)
+        start = start + results(k)%row_length(r)
+      end do
+    end do
+    allocate (efg%transform_offsets(size(supports%particles) + 1))
+    efg%transform_offsets(1) = 1
+    do particle = 1, size(supports%particles)
+      efg%transform_offsets(particle + 1) = efg%transform_offsets(particle) + row_length(particle)
+    end do
+    allocate (efg%transform_node(efg%transform_offsets(size(supports%particles) + 1) - 1))
+    allocate (efg%transform_value(size(efg%transform_node)))
+    do particle = 1, size(supports%particles)
+      if (row_cell(particle) == 0) cycle
+      first = efg%transform_offsets(particle)
+      associate (source => results(row_cell(particle)))
+        efg%transform_node(first:first + row_length(particle) - 1) = &
+          source%row_node(row_start(particle):row_start(particle) + row_length(particle) - 1)
+        efg%transform_value(first:first + row_length(particle) - 1) = &
+          source%row_value(row_start(particle):row_start(particle) + row_length(particle) - 1)
+      end associate
+    end do
+
+    efg%singular_moment_points = 0
+    do k = 1, cell_count
+      efg%singular_moment_points = efg%singular_moment_points + results(k)%singular_points
+    end do
+  end subroutine assemble
+
+  !> The section's EFG fields must select what is built (the deck reader checks them too; a
+  !> model built otherwise is checked here).
+  subroutine check_section(model, part, error)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: part
+    type(error_t), allocatable, intent(out) :: error
+    character(len=:), allocatable :: where
+
+    if (part < 1 .or. part > size(model%parts)) then
+      call make_error(error, "EFG set-up: part index "//text(part)//" is not a part of the model")
+      return
+    end if
+    where = "EFG part "//text(model%parts(part)%id)
+    if (model%parts(part)%formulation /= formulation_efg) then
+      call make_error(error, where//": the part is not meshfree (its section is not ELFORM 41)")
+      return
+    end if
+    if (model%parts(part)%section < 1 .or. model%parts(part)%section > size(model%sections)) then
+      call make_error(error, where//": the part has no section")
+      return
+    end if
+    associate (section => model%sections(model%parts(part)%section))
+      where = where//", section "//text(section%id)
+      if (any(section%support_scale <= 1.0_wp)) then
+        call make_error(error, where//": DX, DY and DZ must be greater than 1 (at 1.0 a vertex "// &
+                        "weight vanishes on the cell's far corner)")
+      else if (section%kernel /= kernel_cubic_box .and. section%kernel /= kernel_cubic_sphere) then
+        call make_error(error, where//": ISPLINE must be 0 (cubic spline, box) or 2 (cubic spline, sphere)")
+      else if (section%dilation_basis /= 0) then
+        call make_error(error, where//": IDILA must be 0 (support from the nodes sharing an element)")
+      else if (section%kernel_tolerance /= 0.0_wp) then
+        call make_error(error, where//": TOLDEF must be 0 (Lagrangian kernel)")
+      else if (section%boundary_treatment /= boundary_coupled .and. &
+               section%boundary_treatment /= boundary_full_transformation) then
+        call make_error(error, where//": IEBT must be 3 (coupled FE/EFG) or 1 (full transformation)")
+      else if (section%domain_integration /= integration_local_boundary .and. &
+               section%domain_integration /= integration_gauss) then
+        call make_error(error, where//": IDIM must be 1 (local boundary integration) or 2 (Gauss)")
+      end if
+    end associate
+  end subroutine check_section
+
+  !> Inverted cells, moment residuals above round-off, non-positive masses.
+  subroutine check_results(model, part, supports, results, efg, error)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: part
+    type(part_supports_t), intent(in) :: supports
+    type(cell_result_t), intent(in) :: results(:)
+    type(efg_part_t), intent(in) :: efg
+    type(error_t), allocatable, intent(out) :: error
+    character(len=:), allocatable :: where, listed
+    real(wp) :: worst
+    integer :: k, worst_cell, bad, j
+
+    where = "EFG part "//text(model%parts(part)%id)
+    do k = 1, size(results)
+      if (any(results(k)%point_volume <= 0.0_wp)) then
+        call make_error(error, where//": element "//text(model%solid_ids(supports%cells(k)))// &
+                        " has a non-positive (sub-)cell volume: it is inverted or degenerate")
+        return
+      end if
+    end do
+
+    worst = 0.0_wp
+    worst_cell = 1
+    do k = 1, size(results)
+      if (results(k)%worst_residual > worst) then
+        worst = results(k)%worst_residual
+        worst_cell = k
+      end if
+    end do
+    if (worst > moment_residual_tolerance) then
+      call make_error(error, where//": element "//text(model%solid_ids(supports%cells(worst_cell)))// &
+                      ": the moment equations M alpha = b are not solved to round-off (residual "// &
+                      real_text(worst)//"): b(X) is not in the range of M(X), so an interior vertex of "// &
+                      "the cell does not cover it; each particle's support must be DX times the largest "// &
+                      "distance to the nodes sharing an element with it (formulation section 2)")
+      return
+    end if
+
+    bad = 0
+    listed = ""
+    do j = 1, size(efg%mass_volume)
+      if (efg%mass_volume(j) > 0.0_wp) cycle
+      bad = bad + 1
+      if (bad <= 5) listed = listed//" "//text(model%node_ids(efg%mass_node(j)))// &
+                             " ("//real_text(efg%mass_volume(j))//")"
+    end do
+    if (bad > 0) then
+      associate (section => model%sections(model%parts(part)%section))
+        call make_error(error, where//": "//text(bad)//" node(s) get a non-positive row-sum mass; "// &
+                        "node id (volume share):"//listed//". The supports are too large for this "// &
+                        "thin part (DX "//real_text(section%support_scale(1))//", "// &
+                        trim(merge("spherical", "box      ", section%kernel == kernel_cubic_sphere))// &
+                        " kernel): reduce DX or use the box kernel (ISPLINE 0)")
+      end associate
+    end if
+  end subroutine check_results
+
+  pure function text(value) result(string)
+    integer, intent(in) :: value
+    character(len=:), allocatable :: string
+    character(len=16) :: buffer
+    write (buffer, '(i0)') value
+    string = trim(buffer)
+  end function text
+
+  pure function real_text(value) result(string)
+    real(wp), intent(in) :: value
+    character(len=:), allocatable :: string
+    character(len=24) :: buffer
+    write (buffer, '(es10.3)') value
+    string = trim(adjustl(buffer))
+  end function real_text
+end module efg_setup

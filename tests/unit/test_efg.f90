@@ -1,0 +1,737 @@
+!> Unit tests of the meshfree (EFG) set-up on small hand-built models (formulation section 7):
+!> kernel and neighbour search; partition of unity and linear reproduction of the coupled shape
+!> functions at random points of distorted cells; Kronecker delta at Gamma nodes and vanishing
+!> particle functions on the boundary; continuity across cell faces and across an FE/EFG
+!> interface; integration constraint and exact smoothed gradients of linear fields (modified SCNI),
+!> and their failure for the Gauss variant; row-sum masses; the transformation of eq. 16; node
+!> classes; error messages.
+!>
+!> Blocks of hexahedra have their interior nodes moved randomly by up to 25% of the cell size
+!> (the outer surface stays a box, so the part volume is known exactly).
+program test_efg
+  use kinds, only: wp, long_int, block_size
+  use error_handling, only: error_t
+  use model, only: model_t, formulation_efg, formulation_fe, kernel_cubic_box, kernel_cubic_sphere, &
+                   boundary_full_transformation, boundary_coupled, integration_local_boundary, integration_gauss, &
+                   law_elastic
+  use efg_part, only: efg_part_t
+  use efg_setup, only: build_efg_part
+  use efg_kernel, only: cubic_spline, kernel_weight, kernel_weight_gradient
+  use efg_supports, only: part_supports_t, build_part_supports
+  use efg_neighbour_search, only: particle_grid_t, build_particle_grid, find_covering_particles
+  use efg_shape_functions, only: cell_shape_context_t, prepare_cell_context, evaluate_shape_functions
+  use efg_cell_geometry, only: vertex_parametric, trilinear_functions
+  use hex8_geometry, only: hex8_volume
+  use testing, only: test_suite_t, check, check_close, finish_suite
+  implicit none
+
+  type(test_suite_t) :: suite
+  integer :: random_state = 20090321
+  real(wp), parameter :: tight = 1.0e-12_wp
+  !> A linear field d = A X + c for the consistency checks.
+  real(wp), parameter :: field_gradient(3, 3) = reshape([0.7_wp, -0.2_wp, 0.4_wp, 0.3_wp, -0.5_wp, 0.1_wp, &
+                                                         -0.6_wp, 0.2_wp, 0.9_wp], [3, 3])
+  real(wp), parameter :: field_offset(3) = [0.3_wp, -1.1_wp, 0.6_wp]
+
+  !> One structured block: cells(1) x cells(2) x cells(3) hexahedra; cells with i >= efg_cells
+  !> (0-based) belong to an FE part.
+  type :: block_t
+    integer :: cells(3) = 0
+    integer :: efg_cells = 0
+    real(wp) :: lengths(3) = 1.0_wp
+  end type block_t
+
+  suite%name = "efg"
+  call test_kernel()
+  call test_neighbour_search()
+  call test_node_classes()
+  call test_shape_functions(kernel_cubic_box, 1.01_wp, boundary_coupled, [5, 4, 3])
+  call test_shape_functions(kernel_cubic_box, 1.2_wp, boundary_coupled, [5, 4, 3])
+  call test_shape_functions(kernel_cubic_box, 1.5_wp, boundary_coupled, [5, 4, 3])
+  call test_shape_functions(kernel_cubic_box, 2.0_wp, boundary_coupled, [5, 4, 3])
+  call test_shape_functions(kernel_cubic_sphere, 1.01_wp, boundary_coupled, [5, 4, 3])
+  call test_shape_functions(kernel_cubic_sphere, 1.5_wp, boundary_coupled, [5, 4, 3])
+  call test_shape_functions(kernel_cubic_sphere, 2.0_wp, boundary_coupled, [4, 4, 4])
+  call test_shape_functions(kernel_cubic_box, 1.5_wp, boundary_full_transformation, [4, 4, 3])
+  call test_interface_continuity()
+  call test_setup(kernel_cubic_box, 1.01_wp, boundary_coupled, integration_local_boundary, [5, 4, 3], .true.)
+  call test_setup(kernel_cubic_box, 1.2_wp, boundary_coupled, integration_local_boundary, [5, 4, 3], .true.)
+  call test_setup(kernel_cubic_box, 1.5_wp, boundary_coupled, integration_local_boundary, [5, 4, 3], .true.)
+  call test_setup(kernel_cubic_box, 2.0_wp, boundary_coupled, integration_local_boundary, [5, 4, 3], .true.)
+  call test_setup(kernel_cubic_sphere, 1.01_wp, boundary_coupled, integration_local_boundary, [5, 4, 3], .true.)
+  call test_setup(kernel_cubic_sphere, 1.2_wp, boundary_coupled, integration_local_boundary, [5, 4, 3], .true.)
+  call test_setup(kernel_cubic_sphere, 1.5_wp, boundary_coupled, integration_local_boundary, [5, 5, 5], .true.)
+  call test_setup(kernel_cubic_sphere, 2.0_wp, boundary_coupled, integration_local_boundary, [5, 4, 3], .false.)
+  call test_setup(kernel_cubic_box, 1.5_wp, boundary_full_transformation, integration_local_boundary, [4, 4, 3], &
+                  .true.)
+  call test_setup(kernel_cubic_box, 1.5_wp, boundary_coupled, integration_gauss, [5, 4, 3], .true.)
+  call test_setup(kernel_cubic_sphere, 1.2_wp, boundary_coupled, integration_gauss, [5, 4, 3], .true.)
+  call test_coupled_setup()
+  call test_negative_mass_message()
+  call test_section_errors()
+  call finish_suite(suite)
+
+contains
+
+  ! ----------------------------------------------------------------------------------------
+  ! helpers
+
+  !> Deterministic uniform numbers in [-1, 1] (Park-Miller), the same on every compiler.
+  function random_uniform() result(value)
+    real(wp) :: value
+    random_state = int(mod(16807_long_int*int(random_state, long_int), 2147483647_long_int))
+    value = 2.0_wp*real(random_state, wp)/2147483647.0_wp - 1.0_wp
+  end function random_uniform
+
+  pure integer function node_at(block, i, j, k)
+    type(block_t), intent(in) :: block
+    integer, intent(in) :: i, j, k
+    node_at = 1 + i + (block%cells(1) + 1)*(j + (block%cells(2) + 1)*k)
+  end function node_at
+
+  pure integer function cell_at(block, i, j, k)
+    type(block_t), intent(in) :: block
+    integer, intent(in) :: i, j, k
+    cell_at = 1 + i + block%cells(1)*(j + block%cells(2)*k)
+  end function cell_at
+
+  !> A block model: part 1 meshfree (section 1: kernel, scale, IEBT, IDIM), part 2 (if any)
+  !> fully integrated hexahedra. Node ids are 1000 + index, element ids 500 + index, part ids
+  !> 7 and 8, so that messages can be checked for ids rather than indices.
+  subroutine build_block(block, kernel, scale, boundary_treatment, domain_integration, model)
+    type(block_t), intent(in) :: block
+    integer, intent(in) :: kernel, boundary_treatment, domain_integration
+    real(wp), intent(in) :: scale
+    type(model_t), intent(out) :: model
+    integer :: i, j, k, node_count, cell_count, cell, index(3)
+    real(wp) :: spacing(3)
+
+    spacing = block%lengths/real(block%cells, wp)
+    node_count = product(block%cells + 1)
+    cell_count = product(block%cells)
+    allocate (model%coordinates(3, node_count), model%node_ids(node_count))
+    do k = 0, block%cells(3)
+      do j = 0, block%cells(2)
+        do i = 0, block%cells(1)
+          index = [i, j, k]
+          associate (node => node_at(block, i, j, k))
+            model%node_ids(node) = 1000 + node
+            model%coordinates(:, node) = real(index, wp)*spacing
+            if (all(index > 0 .and. index < block%cells)) then
+              model%coordinates(1, node) = model%coordinates(1, node) + 0.25_wp*spacing(1)*random_uniform()
+              model%coordinates(2, node) = model%coordinates(2, node) + 0.25_wp*spacing(2)*random_uniform()
+              model%coordinates(3, node) = model%coordinates(3, node) + 0.25_wp*spacing(3)*random_uniform()
+            end if
+          end associate
+        end do
+      end do
+    end do
+    allocate (model%solid_nodes(8, cell_count), model%solid_part(cell_count), model%solid_ids(cell_count))
+    do k = 0, block%cells(3) - 1
+      do j = 0, block%cells(2) - 1
+        do i = 0, block%cells(1) - 1
+          cell = cell_at(block, i, j, k)
+          model%solid_ids(cell) = 500 + cell
+          model%solid_nodes(:, cell) = [node_at(block, i, j, k), node_at(block, i + 1, j, k), &
+                                        node_at(block, i + 1, j + 1, k), node_at(block, i, j + 1, k), &
+                                        node_at(block, i, j, k + 1), node_at(block, i + 1, j, k + 1), &
+                                        node_at(block, i + 1, j + 1, k + 1), node_at(block, i, j + 1, k + 1)]
+          model%solid_part(cell) = merge(1, 2, i < block%efg_cells)
+        end do
+      end do
+    end do
+    allocate (model%parts(2), model%sections(2), model%materials(1))
+    model%materials(1)%id = 1
+    model%materials(1)%law = law_elastic
+    model%materials(1)%density = 7.85e-9_wp
+    model%materials(1)%youngs_modulus = 210000.0_wp
+    model%materials(1)%poissons_ratio = 0.3_wp
+    model%sections(1)%id = 3
+    model%sections(1)%element_formulation = 41
+    model%sections(1)%support_scale = scale
+    model%sections(1)%kernel = kernel
+    model%sections(1)%boundary_treatment = boundary_treatment
+    model%sections(1)%domain_integration = domain_integration
+    model%sections(2)%id = 4
+    model%sections(2)%element_formulation = 2
+    model%parts(1)%id = 7
+    model%parts(1)%section = 1
+    model%parts(1)%material = 1
+    model%parts(1)%formulation = formulation_efg
+    model%parts(2)%id = 8
+    model%parts(2)%section = 2
+    model%parts(2)%material = 1
+    model%parts(2)%formulation = formulation_fe
+  end subroutine build_block
+
+  function block_of(cells, efg_cells) result(block)
+    integer, intent(in) :: cells(3)
+    integer, intent(in), optional :: efg_cells
+    type(block_t) :: block
+    block%cells = cells
+    block%efg_cells = cells(1)
+    if (present(efg_cells)) block%efg_cells = efg_cells
+    block%lengths = real(cells, wp)*[0.3_wp, 0.25_wp, 0.2_wp]
+  end function block_of
+
+  function label(kernel, scale, boundary_treatment, domain_integration) result(text)
+    integer, intent(in) :: kernel, boundary_treatment, domain_integration
+    real(wp), intent(in) :: scale
+    character(len=:), allocatable :: text
+    character(len=64) :: buffer
+    write (buffer, '(a,f4.2,a,i0,a,i0)') merge("box    DX ", "sphere DX ", kernel == kernel_cubic_box), scale, &
+      " IEBT ", boundary_treatment, " IDIM ", domain_integration
+    text = trim(buffer)
+  end function label
+
+  !> Supports, bins and the coupled-function context of every cell of part 1.
+  subroutine part_shape_data(model, supports, grid)
+    type(model_t), intent(in) :: model
+    type(part_supports_t), intent(out) :: supports
+    type(particle_grid_t), intent(out) :: grid
+    associate (section => model%sections(1))
+      call build_part_supports(model, 1, section%support_scale, section%kernel, &
+                               section%boundary_treatment == boundary_full_transformation, supports)
+    end associate
+    call build_particle_grid(supports%particle_coordinates, supports%particle_radius, grid)
+  end subroutine part_shape_data
+
+  !> Exact volume of part 1 from the FE solids' volume formula (independent of the EFG code).
+  function part_volume(model) result(volume)
+    type(model_t), intent(in) :: model
+    real(wp) :: volume
+    real(wp) :: x(block_size, 8), y(block_size, 8), z(block_size, 8), cell_volume(block_size)
+    integer :: cell
+
+    volume = 0.0_wp
+    do cell = 1, size(model%solid_part)
+      if (model%solid_part(cell) /= 1) cycle
+      x(1, :) = model%coordinates(1, model%solid_nodes(:, cell))
+      y(1, :) = model%coordinates(2, model%solid_nodes(:, cell))
+      z(1, :) = model%coordinates(3, model%solid_nodes(:, cell))
+      call hex8_volume(1, x, y, z, cell_volume)
+      volume = volume + cell_volume(1)
+    end do
+  end function part_volume
+
+  !> Field sum_k Psi_k d(node_k) from values aligned with the context's nodes.
+  pure function field_value(context, values, nodal) result(value)
+    type(cell_shape_context_t), intent(in) :: context
+    real(wp), intent(in) :: values(:), nodal(:)
+    real(wp) :: value
+    value = dot_product(values(1:context%node_count), nodal(context%nodes(1:context%node_count)))
+  end function field_value
+
+  ! ----------------------------------------------------------------------------------------
+  ! kernel and neighbour search
+
+  subroutine test_kernel()
+    real(wp) :: value, derivative, left, right, weight, gradient(3), plus, minus, point(3)
+    real(wp), parameter :: centre(3) = [0.1_wp, 0.2_wp, -0.3_wp], radius(3) = [0.5_wp, 0.7_wp, 0.6_wp]
+    real(wp), parameter :: step = 1.0e-6_wp
+    integer :: k, kernel
+
+    call cubic_spline(0.0_wp, value, derivative)
+    call check_close(suite, "spline w(0) = 2/3", value, 2.0_wp/3.0_wp, thr=1.0e-15_wp)
+    call cubic_spline(0.5_wp, left, derivative)
+    call cubic_spline(0.5_wp + 1.0e-14_wp, right, derivative)
+    call check_close(suite, "spline continuous at 1/2", left, right, thr=1.0e-13_wp)
+    call check_close(suite, "spline w(1/2) = 1/6", left, 1.0_wp/6.0_wp, thr=1.0e-15_wp)
+    call cubic_spline(1.0_wp, value, derivative)
+    call check(suite, "spline vanishes at r = 1", value == 0.0_wp .and. derivative == 0.0_wp)
+    ! gradient against central differences, both kernels
+    point = [0.35_wp, 0.05_wp, -0.1_wp]
+    do kernel = 0, 2, 2
+      call kernel_weight_gradient(kernel, centre, radius, point, weight, gradient)
+      call check_close(suite, "kernel weight and gradient routine agree", weight, &
+                       kernel_weight(kernel, centre, radius, point), thr=1.0e-15_wp)
+      do k = 1, 3
+        point(k) = point(k) + step
+        plus = kernel_weight(kernel, centre, radius, point)
+        point(k) = point(k) - 2.0_wp*step
+        minus = kernel_weight(kernel, centre, radius, point)
+        point(k) = point(k) + step
+        call check_close(suite, "kernel gradient = central difference", gradient(k), (plus - minus)/(2.0_wp*step), &
+                         thr=1.0e-8_wp)
+      end do
+    end do
+  end subroutine test_kernel
+
+  !> The bins return exactly the particles a brute-force scan finds, in ascending order.
+  subroutine test_neighbour_search()
+    integer, parameter :: particle_count = 300
+    real(wp) :: centres(3, particle_count), radius(3, particle_count), point(3)
+    type(particle_grid_t) :: grid
+    integer, allocatable :: found(:)
+    integer :: expected(particle_count), expected_count, found_count, trial, particle, kernel
+    logical :: same
+
+    do particle = 1, particle_count
+      centres(:, particle) = [random_uniform(), random_uniform(), random_uniform()]
+      radius(:, particle) = 0.15_wp + 0.1_wp*abs([random_uniform(), random_uniform(), random_uniform()])
+    end do
+    radius(:, 7) = 1.5_wp   ! one very large support
+    same = .true.
+    do kernel = 0, 2, 2
+      if (kernel == kernel_cubic_sphere) radius(2:3, :) = spread(radius(1, :), 1, 2)
+      call build_particle_grid(centres, radius, grid)
+      do trial = 1, 200
+        point = 1.1_wp*[random_uniform(), random_uniform(), random_uniform()]
+        expected_count = 0
+        do particle = 1, particle_count
+          if (kernel_weight(kernel, centres(:, particle), radius(:, particle), point) > 0.0_wp) then
+            expected_count = expected_count + 1
+            expected(expected_count) = particle
+          end if
+        end do
+        call find_covering_particles(grid, centres, radius, kernel, point, found, found_count)
+        if (found_count /= expected_count) then
+          same = .false.
+        else if (any(found(1:found_count) /= expected(1:expected_count))) then
+          same = .false.
+        end if
+      end do
+    end do
+    call check(suite, "neighbour search = brute force (box and sphere, 400 points)", same)
+  end subroutine test_neighbour_search
+
+  ! ----------------------------------------------------------------------------------------
+  ! node classes
+
+  subroutine test_node_classes()
+    type(model_t) :: model
+    type(efg_part_t) :: efg
+    type(error_t), allocatable :: error
+    character(len=80) :: detail
+
+    call build_block(block_of([4, 4, 4]), kernel_cubic_box, 1.5_wp, boundary_coupled, integration_local_boundary, model)
+    call build_efg_part(model, 1, efg, error)
+    call check(suite, "4x4x4 block builds", .not. allocated(error))
+    write (detail, '(a,i0,a,i0)') "particles ", size(efg%particles), " Gamma nodes ", size(efg%gamma_nodes)
+    call check(suite, "4x4x4 block: 27 interior particles, 98 Gamma nodes", &
+               size(efg%particles) == 27 .and. size(efg%gamma_nodes) == 98, trim(detail))
+    call check(suite, "4x4x4 block: 512 points, 125 mass nodes, 27 transformation rows", &
+               size(efg%point_volume) == 512 .and. size(efg%mass_node) == 125 .and. &
+               size(efg%transform_offsets) == 28)
+
+    ! one cell thick: no particle, FE in disguise with sub-cell integration
+    call build_block(block_of([4, 3, 1]), kernel_cubic_box, 1.5_wp, boundary_coupled, integration_local_boundary, model)
+    call build_efg_part(model, 1, efg, error)
+    call check(suite, "one cell thick part builds", .not. allocated(error))
+    call check(suite, "one cell thick part: no interior particle", size(efg%particles) == 0 .and. &
+               size(efg%gamma_nodes) == 40 .and. size(efg%transform_node) == 0)
+    call check_linear_gradients(model, efg, "one cell thick", tight)
+    call check_masses(model, efg, part_volume(model), "one cell thick")
+
+    ! full transformation: every node is a particle
+    call build_block(block_of([3, 3, 3]), kernel_cubic_box, 1.5_wp, boundary_full_transformation, &
+                     integration_local_boundary, model)
+    call build_efg_part(model, 1, efg, error)
+    call check(suite, "IEBT 1: every node is a particle", .not. allocated(error) .and. size(efg%particles) == 64 &
+               .and. size(efg%gamma_nodes) == 0)
+  end subroutine test_node_classes
+
+  ! ----------------------------------------------------------------------------------------
+  ! properties 1-3 of the shape functions
+
+  subroutine test_shape_functions(kernel, scale, boundary_treatment, cells)
+    integer, intent(in) :: kernel, boundary_treatment, cells(3)
+    real(wp), intent(in) :: scale
+    type(model_t) :: model
+    type(block_t) :: block
+    type(part_supports_t) :: supports
+    type(particle_grid_t) :: grid
+    type(cell_shape_context_t) :: context, neighbour_context
+    real(wp), allocatable :: values(:), neighbour_values(:), nodal(:)
+    real(wp) :: parametric(3), neighbour_parametric(3), point(3), other_point(3), residual, reproduced(3)
+    real(wp) :: unity_error, reproduction_error, delta_error, vanishing_error, continuity_error, scale_of_field
+    integer :: i, j, k, cell, trial, rank, a, local, direction, side, neighbour(3), singular
+    logical :: coupled
+    character(len=:), allocatable :: name
+
+    block = block_of(cells)
+    coupled = boundary_treatment == boundary_coupled
+    name = label(kernel, scale, boundary_treatment, integration_local_boundary)
+    call build_block(block, kernel, scale, boundary_treatment, integration_local_boundary, model)
+    call part_shape_data(model, supports, grid)
+    allocate (nodal(size(model%coordinates, 2)))
+    do a = 1, size(nodal)
+      nodal(a) = random_uniform()
+    end do
+    scale_of_field = maxval(abs(nodal))
+    unity_error = 0.0_wp
+    reproduction_error = 0.0_wp
+    delta_error = 0.0_wp
+    vanishing_error = 0.0_wp
+    continuity_error = 0.0_wp
+    singular = 0
+    do k = 0, cells(3) - 1
+      do j = 0, cells(2) - 1
+        do i = 0, cells(1) - 1
+          cell = cell_at(block, i, j, k)
+          call prepare_cell_context(supports, grid, model%coordinates, model%solid_nodes(:, cell), cell, context)
+          if (allocated(values)) deallocate (values)
+          allocate (values(context%node_count))
+          ! 1. partition of unity and linear reproduction at random points
+          do trial = 1, 4
+            parametric = [random_uniform(), random_uniform(), random_uniform()]
+            call evaluate_shape_functions(context, parametric, point, values, rank, residual)
+            if (rank > 0 .and. rank < 4) singular = singular + 1
+            unity_error = max(unity_error, abs(sum(values) - 1.0_wp))
+            reproduced = matmul(model%coordinates(:, context%nodes(1:context%node_count)), values)
+            reproduction_error = max(reproduction_error, maxval(abs(reproduced - point))/maxval(block%lengths))
+          end do
+          ! 2. Kronecker delta at the Gamma vertices
+          if (coupled) then
+            do a = 1, 8
+              local = context%vertex_local(a)
+              if (context%vertex_is_particle(a)) cycle
+              call evaluate_shape_functions(context, vertex_parametric(:, a), point, values, rank, residual)
+              delta_error = max(delta_error, abs(values(local) - 1.0_wp), &
+                                maxval(abs(values(1:local - 1))), maxval(abs(values(local + 1:))))
+            end do
+          end if
+          ! 2. particle functions vanish on the part's boundary faces; 3. continuity across
+          ! the faces shared with the next cell in each direction
+          do direction = 1, 3
+            do side = -1, 1, 2
+              neighbour = [i, j, k]
+              neighbour(direction) = neighbour(direction) + side
+              do trial = 1, 2
+                parametric = [random_uniform(), random_uniform(), random_uniform()]
+                parametric(direction) = real(side, wp)
+                call evaluate_shape_functions(context, parametric, point, values, rank, residual)
+                if (any(neighbour < 0) .or. any(neighbour >= cells)) then
+                  if (coupled) then
+                    do local = 1, context%node_count
+                      if (any(supports%particles == context%nodes(local))) &
+                        vanishing_error = max(vanishing_error, abs(values(local)))
+                    end do
+                  end if
+                else if (side == 1) then
+                  associate (other => cell_at(block, neighbour(1), neighbour(2), neighbour(3)))
+                    call prepare_cell_context(supports, grid, model%coordinates, model%solid_nodes(:, other), &
+                                              other, neighbour_context)
+                  end associate
+                  if (allocated(neighbour_values)) deallocate (neighbour_values)
+                  allocate (neighbour_values(neighbour_context%node_count))
+                  neighbour_parametric = parametric
+                  neighbour_parametric(direction) = -1.0_wp
+                  call evaluate_shape_functions(neighbour_context, neighbour_parametric, other_point, &
+                                                neighbour_values, rank, residual)
+                  continuity_error = max(continuity_error, maxval(abs(point - other_point)), &
+                                         abs(field_value(context, values, nodal) &
+                                             - field_value(neighbour_context, neighbour_values, nodal))/scale_of_field)
+                end if
+              end do
+            end do
+          end do
+        end do
+      end do
+    end do
+    write (*, '(a,a,4(a,es8.1),a,i0,a)') "  shape functions ", name, ": unity ", unity_error, &
+      ", reproduction ", reproduction_error, ", Kronecker ", delta_error, ", continuity ", continuity_error, &
+      " (", singular, " singular M among the random points)"
+    call check_close(suite, "partition of unity, "//name, unity_error, 0.0_wp, thr=tight)
+    call check_close(suite, "linear reproduction, "//name, reproduction_error, 0.0_wp, thr=tight)
+    call check_close(suite, "continuity across cell faces, "//name, continuity_error, 0.0_wp, thr=tight)
+    if (coupled) then
+      call check_close(suite, "Kronecker delta at Gamma nodes, "//name, delta_error, 0.0_wp, thr=tight)
+      call check_close(suite, "particle functions vanish on the boundary, "//name, vanishing_error, 0.0_wp, thr=tight)
+    end if
+  end subroutine test_shape_functions
+
+  !> An EFG part (i < 3) and an FE part (i >= 3) sharing the face x-plane i = 3: the coupled field
+  !> evaluated from the EFG cell equals the FE trilinear field of the FE cell.
+  subroutine test_interface_continuity()
+    type(model_t) :: model
+    type(block_t) :: block
+    type(part_supports_t) :: supports
+    type(particle_grid_t) :: grid
+    type(cell_shape_context_t) :: context
+    real(wp), allocatable :: values(:), nodal(:)
+    real(wp) :: parametric(3), point(3), fe_point(3), residual, phi(8), interface_error, field_scale
+    integer :: j, k, trial, rank, a, kernel
+    real(wp) :: scale
+
+    block = block_of([5, 4, 3], efg_cells=3)
+    do kernel = 0, 2, 2
+      scale = merge(2.0_wp, 1.5_wp, kernel == kernel_cubic_box)
+      call build_block(block, kernel, scale, boundary_coupled, integration_local_boundary, model)
+      call part_shape_data(model, supports, grid)
+      if (allocated(nodal)) deallocate (nodal)
+      allocate (nodal(size(model%coordinates, 2)))
+      do a = 1, size(nodal)
+        nodal(a) = random_uniform()
+      end do
+      field_scale = maxval(abs(nodal))
+      interface_error = 0.0_wp
+      do k = 0, block%cells(3) - 1
+        do j = 0, block%cells(2) - 1
+          associate (efg_cell => cell_at(block, 2, j, k), fe_cell => cell_at(block, 3, j, k))
+            call prepare_cell_context(supports, grid, model%coordinates, model%solid_nodes(:, efg_cell), efg_cell, &
+                                      context)
+            if (allocated(values)) deallocate (values)
+            allocate (values(context%node_count))
+            do trial = 1, 4
+              parametric = [1.0_wp, random_uniform(), random_uniform()]
+              call evaluate_shape_functions(context, parametric, point, values, rank, residual)
+              call trilinear_functions([-1.0_wp, parametric(2), parametric(3)], phi)
+              fe_point = matmul(model%coordinates(:, model%solid_nodes(:, fe_cell)), phi)
+              interface_error = max(interface_error, maxval(abs(point - fe_point)), &
+                                    abs(field_value(context, values, nodal) &
+                                        - dot_product(phi, nodal(model%solid_nodes(:, fe_cell))))/field_scale)
+            end do
+          end associate
+        end do
+      end do
+      write (*, '(a,a,es8.1)') "  FE/EFG interface, ", label(kernel, scale, boundary_coupled, 1)//": field jump ", &
+        interface_error
+      call check_close(suite, "FE/EFG interface: coupled field = FE field, "// &
+                       label(kernel, scale, boundary_coupled, 1), interface_error, 0.0_wp, thr=tight)
+    end do
+  end subroutine test_interface_continuity
+
+  ! ----------------------------------------------------------------------------------------
+  ! properties 4 and 6 and the transformation, through build_efg_part
+
+  subroutine test_setup(kernel, scale, boundary_treatment, domain_integration, cells, check_mass)
+    integer, intent(in) :: kernel, boundary_treatment, domain_integration, cells(3)
+    real(wp), intent(in) :: scale
+    logical, intent(in) :: check_mass
+    type(model_t) :: model
+    type(efg_part_t) :: efg
+    type(error_t), allocatable :: error
+    type(block_t) :: block
+    character(len=:), allocatable :: name
+    real(wp) :: constraint_error
+
+    block = block_of(cells)
+    name = label(kernel, scale, boundary_treatment, domain_integration)
+    call build_block(block, kernel, scale, boundary_treatment, domain_integration, model)
+    call build_efg_part(model, 1, efg, error)
+    if (allocated(error)) then
+      ! expected only where negative masses are allowed; everything else is still built
+      write (*, '(a,a,a,a)') "  set-up ", name, ": ", error%message
+      call check(suite, "set-up builds, "//name, .not. check_mass, error%message)
+      if (check_mass) return
+    end if
+    call check_structure(model, efg, name)
+    constraint_error = integration_constraint_error(model, efg)
+    write (*, '(a,a,a,es8.1,a,i0,a,f6.3,a)') "  set-up ", name, ": integration constraint ", constraint_error, &
+      ", singular moment points ", efg%singular_moment_points, ", ", efg%setup_seconds, " s"
+    if (domain_integration == integration_local_boundary .and. boundary_treatment == boundary_coupled) then
+      call check_close(suite, "integration constraint sum_g bbar_I W_g = 0, "//name, constraint_error, 0.0_wp, &
+                       thr=tight)
+    else if (domain_integration == integration_gauss) then
+      call check(suite, "Gauss variant breaks the integration constraint (> 1e-6), "//name, constraint_error > 1.0e-6_wp)
+    end if
+    ! direct gradients reproduce linear fields too; smoothed gradients do by the divergence theorem
+    call check_linear_gradients(model, efg, name, merge(tight, 1.0e-10_wp, domain_integration == 1))
+    if (check_mass) then
+      call check_masses(model, efg, part_volume(model), name)
+    else
+      ! spherical supports of DX 2 in a part 3 cells thick: masses may be negative (formulation
+      ! section 2); only the total is checked
+      call check_close(suite, "total row-sum mass = part volume, "//name, sum(efg%mass_volume), &
+                       product(block%lengths), rel=tight)
+    end if
+    call check_transformation(model, efg, name)
+  end subroutine test_setup
+
+  !> Coupled FE + EFG block: the EFG part's set-up treats the interface nodes as Gamma nodes and
+  !> passes the same checks.
+  subroutine test_coupled_setup()
+    type(model_t) :: model
+    type(efg_part_t) :: efg
+    type(error_t), allocatable :: error
+    type(block_t) :: block
+    integer :: j, k
+    logical :: interface_gamma
+
+    block = block_of([6, 4, 4], efg_cells=3)
+    call build_block(block, kernel_cubic_box, 1.5_wp, boundary_coupled, integration_local_boundary, model)
+    call build_efg_part(model, 1, efg, error)
+    call check(suite, "coupled block: EFG part builds", .not. allocated(error))
+    if (allocated(error)) return
+    interface_gamma = .true.
+    do k = 0, 4
+      do j = 0, 4
+        interface_gamma = interface_gamma .and. any(efg%gamma_nodes == node_at(block, 3, j, k))
+      end do
+    end do
+    call check(suite, "coupled block: interface nodes are Gamma nodes", interface_gamma)
+    call check(suite, "coupled block: 2 x 3 x 3 interior particles", size(efg%particles) == 18)
+    call check(suite, "coupled block: only part cells hold points", all(model%solid_part(efg%point_cell) == 1))
+    call check_close(suite, "coupled block: integration constraint", integration_constraint_error(model, efg), &
+                     0.0_wp, thr=tight)
+    call check_linear_gradients(model, efg, "coupled block", tight)
+    call check_masses(model, efg, part_volume(model), "coupled block")
+  end subroutine test_coupled_setup
+
+  !> Offsets, ascending nodes within each point, nodes of the part only.
+  subroutine check_structure(model, efg, name)
+    type(model_t), intent(in) :: model
+    type(efg_part_t), intent(in) :: efg
+    character(len=*), intent(in) :: name
+    integer :: g, points
+    logical :: ordered
+
+    points = size(efg%point_volume)
+    ordered = size(efg%point_offsets) == points + 1 .and. efg%point_offsets(1) == 1 .and. &
+              efg%point_offsets(points + 1) == size(efg%pair_node) + 1
+    do g = 1, points
+      associate (pairs => efg%pair_node(efg%point_offsets(g):efg%point_offsets(g + 1) - 1))
+        if (size(pairs) > 1) ordered = ordered .and. all(pairs(2:) > pairs(:size(pairs) - 1))
+      end associate
+    end do
+    call check(suite, "pairs ordered by node, "//name, ordered)
+    call check(suite, "pair nodes belong to the part, "//name, &
+               all([(any(efg%mass_node == efg%pair_node(g)), g=1, size(efg%pair_node))]))
+    call check(suite, "point lengths positive, "//name, all(efg%point_length > 0.0_wp) .and. &
+               all(efg%point_length <= 0.3_wp))
+    call check(suite, "material and part recorded, "//name, efg%part == 1 .and. efg%material == 1 .and. &
+               size(model%parts) == 2)
+  end subroutine check_structure
+
+  !> Largest |sum_g W_g bbar_I(g)| over the interior particles, relative to sum_g W_g |bbar_I(g)|.
+  function integration_constraint_error(model, efg) result(worst)
+    type(model_t), intent(in) :: model
+    type(efg_part_t), intent(in) :: efg
+    real(wp) :: worst
+    real(wp), allocatable :: total(:, :), magnitude(:)
+    integer :: g, pair, j
+
+    allocate (total(3, size(model%coordinates, 2)), magnitude(size(model%coordinates, 2)))
+    total = 0.0_wp
+    magnitude = 0.0_wp
+    do g = 1, size(efg%point_volume)
+      do pair = efg%point_offsets(g), efg%point_offsets(g + 1) - 1
+        associate (node => efg%pair_node(pair))
+          total(:, node) = total(:, node) + efg%point_volume(g)*efg%pair_gradient(:, pair)
+          magnitude(node) = magnitude(node) + efg%point_volume(g)*norm2(efg%pair_gradient(:, pair))
+        end associate
+      end do
+    end do
+    worst = 0.0_wp
+    do j = 1, size(efg%particles)
+      associate (node => efg%particles(j))
+        if (magnitude(node) > 0.0_wp) worst = max(worst, norm2(total(:, node))/magnitude(node))
+      end associate
+    end do
+  end function integration_constraint_error
+
+  !> d = A X + c on every node: the gradient at every point is A, and sum_g W_g grad = A V.
+  subroutine check_linear_gradients(model, efg, name, tolerance)
+    type(model_t), intent(in) :: model
+    type(efg_part_t), intent(in) :: efg
+    character(len=*), intent(in) :: name
+    real(wp), intent(in) :: tolerance
+    real(wp) :: gradient(3, 3), integral(3, 3), worst, volume
+    integer :: g, pair, i
+
+    worst = 0.0_wp
+    integral = 0.0_wp
+    volume = 0.0_wp
+    do g = 1, size(efg%point_volume)
+      gradient = 0.0_wp
+      do pair = efg%point_offsets(g), efg%point_offsets(g + 1) - 1
+        associate (node => efg%pair_node(pair))
+          do i = 1, 3
+            gradient(i, :) = gradient(i, :) + (dot_product(field_gradient(i, :), model%coordinates(:, node)) &
+                                               + field_offset(i))*efg%pair_gradient(:, pair)
+          end do
+        end associate
+      end do
+      worst = max(worst, maxval(abs(gradient - field_gradient)))
+      integral = integral + efg%point_volume(g)*gradient
+      volume = volume + efg%point_volume(g)
+    end do
+    write (*, '(a,a,a,es8.1)') "  linear field ", name, ": gradient error ", worst/maxval(abs(field_gradient))
+    call check_close(suite, "gradient of a linear field exact at every point, "//name, &
+                     worst/maxval(abs(field_gradient)), 0.0_wp, thr=tolerance)
+    call check_close(suite, "integral of the gradient of a linear field = A V, "//name, &
+                     reshape(integral, [9]), reshape(field_gradient*volume, [9]), thr=tolerance*volume)
+  end subroutine check_linear_gradients
+
+  subroutine check_masses(model, efg, volume, name)
+    type(model_t), intent(in) :: model
+    type(efg_part_t), intent(in) :: efg
+    real(wp), intent(in) :: volume
+    character(len=*), intent(in) :: name
+    integer :: g
+    call check(suite, "row-sum masses positive, "//name, all(efg%mass_volume > 0.0_wp))
+    call check(suite, "one mass share per part node, "//name, size(efg%mass_node) == &
+               count([(any(model%solid_nodes(:, pack([(g, g=1, size(model%solid_part))], model%solid_part == 1)) &
+                            == g), g=1, size(model%coordinates, 2))]))
+    call check_close(suite, "total row-sum mass = part volume, "//name, sum(efg%mass_volume), volume, rel=tight)
+    call check_close(suite, "point volumes add up to the part volume, "//name, sum(efg%point_volume), volume, &
+                     rel=tight)
+  end subroutine check_masses
+
+  !> uhat_J = sum_I Psi_I(X_J) d_I reproduces d = A X + c at the particles (eq. 16).
+  subroutine check_transformation(model, efg, name)
+    type(model_t), intent(in) :: model
+    type(efg_part_t), intent(in) :: efg
+    character(len=*), intent(in) :: name
+    real(wp) :: physical(3), worst, unity
+    integer :: j, k
+
+    worst = 0.0_wp
+    unity = 0.0_wp
+    do j = 1, size(efg%particles)
+      physical = 0.0_wp
+      do k = efg%transform_offsets(j), efg%transform_offsets(j + 1) - 1
+        associate (node => efg%transform_node(k))
+          physical = physical + efg%transform_value(k)*(matmul(field_gradient, model%coordinates(:, node)) &
+                                                        + field_offset)
+        end associate
+      end do
+      associate (node => efg%particles(j))
+        worst = max(worst, maxval(abs(physical - matmul(field_gradient, model%coordinates(:, node)) - field_offset)))
+      end associate
+      unity = max(unity, abs(sum(efg%transform_value(efg%transform_offsets(j):efg%transform_offsets(j + 1) - 1)) &
+                             - 1.0_wp))
+    end do
+    call check_close(suite, "transformation reproduces linear fields at particles, "//name, worst, 0.0_wp, thr=tight)
+    call check_close(suite, "transformation rows sum to one, "//name, unity, 0.0_wp, thr=tight)
+  end subroutine check_transformation
+
+  ! ----------------------------------------------------------------------------------------
+  ! errors
+
+  !> Spherical supports of DX 2 in a part 3 cells thick give negative row-sum masses; the
+  !> message names the part id, a node id and the remedy.
+  subroutine test_negative_mass_message()
+    type(model_t) :: model
+    type(efg_part_t) :: efg
+    type(error_t), allocatable :: error
+
+    call build_block(block_of([5, 4, 3]), kernel_cubic_sphere, 2.0_wp, boundary_coupled, &
+                     integration_local_boundary, model)
+    call build_efg_part(model, 1, efg, error)
+    call check(suite, "negative mass reported", allocated(error))
+    if (.not. allocated(error)) return
+    write (*, '(a,a)') "  negative mass message: ", error%message
+    call check(suite, "negative mass message names the part id", index(error%message, "EFG part 7") > 0)
+    call check(suite, "negative mass message names node ids", index(error%message, "node id") > 0 .and. &
+               scan(error%message(index(error%message, "node id"):), "1") > 0)
+    call check(suite, "negative mass message gives the remedy", index(error%message, "reduce DX") > 0 .and. &
+               index(error%message, "box kernel") > 0)
+  end subroutine test_negative_mass_message
+
+  subroutine test_section_errors()
+    type(model_t) :: model
+    type(efg_part_t) :: efg
+    type(error_t), allocatable :: error
+
+    call build_block(block_of([2, 2, 2]), kernel_cubic_box, 1.0_wp, boundary_coupled, integration_local_boundary, model)
+    call build_efg_part(model, 1, efg, error)
+    call check(suite, "DX = 1 rejected", allocated(error))
+    if (allocated(error)) call check(suite, "DX message names part and section", &
+                                     index(error%message, "EFG part 7, section 3: DX") > 0, error%message)
+    call build_block(block_of([2, 2, 2]), kernel_cubic_box, 1.5_wp, boundary_coupled, integration_local_boundary, model)
+    call build_efg_part(model, 2, efg, error)
+    call check(suite, "FE part rejected by the EFG set-up", allocated(error))
+  end subroutine test_section_errors
+end program test_efg
