@@ -7,18 +7,20 @@
 !>   Lbar = dFbar/dt Fmid^-1 at the mid-step Fmid = Fbar - dt/2 dFbar/dt,
 !> rate of deformation and spin from Lbar, the same objective stress update and material
 !> routines as the finite elements, then the first Piola-Kirchhoff stress P = J sigma Fbar^-T
-!> and one force per pair, W_g P bbar. Points are processed in blocks of `block_size` (the
-!> material kernels work on blocks); each block writes only its own pairs. Nodes then gather
-!> their pairs in a fixed order (node -> pair list), so the sum does not depend on the number
-!> of threads. `d` is the solver's nodal displacement: physical at Gamma nodes, generalized at
-!> interior particles.
+!> stored per point as W_g P. Points are processed in blocks of `block_size` (the material
+!> kernels work on blocks); each block writes only its own points. Every node then gathers
+!> f = sum over its pairs of (W P)_g bbar in a fixed order (node -> pair list, with the pairs'
+!> gradients copied in node order at set-up), so the sum does not depend on the number of
+!> threads and no per-pair force is written. `d` is the solver's nodal displacement: physical at
+!> Gamma nodes, generalized at interior particles.
 !>
-!> Internal energy is the work of the pair forces, integrated as central differences
+!> Internal energy is the work of the point forces, integrated as central differences
 !> integrate the kinetic energy 1/2 m v(n-1/2) . v(n+1/2) (the finite elements do the same, see
 !> solid_block): the forces f(m) of call m work over (dt(m-1/2) + dt(m+1/2))/2 against
-!> (v(m-1/2) + v(m+1/2))/2; call m+1 completes that with f(m) . v(m+1/2), read from the pair
-!> forces before they are overwritten, and books half of the new forces' work with the current
-!> step. The stress-power integral would drift by percents over 10^4 cycles at TSSFAC 0.9.
+!> (v(m-1/2) + v(m+1/2))/2; call m+1 completes that with f(m) . v(m+1/2) and books half of the
+!> new forces' work with the current step. The power of a point's forces needs no pair loop:
+!> sum over pairs of (W P bbar) . v = W P : dFbar/dt. The stress-power integral would drift by
+!> percents over 10^4 cycles at TSSFAC 0.9.
 module efg_forces
   use kinds, only: wp, block_size
   use gather_list, only: gather_list_t, build_gather_list
@@ -52,9 +54,11 @@ module efg_forces
     real(wp) :: density = 0.0_wp
     real(wp) :: bulk_quadratic = 1.5_wp, bulk_linear = 0.06_wp
     type(efg_block_t), allocatable :: blocks(:)
-    real(wp), allocatable :: pair_force(:, :)     !< (3, pairs), written by the blocks
+    real(wp), allocatable :: point_stress(:, :)   !< (9, points): W_g P_g, column-major 3x3
     integer, allocatable :: nodes(:)              !< the part's nodes that receive forces
-    type(gather_list_t) :: node_pairs             !< position in `nodes` -> pairs, in pair order
+    integer, allocatable :: node_offsets(:)       !< pairs of nodes(j): node_offsets(j) : node_offsets(j+1)-1
+    integer, allocatable :: node_pair_point(:)    !< the point of each pair, in node order
+    real(wp), allocatable :: node_pair_gradient(:, :) !< (3, pairs): bbar of each pair, in node order
     real(wp), allocatable :: block_time_step(:)
     integer, allocatable :: block_critical_point(:), block_inverted_point(:)
   end type efg_solver_t
@@ -66,8 +70,9 @@ contains
     type(model_t), intent(in) :: model
     type(efg_part_t), intent(in) :: geometry
     type(efg_solver_t), intent(out) :: solver
-    integer :: point_count, block_count, b, history_count, k
-    integer, allocatable :: local_index(:), pair_slot(:)
+    integer :: point_count, block_count, b, history_count, k, g
+    integer, allocatable :: local_index(:), pair_slot(:), pair_point(:)
+    type(gather_list_t) :: node_pairs
 
     solver%geometry = geometry
     associate (part => model%parts(geometry%part), material => model%materials(geometry%material))
@@ -86,8 +91,8 @@ contains
         call initialize_material_history(material, solver%blocks(b)%point_count, solver%blocks(b)%history)
       end do
     end associate
-    allocate (solver%pair_force(3, size(geometry%pair_node)))
-    solver%pair_force = 0.0_wp
+    allocate (solver%point_stress(9, point_count))
+    solver%point_stress = 0.0_wp
     allocate (solver%block_time_step(block_count), solver%block_critical_point(block_count), &
               solver%block_inverted_point(block_count))
     solver%block_time_step = huge(1.0_wp)
@@ -104,10 +109,18 @@ contains
     do k = 1, size(geometry%pair_node)
       pair_slot(k) = local_index(geometry%pair_node(k))
     end do
-    call build_gather_list(size(solver%nodes), pair_slot, solver%node_pairs)
+    call build_gather_list(size(solver%nodes), pair_slot, node_pairs)
+    ! copy the pairs in node order, so that the force gather reads them contiguously
+    allocate (pair_point(size(geometry%pair_node)))
+    do g = 1, size(geometry%point_volume)
+      pair_point(geometry%point_offsets(g):geometry%point_offsets(g + 1) - 1) = g
+    end do
+    solver%node_offsets = node_pairs%offsets
+    solver%node_pair_point = pair_point(node_pairs%corners)
+    solver%node_pair_gradient = geometry%pair_gradient(:, node_pairs%corners)
   end subroutine set_up_efg_solver
 
-  !> Stresses, pair forces and stable steps of every point of one part. `dt` is the step just
+  !> Stresses (W P) and stable steps of every point of one part. `dt` is the step just
   !> taken (0 at the start); displacement and velocity are the solver's d^{n+1} and v^{n+1/2}.
   subroutine compute_efg_forces(material, solver, displacement, velocity, dt)
     type(material_t), intent(in) :: material
@@ -118,34 +131,43 @@ contains
     !$omp parallel do schedule(dynamic, 2) default(shared) private(b)
     do b = 1, size(solver%blocks)
       call compute_efg_block(material, solver%geometry, solver%density, solver%bulk_quadratic, &
-                             solver%bulk_linear, solver%blocks(b), displacement, velocity, dt, solver%pair_force, &
+                             solver%bulk_linear, solver%blocks(b), displacement, velocity, dt, solver%point_stress, &
                              solver%block_time_step(b), solver%block_critical_point(b), &
                              solver%block_inverted_point(b))
     end do
     !$omp end parallel do
   end subroutine compute_efg_forces
 
-  !> internal_force(:, node) += the node's pair forces, in pair order.
+  !> internal_force(:, node) += sum over the node's pairs of (W P)_g bbar, in pair order.
   subroutine add_efg_forces(solver, internal_force)
     type(efg_solver_t), intent(in) :: solver
     real(wp), intent(inout) :: internal_force(:, :)
-    integer :: k, slot, node
-    real(wp) :: force(3)
-    !$omp parallel do schedule(static) default(shared) private(k, slot, node, force)
-    do k = 1, size(solver%nodes)
-      node = solver%nodes(k)
-      force = 0.0_wp
-      do slot = solver%node_pairs%offsets(k), solver%node_pairs%offsets(k + 1) - 1
-        force = force + solver%pair_force(:, solver%node_pairs%corners(slot))
+    integer :: j, k, g
+    real(wp) :: fx, fy, fz, gx, gy, gz
+    !$omp parallel do schedule(static) default(shared) private(j, k, g, fx, fy, fz, gx, gy, gz)
+    do j = 1, size(solver%nodes)
+      fx = 0.0_wp
+      fy = 0.0_wp
+      fz = 0.0_wp
+      do k = solver%node_offsets(j), solver%node_offsets(j + 1) - 1
+        g = solver%node_pair_point(k)
+        gx = solver%node_pair_gradient(1, k)
+        gy = solver%node_pair_gradient(2, k)
+        gz = solver%node_pair_gradient(3, k)
+        fx = fx + solver%point_stress(1, g)*gx + solver%point_stress(4, g)*gy + solver%point_stress(7, g)*gz
+        fy = fy + solver%point_stress(2, g)*gx + solver%point_stress(5, g)*gy + solver%point_stress(8, g)*gz
+        fz = fz + solver%point_stress(3, g)*gx + solver%point_stress(6, g)*gy + solver%point_stress(9, g)*gz
       end do
-      internal_force(:, node) = internal_force(:, node) + force
+      internal_force(1, solver%nodes(j)) = internal_force(1, solver%nodes(j)) + fx
+      internal_force(2, solver%nodes(j)) = internal_force(2, solver%nodes(j)) + fy
+      internal_force(3, solver%nodes(j)) = internal_force(3, solver%nodes(j)) + fz
     end do
     !$omp end parallel do
   end subroutine add_efg_forces
 
   !> One block of integration points.
   subroutine compute_efg_block(material, geometry, density, bulk_quadratic, bulk_linear, block, &
-                               displacement, velocity, dt, pair_force, critical_time_step, critical_point, &
+                               displacement, velocity, dt, point_stress, critical_time_step, critical_point, &
                                inverted_point)
     type(material_t), intent(in) :: material
     type(efg_part_t), intent(in) :: geometry
@@ -153,7 +175,7 @@ contains
     type(efg_block_t), intent(inout) :: block
     real(wp), intent(in) :: displacement(:, :), velocity(:, :)
     real(wp), intent(in) :: dt
-    real(wp), intent(inout) :: pair_force(:, :)
+    real(wp), intent(inout) :: point_stress(:, :)
     real(wp), intent(out) :: critical_time_step
     integer, intent(out) :: critical_point, inverted_point
     real(wp) :: gradient(block_size, 9), volumetric_rate(block_size), strain_increment(block_size, 6)
@@ -162,15 +184,16 @@ contains
     real(wp) :: current_density(block_size), sound_speed(block_size), cell_volume(block_size)
     real(wp) :: bulk_viscosity(block_size), length(block_size), unit_area(block_size)
     real(wp) :: point_time_step(block_size), deformation(3, 3, block_size), reference_density(block_size)
-    real(wp) :: mean_step, old_power, new_power
+    real(wp) :: rate(3, 3, block_size), point_gradient(9), mean_step, old_power, new_power
     integer :: nel, i, g
 
     nel = block%point_count
     do i = 1, nel
       g = block%first_point + i - 1
-      call point_kinematics(geometry, g, displacement, velocity, dt, deformation(:, :, i), jacobian(i), &
-                            mid_jacobian(i), gradient(i, :))
-      volumetric_rate(i) = gradient(i, 1) + gradient(i, 5) + gradient(i, 9)
+      call point_kinematics(geometry, g, displacement, velocity, dt, deformation(:, :, i), rate(:, :, i), &
+                            jacobian(i), mid_jacobian(i), point_gradient)
+      gradient(i, :) = point_gradient
+      volumetric_rate(i) = point_gradient(1) + point_gradient(5) + point_gradient(9)
     end do
     call deformation_increments(nel, dt, gradient, volumetric_rate, strain_increment, spin_increment)
 
@@ -199,10 +222,10 @@ contains
     mean_step = 0.5_wp*(block%previous_time_step + dt)
     do i = 1, nel
       g = block%first_point + i - 1
-      old_power = pair_power(geometry, g, pair_force, velocity)
-      call write_pair_forces(geometry, g, deformation(:, :, i), jacobian(i), block%stress(i, :), &
-                             bulk_viscosity(i), pair_force)
-      new_power = pair_power(geometry, g, pair_force, velocity)
+      old_power = stress_power(point_stress(:, g), rate(:, :, i))
+      call store_point_stress(geometry%point_volume(g), deformation(:, :, i), jacobian(i), block%stress(i, :), &
+                              bulk_viscosity(i), point_stress(:, g))
+      new_power = stress_power(point_stress(:, g), rate(:, :, i))
       block%internal_energy(i) = block%internal_energy(i) + 0.5_wp*mean_step*(block%force_power(i) + old_power) &
                                  - 0.5_wp*block%previous_time_step*block%force_power(i) + 0.5_wp*dt*new_power
       block%force_power(i) = new_power
@@ -224,28 +247,59 @@ contains
     end do
   end subroutine compute_efg_block
 
-  !> Fbar at the end of the step, J, J at mid-step and the velocity gradient at mid-step
-  !> (row-major: gradient(3 (i - 1) + j) = dv_i / dx_j).
-  subroutine point_kinematics(geometry, g, displacement, velocity, dt, deformation, jacobian, mid_jacobian, &
-                              gradient)
+  !> Fbar at the end of the step, its rate, J, J at mid-step and the velocity gradient at
+  !> mid-step (row-major: gradient(3 (i - 1) + j) = dv_i / dx_j).
+  subroutine point_kinematics(geometry, g, displacement, velocity, dt, deformation, rate, jacobian, &
+                              mid_jacobian, gradient)
     type(efg_part_t), intent(in) :: geometry
     integer, intent(in) :: g
     real(wp), intent(in) :: displacement(:, :), velocity(:, :), dt
-    real(wp), intent(out) :: deformation(3, 3), jacobian, mid_jacobian, gradient(9)
-    real(wp) :: rate(3, 3), middle(3, 3), inverse(3, 3), velocity_gradient(3, 3)
+    real(wp), intent(out) :: deformation(3, 3), rate(3, 3), jacobian, mid_jacobian, gradient(9)
+    real(wp) :: middle(3, 3), inverse(3, 3), velocity_gradient(3, 3)
+    real(wp) :: f11, f21, f31, f12, f22, f32, f13, f23, f33
+    real(wp) :: r11, r21, r31, r12, r22, r32, r13, r23, r33, bx, by, bz, dx, dy, dz, vx, vy, vz
     integer :: k, node, i, j
-    deformation = 0.0_wp
-    rate = 0.0_wp
+    ! scalar accumulators: the pair loop is the hot spot of the meshfree update
+    f11 = 0.0_wp; f21 = 0.0_wp; f31 = 0.0_wp; f12 = 0.0_wp; f22 = 0.0_wp; f32 = 0.0_wp
+    f13 = 0.0_wp; f23 = 0.0_wp; f33 = 0.0_wp
+    r11 = 0.0_wp; r21 = 0.0_wp; r31 = 0.0_wp; r12 = 0.0_wp; r22 = 0.0_wp; r32 = 0.0_wp
+    r13 = 0.0_wp; r23 = 0.0_wp; r33 = 0.0_wp
     do k = geometry%point_offsets(g), geometry%point_offsets(g + 1) - 1
       node = geometry%pair_node(k)
-      do j = 1, 3
-        deformation(:, j) = deformation(:, j) + displacement(:, node)*geometry%pair_gradient(j, k)
-        rate(:, j) = rate(:, j) + velocity(:, node)*geometry%pair_gradient(j, k)
-      end do
+      bx = geometry%pair_gradient(1, k)
+      by = geometry%pair_gradient(2, k)
+      bz = geometry%pair_gradient(3, k)
+      dx = displacement(1, node)
+      dy = displacement(2, node)
+      dz = displacement(3, node)
+      vx = velocity(1, node)
+      vy = velocity(2, node)
+      vz = velocity(3, node)
+      f11 = f11 + dx*bx; f21 = f21 + dy*bx; f31 = f31 + dz*bx
+      f12 = f12 + dx*by; f22 = f22 + dy*by; f32 = f32 + dz*by
+      f13 = f13 + dx*bz; f23 = f23 + dy*bz; f33 = f33 + dz*bz
+      r11 = r11 + vx*bx; r21 = r21 + vy*bx; r31 = r31 + vz*bx
+      r12 = r12 + vx*by; r22 = r22 + vy*by; r32 = r32 + vz*by
+      r13 = r13 + vx*bz; r23 = r23 + vy*bz; r33 = r33 + vz*bz
     end do
-    do i = 1, 3
-      deformation(i, i) = deformation(i, i) + 1.0_wp
-    end do
+    deformation(1, 1) = f11 + 1.0_wp
+    deformation(2, 1) = f21
+    deformation(3, 1) = f31
+    deformation(1, 2) = f12
+    deformation(2, 2) = f22 + 1.0_wp
+    deformation(3, 2) = f32
+    deformation(1, 3) = f13
+    deformation(2, 3) = f23
+    deformation(3, 3) = f33 + 1.0_wp
+    rate(1, 1) = r11
+    rate(2, 1) = r21
+    rate(3, 1) = r31
+    rate(1, 2) = r12
+    rate(2, 2) = r22
+    rate(3, 2) = r32
+    rate(1, 3) = r13
+    rate(2, 3) = r23
+    rate(3, 3) = r33
     middle = deformation - 0.5_wp*dt*rate
     jacobian = determinant(deformation)
     mid_jacobian = determinant(middle)
@@ -258,37 +312,39 @@ contains
     end do
   end subroutine point_kinematics
 
-  !> pair_force(:, k) = W_g P bbar_k with P = J (sigma - q I) Fbar^-T.
-  subroutine write_pair_forces(geometry, g, deformation, jacobian, stress, bulk_viscosity, pair_force)
-    type(efg_part_t), intent(in) :: geometry
-    integer, intent(in) :: g
-    real(wp), intent(in) :: deformation(3, 3), jacobian, stress(6), bulk_viscosity
-    real(wp), intent(inout) :: pair_force(:, :)
-    real(wp) :: cauchy(3, 3), inverse(3, 3), first_piola(3, 3)
-    integer :: k
-    cauchy = reshape([stress(1), stress(4), stress(6), stress(4), stress(2), stress(5), &
-                      stress(6), stress(5), stress(3)], [3, 3])
-    cauchy(1, 1) = cauchy(1, 1) - bulk_viscosity
-    cauchy(2, 2) = cauchy(2, 2) - bulk_viscosity
-    cauchy(3, 3) = cauchy(3, 3) - bulk_viscosity
+  !> W_g P with P = J (sigma - q I) Fbar^-T, the first Piola-Kirchhoff stress.
+  pure subroutine store_point_stress(volume, deformation, jacobian, stress, bulk_viscosity, point_stress)
+    real(wp), intent(in) :: volume, deformation(3, 3), jacobian, stress(6), bulk_viscosity
+    real(wp), intent(out) :: point_stress(9)
+    real(wp) :: cauchy(3, 3), inverse(3, 3), scale
+    integer :: i, j
+    cauchy(1, 1) = stress(1) - bulk_viscosity
+    cauchy(2, 2) = stress(2) - bulk_viscosity
+    cauchy(3, 3) = stress(3) - bulk_viscosity
+    cauchy(1, 2) = stress(4)
+    cauchy(2, 1) = stress(4)
+    cauchy(2, 3) = stress(5)
+    cauchy(3, 2) = stress(5)
+    cauchy(3, 1) = stress(6)
+    cauchy(1, 3) = stress(6)
     call invert(deformation, jacobian, inverse)
-    first_piola = geometry%point_volume(g)*jacobian*matmul(cauchy, transpose(inverse))
-    do k = geometry%point_offsets(g), geometry%point_offsets(g + 1) - 1
-      pair_force(:, k) = matmul(first_piola, geometry%pair_gradient(:, k))
+    scale = volume*jacobian
+    ! (sigma F^-T)_ij = sum_k sigma_ik (F^-1)_jk; stored column-major
+    do j = 1, 3
+      do i = 1, 3
+        point_stress(i + 3*(j - 1)) = scale*(cauchy(i, 1)*inverse(j, 1) + cauchy(i, 2)*inverse(j, 2) &
+                                             + cauchy(i, 3)*inverse(j, 3))
+      end do
     end do
-  end subroutine write_pair_forces
+  end subroutine store_point_stress
 
-  !> Power of point g's pair forces on the velocities: sum over its pairs of f . v(node).
-  pure real(wp) function pair_power(geometry, g, pair_force, velocity)
-    type(efg_part_t), intent(in) :: geometry
-    integer, intent(in) :: g
-    real(wp), intent(in) :: pair_force(:, :), velocity(:, :)
-    integer :: k
-    pair_power = 0.0_wp
-    do k = geometry%point_offsets(g), geometry%point_offsets(g + 1) - 1
-      pair_power = pair_power + dot_product(pair_force(:, k), velocity(:, geometry%pair_node(k)))
-    end do
-  end function pair_power
+  !> (W P) : dFbar/dt, the power of a point's forces (W P column-major).
+  pure real(wp) function stress_power(point_stress, rate)
+    real(wp), intent(in) :: point_stress(9), rate(3, 3)
+    stress_power = point_stress(1)*rate(1, 1) + point_stress(2)*rate(2, 1) + point_stress(3)*rate(3, 1) &
+                   + point_stress(4)*rate(1, 2) + point_stress(5)*rate(2, 2) + point_stress(6)*rate(3, 2) &
+                   + point_stress(7)*rate(1, 3) + point_stress(8)*rate(2, 3) + point_stress(9)*rate(3, 3)
+  end function stress_power
 
   !> Smallest principal stretch of F: the square root of the smallest eigenvalue of C = F^T F,
   !> from the trigonometric solution of the characteristic cubic of a symmetric 3x3 matrix

@@ -15,7 +15,7 @@ module efg_kernel
   implicit none
   private
 
-  public :: cubic_spline, kernel_weight, kernel_weight_gradient
+  public :: cubic_spline, kernel_weight, kernel_weights, kernel_weight_gradient
 
 contains
 
@@ -40,6 +40,40 @@ contains
       derivative = 0.0_wp
     end if
   end subroutine cubic_spline
+
+  !> The cubic B-spline value alone, without branches (both pieces computed, r clamped at 1 where
+  !> the outer piece vanishes) so that the loop of `kernel_weights` vectorizes.
+  elemental function spline_value(r) result(value)
+    real(wp), intent(in) :: r
+    real(wp) :: value
+    real(wp) :: clamped, rest
+
+    clamped = min(r, 1.0_wp)
+    rest = 1.0_wp - clamped
+    value = merge(2.0_wp/3.0_wp - 4.0_wp*clamped*clamped*rest, 4.0_wp/3.0_wp*rest*rest*rest, clamped <= 0.5_wp)
+  end function spline_value
+
+  !> Kernel weights of many particles at one point: the inner loop of every shape-function
+  !> evaluation. `inverse_radius` (3, n) holds 1/a_Ik (sphere: 1/a_I in component 1).
+  pure subroutine kernel_weights(kernel, centres, inverse_radius, point, weights)
+    integer, intent(in) :: kernel
+    real(wp), intent(in) :: centres(:, :), inverse_radius(:, :), point(3)
+    real(wp), intent(out) :: weights(:)
+    integer :: i
+
+    if (kernel == kernel_cubic_sphere) then
+      do i = 1, size(weights)
+        weights(i) = spline_value(sqrt((point(1) - centres(1, i))**2 + (point(2) - centres(2, i))**2 &
+                                       + (point(3) - centres(3, i))**2)*inverse_radius(1, i))
+      end do
+    else
+      do i = 1, size(weights)
+        weights(i) = spline_value(abs(point(1) - centres(1, i))*inverse_radius(1, i)) &
+                     *spline_value(abs(point(2) - centres(2, i))*inverse_radius(2, i)) &
+                     *spline_value(abs(point(3) - centres(3, i))*inverse_radius(3, i))
+      end do
+    end if
+  end subroutine kernel_weights
 
   !> Kernel weight w_I(X) of a particle at `centre` with support radii `radius` (box:
   !> a_I1, a_I2, a_I3; sphere: a_I in every component) at `point`.

@@ -27,7 +27,7 @@
 !> vertices take the exact gradients of their trilinear functions.
 module efg_shape_functions
   use kinds, only: wp
-  use efg_kernel, only: kernel_weight, kernel_weight_gradient
+  use efg_kernel, only: kernel_weights, kernel_weight_gradient
   use efg_cell_geometry, only: trilinear_functions, trilinear_natural_derivatives, cell_jacobian, inverse_3, &
                                mean_edge_length
   use efg_supports, only: part_supports_t
@@ -59,6 +59,7 @@ module efg_shape_functions
     integer, allocatable :: particle_local(:)         !< local node of each candidate particle
     real(wp), allocatable :: particle_coordinates(:, :)
     real(wp), allocatable :: particle_radius(:, :)
+    real(wp), allocatable :: particle_inverse_radius(:, :) !< 1 / particle_radius
     integer, allocatable :: candidates(:)             !< particle numbers (search scratch)
   end type cell_shape_context_t
 
@@ -113,6 +114,7 @@ contains
     do k = 1, candidate_count
       context%particle_coordinates(:, k) = supports%particle_coordinates(:, context%candidates(k))
       context%particle_radius(:, k) = supports%particle_radius(:, context%candidates(k))
+      context%particle_inverse_radius(:, k) = 1.0_wp/context%particle_radius(:, k)
     end do
 
     ! Gamma vertices, ascending and without repeats (degenerate cells repeat nodes)
@@ -229,15 +231,17 @@ contains
     if (all(moment == 0.0_wp) .and. all(moment_gradient == 0.0_wp)) return
 
     ! weighted basis rows of the covering particles
-    covering_count = 0
-    do i = 1, context%particle_count
-      if (with_gradients) then
+    if (with_gradients) then
+      do i = 1, context%particle_count
         call kernel_weight_gradient(context%kernel, context%particle_coordinates(:, i), &
                                     context%particle_radius(:, i), point, weight(i), weight_gradient(:, i))
-      else
-        weight(i) = kernel_weight(context%kernel, context%particle_coordinates(:, i), &
-                                  context%particle_radius(:, i), point)
-      end if
+      end do
+    else
+      call kernel_weights(context%kernel, context%particle_coordinates(:, 1:context%particle_count), &
+                          context%particle_inverse_radius(:, 1:context%particle_count), point, weight)
+    end if
+    covering_count = 0
+    do i = 1, context%particle_count
       if (weight(i) <= 0.0_wp) cycle
       covering_count = covering_count + 1
       covering(covering_count) = i
@@ -398,10 +402,12 @@ contains
 
     if (allocated(context%particle_local)) then
       if (size(context%particle_local) >= count) return
-      deallocate (context%particle_local, context%particle_coordinates, context%particle_radius, context%nodes)
+      deallocate (context%particle_local, context%particle_coordinates, context%particle_radius, &
+                  context%particle_inverse_radius, context%nodes)
     end if
     capacity = max(count, 64)
     allocate (context%particle_local(capacity), context%particle_coordinates(3, capacity), &
-              context%particle_radius(3, capacity), context%nodes(capacity + 8))
+              context%particle_radius(3, capacity), context%particle_inverse_radius(3, capacity), &
+              context%nodes(capacity + 8))
   end subroutine ensure_size
 end module efg_shape_functions

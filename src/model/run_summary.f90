@@ -19,6 +19,7 @@ module run_summary
     ! seconds
     real(wp) :: wall_s = 0.0_wp, setup_s = 0.0_wp, output_s = 0.0_wp
     real(wp) :: fe_solid_s = 0.0_wp, fe_shell_s = 0.0_wp, efg_s = 0.0_wp, contact_s = 0.0_wp
+    real(wp) :: efg_setup_s = 0.0_wp             !< part of setup_s: EFG neighbours, shape functions, gradients
     ! sizes
     integer :: fe_elements = 0, efg_particles = 0, dofs_total = 0, dofs_efg = 0
   end type run_summary_t

@@ -389,11 +389,11 @@ contains
     integer(hid_t), intent(in) :: file_id
     type(run_summary_t), intent(in) :: summary
     type(error_t), allocatable, intent(inout) :: error
-    character(len=*), parameter :: second_names(7) = [character(len=10) :: "wall_s", &
-      "fe_solid_s", "fe_shell_s", "efg_s", "contact_s", "output_s", "setup_s"]
+    character(len=*), parameter :: second_names(8) = [character(len=11) :: "wall_s", &
+      "fe_solid_s", "fe_shell_s", "efg_s", "contact_s", "output_s", "setup_s", "efg_setup_s"]
     character(len=*), parameter :: count_names(6) = [character(len=13) :: "cycles", "threads", &
       "fe_elements", "efg_particles", "dofs_total", "dofs_efg"]
-    real(wp) :: seconds(7)
+    real(wp) :: seconds(8)
     integer :: counts(6), entry, status
     integer(hid_t) :: group_id
 
@@ -405,7 +405,7 @@ contains
       return
     end if
     seconds = [summary%wall_s, summary%fe_solid_s, summary%fe_shell_s, summary%efg_s, &
-               summary%contact_s, summary%output_s, summary%setup_s]
+               summary%contact_s, summary%output_s, summary%setup_s, summary%efg_setup_s]
     counts = [summary%cycles, summary%threads, summary%fe_elements, summary%efg_particles, &
               summary%dofs_total, summary%dofs_efg]
     do entry = 1, size(seconds)

@@ -112,6 +112,7 @@ contains
     summary%efg_particles = 0
     summary%dofs_efg = 0
     do k = 1, size(state%efg)
+      summary%efg_setup_s = summary%efg_setup_s + state%efg(k)%geometry%setup_seconds
       summary%efg_particles = summary%efg_particles + size(state%efg(k)%geometry%particles)
       summary%dofs_efg = summary%dofs_efg + 3*size(state%efg(k)%geometry%mass_node)
     end do
@@ -123,7 +124,7 @@ contains
     if (size(state%efg) > 0) then
       write (line, '(a,i0,a,i0,a,f0.1,a,f0.3,a)') "meshfree: ", size(state%efg), " EFG part(s), ", &
         summary%efg_particles, " interior particles, ", 100.0_wp*real(summary%dofs_efg, wp)/real(summary%dofs_total, wp), &
-        "% of the dofs; set-up ", sum(state%efg%geometry%setup_seconds), " s"
+        "% of the dofs; set-up ", summary%efg_setup_s, " s"
       write (*, '(a)') trim(line)
     end if
     if (state%added_mass > 0.0_wp) then
@@ -143,13 +144,18 @@ contains
     write (line, '(a,i0,a,es12.5,a)') "  ", summary%cycles, " cycles to time ", summary%end_time, &
       ", wall time "//format_duration(summary%wall_s)
     write (*, '(a)') trim(line)
-    write (line, '(a,f10.3,a,f10.3,a,f10.3,a,f10.3)') "  seconds: setup", summary%setup_s, "  solids", &
-      summary%fe_solid_s, "  output", summary%output_s, "  other", &
-      max(0.0_wp, summary%wall_s - summary%setup_s - summary%fe_solid_s - summary%output_s)
+    write (line, '(a,f9.3,a,f9.3,a,f9.3,a,f9.3,a,f9.3)') "  seconds: setup", summary%setup_s, "  solids", &
+      summary%fe_solid_s, "  meshfree", summary%efg_s, "  output", summary%output_s, "  other", &
+      max(0.0_wp, summary%wall_s - summary%setup_s - summary%fe_solid_s - summary%efg_s - summary%output_s)
     write (*, '(a)') trim(line)
     if (summary%cycles > 0 .and. summary%fe_elements > 0) then
       per_element = 1.0e9_wp*summary%fe_solid_s/(real(summary%cycles, wp)*real(summary%fe_elements, wp))
       write (line, '(a,f0.1,a)') "  solid elements: ", per_element, " ns per element per cycle"
+      write (*, '(a)') trim(line)
+    end if
+    if (summary%cycles > 0 .and. summary%efg_particles > 0) then
+      per_element = 1.0e9_wp*summary%efg_s/(real(summary%cycles, wp)*real(summary%efg_particles, wp))
+      write (line, '(a,f0.1,a)') "  meshfree: ", per_element, " ns per interior particle per cycle"
       write (*, '(a)') trim(line)
     end if
     write (*, '(a)') "  results: "//options%output_dir//"/"//options%job_id//".h5 (and .xdmf for ParaView)"
