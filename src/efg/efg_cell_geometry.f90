@@ -10,15 +10,14 @@ module efg_cell_geometry
   implicit none
   private
 
-  public :: trilinear_functions, trilinear_natural_derivatives, map_to_cell, cell_jacobian
+  public :: trilinear_functions, trilinear_natural_derivatives, cell_jacobian
   public :: determinant_3, inverse_3, subcell_volumes, largest_face_area, mean_edge_length
 
   !> Parametric coordinates (s, t, u) of the eight vertices.
   real(wp), parameter, public :: vertex_parametric(3, 8) = reshape([ &
-                                                                   -1.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, -1.0_wp, -1.0_wp, &
-                                                                   1.0_wp, 1.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, -1.0_wp, &
-                                                                   -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp, 1.0_wp, &
-                                                                   1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp], [3, 8])
+                                  -1.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp, &
+                                  -1.0_wp, 1.0_wp, -1.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp, 1.0_wp, &
+                                  1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp], [3, 8])
 
   !> The six faces, four vertices each in order around the face (outward normal by the
   !> right-hand rule for a positively oriented cell).
@@ -64,16 +63,6 @@ contains
     end do
   end subroutine trilinear_natural_derivatives
 
-  !> The point X(s, t, u) of the cell.
-  pure function map_to_cell(vertices, parametric) result(point)
-    real(wp), intent(in) :: vertices(3, 8), parametric(3)
-    real(wp) :: point(3)
-    real(wp) :: values(8)
-
-    call trilinear_functions(parametric, values)
-    point = matmul(vertices, values)
-  end function map_to_cell
-
   !> Jacobian J(i, a) = dX_i / ds_a of the trilinear map.
   pure function cell_jacobian(vertices, parametric) result(jacobian)
     real(wp), intent(in) :: vertices(3, 8), parametric(3)
@@ -84,6 +73,7 @@ contains
     jacobian = matmul(vertices, transpose(derivatives))
   end function cell_jacobian
 
+  !> Determinant of a 3x3 matrix (det J: the volume density of the trilinear map).
   pure function determinant_3(matrix) result(determinant)
     real(wp), intent(in) :: matrix(3, 3)
     real(wp) :: determinant

@@ -30,7 +30,7 @@ module efg_setup
   !> Largest |M alpha - b| accepted as round-off. It is about 1e-15 when the support rule of
   !> formulation section 2 holds; anything near this bound means a particle needed by b does not
   !> cover the point.
-  real(wp), parameter, public :: moment_residual_tolerance = 1.0e-9_wp
+  real(wp), parameter, public :: moment_residual_tolerance = 1.0e-10_wp
 
   !> What one background cell contributes, kept until the cells are assembled in order.
   type :: cell_result_t
@@ -107,16 +107,16 @@ contains
     type(cell_shape_context_t) :: context
     real(wp), allocatable :: gradients(:, :, :), mass_volume(:), row_value(:)
     integer, allocatable :: row_node(:)
-    real(wp) :: volumes(8)
+    real(wp) :: volumes(8), largest_area
     integer :: n, g, k, pair, vertex, particle, row_count, total
 
     call prepare_cell_context(supports, grid, model%coordinates, model%solid_nodes(:, cell), cell, context)
     n = context%node_count
     volumes = subcell_volumes(context%vertices)
-    result%point_length = sum(volumes)/largest_face_area(context%vertices)
+    largest_area = largest_face_area(context%vertices)
     ! an inverted or degenerate cell is reported by the caller; nothing else is computed for it
-    if (any(volumes <= 0.0_wp)) then
-      result%point_volume = volumes
+    if (any(volumes <= 0.0_wp) .or. largest_area <= 0.0_wp) then
+      result%point_volume = min(volumes, 0.0_wp)
       allocate (result%pair_node(0), result%pair_gradient(3, 0), result%mass_node(0), result%mass_volume(0))
       allocate (result%row_particle(0), result%row_length(0), result%row_node(0), result%row_value(0))
       return
@@ -130,6 +130,7 @@ contains
       result%point_volume = volumes
       call cell_smoothed_gradients(context, volumes, gradients, result%singular_points, result%worst_residual)
     end if
+    result%point_length = sum(volumes)/largest_area
     ! pairs: every local node whose gradient is not exactly zero, in ascending node order
     do g = 1, 8
       result%pair_count(g) = count(any(gradients(:, 1:n, g) /= 0.0_wp, dim=1))
@@ -360,8 +361,8 @@ contains
     if (bad > 0) then
       associate (section => model%sections(model%parts(part)%section))
         call make_error(error, where//": "//text(bad)//" node(s) get a non-positive row-sum mass; "// &
-                        "node id (volume share):"//listed//". The supports are too large for this "// &
-                        "thin part (DX "//real_text(section%support_scale(1))//", "// &
+                        "node id (volume share):"//listed//". Likely cause: the supports are too large "// &
+                        "for the part's thickness (DX "//fixed_text(section%support_scale(1))//", "// &
                         trim(merge("spherical", "box      ", section%kernel == kernel_cubic_sphere))// &
                         " kernel): reduce DX or use the box kernel (ISPLINE 0)")
       end associate
@@ -375,6 +376,14 @@ contains
     write (buffer, '(i0)') value
     string = trim(buffer)
   end function text
+
+  pure function fixed_text(value) result(string)
+    real(wp), intent(in) :: value
+    character(len=:), allocatable :: string
+    character(len=24) :: buffer
+    write (buffer, '(f0.2)') value
+    string = trim(adjustl(buffer))
+  end function fixed_text
 
   pure function real_text(value) result(string)
     real(wp), intent(in) :: value

@@ -15,16 +15,19 @@
 !> M is 4x4, symmetric, positive semi-definite and genuinely singular at many points near edges
 !> and corners of a part (one or few covering particles, coplanar particles). b always lies in
 !> its range because every interior vertex of the cell covers the whole cell (support rule of
-!> section 2), and Psi does not depend on which solution is taken. So alpha comes from a
-!> rank-revealing solve: column-pivoted QR (LAPACK dgeqp3) of the rows sqrt(w_I) p(xi_I)^T,
-!> M P = R^T R, keeping the leading columns whose |R_kk| exceed 1e-10 |R_11| and taking the
-!> basic solution. A plain Cholesky of M would fail on those points and a threshold on the
-!> eigenvalues of M itself (the squared singular values) costs accuracy. The residual
-!> |M alpha - b| = |sum_I Psi_I p(xi_I) - b| is returned for the caller's round-off assertion.
+!> section 2), and Psi does not depend on which solution is taken. So the solve is rank-revealing:
+!> column-pivoted QR (LAPACK dgeqp3) of the rows A = [sqrt(w_I) p(xi_I)^T], A P = Q R, keeping
+!> the leading columns whose |R_kk| exceed 1e-10 |R_11|. Then Psi_I = sqrt(w_I) (A alpha)_I with
+!> A alpha = Q [y; 0] and R11^T y = (P^T b)(1:rank): one triangular solve and one product with Q
+!> (dormqr), never alpha itself, whose computation would square the condition number. A plain
+!> Cholesky of M would fail on the singular points and a threshold on the eigenvalues of M (the
+!> squared singular values) costs accuracy. The residual |M alpha - b| = |sum_I Psi_I p(xi_I) - b|
+!> is returned for the caller's round-off assertion.
 !>
 !> Direct gradients (for the Gauss variant, IDIM 2): dPsi_I = dw_I p^T alpha + w_I dp^T alpha
-!> + w_I p^T dalpha with M dalpha = db - dM alpha, solved with the same factorization; Gamma
-!> vertices take the exact gradients of their trilinear functions.
+!> + w_I p^T dalpha with M dalpha = db - dM alpha, solved with the same factorization (and the
+!> same product with Q for w_I p^T dalpha); Gamma vertices take the exact gradients of their
+!> trilinear functions.
 module efg_shape_functions
   use kinds, only: wp
   use efg_kernel, only: kernel_weights, kernel_weight_gradient
@@ -175,11 +178,11 @@ contains
     real(wp), intent(out) :: residual
     real(wp), intent(out), optional :: gradients(:, :)
     real(wp) :: phi(8), natural(3, 8), phi_gradient(3, 8), jacobian(3, 3)
-    real(wp) :: moment(4), moment_gradient(4, 3), basis(4), alpha(4), alpha_gradient(4, 3)
+    real(wp) :: moment(4), moment_gradient(4, 3), basis(4), alpha(4)
     real(wp) :: right_side(4, 3), reproduced(4), weight_gradient(3, context%particle_count)
     real(wp) :: weight(context%particle_count), shifted(4, context%particle_count)
     real(wp) :: rows(max(context%particle_count, 1), 4), tau(4), work(256)
-    real(wp) :: projected(max(context%particle_count, 4))
+    real(wp) :: projected(max(context%particle_count, 4)), projected_gradient(max(context%particle_count, 4), 3)
     real(wp) :: inverse_h, basis_alpha
     integer :: covering(context%particle_count), covering_count, pivot(4), info, a, i, k, n, local
     logical :: with_gradients
@@ -254,7 +257,7 @@ contains
       return
     end if
 
-    ! rank-revealing factorization M P = R^T R
+    ! rank-revealing factorization A P = Q R (so P^T M P = R^T R)
     pivot = 0
     call dgeqp3(covering_count, 4, rows, size(rows, 1), pivot, tau, work, size(work), info)
     rank = 0
@@ -281,14 +284,15 @@ contains
     residual = maxval(abs(reproduced - moment))
 
     if (.not. with_gradients) return
-    ! the direct derivatives need alpha itself: alpha(pivot) = R11^-1 y
+    ! Direct derivatives. p_I.alpha = Psi_I / w_I and w_I p_I.dalpha_k = sqrt(w_I) (Q y_k)_I with
+    ! R11^T y_k = (P^T (db_k - dM_k alpha))(1:rank) come through Q as above; only the terms
+    ! dp_k.alpha = -alpha_(k+1) / h need alpha itself (alpha(pivot) = R11^-1 y).
     alpha = solve_factored(rows, pivot, rank, moment)
-    ! M dalpha_k = db_k - dM_k alpha,
     ! dM_k alpha = sum_I [dw_Ik (p_I.alpha) p_I + w_I ((p_I.alpha) dp_k + (dp_k.alpha) p_I)]
     right_side = moment_gradient
     do i = 1, covering_count
       associate (particle => covering(i))
-        basis_alpha = dot_product(shifted(:, particle), alpha)
+        basis_alpha = projected(i)/sqrt(weight(particle))
         do k = 1, 3
           right_side(:, k) = right_side(:, k) - weight_gradient(k, particle)*basis_alpha*shifted(:, particle) &
                              + weight(particle)*alpha(k + 1)*inverse_h*shifted(:, particle)
@@ -296,28 +300,27 @@ contains
         end do
       end associate
     end do
+    projected_gradient = 0.0_wp
     do k = 1, 3
-      alpha_gradient(:, k) = solve_factored(rows, pivot, rank, right_side(:, k))
+      projected_gradient(1:rank, k) = forward_solve(rows, rank, right_side(pivot, k))
     end do
-    reproduced = 0.0_wp
+    call dormqr("L", "N", covering_count, 3, min(covering_count, 4), rows, size(rows, 1), tau, projected_gradient, &
+                size(projected_gradient, 1), work, size(work), info)
     do i = 1, covering_count
       associate (particle => covering(i))
         local = context%particle_local(particle)
-        basis_alpha = dot_product(shifted(:, particle), alpha)
+        basis_alpha = projected(i)/sqrt(weight(particle))
         do k = 1, 3
-          gradients(k, local) = weight_gradient(k, particle)*basis_alpha &
-                                - weight(particle)*alpha(k + 1)*inverse_h &
-                                + weight(particle)*dot_product(shifted(:, particle), alpha_gradient(:, k))
+          gradients(k, local) = weight_gradient(k, particle)*basis_alpha - weight(particle)*alpha(k + 1)*inverse_h &
+                                + sqrt(weight(particle))*projected_gradient(i, k)
         end do
       end associate
     end do
+    ! residuals of the derivative equations, M dalpha_k - (db_k - dM_k alpha), scaled by h
     do k = 1, 3
       reproduced = 0.0_wp
       do i = 1, covering_count
-        associate (particle => covering(i))
-          reproduced = reproduced + weight(particle)*dot_product(shifted(:, particle), alpha_gradient(:, k)) &
-                       *shifted(:, particle)
-        end associate
+        reproduced = reproduced + sqrt(weight(covering(i)))*projected_gradient(i, k)*shifted(:, covering(i))
       end do
       residual = max(residual, context%scale_length*maxval(abs(reproduced - right_side(:, k))))
     end do
