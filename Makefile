@@ -41,7 +41,7 @@ ifeq ($(MODE),release)
 all: bin/crashfree
 bin/crashfree: $(PROGRAM)
 	@mkdir -p bin lib
-	@cp $(PROGRAM) bin/crashfree
+	@cp $(PROGRAM) bin/crashfree.new && mv -f bin/crashfree.new bin/crashfree
 	@cp $(LIBRARY) $(MOD)/*.mod lib/
 else
 all: $(PROGRAM)

@@ -4,7 +4,7 @@ module explicit_setup
   use kinds, only: wp, block_size
   use error_handling, only: error_t, make_error
   use gather_list, only: gather_list_t, build_gather_list
-  use model, only: model_t, formulation_efg
+  use model, only: model_t, formulation_efg, boundary_full_transformation
   use efg_part, only: efg_part_t
   use efg_setup, only: build_efg_part
   use efg_forces, only: set_up_efg_solver
@@ -190,6 +190,12 @@ contains
     do part = 1, size(model%parts)
       if (model%parts(part)%formulation /= formulation_efg) cycle
       count = count + 1
+      if (model%sections(model%parts(part)%section)%boundary_treatment == boundary_full_transformation) then
+        call make_error(error, "part "//trim(id_text(model%parts(part)%id))//": IEBT = 1 (full transformation) is "// &
+                        "a verification variant of the linear static analysis; explicit runs need the coupled "// &
+                        "boundary treatment IEBT = 3 (the default)")
+        return
+      end if
       call build_efg_part(model, part, geometry, error)
       if (allocated(error)) return
       call set_up_efg_solver(model, geometry, state%efg(count))
@@ -203,6 +209,12 @@ contains
       end associate
     end do
   end subroutine set_up_meshfree_parts
+
+  pure function id_text(id) result(text)
+    integer, intent(in) :: id
+    character(len=12) :: text
+    write (text, '(i0)') id
+  end function id_text
 
   pure integer function corner_slot(lane, corner, block)
     integer, intent(in) :: lane, corner, block
