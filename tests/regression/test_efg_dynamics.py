@@ -35,14 +35,17 @@ def parts_and_sections(fe_formulation=1):
             "*HOURGLASS\n" + fields(1, 4, 0.1)]
 
 
-@pytest.mark.parametrize("coupled", [False, True], ids=["efg", "coupled"])
+@pytest.mark.parametrize("coupled", [False, True], ids=["efg-block", "coupled-bar"])
 def test_free_vibration_keeps_energy(tmp_path, run_deck, coupled):
-    nodes, elements = block_mesh((4, 4, 4), (10.0, 10.0, 10.0), perturbation=0.15, seed=3)
+    # an EFG block, or a bar of 40 x 10 x 10 mm whose left half is EFG and right half FE
+    cells, lengths = ((8, 3, 3), (40.0, 10.0, 10.0)) if coupled else ((4, 4, 4), (10.0, 10.0, 10.0))
+    nodes, elements = block_mesh(cells, lengths, perturbation=0.15, seed=3)
     centres = nodes[elements].mean(axis=1)
-    meshfree = centres[:, 0] < 5.0 if coupled else np.ones(len(elements), bool)
+    meshfree = centres[:, 0] < 20.0 if coupled else np.ones(len(elements), bool)
     initial = ["*INITIAL_VELOCITY_NODE"]
     for k, position in enumerate(nodes):
-        initial.append(fields(k + 1, *[float(v) for v in 1.0 * np.cos(np.pi * position / 10.0)]))
+        shape = np.cos(np.pi * position / np.array(lengths))
+        initial.append(fields(k + 1, *[float(v) for v in shape]))
     deck = write_deck(
         tmp_path / "vibration.k",
         "*CONTROL_TERMINATION\n" + fields(100.0, 10000),
