@@ -10,7 +10,7 @@ module model
   private
 
   public :: model_t, material_t, section_t, hourglass_t, part_t, node_set_t, part_set_t
-  public :: spc_t, prescribed_motion_t, nodal_load_t, rigid_wall_t, output_control_t
+  public :: spc_t, prescribed_motion_t, nodal_load_t, segment_load_t, rigid_wall_t, output_control_t
 
   !> Material laws, numbered as LS-DYNA numbers them.
   integer, parameter, public :: law_elastic = 1
@@ -44,6 +44,9 @@ module model
   integer, parameter, public :: kernel_cubic_box = 0, kernel_cubic_sphere = 2
   integer, parameter, public :: boundary_full_transformation = 1, boundary_coupled = 3
   integer, parameter, public :: integration_local_boundary = 1, integration_gauss = 2
+  !> Conventional EFG: 4x4x4 Gauss points per cell with direct MLS gradients (IDIM = 4, a
+  !> crashfree extension for the verification of Table 1 of the paper).
+  integer, parameter, public :: integration_gauss_conventional = 4
 
   !> One solid section (*SECTION_SOLID, *SECTION_SOLID_EFG).
   type :: section_t
@@ -123,6 +126,22 @@ module model
     real(wp) :: scale = 1.0_wp
   end type nodal_load_t
 
+  !> A distributed load on one quadrilateral (or triangular) segment: *LOAD_SEGMENT (pressure),
+  !> *LOAD_SEGMENT_SET, *LOAD_SEGMENT_NONUNIFORM (values per corner, optional direction).
+  !> Load per unit area at time t and point s of the segment:
+  !>   scale * curve(t - arrival_time) * sum_k N_k(s) nodal_values(k) * (direction or -normal)
+  !> where `normal` is the unit normal by the right-hand rule over nodes 1-2-3-4: a positive
+  !> pressure pushes against it (LS-DYNA's sign).
+  type :: segment_load_t
+    integer :: nodes(4) = 0                  !< node indices (a triangle repeats node 3)
+    integer :: curve = 0                     !< index into model%curves (0: constant 1)
+    real(wp) :: scale = 1.0_wp               !< SF
+    real(wp) :: arrival_time = 0.0_wp        !< AT
+    real(wp) :: nodal_values(4) = 1.0_wp     !< pressure or traction at each corner
+    logical :: along_normal = .true.         !< pressure; false: traction along `direction`
+    real(wp) :: direction(3) = 0.0_wp        !< unit direction of a traction
+  end type segment_load_t
+
   !> A planar rigid wall (*RIGIDWALL_PLANAR with its options).
   type :: rigid_wall_t
     integer :: id = 0
@@ -175,8 +194,10 @@ module model
     type(spc_t), allocatable :: spcs(:)
     type(prescribed_motion_t), allocatable :: motions(:)
     type(nodal_load_t), allocatable :: loads(:)
+    type(segment_load_t), allocatable :: segment_loads(:)
     type(rigid_wall_t), allocatable :: walls(:)
     ! controls
+    logical :: implicit_static = .false.             !< *CONTROL_IMPLICIT_GENERAL IMFLAG = 1: linear static
     real(wp) :: end_time = 0.0_wp                    !< ENDTIM
     integer :: end_cycle = 0                         !< ENDCYC (0 = no limit)
     real(wp) :: time_step_scale = 0.9_wp             !< TSSFAC
