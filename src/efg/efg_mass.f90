@@ -7,8 +7,6 @@
 !> the sign after adding all cells.
 module efg_mass
   use kinds, only: wp
-  use model, only: integration_gauss
-  use efg_cell_geometry, only: vertex_parametric, gauss_abscissa, cell_jacobian, determinant_3
   use efg_shape_functions, only: cell_shape_context_t, evaluate_shape_functions
   implicit none
   private
@@ -17,33 +15,27 @@ module efg_mass
 
 contains
 
-  !> Volume shares of the local nodes of the context's cell: the 8 sub-cell centres with the
-  !> exact sub-cell volumes (IDIM 1) or the 2x2x2 Gauss points with W = det J (IDIM 2).
-  subroutine cell_mass_volumes(context, domain_integration, subcell_volume, mass_volume, singular_points, &
-                               worst_residual)
+  !> Volume shares of the local nodes of the context's cell, sum_g Psi(X_g) W_g over the points
+  !> `parametric(:, g)` of the cell with weights `volume(g)`. The set-up passes the 8 sub-cell
+  !> centres with the exact sub-cell volumes (IDIM 1) or the integration points themselves, the
+  !> Gauss points with W = weight det J (IDIM 2: 8, IDIM 4: 64).
+  subroutine cell_mass_volumes(context, parametric, volume, mass_volume, singular_points, worst_residual)
     type(cell_shape_context_t), intent(in) :: context
-    integer, intent(in) :: domain_integration
-    real(wp), intent(in) :: subcell_volume(8)
+    real(wp), intent(in) :: parametric(:, :)
+    real(wp), intent(in) :: volume(:)
     real(wp), intent(out) :: mass_volume(:)
     integer, intent(inout) :: singular_points
     real(wp), intent(inout) :: worst_residual
-    real(wp) :: values(context%node_count), parametric(3), point(3), residual, volume
+    real(wp) :: values(context%node_count), point(3), residual
     integer :: g, rank, n
 
     n = context%node_count
     mass_volume(1:n) = 0.0_wp
-    do g = 1, 8
-      if (domain_integration == integration_gauss) then
-        parametric = gauss_abscissa*vertex_parametric(:, g)
-        volume = determinant_3(cell_jacobian(context%vertices, parametric))
-      else
-        parametric = 0.5_wp*vertex_parametric(:, g)
-        volume = subcell_volume(g)
-      end if
-      call evaluate_shape_functions(context, parametric, point, values, rank, residual)
+    do g = 1, size(volume)
+      call evaluate_shape_functions(context, parametric(:, g), point, values, rank, residual)
       if (rank > 0 .and. rank < 4) singular_points = singular_points + 1
       worst_residual = max(worst_residual, residual)
-      mass_volume(1:n) = mass_volume(1:n) + values*volume
+      mass_volume(1:n) = mass_volume(1:n) + values*volume(g)
     end do
   end subroutine cell_mass_volumes
 end module efg_mass

@@ -4,7 +4,8 @@
 !> Steps: nodes, Gamma nodes, particles and supports (efg_supports) -> bins over the supports
 !> (efg_neighbour_search) -> per background cell, independently and in parallel: the coupled
 !> shape functions (efg_shape_functions) at the sub-cell face points, the smoothed gradients
-!> (efg_smoothed_gradient), the row-sum mass shares (efg_mass) and the transformation rows of the
+!> (efg_smoothed_gradient; or the direct gradients at 2x2x2 or 4x4x4 Gauss points for the
+!> variants IDIM 2 and 4), the row-sum mass shares (efg_mass) and the transformation rows of the
 !> particles the cell owns (efg_transformation) -> assembly in cell order (so the result does not
 !> depend on the thread count) -> checks (moment residuals at round-off, positive masses).
 !> Every step is linear in the number of cells. See docs/efg.md.
@@ -13,9 +14,10 @@ module efg_setup
   use error_handling, only: error_t, make_error
   use wall_clock, only: seconds_now
   use model, only: model_t, formulation_efg, kernel_cubic_box, kernel_cubic_sphere, boundary_full_transformation, &
-                   boundary_coupled, integration_local_boundary, integration_gauss
+                   boundary_coupled, integration_local_boundary, integration_gauss, &
+                   integration_gauss_conventional
   use efg_part, only: efg_part_t
-  use efg_cell_geometry, only: subcell_volumes, largest_face_area
+  use efg_cell_geometry, only: subcell_volumes, largest_face_area, vertex_parametric, cell_gauss_rule
   use efg_supports, only: part_supports_t, build_part_supports
   use efg_neighbour_search, only: particle_grid_t, build_particle_grid
   use efg_shape_functions, only: cell_shape_context_t, prepare_cell_context
@@ -34,9 +36,9 @@ module efg_setup
 
   !> What one background cell contributes, kept until the cells are assembled in order.
   type :: cell_result_t
-    real(wp) :: point_volume(8) = 0.0_wp
+    real(wp), allocatable :: point_volume(:)       !< W_g of the cell's points (8 or 64)
     real(wp) :: point_length = 0.0_wp
-    integer :: pair_count(8) = 0
+    integer, allocatable :: pair_count(:)          !< pairs of each point
     integer, allocatable :: pair_node(:)
     real(wp), allocatable :: pair_gradient(:, :)
     integer, allocatable :: mass_node(:)
@@ -82,6 +84,8 @@ contains
     end associate
     efg%gamma_nodes = supports%gamma_nodes
     efg%particles = supports%particles
+    efg%surface_nodes = supports%surface_nodes
+    efg%surface_rows = supports%particle_of_node(supports%surface_nodes)
     call build_particle_grid(supports%particle_coordinates, supports%particle_radius, grid)
 
     ! cells are independent; each writes only its own result
@@ -105,39 +109,53 @@ contains
     integer, intent(in) :: domain_integration, cell
     type(cell_result_t), intent(inout) :: result
     type(cell_shape_context_t) :: context
-    real(wp), allocatable :: gradients(:, :, :), mass_volume(:), row_value(:)
+    real(wp), allocatable :: gradients(:, :, :), mass_volume(:), row_value(:), mass_parametric(:, :), rule_weight(:)
     integer, allocatable :: row_node(:)
     real(wp) :: volumes(8), largest_area
-    integer :: n, g, k, pair, vertex, particle, row_count, total
+    integer :: n, g, k, pair, vertex, particle, row_count, total, order, points
 
     call prepare_cell_context(supports, grid, model%coordinates, model%solid_nodes(:, cell), cell, context)
     n = context%node_count
     volumes = subcell_volumes(context%vertices)
     largest_area = largest_face_area(context%vertices)
+    ! points per direction: IDIM 1 has 2x2x2 sub-cells, IDIM 2 2x2x2 and IDIM 4 4x4x4 Gauss points
+    select case (domain_integration)
+    case (integration_gauss_conventional)
+      order = 4
+    case default
+      order = 2
+    end select
+    points = order**3
+    allocate (result%point_volume(points), result%pair_count(points))
+    result%pair_count = 0
     ! an inverted or degenerate cell is reported by the caller; nothing else is computed for it
     if (any(volumes <= 0.0_wp) .or. largest_area <= 0.0_wp) then
-      result%point_volume = min(volumes, 0.0_wp)
+      result%point_volume = min(minval(volumes), 0.0_wp)
       allocate (result%pair_node(0), result%pair_gradient(3, 0), result%mass_node(0), result%mass_volume(0))
       allocate (result%row_particle(0), result%row_length(0), result%row_node(0), result%row_value(0))
       return
     end if
 
-    allocate (gradients(3, n, 8))
-    if (domain_integration == integration_gauss) then
-      call cell_gauss_gradients(context, gradients, result%point_volume, result%singular_points, &
-                                result%worst_residual)
-    else
+    allocate (gradients(3, n, points), mass_parametric(3, points), rule_weight(points))
+    if (domain_integration == integration_local_boundary) then
       result%point_volume = volumes
       call cell_smoothed_gradients(context, volumes, gradients, result%singular_points, result%worst_residual)
+      ! masses at the sub-cell centres with the sub-cell volumes
+      mass_parametric = 0.5_wp*vertex_parametric
+    else
+      call cell_gauss_gradients(context, order, gradients, result%point_volume, result%singular_points, &
+                                result%worst_residual)
+      ! masses at the Gauss points themselves, with their W_g
+      call cell_gauss_rule(order, mass_parametric, rule_weight)
     end if
     result%point_length = sum(volumes)/largest_area
     ! pairs: every local node whose gradient is not exactly zero, in ascending node order
-    do g = 1, 8
+    do g = 1, points
       result%pair_count(g) = count(any(gradients(:, 1:n, g) /= 0.0_wp, dim=1))
     end do
     allocate (result%pair_node(sum(result%pair_count)), result%pair_gradient(3, sum(result%pair_count)))
     pair = 0
-    do g = 1, 8
+    do g = 1, points
       do k = 1, n
         if (all(gradients(:, k, g) == 0.0_wp)) cycle
         pair = pair + 1
@@ -147,7 +165,7 @@ contains
     end do
 
     allocate (mass_volume(n))
-    call cell_mass_volumes(context, domain_integration, volumes, mass_volume, result%singular_points, &
+    call cell_mass_volumes(context, mass_parametric, result%point_volume, mass_volume, result%singular_points, &
                            result%worst_residual)
     result%mass_node = pack(context%nodes(1:n), mass_volume /= 0.0_wp)
     result%mass_volume = pack(mass_volume, mass_volume /= 0.0_wp)
@@ -189,7 +207,10 @@ contains
     integer :: cell_count, point_count, pair_count, k, g, point, pair, first, j, particle, r, start
 
     cell_count = size(results)
-    point_count = 8*cell_count
+    point_count = 0
+    do k = 1, cell_count
+      point_count = point_count + size(results(k)%point_volume)
+    end do
     pair_count = 0
     do k = 1, cell_count
       pair_count = pair_count + sum(results(k)%pair_count)
@@ -204,7 +225,7 @@ contains
       pair = pair + sum(results(k)%pair_count)
       efg%pair_node(first:pair) = results(k)%pair_node
       efg%pair_gradient(:, first:pair) = results(k)%pair_gradient
-      do g = 1, 8
+      do g = 1, size(results(k)%point_volume)
         point = point + 1
         efg%point_cell(point) = supports%cells(k)
         efg%point_volume(point) = results(k)%point_volume(g)
@@ -306,8 +327,10 @@ contains
                section%boundary_treatment /= boundary_full_transformation) then
         call make_error(error, where//": IEBT must be 3 (coupled FE/EFG) or 1 (full transformation)")
       else if (section%domain_integration /= integration_local_boundary .and. &
-               section%domain_integration /= integration_gauss) then
-        call make_error(error, where//": IDIM must be 1 (local boundary integration) or 2 (Gauss)")
+               section%domain_integration /= integration_gauss .and. &
+               section%domain_integration /= integration_gauss_conventional) then
+        call make_error(error, where//": IDIM must be 1 (local boundary integration), 2 (2x2x2 Gauss) or 4 "// &
+                        "(4x4x4 Gauss, conventional EFG for verification)")
       end if
     end associate
   end subroutine check_section

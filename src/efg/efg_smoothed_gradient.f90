@@ -1,6 +1,6 @@
 !> Smoothed gradients of the coupled shape functions at the integration points of one
 !> background cell: the modified SCNI of formulation section 4 (Wang et al. 2009, eqs. 21,
-!> 26-27), and the conventional Gauss variant kept for comparison (Table 1; IDIM 2).
+!> 26-27), and the Gauss variants kept for comparison (Table 1; IDIM 2 and 4).
 !>
 !> Modified SCNI (IDIM 1): the cell is split in its parametric space into 8 sub-cells (sub-cell
 !> g is the octant holding vertex g, one per 2-point Gauss point). For sub-cell g of exact
@@ -17,11 +17,14 @@
 !> zero for interior particles because Psi_I vanishes there (the integration constraints,
 !> eqs. 19/27 and 23-24).
 !>
-!> Gauss variant (IDIM 2): the 8 Gauss points of the cell, W_g = det J (unit weights), and the
-!> direct gradients of the coupled functions. It does not satisfy the integration constraint.
+!> Gauss variants: the n x n x n Gauss-Legendre points of the cell in its parametric space,
+!> W_g = weight_g det J(g), and the direct gradients of the shape functions (not smoothed). IDIM 2:
+!> 2x2x2 points (unit weights); IDIM 4 (a crashfree extension for the verification of Table 1 of
+!> the paper): 4x4x4 points, with IEBT 1 the conventional EFG of the paper's method (a). Neither
+!> satisfies the integration constraint; 4x4x4 points only make its error smaller.
 module efg_smoothed_gradient
   use kinds, only: wp
-  use efg_cell_geometry, only: vertex_parametric, gauss_abscissa, cell_jacobian, determinant_3
+  use efg_cell_geometry, only: vertex_parametric, gauss_abscissa, cell_jacobian, determinant_3, cell_gauss_rule
   use efg_shape_functions, only: cell_shape_context_t, evaluate_shape_functions
   implicit none
   private
@@ -110,23 +113,25 @@ contains
     end function subcell_of
   end subroutine cell_smoothed_gradients
 
-  !> Gauss variant: direct gradients of the coupled functions (3, local node, point) at the 8
-  !> Gauss points of the cell (point g next to vertex g) and their weights W_g = det J.
-  subroutine cell_gauss_gradients(context, gradients, point_volume, singular_points, worst_residual)
+  !> Gauss variants: direct gradients of the shape functions (3, local node, point) at the
+  !> order**3 Gauss points of the cell (efg_cell_geometry's cell_gauss_rule: order 2 puts point g
+  !> next to vertex g, other orders run s fastest) and their weights W_g = weight_g det J(g).
+  subroutine cell_gauss_gradients(context, order, gradients, point_volume, singular_points, worst_residual)
     type(cell_shape_context_t), intent(in) :: context
+    integer, intent(in) :: order
     real(wp), intent(out) :: gradients(:, :, :)
-    real(wp), intent(out) :: point_volume(8)
+    real(wp), intent(out) :: point_volume(:)
     integer, intent(inout) :: singular_points
     real(wp), intent(inout) :: worst_residual
-    real(wp) :: values(context%node_count), parametric(3), point(3), residual
+    real(wp) :: values(context%node_count), parametric(3, order**3), weights(order**3), point(3), residual
     integer :: g, rank
 
-    do g = 1, 8
-      parametric = gauss_abscissa*vertex_parametric(:, g)
-      call evaluate_shape_functions(context, parametric, point, values, rank, residual, gradients(:, :, g))
+    call cell_gauss_rule(order, parametric, weights)
+    do g = 1, order**3
+      call evaluate_shape_functions(context, parametric(:, g), point, values, rank, residual, gradients(:, :, g))
       if (rank > 0 .and. rank < 4) singular_points = singular_points + 1
       worst_residual = max(worst_residual, residual)
-      point_volume(g) = determinant_3(cell_jacobian(context%vertices, parametric))
+      point_volume(g) = weights(g)*determinant_3(cell_jacobian(context%vertices, parametric(:, g)))
     end do
   end subroutine cell_gauss_gradients
 

@@ -4,7 +4,8 @@
 !> other cell of the same part shares (free surface, FE/EFG interface, contact and essential
 !> boundaries alike). They keep their trilinear FE functions. Interior particles are the other
 !> nodes of the part and carry MLS functions. With the full transformation (IEBT 1) every node is
-!> a particle.
+!> a particle; the surface nodes are still listed (`surface_nodes`), because that is where a
+!> static solver imposes the essential conditions through the transformation.
 !>
 !> Support radius (section 2): a_Ik = DX_k * max |X_Jk - X_Ik| over every node J that shares a
 !> cell of the part with I (face and body diagonals included), per direction for the box kernel;
@@ -28,6 +29,7 @@ module efg_supports
     logical :: full_transformation = .false.         !< IEBT 1: every node is a particle
     integer, allocatable :: cells(:)                 !< model solid indices of the part, ascending
     integer, allocatable :: nodes(:)                 !< model node indices of the part, ascending
+    integer, allocatable :: surface_nodes(:)         !< model node indices on the part's surface, ascending
     integer, allocatable :: gamma_nodes(:)           !< model node indices, ascending
     integer, allocatable :: particles(:)             !< model node indices, ascending
     integer, allocatable :: particle_of_node(:)      !< (model nodes): particle number, 0 for others
@@ -76,6 +78,8 @@ contains
     end do
 
     call find_boundary_nodes(model%solid_nodes, supports%cells, node_local, count, on_boundary)
+    ! the surface is kept for the essential conditions of IEBT 1, where it holds no Gamma node
+    supports%surface_nodes = pack(supports%nodes, on_boundary)
     if (full_transformation) on_boundary = .false.
     supports%gamma_nodes = pack(supports%nodes, on_boundary)
     supports%particles = pack(supports%nodes, .not. on_boundary)

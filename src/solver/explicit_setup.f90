@@ -4,7 +4,7 @@ module explicit_setup
   use kinds, only: wp, block_size
   use error_handling, only: error_t, make_error
   use gather_list, only: gather_list_t, build_gather_list
-  use model, only: model_t, formulation_efg, boundary_full_transformation
+  use model, only: model_t, formulation_efg, boundary_full_transformation, integration_gauss_conventional
   use efg_part, only: efg_part_t
   use efg_setup, only: build_efg_part
   use efg_forces, only: set_up_efg_solver
@@ -194,6 +194,13 @@ contains
         call make_error(error, "part "//trim(id_text(model%parts(part)%id))//": IEBT = 1 (full transformation) is "// &
                         "a verification variant of the linear static analysis; explicit runs need the coupled "// &
                         "boundary treatment IEBT = 3 (the default)")
+        return
+      end if
+      ! the explicit update assumes 8 integration points per cell (sub-cells or 2x2x2 Gauss)
+      if (model%sections(model%parts(part)%section)%domain_integration == integration_gauss_conventional) then
+        call make_error(error, "part "//trim(id_text(model%parts(part)%id))//": IDIM = 4 (conventional EFG, "// &
+                        "4x4x4 Gauss points) is a verification variant of the linear static analysis; explicit "// &
+                        "runs use IDIM = 1 (the default) or 2")
         return
       end if
       call build_efg_part(model, part, geometry, error)
