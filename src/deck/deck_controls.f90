@@ -1,5 +1,5 @@
 !> *TITLE and the *CONTROL_ keywords: termination, time step, hourglass and bulk-viscosity
-!> defaults, energy bookkeeping.
+!> defaults, energy bookkeeping, and the choice of an implicit (linear static) analysis.
 module deck_controls
   use kinds, only: wp
   use error_handling, only: error_list_t
@@ -13,7 +13,8 @@ module deck_controls
   private
 
   public :: read_title, read_termination, read_time_step, read_hourglass_control
-  public :: read_bulk_viscosity, read_energy_control
+  public :: read_bulk_viscosity, read_energy_control, read_implicit_general
+  public :: read_implicit_solution
 
   integer, parameter :: standard_widths(8) = 10
 
@@ -159,4 +160,98 @@ contains
     input%model%hourglass_energy_in_balance = hourglass == 2
     input%model%wall_energy_in_balance = wall /= 1
   end subroutine read_energy_control
+
+  !> *CONTROL_IMPLICIT_GENERAL: IMFLAG DT0 IMFORM NSBS IGS CNSTN FORM ZERO_V. IMFLAG 0 (blank)
+  !> is the explicit analysis and 1 crashfree's implicit one, a linear static analysis; any
+  !> other value is an error. With IMFLAG 0 the other fields are not used. With IMFLAG 1,
+  !> geometric stiffness (IGS 1 or < 0) is an error, since it belongs to a nonlinear analysis;
+  !> DT0 and CNSTN are ignored with a warning. IMFORM, NSBS, FORM and ZERO_V concern springback
+  !> and the switching between explicit and implicit (IMFLAG 2, 4, 5) and are not used.
+  subroutine read_implicit_general(deck, block, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    integer :: line, analysis, formulation, springback_steps, geometric, tangent, form, &
+               zero_velocity
+    real(wp) :: first_step
+    line = 0
+    if (.not. require_card(deck, block, line, standard_widths, card, log, "card 1 (IMFLAG DT0 "// &
+                           "IMFORM NSBS IGS CNSTN FORM ZERO_V)", "IMFLAG")) return
+    call get_integer(deck, card, 1, "IMFLAG", analysis, log)
+    call get_real(deck, card, 2, "DT0", first_step, log)
+    call get_integer(deck, card, 3, "IMFORM", formulation, log, default=2)
+    call get_integer(deck, card, 4, "NSBS", springback_steps, log, default=1)
+    call get_integer(deck, card, 5, "IGS", geometric, log, default=2)
+    call get_integer(deck, card, 6, "CNSTN", tangent, log)
+    call get_integer(deck, card, 7, "FORM", form, log)
+    call get_integer(deck, card, 8, "ZERO_V", zero_velocity, log)
+    if (card%failed) return
+    select case (analysis)
+    case (0)
+      input%model%implicit_static = .false.
+      return
+    case (1)
+      input%model%implicit_static = .true.
+    case default
+      call card_problem(deck, log, card, "IMFLAG", "crashfree's implicit analysis is linear "// &
+        "static: IMFLAG 0 or 1 (0 explicit, 1 implicit linear static), found "// &
+        integer_text(analysis)//analysis_note(analysis))
+      return
+    end select
+    if (geometric == 1 .or. geometric < 0) call card_problem(deck, log, card, "IGS", &
+      "geometric stiffness is not available: crashfree's implicit analysis is linear static; "// &
+      "leave IGS blank or 2, found "//integer_text(geometric))
+    call warn_if_set(deck, card, 2, "DT0", "crashfree's linear static analysis takes no "// &
+                     "implicit time step", warnings)
+    call warn_if_set(deck, card, 6, "CNSTN", "a linear analysis uses the elastic stiffness", &
+                     warnings)
+  end subroutine read_implicit_general
+
+  !> What an IMFLAG value crashfree does not have would select, for the message.
+  pure function analysis_note(analysis) result(note)
+    integer, intent(in) :: analysis
+    character(len=:), allocatable :: note
+    select case (analysis)
+    case (2)
+      note = " (an implicit springback step after the explicit analysis)"
+    case (4, 5)
+      note = " (automatic switching between implicit and explicit)"
+    case (6)
+      note = " (eigenvalue extraction)"
+    case (:-1)
+      note = " (a curve switching between explicit and implicit)"
+    case default
+      note = ""
+    end select
+  end function analysis_note
+
+  !> *CONTROL_IMPLICIT_SOLUTION card 1: NSOLVR ILIMIT MAXREF DCTOL ECTOL RCTOL LSTOL ABSTOL.
+  !> NSOLVR is judged once the whole deck is read, since it matters only when
+  !> *CONTROL_IMPLICIT_GENERAL asks for the implicit analysis. The other fields and the further
+  !> cards steer nonlinear iterations, which a linear analysis does not do: they are read
+  !> (card 1) or skipped (cards 2-4) and not used.
+  subroutine read_implicit_solution(deck, block, input, log)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(card_t) :: card
+    integer :: line, k, iterations, reformations
+    real(wp) :: tolerance
+    character(len=6), parameter :: tolerance_names(5) = ["DCTOL ", "ECTOL ", "RCTOL ", "LSTOL ", &
+                                                         "ABSTOL"]
+    line = 0
+    if (.not. require_card(deck, block, line, standard_widths, card, log, "card 1 (NSOLVR "// &
+                           "ILIMIT MAXREF DCTOL ECTOL RCTOL LSTOL ABSTOL)", "NSOLVR")) return
+    call get_integer(deck, card, 1, "NSOLVR", input%implicit_solver, log)
+    call get_integer(deck, card, 2, "ILIMIT", iterations, log)
+    call get_integer(deck, card, 3, "MAXREF", reformations, log)
+    do k = 1, 5
+      call get_real(deck, card, k + 3, trim(tolerance_names(k)), tolerance, log)
+    end do
+    input%implicit_solution_line = line
+  end subroutine read_implicit_solution
 end module deck_controls

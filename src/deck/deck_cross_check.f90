@@ -4,14 +4,15 @@
 module deck_cross_check
   use kinds, only: wp
   use error_handling, only: error_list_t, add_error
-  use model, only: model_t, spc_t, prescribed_motion_t, nodal_load_t, rigid_wall_t, &
-                   formulation_fe, formulation_efg
+  use model, only: model_t, spc_t, prescribed_motion_t, nodal_load_t, segment_load_t, &
+                   rigid_wall_t, formulation_fe, formulation_efg
   use deck_problems, only: problem_log_t, report_problem, has_problems
   use deck_numbers, only: integer_text, real_text
   use deck_lexer, only: deck_t, line_location
-  use deck_fields, only: located_problem
+  use deck_fields, only: located_problem, located_warning
   use deck_input, only: deck_input_t, set_input_t, velocity_input_t, velocity_by_set, &
                         velocity_by_node, velocity_generation
+  use deck_segments, only: segment_has_no_area
   use deck_id_index, only: id_index_t, build_id_index, find_id, lower_bound
   use deck_element_check, only: check_hexahedron, shape_inside_out, shape_flat
   use deck_efg_cards, only: elform_efg
@@ -23,7 +24,7 @@ module deck_cross_check
   !> Sorted ids of everything that can be referenced.
   type :: deck_indices_t
     type(id_index_t) :: nodes, solids, parts, sections, materials, hourglasses, curves
-    type(id_index_t) :: node_sets, part_sets
+    type(id_index_t) :: node_sets, part_sets, segment_sets
   end type deck_indices_t
 
   character(len=1), parameter :: axis_names(3) = ["x", "y", "z"]
@@ -46,14 +47,17 @@ contains
     call resolve_parts(deck, input, indices, log)
     call resolve_node_sets(deck, input, indices, log)
     call resolve_part_sets(deck, input, indices, log)
+    call resolve_segment_sets(deck, input, indices, log)
     call build_constraints(deck, input, indices, log)
     call build_motions(deck, input, indices, log)
     call build_loads(deck, input, indices, log)
+    call build_segment_loads(deck, input, indices, log)
     call build_initial_velocities(deck, input, indices, log)
     call build_walls(deck, input, indices, log)
     call build_history_nodes(deck, input, indices, log, warnings)
     call check_mesh(deck, input, mesh_resolved, log)
     call check_controls(deck, input, log)
+    call check_implicit_solution(deck, input, log, warnings)
     call set_effective_hourglass(input)
     if (has_problems(log)) return
     model = input%model
@@ -105,6 +109,9 @@ contains
     call index_ids(deck, [(input%part_sets(k)%id, k=1, input%part_set_count)], &
                    [(input%part_sets(k)%line, k=1, input%part_set_count)], "SID", "part set", &
                    indices%part_sets, log)
+    call index_ids(deck, [(input%segment_sets(k)%id, k=1, input%segment_set_count)], &
+                   [(input%segment_sets(k)%line, k=1, input%segment_set_count)], "SID", &
+                   "segment set", indices%segment_sets, log)
   end subroutine index_definitions
 
   subroutine index_ids(deck, ids, lines, field, noun, index, log)
@@ -279,6 +286,58 @@ contains
       end associate
     end do
   end subroutine resolve_part_sets
+
+  !> Segment set node ids to node indices. A segment with an undefined node or without area
+  !> is reported at its line and marked unusable, so that loads on the set skip it.
+  subroutine resolve_segment_sets(deck, input, indices, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(inout) :: input
+    type(deck_indices_t), intent(in) :: indices
+    type(problem_log_t), intent(inout) :: log
+    integer :: set, segment
+    do set = 1, input%segment_set_count
+      associate (given => input%segment_sets(set))
+        do segment = 1, given%count
+          if (.not. given%usable(segment)) cycle
+          given%usable(segment) = resolve_segment(deck, input%model%coordinates, indices, &
+            given%lines(segment), given%nodes(:, segment), " of segment set "// &
+            integer_text(given%id), log)
+        end do
+      end associate
+    end do
+  end subroutine resolve_segment_sets
+
+  !> Node ids of one segment to indices (in place); a node not defined, or a segment without
+  !> area, is reported at `line` and gives false. `owner` completes the message ("of segment
+  !> set 3").
+  logical function resolve_segment(deck, coordinates, indices, line, nodes, owner, log)
+    type(deck_t), intent(in) :: deck
+    real(wp), intent(in) :: coordinates(:, :)
+    type(deck_indices_t), intent(in) :: indices
+    integer, intent(in) :: line
+    integer, intent(inout) :: nodes(4)
+    character(len=*), intent(in) :: owner
+    type(problem_log_t), intent(inout) :: log
+    integer :: k, position(4)
+    resolve_segment = .true.
+    do k = 1, 4
+      position(k) = find_id(indices%nodes, nodes(k))
+      if (position(k) > 0 .or. (k == 4 .and. nodes(4) == nodes(3))) cycle
+      call located_problem(deck, log, line, "N"//integer_text(k), "node "// &
+        integer_text(nodes(k))//owner//" is not defined")
+      resolve_segment = .false.
+    end do
+    if (.not. resolve_segment) return
+    if (segment_has_no_area(coordinates(:, position))) then
+      call located_problem(deck, log, line, "N1-N4", "the segment (nodes "// &
+        integer_text(nodes(1))//" "//integer_text(nodes(2))//" "//integer_text(nodes(3))// &
+        " "//integer_text(nodes(4))//")"//owner//" has no area: its corners coincide or lie "// &
+        "on one line")
+      resolve_segment = .false.
+      return
+    end if
+    nodes = position
+  end function resolve_segment
 
   !> Listed ids of a set to indices; `seen(i) == stamp` marks indices already taken.
   subroutine list_members(deck, given, index, noun, stamp, seen, members, count, log)
@@ -519,6 +578,59 @@ contains
     end do
     input%model%loads = loads(1:count)
   end subroutine build_loads
+
+  !> One segment_load_t per segment: a *LOAD_SEGMENT(_NONUNIFORM) segment as given, a
+  !> *LOAD_SEGMENT_SET line once for every segment of its set. Always allocated.
+  subroutine build_segment_loads(deck, input, indices, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(inout) :: input
+    type(deck_indices_t), intent(in) :: indices
+    type(problem_log_t), intent(inout) :: log
+    type(segment_load_t), allocatable :: loads(:)
+    type(segment_load_t) :: load
+    integer :: k, count, total, set, segment
+
+    total = 0
+    do k = 1, input%segment_load_count
+      set = find_id(indices%segment_sets, input%segment_loads(k)%segment_set)
+      if (input%segment_loads(k)%segment_set == 0) then
+        total = total + 1
+      else if (set > 0) then
+        total = total + input%segment_sets(set)%count
+      end if
+    end do
+    allocate (loads(total))
+    count = 0
+    do k = 1, input%segment_load_count
+      associate (given => input%segment_loads(k))
+        load = given%load
+        load%curve = find_curve(deck, indices, given%curve_id, given%line, log)
+        if (given%segment_set == 0) then
+          if (.not. given%usable) cycle
+          if (.not. resolve_segment(deck, input%model%coordinates, indices, given%node_line, &
+                                    load%nodes, "", log)) cycle
+          count = count + 1
+          loads(count) = load
+          cycle
+        end if
+        set = find_id(indices%segment_sets, given%segment_set)
+        if (set == 0) then
+          call located_problem(deck, log, given%line, "SSID", "segment set "// &
+            integer_text(given%segment_set)//" is not defined (no *SET_SEGMENT with this SID)")
+          cycle
+        end if
+        associate (segments => input%segment_sets(set))
+          do segment = 1, segments%count
+            if (.not. segments%usable(segment)) cycle
+            load%nodes = segments%nodes(:, segment)
+            count = count + 1
+            loads(count) = load
+          end do
+        end associate
+      end associate
+    end do
+    input%model%segment_loads = loads(1:count)
+  end subroutine build_segment_loads
 
   integer function find_curve(deck, indices, id, line, log)
     type(deck_t), intent(in) :: deck
@@ -864,6 +976,37 @@ contains
       end if
     end associate
   end subroutine check_controls
+
+  !> *CONTROL_IMPLICIT_SOLUTION NSOLVR, which matters only for an implicit analysis
+  !> (*CONTROL_IMPLICIT_GENERAL IMFLAG 1, in any place of the deck): 1 (linear) is accepted;
+  !> blank, 0 and LS-DYNA's default 12 (nonlinear) are solved as linear with a warning; any other
+  !> value is an error. In an explicit analysis the keyword is ignored with a warning.
+  subroutine check_implicit_solution(deck, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(in) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    integer :: line
+    line = input%implicit_solution_line
+    if (line == 0) return
+    if (.not. input%model%implicit_static) then
+      call located_warning(deck, warnings, line, "NSOLVR", "ignored (the analysis is explicit: "// &
+                           "*CONTROL_IMPLICIT_GENERAL IMFLAG 1 is not given)")
+      return
+    end if
+    select case (input%implicit_solver)
+    case (1)
+    case (0)
+      call located_warning(deck, warnings, line, "NSOLVR", "blank means LS-DYNA's default 12 "// &
+        "(nonlinear, BFGS updates); crashfree's implicit analysis is linear static, as NSOLVR 1")
+    case (12)
+      call located_warning(deck, warnings, line, "NSOLVR", "12 (nonlinear, BFGS updates) is "// &
+        "solved as linear: crashfree's implicit analysis is linear static, as NSOLVR 1")
+    case default
+      call located_problem(deck, log, line, "NSOLVR", "crashfree's implicit analysis is linear "// &
+        "static: NSOLVR 1 (linear), or blank, found "//integer_text(input%implicit_solver))
+    end select
+  end subroutine check_implicit_solution
 
   !> Each part's effective hourglass and bulk-viscosity values (LS-DYNA's rules): the part's
   !> *HOURGLASS where it gives a value, else *CONTROL_HOURGLASS IHQ/QH and

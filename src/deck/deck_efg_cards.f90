@@ -5,13 +5,15 @@
 !> and differ from LS-DYNA's where docs/keywords.md says so: IDIM blank is 1 (local boundary
 !> integration; LS-DYNA: 2) and TOLDEF blank is 0 (Lagrangian kernel; LS-DYNA: 0.01). A value
 !> that selects something crashfree does not have is an error naming its field, never a
-!> silent substitution.
+!> silent substitution. IDIM 4 is crashfree's own value (no LS-DYNA meaning): conventional EFG,
+!> 4x4x4 Gauss points per cell with direct MLS gradients, kept for the verification of Table 1
+!> of the paper.
 module deck_efg_cards
   use kinds, only: wp
   use error_handling, only: error_list_t
   use model, only: section_t, kernel_cubic_box, kernel_cubic_sphere, &
                    boundary_full_transformation, boundary_coupled, integration_local_boundary, &
-                   integration_gauss
+                   integration_gauss, integration_gauss_conventional
   use deck_problems, only: problem_log_t
   use deck_numbers, only: integer_text, real_text
   use deck_lexer, only: deck_t
@@ -107,13 +109,14 @@ contains
     end select
 
     select case (domain_integration)
-    case (integration_local_boundary, integration_gauss)
+    case (integration_local_boundary, integration_gauss, integration_gauss_conventional)
       section%domain_integration = domain_integration
     case default
       call card_problem(deck, log, card, "IDIM", "domain integration "// &
         integer_text(domain_integration)//" is not available; crashfree has IDIM 1 (local "// &
-        "boundary integration, the default for a blank field) and 2 (2x2x2 Gauss points per "// &
-        "cell, for comparison)"//zero_note(domain_integration))
+        "boundary integration, the default for a blank field), 2 (2x2x2 Gauss points per "// &
+        "cell, for comparison) and 4 (crashfree's extension: conventional EFG, 4x4x4 Gauss "// &
+        "points per cell with direct MLS gradients)"//zero_note(domain_integration))
     end select
 
     if (kernel_tolerance /= 0.0_wp) then

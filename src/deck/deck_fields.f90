@@ -19,7 +19,7 @@ module deck_fields
   public :: card_t, open_card, next_line, require_card, next_definition, get_integer, get_real
   public :: get_text, has_data, card_is_empty
   public :: field_is_blank, card_problem, line_problem, line_title, id_heading, warn_if_set
-  public :: keyword_label, located_problem
+  public :: keyword_label, located_problem, located_warning
 
   !> One data line split into fields, and the block (keyword) it belongs to.
   type :: card_t
@@ -323,6 +323,17 @@ contains
     character(len=*), intent(in) :: name, message
     call line_problem(deck, log, line, block_of_line(deck, line), name, message)
   end subroutine located_problem
+
+  !> Add the warning `file:line: *KEYWORD: field NAME: message` for line `line`, finding its
+  !> keyword.
+  subroutine located_warning(deck, warnings, line, name, message)
+    type(deck_t), intent(in) :: deck
+    type(error_list_t), intent(inout) :: warnings
+    integer, intent(in) :: line
+    character(len=*), intent(in) :: name, message
+    call add_error(warnings, line_location(deck, line)//": *"// &
+      keyword_label(deck, block_of_line(deck, line))//": field "//name//": "//message)
+  end subroutine located_warning
 
   !> The keyword of block `block` as the deck writes it (upper case, options included).
   function keyword_label(deck, block) result(label)

@@ -3,19 +3,22 @@
 !> (by node or by set) before they are expanded per node.
 module deck_input
   use kinds, only: wp
-  use model, only: model_t, rigid_wall_t
+  use model, only: model_t, rigid_wall_t, segment_load_t
   use deck_keywords, only: keyword_count, keyword_node, keyword_element_solid, keyword_part, &
     keyword_section_solid, keyword_section_solid_efg, keyword_mat_elastic, &
     keyword_mat_plastic_kinematic, keyword_hourglass, keyword_define_curve, &
     keyword_set_node_list, keyword_set_node_list_generate, keyword_set_part_list, &
     keyword_spc_node, keyword_spc_set, keyword_motion_node, keyword_motion_set, &
     keyword_load_node_point, keyword_load_node_set, keyword_initial_velocity, &
-    keyword_initial_velocity_node, keyword_initial_velocity_generation, keyword_rigidwall_planar
+    keyword_initial_velocity_node, keyword_initial_velocity_generation, keyword_rigidwall_planar, &
+    keyword_load_segment, keyword_load_segment_set, keyword_load_segment_nonuniform, &
+    keyword_set_segment
   implicit none
   private
 
   public :: id_list_t, set_input_t, spc_input_t, motion_input_t, load_input_t
-  public :: velocity_input_t, wall_input_t, deck_input_t, prepare_input, append_id
+  public :: velocity_input_t, wall_input_t, segment_set_input_t, segment_load_input_t
+  public :: deck_input_t, prepare_input, append_id
 
   !> How an initial velocity was given.
   integer, parameter, public :: velocity_by_set = 1, velocity_by_node = 2, &
@@ -36,6 +39,30 @@ module deck_input
     logical :: generated = .false.
     type(id_list_t) :: members
   end type set_input_t
+
+  !> *SET_SEGMENT(_TITLE): card 1 as for the other sets (`members` is not used), then the
+  !> segments as written: node ids, N4 = N3 for a triangle. The cross-check turns the ids into
+  !> node indices.
+  type, extends(set_input_t) :: segment_set_input_t
+    integer :: count = 0
+    integer, allocatable :: nodes(:, :)     !< (4, count)
+    integer, allocatable :: lines(:)        !< the line of each segment
+    !> False once a problem of the segment was reported (a bad id, a repeated node; in the
+    !> cross-check an undefined node or no area), so that loads skip it without repeating it.
+    logical, allocatable :: usable(:)
+  end type segment_set_input_t
+
+  !> One *LOAD_SEGMENT(_ID) or *LOAD_SEGMENT_NONUNIFORM(_ID) segment (node ids in
+  !> `load%nodes`), or one *LOAD_SEGMENT_SET(_ID) line (`segment_set` > 0), before ids are
+  !> resolved.
+  type :: segment_load_input_t
+    type(segment_load_t) :: load
+    integer :: curve_id = 0
+    integer :: segment_set = 0          !< SSID (0: the one segment in load%nodes)
+    logical :: usable = .true.          !< false once a problem of its nodes was reported
+    integer :: line = 0                 !< the card with LCID
+    integer :: node_line = 0            !< the card with N1-N4
+  end type segment_load_input_t
 
   !> *BOUNDARY_SPC_NODE/_SET line (or a *NODE TC code): `target` is a node or set id.
   type :: spc_input_t
@@ -95,6 +122,7 @@ module deck_input
     integer :: material_count = 0, hourglass_count = 0, curve_count = 0
     integer :: node_set_count = 0, part_set_count = 0, spc_count = 0, motion_count = 0
     integer :: load_count = 0, velocity_count = 0, wall_count = 0
+    integer :: segment_set_count = 0, segment_load_count = 0
     integer, allocatable :: node_lines(:), node_constraints(:)     !< TC code of each node
     integer, allocatable :: solid_lines(:), solid_node_lines(:)   !< PID card, node card
     integer, allocatable :: part_lines(:), section_lines(:), material_lines(:)
@@ -105,6 +133,8 @@ module deck_input
     type(load_input_t), allocatable :: loads(:)
     type(velocity_input_t), allocatable :: velocities(:)
     type(wall_input_t), allocatable :: walls(:)
+    type(segment_set_input_t), allocatable :: segment_sets(:)
+    type(segment_load_input_t), allocatable :: segment_loads(:)
     !> *DATABASE_HISTORY_NODE(_SET) requests in deck order; a node set id is stored with a
     !> negative field number (-k for field IDk) so that nodes and sets keep their order.
     type(id_list_t) :: history_requests
@@ -113,6 +143,8 @@ module deck_input
     integer :: plot_count = 0              !< *DATABASE_BINARY_D3PLOT NPLTC
     integer :: plot_line = 0
     integer :: nodout_line = 0
+    integer :: implicit_solution_line = 0  !< *CONTROL_IMPLICIT_SOLUTION card (0: not given)
+    integer :: implicit_solver = 0         !< its NSOLVR (0: blank)
     real(wp) :: bulk_quadratic = 1.5_wp    !< *CONTROL_BULK_VISCOSITY Q1
     real(wp) :: bulk_linear = 0.06_wp      !< *CONTROL_BULK_VISCOSITY Q2
   end type deck_input_t
@@ -152,6 +184,9 @@ contains
                                lines(keyword_initial_velocity_node) + &
                                lines(keyword_initial_velocity_generation)))
     allocate (input%walls(lines(keyword_rigidwall_planar)))
+    allocate (input%segment_sets(blocks(keyword_set_segment)))
+    allocate (input%segment_loads(lines(keyword_load_segment) + lines(keyword_load_segment_set) + &
+                                  lines(keyword_load_segment_nonuniform)))
   end subroutine prepare_input
 
   !> Append one id with its origin, growing the list by doubling.

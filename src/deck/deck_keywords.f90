@@ -18,9 +18,12 @@ module deck_keywords
     keyword_define_curve = 23, keyword_motion_node = 24, keyword_motion_set = 25, &
     keyword_load_node_point = 26, keyword_load_node_set = 27, keyword_rigidwall_planar = 28, &
     keyword_d3plot = 29, keyword_glstat = 30, keyword_matsum = 31, keyword_nodout = 32, &
-    keyword_rwforc = 33, keyword_history_node = 34, keyword_history_node_set = 35
+    keyword_rwforc = 33, keyword_history_node = 34, keyword_history_node_set = 35, &
+    keyword_control_implicit_general = 36, keyword_control_implicit_solution = 37, &
+    keyword_load_segment = 38, keyword_load_segment_set = 39, &
+    keyword_load_segment_nonuniform = 40, keyword_set_segment = 41
   !> Number of keyword codes.
-  integer, parameter, public :: keyword_count = 35
+  integer, parameter, public :: keyword_count = 41
 
   !> A keyword name taken apart: its code and the options given with it.
   type :: keyword_t
@@ -32,7 +35,7 @@ module deck_keywords
     logical :: forces = .false.    !< *RIGIDWALL_PLANAR_FORCES
   end type keyword_t
 
-  integer, parameter :: entry_count = 42
+  integer, parameter :: entry_count = 48
   character(len=*), parameter :: base_names(entry_count) = [character(len=36) :: &
     "TITLE", "NODE", "ELEMENT_SOLID", "PART", "SECTION_SOLID", "SECTION_SOLID_EFG", &
     "MAT_ELASTIC", "MAT_001", "MAT_PLASTIC_KINEMATIC", "MAT_003", "HOURGLASS", &
@@ -43,6 +46,8 @@ module deck_keywords
     "BOUNDARY_PRESCRIBED_MOTION_SET", "LOAD_NODE_POINT", "LOAD_NODE_SET", "RIGIDWALL_PLANAR", &
     "DATABASE_BINARY_D3PLOT", "DATABASE_GLSTAT", "DATABASE_MATSUM", "DATABASE_NODOUT", &
     "DATABASE_RWFORC", "DATABASE_HISTORY_NODE", "DATABASE_HISTORY_NODE_SET", &
+    "CONTROL_IMPLICIT_GENERAL", "CONTROL_IMPLICIT_SOLUTION", "LOAD_SEGMENT", &
+    "LOAD_SEGMENT_SET", "LOAD_SEGMENT_NONUNIFORM", "SET_SEGMENT", &
     "KEYWORD", "INCLUDE", "PARAMETER", "COMMENT", "END"]
   integer, parameter :: base_codes(entry_count) = [keyword_title, keyword_node, &
     keyword_element_solid, keyword_part, keyword_section_solid, keyword_section_solid_efg, &
@@ -55,6 +60,8 @@ module deck_keywords
     keyword_motion_node, keyword_motion_set, keyword_load_node_point, keyword_load_node_set, &
     keyword_rigidwall_planar, keyword_d3plot, keyword_glstat, keyword_matsum, keyword_nodout, &
     keyword_rwforc, keyword_history_node, keyword_history_node_set, &
+    keyword_control_implicit_general, keyword_control_implicit_solution, keyword_load_segment, &
+    keyword_load_segment_set, keyword_load_segment_nonuniform, keyword_set_segment, &
     keyword_unknown, keyword_unknown, keyword_unknown, keyword_unknown, keyword_unknown]
   !> Options each entry accepts (blank-separated).
   character(len=*), parameter :: base_options(entry_count) = [character(len=28) :: &
@@ -67,6 +74,8 @@ module deck_keywords
     "ID", "", "", "FINITE MOVING FORCES ID", &
     "", "", "", "", &
     "", "ID", "", &
+    "", "", "ID", &
+    "ID", "ID", "TITLE", &
     "", "", "", "", ""]
 
 contains

@@ -1,7 +1,7 @@
 !> Boundary conditions, loads, initial velocities and rigid walls: *BOUNDARY_SPC_NODE/_SET,
-!> *BOUNDARY_PRESCRIBED_MOTION_NODE/_SET, *LOAD_NODE_POINT/_SET, *INITIAL_VELOCITY(_NODE,
-!> _GENERATION) and *RIGIDWALL_PLANAR. They are kept as written (by node or set id); the
-!> cross-check expands them per node.
+!> *BOUNDARY_PRESCRIBED_MOTION_NODE/_SET, *LOAD_NODE_POINT/_SET, *LOAD_SEGMENT(_SET,
+!> _NONUNIFORM), *INITIAL_VELOCITY(_NODE, _GENERATION) and *RIGIDWALL_PLANAR. They are kept as
+!> written (by node, segment or set id); the cross-check expands them per node or segment.
 module deck_loads_bcs
   use kinds, only: wp
   use error_handling, only: error_list_t
@@ -11,14 +11,17 @@ module deck_loads_bcs
   use deck_lexer, only: deck_t
   use deck_keywords, only: keyword_t
   use deck_fields, only: card_t, open_card, next_line, require_card, has_data, get_integer, &
-                         get_real, card_problem, warn_if_set, id_heading, line_problem
+                         get_real, card_problem, warn_if_set, id_heading, line_problem, &
+                         card_is_empty, field_is_blank, located_warning
   use deck_input, only: deck_input_t, velocity_input_t, velocity_by_set, velocity_by_node, &
-                        velocity_generation
+                        velocity_generation, segment_load_input_t
+  use deck_segments, only: read_segment_nodes
   implicit none
   private
 
   public :: read_spcs, read_motions, read_loads, read_initial_velocities
   public :: read_initial_velocity_nodes, read_velocity_generations, read_planar_walls
+  public :: read_segment_loads, read_segment_set_loads, read_nonuniform_segment_loads
 
   integer, parameter :: standard_widths(8) = 10
   character(len=*), parameter :: no_rotations = "solid nodes have no rotations"
@@ -184,6 +187,212 @@ contains
       end associate
     end do
   end subroutine read_loads
+
+  !> *LOAD_SEGMENT(_ID): one segment per line, LCID SF AT N1 N2 N3 N4 N5: a pressure, uniform
+  !> over the segment, SF*curve(t - AT). A line that sets nothing is skipped: pydyna writes a card
+  !> of mid-side nodes N6 N7 N8 after every segment, which would otherwise be read as a segment.
+  subroutine read_segment_loads(deck, block, keyword, input, log)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(card_t) :: card
+    type(segment_load_input_t) :: given
+    integer :: line, k, mid_side, nodes(4)
+
+    line = 0
+    if (.not. skip_id_card(deck, block, keyword, line, log)) return
+    do while (next_line(deck, block, line, .true.))
+      call open_card(deck, block, line, standard_widths, card, log)
+      if (card_is_empty(deck, card)) cycle
+      do k = 1, 4
+        call get_integer(deck, card, k + 3, "N"//achar(iachar("0") + k), nodes(k), log)
+      end do
+      call get_integer(deck, card, 8, "N5", mid_side, log)
+      if (card%failed) cycle
+      if (all(nodes == 0) .and. mid_side == 0) then
+        call card_problem(deck, log, card, "N1", "the line has no segment nodes (N1-N4 are "// &
+          "blank): each line of *LOAD_SEGMENT is one segment, LCID SF AT N1 N2 N3 N4 N5; a "// &
+          "card of mid-side nodes N6 N7 N8 (quadratic segments) is not read")
+        cycle
+      end if
+      given = segment_load_input_t(line=line, node_line=line)
+      call read_load_curve(deck, card, given%curve_id, given%load%scale, &
+                           given%load%arrival_time, log)
+      call read_segment_nodes(deck, card, 4, given%load%nodes, given%usable, log)
+      if (mid_side /= 0) call card_problem(deck, log, card, "N5", "quadratic segments "// &
+        "(mid-side nodes) are not available; leave N5 blank, found "//integer_text(mid_side))
+      call add_segment_load(input, given)
+    end do
+  end subroutine read_segment_loads
+
+  !> *LOAD_SEGMENT_SET(_ID): SSID LCID SF AT per line, a uniform pressure on every segment of
+  !> the *SET_SEGMENT SSID.
+  subroutine read_segment_set_loads(deck, block, keyword, input, log)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(card_t) :: card
+    type(segment_load_input_t) :: given
+    integer :: line, set
+
+    line = 0
+    if (.not. skip_id_card(deck, block, keyword, line, log)) return
+    do while (next_line(deck, block, line, .true.))
+      call open_card(deck, block, line, standard_widths, card, log)
+      given = segment_load_input_t(line=line, node_line=line)
+      call get_integer(deck, card, 1, "SSID", set, log)
+      call read_load_curve(deck, card, given%curve_id, given%load%scale, &
+                           given%load%arrival_time, log, first=2)
+      if (card%failed) cycle
+      if (set <= 0) then
+        call card_problem(deck, log, card, "SSID", "segment set id must be > 0, found "// &
+                          integer_text(set))
+        cycle
+      end if
+      given%segment_set = set
+      call add_segment_load(input, given)
+    end do
+  end subroutine read_segment_set_loads
+
+  !> *LOAD_SEGMENT_NONUNIFORM(_ID): card 1 LCID SF AT DT CID V1 V2 V3, then for each segment a
+  !> card of nodes N1-N8 and a card of nodal values P1-P8. The load per unit area is
+  !> SF*curve(t - AT) times the value interpolated from the corners, from AT to DT: a pressure
+  !> along the normal when V1 = V2 = V3 = 0, else a traction along the unit vector of V.
+  subroutine read_nonuniform_segment_loads(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    type(segment_load_input_t) :: common, given
+    integer :: line, first_line, system, segments
+    real(wp) :: vector(3), length
+
+    line = 0
+    if (.not. has_data(deck, block, log, "card 1 (LCID SF AT DT CID V1 V2 V3)", "LCID")) return
+    if (.not. skip_id_card(deck, block, keyword, line, log)) return
+    if (.not. require_card(deck, block, line, standard_widths, card, log, &
+                           "card 1 (LCID SF AT DT CID V1 V2 V3)", "LCID")) return
+    first_line = line
+    common = segment_load_input_t(line=line)
+    call read_load_curve(deck, card, common%curve_id, common%load%scale, &
+                         common%load%arrival_time, log)
+    call get_real(deck, card, 4, "DT", common%load%death, log)
+    call get_integer(deck, card, 5, "CID", system, log)
+    call read_vector(deck, card, 6, ["V1", "V2", "V3"], vector, log)
+    if (.not. card%failed) then
+      if (common%load%death == 0.0_wp) then
+        common%load%death = huge(1.0_wp)
+      else if (common%load%death <= common%load%arrival_time) then
+        call card_problem(deck, log, card, "DT", "death time "//real_text(common%load%death)// &
+          " must be later than the arrival time AT = "//real_text(common%load%arrival_time))
+      end if
+      if (system /= 0) call card_problem(deck, log, card, "CID", no_local_systems)
+      length = norm2(vector)
+      common%load%along_normal = length == 0.0_wp
+      if (length > 0.0_wp) common%load%direction = vector/length
+    end if
+
+    segments = 0
+    do while (next_line(deck, block, line, .true.))
+      call open_card(deck, block, line, standard_widths, card, log)
+      given = common
+      given%node_line = line
+      call read_segment_nodes(deck, card, 1, given%load%nodes, given%usable, log)
+      call reject_mid_side_nodes(deck, card, log)
+      segments = segments + 1
+      if (.not. require_card(deck, block, line, standard_widths, card, log, "the card of "// &
+          "nodal values (P1-P8) after the node card of the segment", "P1")) exit
+      call read_nodal_values(deck, card, given, log, warnings)
+      call add_segment_load(input, given)
+    end do
+    if (segments == 0) call line_problem(deck, log, first_line, block, "N1", "the keyword has "// &
+      "no segment: a card of nodes N1-N8 and a card of nodal values P1-P8 must follow card 1", &
+      unreadable=.true.)
+  end subroutine read_nonuniform_segment_loads
+
+  !> Mid-side nodes N5-N8 of a *LOAD_SEGMENT_NONUNIFORM node card: quadratic segments are not
+  !> available, so each must be blank or 0.
+  subroutine reject_mid_side_nodes(deck, card, log)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(inout) :: card
+    type(problem_log_t), intent(inout) :: log
+    integer :: k, node
+    character(len=2) :: name
+    do k = 5, 8
+      name = "N"//achar(iachar("0") + k)
+      call get_integer(deck, card, k, name, node, log)
+      if (node == 0) cycle
+      call card_problem(deck, log, card, name, "quadratic segments (mid-side nodes N5-N8) "// &
+                        "are not available; leave N5-N8 blank, found "//integer_text(node))
+      return
+    end do
+  end subroutine reject_mid_side_nodes
+
+  !> P1-P4 of a *LOAD_SEGMENT_NONUNIFORM values card (blank: 0). A triangle (N4 = N3) has one
+  !> value at N3: P4 must be blank or equal P3.
+  subroutine read_nodal_values(deck, card, given, log, warnings)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(inout) :: card
+    type(segment_load_input_t), intent(inout) :: given
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    integer :: k
+    character(len=2) :: name
+    do k = 1, 4
+      name = "P"//achar(iachar("0") + k)
+      call get_real(deck, card, k, name, given%load%nodal_values(k), log)
+    end do
+    do k = 5, 8
+      name = "P"//achar(iachar("0") + k)
+      call warn_if_set(deck, card, k, name, "no mid-side nodes", warnings)
+    end do
+    if (card%failed .or. .not. given%usable) return
+    associate (values => given%load%nodal_values)
+      if (given%load%nodes(4) == given%load%nodes(3)) then
+        if (field_is_blank(deck, card, 4)) then
+          values(4) = values(3)
+        else if (values(4) /= values(3)) then
+          call card_problem(deck, log, card, "P4", "the segment is a triangle (N4 = N3), "// &
+            "which has one value at N3: leave P4 blank or equal to P3 = "//real_text(values(3))// &
+            ", found "//real_text(values(4)))
+        end if
+      end if
+      if (all(values == 0.0_wp)) call located_warning(deck, warnings, card%line, "P1-P4", &
+        "the nodal values are all zero, so the segment carries no load")
+    end associate
+  end subroutine read_nodal_values
+
+  !> LCID SF AT from field `first` on (default 1): the curve is required, SF blank or 0 means 1.
+  subroutine read_load_curve(deck, card, curve_id, scale, arrival_time, log, first)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(inout) :: card
+    integer, intent(out) :: curve_id
+    real(wp), intent(out) :: scale, arrival_time
+    type(problem_log_t), intent(inout) :: log
+    integer, intent(in), optional :: first
+    integer :: k
+    k = 1
+    if (present(first)) k = first
+    call get_integer(deck, card, k, "LCID", curve_id, log)
+    call get_real(deck, card, k + 1, "SF", scale, log)
+    call get_real(deck, card, k + 2, "AT", arrival_time, log)
+    if (scale == 0.0_wp) scale = 1.0_wp
+    if (.not. card%failed) call check_curve_given(deck, card, k, curve_id, log)
+  end subroutine read_load_curve
+
+  subroutine add_segment_load(input, given)
+    type(deck_input_t), intent(inout) :: input
+    type(segment_load_input_t), intent(in) :: given
+    input%segment_load_count = input%segment_load_count + 1
+    input%segment_loads(input%segment_load_count) = given
+  end subroutine add_segment_load
 
   !> *INITIAL_VELOCITY: card 1 NSID NSIDEX BOXID IRIGID ICID, card 2 VX VY VZ VXR VYR VZR,
   !> card 3 (when NSIDEX > 0) the velocities of the exempted nodes.

@@ -26,16 +26,20 @@ module deck_reader
     keyword_initial_velocity_node, keyword_initial_velocity_generation, keyword_define_curve, &
     keyword_motion_node, keyword_motion_set, keyword_load_node_point, keyword_load_node_set, &
     keyword_rigidwall_planar, keyword_d3plot, keyword_glstat, keyword_matsum, keyword_nodout, &
-    keyword_rwforc, keyword_history_node, keyword_history_node_set
+    keyword_rwforc, keyword_history_node, keyword_history_node_set, &
+    keyword_control_implicit_general, keyword_control_implicit_solution, keyword_load_segment, &
+    keyword_load_segment_set, keyword_load_segment_nonuniform, keyword_set_segment
   use deck_input, only: deck_input_t, prepare_input
   use deck_nodes_elements, only: read_nodes, read_solid_elements
   use deck_parts_sections, only: read_parts, read_solid_sections, read_hourglasses
   use deck_materials, only: read_elastic_materials, read_plastic_kinematic_materials
-  use deck_sets_curves, only: read_node_set, read_part_set, read_curve
+  use deck_sets_curves, only: read_node_set, read_part_set, read_segment_set, read_curve
   use deck_loads_bcs, only: read_spcs, read_motions, read_loads, read_initial_velocities, &
-    read_initial_velocity_nodes, read_velocity_generations, read_planar_walls
+    read_initial_velocity_nodes, read_velocity_generations, read_planar_walls, &
+    read_segment_loads, read_segment_set_loads, read_nonuniform_segment_loads
   use deck_controls, only: read_title, read_termination, read_time_step, &
-    read_hourglass_control, read_bulk_viscosity, read_energy_control
+    read_hourglass_control, read_bulk_viscosity, read_energy_control, read_implicit_general, &
+    read_implicit_solution
   use deck_database, only: read_plot_output, read_history_output, read_history_nodes
   use deck_cross_check, only: check_and_build
   implicit none
@@ -158,11 +162,17 @@ contains
       call read_time_step(deck, block, input, log, warnings)
     case (keyword_control_energy)
       call read_energy_control(deck, block, input, log)
+    case (keyword_control_implicit_general)
+      call read_implicit_general(deck, block, input, log, warnings)
+    case (keyword_control_implicit_solution)
+      call read_implicit_solution(deck, block, input, log)
     case (keyword_set_node_list, keyword_set_node_list_generate)
       call read_node_set(deck, block, keyword, keyword%code == keyword_set_node_list_generate, &
                          input, log, warnings)
     case (keyword_set_part_list)
       call read_part_set(deck, block, keyword, input, log, warnings)
+    case (keyword_set_segment)
+      call read_segment_set(deck, block, keyword, input, log, warnings)
     case (keyword_define_curve)
       call read_curve(deck, block, keyword, input, log)
     case (keyword_spc_node, keyword_spc_set)
@@ -171,6 +181,12 @@ contains
       call read_motions(deck, block, keyword, keyword%code == keyword_motion_set, input, log)
     case (keyword_load_node_point, keyword_load_node_set)
       call read_loads(deck, block, keyword%code == keyword_load_node_set, input, log)
+    case (keyword_load_segment)
+      call read_segment_loads(deck, block, keyword, input, log)
+    case (keyword_load_segment_set)
+      call read_segment_set_loads(deck, block, keyword, input, log)
+    case (keyword_load_segment_nonuniform)
+      call read_nonuniform_segment_loads(deck, block, keyword, input, log, warnings)
     case (keyword_initial_velocity)
       call read_initial_velocities(deck, block, input, log, warnings)
     case (keyword_initial_velocity_node)

@@ -1,4 +1,4 @@
-!> *SET_NODE_LIST, *SET_NODE_LIST_GENERATE, *SET_PART_LIST and *DEFINE_CURVE.
+!> *SET_NODE_LIST, *SET_NODE_LIST_GENERATE, *SET_PART_LIST, *SET_SEGMENT and *DEFINE_CURVE.
 module deck_sets_curves
   use kinds, only: wp
   use error_handling, only: error_list_t
@@ -9,10 +9,11 @@ module deck_sets_curves
   use deck_fields, only: card_t, open_card, next_line, next_definition, get_integer, get_real, &
                          get_text, card_problem, warn_if_set
   use deck_input, only: deck_input_t, set_input_t, append_id
+  use deck_segments, only: read_segment_nodes
   implicit none
   private
 
-  public :: read_node_set, read_part_set, read_curve
+  public :: read_node_set, read_part_set, read_segment_set, read_curve
 
   integer, parameter :: standard_widths(8) = 10
   !> *DEFINE_CURVE points: abscissa and ordinate, 20 columns each.
@@ -60,6 +61,38 @@ contains
       call read_members(deck, block, line, "PID", set, log)
     end associate
   end subroutine read_part_set
+
+  !> *SET_SEGMENT: SID card, then one segment per line: N1 N2 N3 N4 A1 A2 A3 A4. N4 blank or
+  !> 0 (or equal to N3) is a triangle; the attributes A1-A4 are not used.
+  subroutine read_segment_set(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    integer :: line, k, n
+
+    line = 0
+    input%segment_set_count = input%segment_set_count + 1
+    associate (set => input%segment_sets(input%segment_set_count))
+      if (.not. read_set_header(deck, block, keyword, line, set%set_input_t, log, warnings)) return
+      ! at most one segment per remaining line
+      n = deck%blocks(block)%last_line - line
+      allocate (set%nodes(4, n), set%lines(n), set%usable(n))
+      do while (next_line(deck, block, line, .true.))
+        call open_card(deck, block, line, standard_widths, card, log)
+        set%count = set%count + 1
+        set%lines(set%count) = line
+        call read_segment_nodes(deck, card, 1, set%nodes(:, set%count), set%usable(set%count), log)
+        do k = 1, 4
+          call warn_if_set(deck, card, k + 4, "A"//digit(k), "segment attributes are not used", &
+                           warnings)
+        end do
+      end do
+    end associate
+  end subroutine read_segment_set
 
   !> [title] and card 1: SID DA1 DA2 DA3 DA4 SOLVER (ITS). False when the card is missing.
   logical function read_set_header(deck, block, keyword, line, set, log, warnings)

@@ -137,6 +137,7 @@ module model
     integer :: curve = 0                     !< index into model%curves (0: constant 1)
     real(wp) :: scale = 1.0_wp               !< SF
     real(wp) :: arrival_time = 0.0_wp        !< AT
+    real(wp) :: death = huge(1.0_wp)         !< DT (NONUNIFORM): zero load after it; huge: never
     real(wp) :: nodal_values(4) = 1.0_wp     !< pressure or traction at each corner
     logical :: along_normal = .true.         !< pressure; false: traction along `direction`
     real(wp) :: direction(3) = 0.0_wp        !< unit direction of a traction

@@ -10,7 +10,7 @@ program test_deck
   use model, only: model_t, formulation_fe, formulation_efg, law_elastic, law_plastic_kinematic, &
                    motion_displacement, motion_velocity, kernel_cubic_box, kernel_cubic_sphere, &
                    boundary_coupled, boundary_full_transformation, integration_local_boundary, &
-                   integration_gauss
+                   integration_gauss, integration_gauss_conventional
   use deck_reader, only: read_deck
   implicit none
 
@@ -41,6 +41,12 @@ program test_deck
   call test_efg_card_errors()
   call test_efg_card_structure()
   call test_efg_cells()
+  call test_efg_conventional_integration()
+  call test_implicit_controls()
+  call test_implicit_control_errors()
+  call test_segment_loads()
+  call test_segment_load_errors()
+  call test_segment_load_structure()
   call execute_command_line("rm -rf "//directory)
   call finish_suite(suite)
 
@@ -260,6 +266,10 @@ contains
                size(model%walls) == 0 .and. size(model%node_sets) == 0 .and. &
                size(model%part_sets) == 0 .and. size(model%curves) == 0 .and. &
                size(model%hourglasses) == 0 .and. size(model%output%history_nodes) == 0)
+    call check(suite, "fixed: no segment loads, allocated", allocated(model%segment_loads))
+    if (allocated(model%segment_loads)) call check(suite, "fixed: segment loads zero-size", &
+                                                   size(model%segment_loads) == 0)
+    call check(suite, "fixed: explicit analysis", .not. model%implicit_static)
     call check(suite, "fixed: initial velocity zero", all(shape(model%initial_velocity) == &
                [3, 8]) .and. all(model%initial_velocity == 0.0_wp))
     call check(suite, "fixed: no warnings", warnings%count == 0)
@@ -885,7 +895,7 @@ contains
       "5,1", &
       "*SECTION_SOLID_EFG", &
       "6", &
-      "1.1"]), [character(len=260) :: &
+      "1.1"]), [character(len=360) :: &
       "@:26: *SECTION_SOLID_EFG: field DX: DX must be greater than 1: at 1.0 a vertex weight "// &
       "vanishes on the cell's far corner; found 1.0 (blank or 0 means 1.01)", &
       "@:26: *SECTION_SOLID_EFG: field DY: DY must be greater than 1: at 1.0 a vertex weight "// &
@@ -900,7 +910,9 @@ contains
       "crashfree has IEBT 3 (coupled FE/EFG, the default for a blank field) and 1 (full "// &
       "transformation)", &
       "@:26: *SECTION_SOLID_EFG: field IDIM: domain integration 3 is not available; crashfree "// &
-      "has IDIM 1 (local boundary integration, the default for a blank field) and 2", &
+      "has IDIM 1 (local boundary integration, the default for a blank field), 2 (2x2x2 Gauss "// &
+      "points per cell, for comparison) and 4 (crashfree's extension: conventional EFG, 4x4x4 "// &
+      "Gauss points per cell with direct MLS gradients)", &
       "@:26: *SECTION_SOLID_EFG: field TOLDEF: semi-Lagrangian and Eulerian kernels (TOLDEF "// &
       "/= 0) are not available; use 0 (found 0.01)", &
       "@:27: *SECTION_SOLID_EFG: field IPS: pressure smoothing is not available; leave IPS "// &
@@ -932,8 +944,10 @@ contains
       "crashfree has IEBT 3 (coupled FE/EFG, the default for a blank field) and 1 (full "// &
       "transformation); 0 is not a default here: leave the field blank", &
       "@:35: *SECTION_SOLID: field IDIM: domain integration 0 is not available; crashfree has "// &
-      "IDIM 1 (local boundary integration, the default for a blank field) and 2 (2x2x2 Gauss "// &
-      "points per cell, for comparison); 0 is not a default here: leave the field blank", &
+      "IDIM 1 (local boundary integration, the default for a blank field), 2 (2x2x2 Gauss "// &
+      "points per cell, for comparison) and 4 (crashfree's extension: conventional EFG, 4x4x4 "// &
+      "Gauss points per cell with direct MLS gradients); 0 is not a default here: leave the "// &
+      "field blank", &
       "@:35: *SECTION_SOLID: field TOLDEF: semi-Lagrangian and Eulerian kernels (TOLDEF /= 0) "// &
       "are not available; use 0 (found -0.5)", &
       "@:38: *SECTION_SOLID_EFG: field ELFORM: *SECTION_SOLID_EFG needs ELFORM 41 (meshfree "// &
@@ -978,4 +992,198 @@ contains
       "node 3 (N3 and N4): the background cells of an EFG part (ELFORM 41) must be proper "// &
       "hexahedra with 8 distinct nodes"], message_lines=1)
   end subroutine test_efg_cells
+
+  !> IDIM 4, crashfree's conventional EFG (4x4x4 Gauss points, direct MLS gradients), in both
+  !> section keywords.
+  subroutine test_efg_conventional_integration()
+    type(model_t) :: model
+    type(error_list_t) :: warnings
+    call read_good("efg_conventional.k", deck_with_sections([character(len=line_length) :: &
+      "*SECTION_SOLID_EFG", "1,41", fixed(["1.2", "   ", "   ", "   ", "   ", "   ", "4  "], 10), &
+      "*SECTION_SOLID", "2,41", "1.3,1.3,1.3,0,0,1,4", &
+      "*PART", "second", fixed(["2", "2", "1"], 10)]), model, warnings)
+    if (.not. allocated(model%sections)) return
+    call check(suite, "IDIM 4: conventional Gauss integration", all([model%sections(1)% &
+      domain_integration, model%sections(2)%domain_integration] == integration_gauss_conventional))
+    call check(suite, "IDIM 4: IEBT blank 3, then 1", model%sections(1)%boundary_treatment == &
+      boundary_coupled .and. model%sections(2)%boundary_treatment == boundary_full_transformation)
+    call check(suite, "IDIM 4: parts are EFG", all(model%parts%formulation == formulation_efg))
+    call check(suite, "IDIM 4: no warnings", warnings%count == 0, warnings%text)
+  end subroutine test_efg_conventional_integration
+
+  ! ---------------------------------------------------------------- implicit analysis
+
+  !> IMFLAG 1 makes the analysis linear static; NSOLVR 1 is silent, a blank NSOLVR and DT0 /
+  !> CNSTN warn; in an explicit deck *CONTROL_IMPLICIT_SOLUTION is ignored with a warning.
+  subroutine test_implicit_controls()
+    type(model_t) :: model
+    type(error_list_t) :: warnings
+    call read_good("implicit.k", cube_deck([character(len=line_length) :: &
+      "*CONTROL_IMPLICIT_SOLUTION", "1,11,15,0.001,0.01,1e10,0.9,1e-10", &
+      "*CONTROL_IMPLICIT_GENERAL", "1,,2,1,2"]), model, warnings)
+    call check(suite, "implicit: IMFLAG 1 is linear static", model%implicit_static)
+    call check(suite, "implicit: NSOLVR 1, no warnings", warnings%count == 0, warnings%text)
+    call read_good("implicit_warnings.k", cube_deck([character(len=line_length) :: &
+      "*CONTROL_IMPLICIT_GENERAL", fixed(["1  ", "0.1", "   ", "   ", "   ", "1  "], 10), &
+      "*CONTROL_IMPLICIT_SOLUTION", fixed(["  ", "11"], 10)]), model, warnings)
+    call check(suite, "implicit warnings: linear static", model%implicit_static)
+    call check(suite, "implicit warnings: three", warnings%count == 3, warnings%text)
+    if (warnings%count == 3) then
+      call check(suite, "implicit warnings: DT0", index(warnings%text, "implicit_warnings.k:25: "// &
+        "*CONTROL_IMPLICIT_GENERAL: field DT0: ignored (crashfree's linear static analysis "// &
+        "takes no implicit time step)") > 0, warnings%text)
+      call check(suite, "implicit warnings: CNSTN", index(warnings%text, "implicit_warnings.k:"// &
+        "25: *CONTROL_IMPLICIT_GENERAL: field CNSTN: ignored (a linear analysis uses the "// &
+        "elastic stiffness)") > 0, warnings%text)
+      call check(suite, "implicit warnings: NSOLVR blank", index(warnings%text, &
+        "implicit_warnings.k:27: *CONTROL_IMPLICIT_SOLUTION: field NSOLVR: blank means "// &
+        "LS-DYNA's default 12 (nonlinear, BFGS updates); crashfree's implicit analysis is "// &
+        "linear static, as NSOLVR 1") > 0, warnings%text)
+    end if
+    call read_good("implicit_off.k", cube_deck([character(len=line_length) :: &
+      "*CONTROL_IMPLICIT_GENERAL", "0,0.1,,,1", &
+      "*CONTROL_IMPLICIT_SOLUTION", "6"]), model, warnings)
+    call check(suite, "implicit off: IMFLAG 0 is explicit", .not. model%implicit_static)
+    call check(suite, "implicit off: solution card ignored", warnings%count == 1 .and. &
+      index(warnings%text, "implicit_off.k:27: *CONTROL_IMPLICIT_SOLUTION: field NSOLVR: "// &
+      "ignored (the analysis is explicit: *CONTROL_IMPLICIT_GENERAL IMFLAG 1 is not given)") > 0, &
+      warnings%text)
+  end subroutine test_implicit_controls
+
+  !> IMFLAG other than 0 and 1, geometric stiffness, and a nonlinear solver in an implicit deck.
+  subroutine test_implicit_control_errors()
+    call read_bad("implicit_errors.k", cube_deck([character(len=line_length) :: &
+      "*CONTROL_IMPLICIT_GENERAL", "2", &
+      "*CONTROL_IMPLICIT_GENERAL", "-3", &
+      "*CONTROL_IMPLICIT_GENERAL", "1,,,,1", &
+      "*CONTROL_IMPLICIT_SOLUTION", "6"]), [character(len=240) :: &
+      "@:25: *CONTROL_IMPLICIT_GENERAL: field IMFLAG: crashfree's implicit analysis is linear "// &
+      "static: IMFLAG 0 or 1 (0 explicit, 1 implicit linear static), found 2 (an implicit "// &
+      "springback step after the explicit analysis)", &
+      "@:27: *CONTROL_IMPLICIT_GENERAL: field IMFLAG: crashfree's implicit analysis is linear "// &
+      "static: IMFLAG 0 or 1 (0 explicit, 1 implicit linear static), found -3 (a curve "// &
+      "switching between explicit and implicit)", &
+      "@:29: *CONTROL_IMPLICIT_GENERAL: field IGS: geometric stiffness is not available: "// &
+      "crashfree's implicit analysis is linear static; leave IGS blank or 2, found 1", &
+      "@:31: *CONTROL_IMPLICIT_SOLUTION: field NSOLVR: crashfree's implicit analysis is linear "// &
+      "static: NSOLVR 1 (linear), or blank, found 6"], message_lines=4)
+  end subroutine test_implicit_control_errors
+
+  ! ---------------------------------------------------------------- segment loads
+
+  !> *LOAD_SEGMENT(_ID) quadrilaterals and triangles, *SET_SEGMENT_TITLE with
+  !> *LOAD_SEGMENT_SET_ID, *LOAD_SEGMENT_NONUNIFORM(_ID) along the normal and along a vector.
+  subroutine test_segment_loads()
+    type(model_t) :: model
+    type(error_list_t) :: warnings
+    integer :: k
+    real(wp), parameter :: never = huge(1.0_wp)
+    call read_good("segments.k", cube_deck([character(len=line_length) :: &
+      "*DEFINE_CURVE", "7", "0,0", "1,1", &
+      "*LOAD_SEGMENT", &
+      fixed(["7  ", "   ", "0.5", "5  ", "6  ", "7  ", "8  "], 10), &
+      "7,-2.0,,1,2,6", &
+      "0,0,0", &
+      "*LOAD_SEGMENT_ID", "         3top", "7,0.0,,1,4,3,3", &
+      "*SET_SEGMENT_TITLE", "bottom", "4", "1,4,3,2", "1,2,6,5,0.5", &
+      "*LOAD_SEGMENT_SET_ID", "        10bottom pressure", "4,7,3.0,0.25", &
+      "*LOAD_SEGMENT_NONUNIFORM", "7,2.0,0.1,0.9,0,0,0,0", "5,6,7,8", "1.0,2.0,3.0,4.0", &
+      "2,3,7", "1.5,2.5,3.5", &
+      "*LOAD_SEGMENT_NONUNIFORM_ID", "         5side", "7,,,,,0.0,3.0,4.0", "1,2,6,5", &
+      "1,1,1,1"]), model, warnings)
+    if (.not. allocated(model%segment_loads)) return
+    call check(suite, "segments: eight loads", size(model%segment_loads) == 8)
+    if (size(model%segment_loads) /= 8) return
+    associate (loads => model%segment_loads)
+      call check(suite, "segments: nodes", all(loads(1)%nodes == [5, 6, 7, 8]) .and. &
+        all(loads(2)%nodes == [1, 2, 6, 6]) .and. all(loads(3)%nodes == [1, 4, 3, 3]) .and. &
+        all(loads(4)%nodes == [1, 4, 3, 2]) .and. all(loads(5)%nodes == [1, 2, 6, 5]) .and. &
+        all(loads(6)%nodes == [5, 6, 7, 8]) .and. all(loads(7)%nodes == [2, 3, 7, 7]) .and. &
+        all(loads(8)%nodes == [1, 2, 6, 5]))
+      call check(suite, "segments: curve index", all(loads%curve == 1))
+      call check_close(suite, "segments: SF (blank and 0 mean 1)", [(loads(k)%scale, k=1, 8)], [1.0_wp, &
+        -2.0_wp, 1.0_wp, 3.0_wp, 3.0_wp, 2.0_wp, 2.0_wp, 1.0_wp], thr=0.0_wp)
+      call check_close(suite, "segments: AT", [(loads(k)%arrival_time, k=1, 8)], [0.5_wp, 0.0_wp, 0.0_wp, &
+        0.25_wp, 0.25_wp, 0.1_wp, 0.1_wp, 0.0_wp], thr=0.0_wp)
+      call check_close(suite, "segments: death (DT blank: never)", [(loads(k)%death, k=1, 8)], [never, never, &
+        never, never, never, 0.9_wp, 0.9_wp, never], thr=0.0_wp)
+      do k = 1, 5
+        call check_close(suite, "segments: uniform values "//count_text(k), &
+                         loads(k)%nodal_values, [1.0_wp, 1.0_wp, 1.0_wp, 1.0_wp], thr=0.0_wp)
+      end do
+      call check_close(suite, "nonuniform: values", loads(6)%nodal_values, [1.0_wp, 2.0_wp, &
+                       3.0_wp, 4.0_wp], thr=0.0_wp)
+      call check_close(suite, "nonuniform: triangle P4 = P3", loads(7)%nodal_values, &
+                       [1.5_wp, 2.5_wp, 3.5_wp, 3.5_wp], thr=0.0_wp)
+      call check(suite, "segments: pressures along the normal", all(loads(1:7)%along_normal))
+      call check(suite, "nonuniform: traction along V", .not. loads(8)%along_normal)
+      call check_close(suite, "nonuniform: unit direction", loads(8)%direction, [0.0_wp, 0.6_wp, &
+                       0.8_wp], rel=1.0e-15_wp)
+      call check_close(suite, "nonuniform: values of the traction", loads(8)%nodal_values, &
+                       [1.0_wp, 1.0_wp, 1.0_wp, 1.0_wp], thr=0.0_wp)
+    end associate
+    call check(suite, "segments: A1 warned", warnings%count == 1 .and. index(warnings%text, &
+      "segments.k:39: *SET_SEGMENT_TITLE: field A1: ignored (segment attributes are not used)") &
+      > 0, warnings%text)
+  end subroutine test_segment_loads
+
+  !> Every problem of a segment load or set names its field, all listed at once: undefined,
+  !> repeated and non-positive nodes, no area, curves, sets, mid-side nodes, DT, CID, P4.
+  subroutine test_segment_load_errors()
+    call read_bad("segment_errors.k", cube_deck([character(len=line_length) :: &
+      "*DEFINE_CURVE", "7", "0,0", &
+      "*LOAD_SEGMENT", &
+      "7,,,1,2,99,4", "7,,,1,2,1,4", "7,,,1,2,3,4,9", "0,,,1,2,3,4", "8,,,1,2,3,4", &
+      "7,,,1,2,9,10", "7,1.0,,0,2,3", "7", &
+      "*SET_SEGMENT", "3", "1,2,3,77", "1,1,2,3", &
+      "*LOAD_SEGMENT_SET", "3,7", "5,7", "-1,7", &
+      "*LOAD_SEGMENT_NONUNIFORM", "7,,1.0,0.5,2", "1,2,3,3,0,11", "1.0,2.0,3.0,4.0", &
+      "5,6,7,8", "0,0,0,0", &
+      "*SET_SEGMENT", "3", "5,6,7,8", &
+      "*NODE", node_line(9, 2.0_wp, 0.0_wp, 0.0_wp), node_line(10, 3.0_wp, 0.0_wp, 0.0_wp)]), &
+      [character(len=240) :: &
+      "@:28: *LOAD_SEGMENT: field N3: node 99 is not defined", &
+      "@:29: *LOAD_SEGMENT: field N3: the segment repeats node 1 (N1 and N3); only N4 may "// &
+      "repeat N3 (a triangle)", &
+      "@:30: *LOAD_SEGMENT: field N5: quadratic segments (mid-side nodes) are not available; "// &
+      "leave N5 blank, found 9", &
+      "@:31: *LOAD_SEGMENT: field LCID: a load curve id > 0 is required (field 1), found 0", &
+      "@:32: *LOAD_SEGMENT: field LCID: curve 8 is not defined (no *DEFINE_CURVE with this LCID)", &
+      "@:33: *LOAD_SEGMENT: field N1-N4: the segment (nodes 1 2 9 10) has no area: its corners "// &
+      "coincide or lie on one line", &
+      "@:34: *LOAD_SEGMENT: field N1: node id must be > 0, found 0", &
+      "@:35: *LOAD_SEGMENT: field N1: the line has no segment nodes (N1-N4 are blank): each "// &
+      "line of *LOAD_SEGMENT is one segment, LCID SF AT N1 N2 N3 N4 N5; a card of mid-side "// &
+      "nodes N6 N7 N8 (quadratic segments) is not read", &
+      "@:38: *SET_SEGMENT: field N4: node 77 of segment set 3 is not defined", &
+      "@:39: *SET_SEGMENT: field N2: the segment repeats node 1 (N1 and N2); only N4 may "// &
+      "repeat N3 (a triangle)", &
+      "@:42: *LOAD_SEGMENT_SET: field SSID: segment set 5 is not defined (no *SET_SEGMENT with "// &
+      "this SID)", &
+      "@:43: *LOAD_SEGMENT_SET: field SSID: segment set id must be > 0, found -1", &
+      "@:45: *LOAD_SEGMENT_NONUNIFORM: field DT: death time 0.5 must be later than the arrival "// &
+      "time AT = 1.0", &
+      "@:45: *LOAD_SEGMENT_NONUNIFORM: field CID: local coordinate systems are not available; "// &
+      "leave it blank or 0", &
+      "@:46: *LOAD_SEGMENT_NONUNIFORM: field N6: quadratic segments (mid-side nodes N5-N8) are "// &
+      "not available; leave N5-N8 blank, found 11", &
+      "@:47: *LOAD_SEGMENT_NONUNIFORM: field P4: the segment is a triangle (N4 = N3), which has "// &
+      "one value at N3: leave P4 blank or equal to P3 = 3.0, found 4.0", &
+      "@:51: *SET_SEGMENT: field SID: segment set id 3 is defined twice (first at @:37)"], &
+      message_lines=17)
+  end subroutine test_segment_load_errors
+
+  !> *LOAD_SEGMENT_NONUNIFORM without the values card of a segment, or without any segment.
+  subroutine test_segment_load_structure()
+    call read_bad("nonuniform_no_values.k", cube_deck([character(len=line_length) :: &
+      "*DEFINE_CURVE", "7", "0,0", "*LOAD_SEGMENT_NONUNIFORM", "7", "5,6,7,8"]), &
+      [character(len=200) :: "@:29: *LOAD_SEGMENT_NONUNIFORM: field P1: the card of nodal "// &
+      "values (P1-P8) after the node card of the segment is missing: the keyword ends after "// &
+      "this line"], message_lines=1)
+    call read_bad("nonuniform_no_segment.k", cube_deck([character(len=line_length) :: &
+      "*DEFINE_CURVE", "7", "0,0", "*LOAD_SEGMENT_NONUNIFORM", "7"]), &
+      [character(len=200) :: "@:28: *LOAD_SEGMENT_NONUNIFORM: field N1: the keyword has no "// &
+      "segment: a card of nodes N1-N8 and a card of nodal values P1-P8 must follow card 1"], &
+      message_lines=1)
+  end subroutine test_segment_load_structure
 end program test_deck
