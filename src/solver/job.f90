@@ -1,4 +1,6 @@
-!> One crashfree job: read and check the deck, set up, run, write results, summarise.
+!> One crashfree job: read and check the deck, set up, run, write results, summarise. A deck with
+!> *CONTROL_IMPLICIT_GENERAL IMFLAG 1 runs the linear static analysis instead of the explicit
+!> set-up and time loop (same results file, one state at the end time).
 !>
 !> Exit status: 0 normal termination; 1 error termination during the run (results up to that
 !> point are written); 2 the deck or the command line was rejected (nothing is run).
@@ -11,6 +13,7 @@ module job
   use explicit_state, only: explicit_state_t
   use explicit_setup, only: set_up_explicit_state
   use explicit_solver, only: run_explicit
+  use static_analysis, only: run_static
   use results_file, only: results_file_t, open_results, close_results
   use run_summary, only: run_summary_t, status_normal, status_error
   use wall_clock, only: seconds_now
@@ -54,7 +57,7 @@ contains
       write (error_unit, '(a)') "crashfree: the deck was rejected; nothing was run"
       return
     end if
-    call set_up_explicit_state(model, state, error)
+    if (.not. model%implicit_static) call set_up_explicit_state(model, state, error)
     if (allocated(error)) then
       write (error_unit, '(a)') "crashfree: "//error%message
       return
@@ -69,10 +72,14 @@ contains
       write (error_unit, '(a)') "crashfree: "//error%message
       return
     end if
-    call describe_model(model, state, summary)
+    if (.not. model%implicit_static) call describe_model(model, state, summary)
     summary%setup_s = seconds_now() - started
 
-    call run_explicit(model, state, results, summary, error)
+    if (model%implicit_static) then
+      call run_static(model, results, summary, error)
+    else
+      call run_explicit(model, state, results, summary, error)
+    end if
 
     summary%wall_s = seconds_now() - started
     if (allocated(error)) then
