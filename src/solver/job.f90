@@ -96,7 +96,7 @@ contains
       write (error_unit, '(a)') "crashfree: "//close_error%message
       exit_status = 1
     end if
-    call print_summary(summary, options)
+    call print_summary(summary, options, model%implicit_static)
     if (allocated(error)) write (error_unit, '(a)') "crashfree: error termination: "//error%message
   end subroutine run_job
 
@@ -141,9 +141,12 @@ contains
     end if
   end subroutine describe_model
 
-  subroutine print_summary(summary, options)
+  !> The end-of-run summary; the cost per element and cycle only for explicit runs (a static
+  !> analysis reports its own phases).
+  subroutine print_summary(summary, options, static)
     type(run_summary_t), intent(in) :: summary
     type(run_options_t), intent(in) :: options
+    logical, intent(in) :: static
     character(len=200) :: line
     real(wp) :: per_element
     write (*, '(a)') ""
@@ -155,12 +158,12 @@ contains
       summary%fe_solid_s, "  meshfree", summary%efg_s, "  output", summary%output_s, "  other", &
       max(0.0_wp, summary%wall_s - summary%setup_s - summary%fe_solid_s - summary%efg_s - summary%output_s)
     write (*, '(a)') trim(line)
-    if (summary%cycles > 0 .and. summary%fe_elements > 0) then
+    if (.not. static .and. summary%cycles > 0 .and. summary%fe_elements > 0) then
       per_element = 1.0e9_wp*summary%fe_solid_s/(real(summary%cycles, wp)*real(summary%fe_elements, wp))
       write (line, '(a,f0.1,a)') "  solid elements: ", per_element, " ns per element per cycle"
       write (*, '(a)') trim(line)
     end if
-    if (summary%cycles > 0 .and. summary%efg_particles > 0) then
+    if (.not. static .and. summary%cycles > 0 .and. summary%efg_particles > 0) then
       per_element = 1.0e9_wp*summary%efg_s/(real(summary%cycles, wp)*real(summary%efg_particles, wp))
       write (line, '(a,f0.1,a)') "  meshfree: ", per_element, " ns per interior particle per cycle"
       write (*, '(a)') trim(line)
