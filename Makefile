@@ -3,6 +3,7 @@
 #   make run        install what is missing, build, run the default deck, plot
 #   make test       install what is missing, build, unit tests (debug build) and regression tests
 #   make bench      performance figures (ns per element per cycle)
+#   make verify     verification studies (patch test, cantilever): docs/verification.md (NCPU=n)
 #   make MODE=debug checked build in build/debug
 MODE ?= release
 FC := gfortran
@@ -35,7 +36,7 @@ ALL_SOURCES := $(LIBRARY_SOURCES) src/app/crashfree.f90 $(TEST_SUPPORT) $(TEST_S
 
 vpath %.f90 $(sort $(dir $(ALL_SOURCES)))
 
-.PHONY: all deps run test unit regression bench clean debug
+.PHONY: all deps run test unit regression bench clean debug verify
 # The release build is also published as bin/crashfree and lib/ (library and .mod files).
 ifeq ($(MODE),release)
 all: bin/crashfree
@@ -94,6 +95,20 @@ test: deps
 bench: deps
 	@$(MAKE) --no-print-directory all
 	@bash tools/bench.sh
+
+# Verification studies: write the decks, run every case (NCPU threads each, default 1), then
+# write docs/verification.md and its plots (also when a case failed; the exit status says so).
+VERIFY_DIR := results/verification
+verify: deps
+	@$(MAKE) --no-print-directory all
+	@$(PYTHON) verification/patch_test.py --out $(VERIFY_DIR)/patch
+	@$(PYTHON) verification/cantilever.py --out $(VERIFY_DIR)/cantilever --traction both --interpolated-levels 2 4 8 \
+	    --width-series 4
+	@status=0; $(PYTHON) verification/run_cases.py $(VERIFY_DIR)/patch/manifest.json \
+	    $(VERIFY_DIR)/cantilever/manifest.json --ncpu $(or $(NCPU),1) || status=$$?; \
+	  $(PYTHON) postproc/verification_report.py $(VERIFY_DIR) --doc docs/verification.md \
+	    --figures docs/verification || status=$$?; \
+	  exit $$status
 
 clean:
 	rm -rf build lib bin
