@@ -3,11 +3,11 @@
 # regression tests on the release binary. The last line adds both up: "N passed, N failed".
 set -u
 jobs=$(nproc 2>/dev/null || echo 2)
-make --no-print-directory -j"$jobs" all || { echo "0 passed, 1 failed"; exit 1; }
+make --no-print-directory -s -j"$jobs" all || { echo "0 passed, 1 failed"; exit 1; }
 
 echo "== unit tests (MODE=debug: -std=f2008 -fcheck=all -ffpe-trap=invalid,zero,overflow) =="
 unit_log=$(mktemp)
-make --no-print-directory -j"$jobs" MODE=debug unit 2>&1 | tee "$unit_log"
+make --no-print-directory -s -j"$jobs" MODE=debug unit 2>&1 | tee "$unit_log"
 unit_line=$(grep -E '^unit: [0-9]+ passed, [0-9]+ failed' "$unit_log" | tail -n 1)
 unit_passed=0
 unit_failed=1
