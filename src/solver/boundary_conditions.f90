@@ -1,9 +1,10 @@
 !> Nodal loads, single-point constraints and prescribed motions.
 !>
 !> Kinematic conditions act on the half-step velocities: a constrained or prescribed dof gets
-!> the velocity its condition demands for the coming step. The velocity change is an impulse J
-!> from the support at t^n; its work in the central-difference sense, J (v^{n-1/2} + v^{n+1/2})/2,
-!> is booked as external work so that the energy balance closes.
+!> the velocity its condition demands for the coming step. The support exerts the impulse J
+!> that turns the velocity the forces would have given, v^{n-1/2} + a_free dt, into that one; its
+!> work in the central-difference sense, J (v^{n-1/2} + v^{n+1/2})/2, is booked as external work
+!> so that the energy balance closes.
 module boundary_conditions
   use kinds, only: wp
   use curves, only: curve_value
@@ -29,14 +30,18 @@ contains
 
   !> Prescribed dofs follow their motion, not the forces: their acceleration is the prescribed
   !> one (VAD = 1) or zero (velocity and displacement are imposed on the half-step velocities),
-  !> so that integer-step velocities, kinetic energy and output show the prescribed motion.
-  subroutine hold_prescribed_accelerations(model, time, acceleration)
+  !> so that integer-step velocities, kinetic energy and output show the prescribed motion. The
+  !> acceleration the forces would have given each prescribed dof is kept in
+  !> `free_acceleration`: the support's reaction does the work between the two.
+  subroutine hold_prescribed_accelerations(model, time, acceleration, free_acceleration)
     type(model_t), intent(in) :: model
     real(wp), intent(in) :: time
     real(wp), intent(inout) :: acceleration(:, :)
+    real(wp), intent(out) :: free_acceleration(:)
     integer :: k
     do k = 1, size(model%motions)
       associate (motion => model%motions(k))
+        free_acceleration(k) = acceleration(motion%direction, motion%node)
         if (time < motion%birth .or. time > motion%death) cycle
         if (motion%kind == motion_acceleration) then
           acceleration(motion%direction, motion%node) = &
@@ -83,17 +88,18 @@ contains
   !> `time` to `time + dt` (`average_dt` is the step of the velocity update). Returns the
   !> kinetic energy the supports added (external work).
   subroutine impose_kinematic_conditions(model, fixed, time, dt, average_dt, displacement, acceleration, &
-                                         mass, velocity, support_work)
+                                         free_acceleration, mass, velocity, support_work)
     type(model_t), intent(in) :: model
     logical, intent(in) :: fixed(:, :)
     real(wp), intent(in) :: time, dt, average_dt
     real(wp), intent(in) :: displacement(:, :)
     real(wp), intent(in) :: acceleration(:, :)
+    real(wp), intent(in) :: free_acceleration(:)
     real(wp), intent(in) :: mass(:)
     real(wp), intent(inout) :: velocity(:, :)
     real(wp), intent(out) :: support_work
     integer :: k, node, direction
-    real(wp) :: target, local_time, value
+    real(wp) :: target, local_time, value, previous, free
 
     support_work = 0.0_wp
     do k = 1, size(model%spcs)
@@ -126,8 +132,10 @@ contains
           cycle
         end select
         ! impulse m (target - v) times the mean of v^{n-1/2} = v - a dt and v^{n+1/2} = target
-        support_work = support_work + 0.5_wp*mass(node)*(target - velocity(direction, node))* &
-                       (target + velocity(direction, node) - average_dt*acceleration(direction, node))
+        ! v^{n-1/2}, and the velocity the forces alone would have given
+        previous = velocity(direction, node) - average_dt*acceleration(direction, node)
+        free = previous + average_dt*free_acceleration(k)
+        support_work = support_work + 0.5_wp*mass(node)*(target - free)*(target + previous)
         velocity(direction, node) = target
       end associate
     end do

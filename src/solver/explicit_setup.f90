@@ -16,7 +16,7 @@ module explicit_setup
   implicit none
   private
 
-  public :: set_up_explicit_state
+  public :: set_up_explicit_state, set_up_warnings
 
 contains
 
@@ -34,12 +34,12 @@ contains
     state%velocity = model%initial_velocity
     allocate (state%displacement(3, node_count), state%acceleration(3, node_count), &
               state%internal_force(3, node_count), state%external_force(3, node_count), &
-              state%reaction_force(3, node_count), state%mass(node_count), state%fixed(3, node_count))
+              state%free_acceleration(size(model%motions)), state%mass(node_count), state%fixed(3, node_count))
     state%displacement = 0.0_wp
     state%acceleration = 0.0_wp
     state%internal_force = 0.0_wp
     state%external_force = 0.0_wp
-    state%reaction_force = 0.0_wp
+    state%free_acceleration = 0.0_wp
     call fixed_dof_mask(model, state%fixed)
     where (state%fixed) state%velocity = 0.0_wp
 
@@ -216,6 +216,43 @@ contains
       end associate
     end do
   end subroutine set_up_meshfree_parts
+
+  !> Things the user should know before the run starts, one per line (empty: nothing):
+  !> conditions and loads on interior particles of meshfree parts act on generalized
+  !> displacements, and mass scaling leaves meshfree parts alone.
+  function set_up_warnings(model, state) result(text)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(in) :: state
+    character(len=:), allocatable :: text
+    integer :: count, first, k
+    text = ""
+    if (size(state%efg) == 0) return
+    count = 0
+    first = 0
+    do k = 1, size(model%spcs)
+      call note_particle(model%spcs(k)%node)
+    end do
+    do k = 1, size(model%motions)
+      call note_particle(model%motions(k)%node)
+    end do
+    do k = 1, size(model%loads)
+      call note_particle(model%loads(k)%node)
+    end do
+    if (count > 0) text = "warning: "//trim(id_text(count))//" constraint(s) or load(s) act on interior "// &
+      "particles of meshfree parts (node "//trim(id_text(model%node_ids(first)))//" first): they act on "// &
+      "generalized displacements, not on the nodes' own motion; put them on the parts' surfaces"
+    if (model%mass_scaled_time_step /= 0.0_wp) then
+      if (len(text) > 0) text = text//new_line('a')
+      text = text//"warning: mass scaling (DT2MS) applies to finite elements only; meshfree parts keep their density"
+    end if
+  contains
+    subroutine note_particle(node)
+      integer, intent(in) :: node
+      if (.not. state%is_particle(node)) return
+      count = count + 1
+      if (first == 0) first = node
+    end subroutine note_particle
+  end function set_up_warnings
 
   pure function id_text(id) result(text)
     integer, intent(in) :: id

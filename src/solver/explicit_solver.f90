@@ -35,7 +35,7 @@ contains
     type(history_set_t) :: histories
     type(output_plan_t) :: plan
     type(progress_t) :: progress
-    type(phase_timer_t) :: element_timer, meshfree_timer, output_timer
+    type(phase_timer_t) :: element_timer, meshfree_timer, output_timer, contact_timer
     type(error_t), allocatable :: output_error
     real(wp) :: previous_step, step, work
     logical :: finished, wrote_state
@@ -51,7 +51,7 @@ contains
     call stop_phase(meshfree_timer)
     call assemble_nodal_loads(model, 0.0_wp, state%external_force)
     call compute_accelerations(state)
-    call hold_prescribed_accelerations(model, 0.0_wp, state%acceleration)
+    call hold_prescribed_accelerations(model, 0.0_wp, state%acceleration, state%free_acceleration)
     call select_time_step(model, state, is_first=.true.)
     call update_energy_totals(state)
     state%energy%initial_total = total_energy(state)
@@ -60,6 +60,10 @@ contains
     call start_phase(output_timer)
     call write_due_output(model, state, plan, histories, results, finished, wrote_state, output_error)
     call stop_phase(output_timer)
+    if (allocated(output_error)) then
+      finished = .true.
+      if (.not. allocated(error)) call move_alloc(output_error, error)
+    end if
     call start_progress(progress, model%end_time, model%end_cycle)
     previous_step = 0.0_wp
 
@@ -68,12 +72,15 @@ contains
       ! velocities at the half step, then the supports and walls correct them
       call update_velocities(state, 0.5_wp*(previous_step + step))
       call impose_kinematic_conditions(model, state%fixed, state%time, step, 0.5_wp*(previous_step + step), &
-                                       state%displacement, state%acceleration, state%mass, state%velocity, work)
+                                       state%displacement, state%acceleration, state%free_acceleration, &
+                                       state%mass, state%velocity, work)
       state%energy%external_work = state%energy%external_work + work
       if (size(model%walls) > 0) then
+        call start_phase(contact_timer)
         call enforce_planar_walls(model%walls, state%walls, state%time, step, 0.5_wp*(previous_step + step), &
                                   state%coordinates, state%acceleration, state%mass, state%is_particle, &
                                   state%velocity, work)
+        call stop_phase(contact_timer)
         state%energy%rigid_wall = state%energy%rigid_wall + work
       end if
       call update_positions(state, step)
@@ -94,7 +101,7 @@ contains
       state%energy%external_work = state%energy%external_work + &
                                    0.5_wp*load_work(model, state%external_force, state%velocity, step)
       call compute_accelerations(state)
-      call hold_prescribed_accelerations(model, state%time, state%acceleration)
+      call hold_prescribed_accelerations(model, state%time, state%acceleration, state%free_acceleration)
       call select_time_step(model, state, is_first=.false.)
       call check_state(model, state, error)
 
@@ -112,6 +119,7 @@ contains
     summary%cycles = state%cycle
     summary%fe_solid_s = element_timer%seconds
     summary%efg_s = meshfree_timer%seconds
+    summary%contact_s = contact_timer%seconds
     summary%output_s = output_timer%seconds
   end subroutine run_explicit
 
@@ -185,6 +193,9 @@ contains
     state%controlling_element = critical
     if (is_first .and. model%initial_time_step > 0.0_wp) &
       state%next_time_step = min(state%next_time_step, model%initial_time_step)
+    ! a step that no element set, or a NaN that the comparisons above skipped, is not a step
+    if (smallest >= huge(1.0_wp) .or. any(state%block_time_step /= state%block_time_step)) &
+      state%next_time_step = -huge(1.0_wp)
   end subroutine select_time_step
 
   !> Run-time failures, found after the parallel loops: an inverted element or a state that
@@ -218,11 +229,12 @@ contains
     if (.not. (state%next_time_step > 0.0_wp .and. state%next_time_step < huge(1.0_wp))) then
       element = state%controlling_element
       if (element > 0) then
-        write (text, '(a,es12.5,a,i0,a,i0,a,es12.5,a,i0)') "time step ", state%next_time_step, &
-          " is not usable (element ", model%solid_ids(element), ", part ", &
-          model%parts(model%solid_part(element))%id, ") at time ", state%time, ", cycle ", state%cycle
+        write (text, '(a,i0,a,i0,a,es12.5,a,i0)') "no finite stable time step (the smallest is set by element ", &
+          model%solid_ids(element), ", part ", model%parts(model%solid_part(element))%id, ") at time ", &
+          state%time, ", cycle ", state%cycle
       else
-        write (text, '(a,es12.5,a)') "time step ", state%next_time_step, " is not usable (no element sets it)"
+        write (text, '(a,es12.5,a,i0,a)') "no finite stable time step at time ", state%time, ", cycle ", &
+          state%cycle, ": the state is no longer finite"
       end if
       call make_error(error, trim(text))
     end if

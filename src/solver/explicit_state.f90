@@ -54,7 +54,8 @@ module explicit_state
     real(wp), allocatable :: acceleration(:, :)
     real(wp), allocatable :: internal_force(:, :)
     real(wp), allocatable :: external_force(:, :)
-    real(wp), allocatable :: reaction_force(:, :)        !< at constrained dofs, for external work
+    real(wp), allocatable :: free_acceleration(:)        !< per prescribed motion: the acceleration the
+                                                         !< forces would give its dof (for the support's work)
     real(wp), allocatable :: mass(:)
     logical, allocatable :: fixed(:, :)                  !< SPC per dof
     ! element blocks and their corner forces

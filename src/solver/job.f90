@@ -11,7 +11,7 @@ module job
   use model, only: model_t
   use deck_reader, only: read_deck
   use explicit_state, only: explicit_state_t
-  use explicit_setup, only: set_up_explicit_state
+  use explicit_setup, only: set_up_explicit_state, set_up_warnings
   use explicit_solver, only: run_explicit
   use static_analysis, only: run_static
   use results_file, only: results_file_t, open_results, close_results
@@ -38,6 +38,7 @@ contains
     type(run_summary_t) :: summary
     type(error_list_t) :: warnings
     type(error_t), allocatable :: error, close_error
+    character(len=:), allocatable :: warning_text
     real(wp) :: started
 
     started = seconds_now()
@@ -72,7 +73,11 @@ contains
       write (error_unit, '(a)') "crashfree: "//error%message
       return
     end if
-    if (.not. model%implicit_static) call describe_model(model, state, summary)
+    if (.not. model%implicit_static) then
+      call describe_model(model, state, summary)
+      warning_text = set_up_warnings(model, state)
+      if (len(warning_text) > 0) write (error_unit, '(a)') warning_text
+    end if
     summary%setup_s = seconds_now() - started
 
     if (model%implicit_static) then

@@ -3,7 +3,7 @@
 !> Every output has an interval; it is written at t = 0, whenever the time passes the next
 !> multiple of its interval, and at the last cycle. Without a *DATABASE card, glstat and matsum
 !> (and rwforc for walls) are still recorded at ENDTIM/200 and states at ENDTIM/20, so every run
-!> can be plotted; nodout needs history nodes.
+!> can be plotted; nodout needs history nodes and *DATABASE_NODOUT.
 module run_output
   use kinds, only: wp
   use error_handling, only: error_t
@@ -39,6 +39,7 @@ module run_output
     real(wp), allocatable :: node_velocity(:, :)     !< physical integer-step velocities of a state
     real(wp), allocatable :: node_displacement(:, :) !< physical displacements of a state
     real(wp), allocatable :: generalized_velocity(:, :) !< integer-step solver velocities (work array)
+    real(wp), allocatable :: node_acceleration(:, :) !< physical accelerations (nodout)
     real(wp), allocatable :: part_kinetic(:), part_internal(:), part_hourglass(:)
   end type output_plan_t
 
@@ -63,8 +64,9 @@ contains
     call set_clock(plan%glstat, model%output%glstat_interval, default_history, .true.)
     call set_clock(plan%matsum, model%output%matsum_interval, plan%glstat%interval, .true.)
     call set_clock(plan%rwforc, model%output%rwforc_interval, plan%glstat%interval, size(model%walls) > 0)
+    ! nodout as LS-DYNA: history nodes and a *DATABASE_NODOUT interval (the reader warns otherwise)
     call set_clock(plan%nodout, model%output%nodout_interval, plan%glstat%interval, &
-                   size(model%output%history_nodes) > 0)
+                   size(model%output%history_nodes) > 0 .and. model%output%nodout_interval > 0.0_wp)
 
     capacity = expected_rows(model, plan%glstat)
     call add_history_series(histories, "glstat", glstat_columns, glstat_widths, &
@@ -101,7 +103,7 @@ contains
     end if
     allocate (plan%solid_stress(6, size(model%solid_ids)), plan%solid_plastic_strain(size(model%solid_ids)))
     allocate (plan%node_velocity(3, size(model%node_ids)), plan%node_displacement(3, size(model%node_ids)), &
-              plan%generalized_velocity(3, size(model%node_ids)))
+              plan%generalized_velocity(3, size(model%node_ids)), plan%node_acceleration(3, size(model%node_ids)))
     allocate (plan%part_kinetic(size(model%parts)), plan%part_internal(size(model%parts)), &
               plan%part_hourglass(size(model%parts)))
   end subroutine plan_output
@@ -133,9 +135,10 @@ contains
     if (time >= clock%next_time*(1.0_wp - 1.0e-12_wp) .or. last) then
       clock_due = .true.
       if (clock%interval > 0.0_wp) then
-        do while (clock%next_time <= time*(1.0_wp + 1.0e-12_wp))
-          clock%next_time = clock%next_time + clock%interval
-        end do
+        ! the first multiple of the interval after this time (no loop: the interval may be far
+        ! shorter than the time step)
+        clock%next_time = max(clock%next_time, (aint(time*(1.0_wp + 1.0e-12_wp)/clock%interval) + 1.0_wp)* &
+                                               clock%interval)
       else
         clock%next_time = huge(1.0_wp)
       end if
@@ -161,7 +164,8 @@ contains
     matsum_due = clock_due(plan%matsum, state%time, last)
     if (glstat_due .or. matsum_due) call update_energy_totals(state)
     if (glstat_due) then
-      call append_history_row(histories%series(plan%glstat_series), [state%time, state%next_time_step, &
+      call append_history_row(histories%series(plan%glstat_series), [state%time, &
+        merge(state%next_time_step, state%time_step, state%cycle == 0), &
         state%energy%kinetic, state%energy%internal, state%energy%hourglass, state%energy%contact, &
         state%energy%external_work, total_energy(state), state%energy%rigid_wall, energy_ratio(state), &
         state%added_mass, state%energy%momentum])
@@ -180,7 +184,7 @@ contains
       do k = 1, size(plan%nodout_series)
         associate (node => model%output%history_nodes(k))
           call append_history_row(histories%series(plan%nodout_series(k)), [state%time, &
-            plan%node_displacement(:, node), plan%node_velocity(:, node), state%acceleration(:, node)])
+            plan%node_displacement(:, node), plan%node_velocity(:, node), plan%node_acceleration(:, node)])
         end associate
       end do
     end if
@@ -211,7 +215,7 @@ contains
     plan%last_rwforc_time = state%time
   end subroutine record_wall_forces
 
-  !> Physical nodal displacements and integer-step velocities: the solver's values, with the
+  !> Physical nodal displacements, integer-step velocities and accelerations: the solver's values, with the
   !> interior particles of meshfree parts transformed (eq. 16) so that the output shows the
   !> real deformed shape.
   subroutine physical_node_fields(state, plan)
@@ -221,9 +225,11 @@ contains
     plan%generalized_velocity = state%velocity + 0.5_wp*state%time_step*state%acceleration
     plan%node_displacement = state%displacement
     plan%node_velocity = plan%generalized_velocity
+    plan%node_acceleration = state%acceleration
     do k = 1, size(state%efg)
       call transform_to_physical(state%efg(k), state%displacement, plan%node_displacement)
       call transform_to_physical(state%efg(k), plan%generalized_velocity, plan%node_velocity)
+      call transform_to_physical(state%efg(k), state%acceleration, plan%node_acceleration)
     end do
   end subroutine physical_node_fields
 

@@ -76,7 +76,10 @@ def test_stress_follows_bilinear_law(tmp_path, run_deck, element_formulation):
     # lateral stresses vanish (uniaxial stress)
     with run.open() as results:
         last = results["states"][sorted(results["states"])[-1]]["solid_stress"][0]
+        ratio = results["history/glstat/energy_ratio"][-1]
     assert abs(last[1]) < 1e-3 * SIGY and abs(last[2]) < 1e-3 * SIGY
+    # the work of the prescribed motion's reaction balances the internal energy
+    assert abs(ratio - 1.0) < 0.01, f"energy ratio {ratio:.4f}"
 
 
 def test_cowper_symonds_scales_the_yield_stress(tmp_path, run_deck):
