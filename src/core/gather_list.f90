@@ -1,16 +1,17 @@
-!> Compressed (CSR) lists from nodes to the element corners that touch them.
+!> Compressed (CSR) lists from items (nodes, colours) to the slots that belong to them.
 !>
-!> Element kernels write one force per element corner; a node loop then sums the corners of
-!> each node in a fixed order. No two threads write the same node and the summation order does
-!> not depend on the thread count, so results are bit-identical for any `ncpu`
-!> (LULESH nodeElemCornerList, OpenRadioss Parith/ON).
+!> Used wherever something is summed per node in a fixed order (a meshfree node gathering its
+!> pairs, LULESH nodeElemCornerList, OpenRadioss Parith/ON) and for the colour -> blocks list of
+!> the element step: the order of a list does not depend on the thread count, so results are
+!> bit-identical for any `ncpu`.
 module gather_list
   implicit none
   private
 
   public :: gather_list_t, build_gather_list
 
-  !> `corners(offsets(n):offsets(n+1)-1)` are the corner slots that belong to node n.
+  !> `corners(offsets(n):offsets(n+1)-1)` are the slots that belong to item n (for a node, the
+  !> element corners or meshfree pairs that touch it).
   type :: gather_list_t
     integer, allocatable :: offsets(:)
     integer, allocatable :: corners(:)
@@ -18,8 +19,8 @@ module gather_list
 
 contains
 
-  !> Build the node -> slot list for `slot_node(k)`, the node of slot k (0 = unused slot).
-  !> Slots of one node appear in increasing slot order.
+  !> Build the item -> slot list for `slot_node(k)`, the item of slot k (0 = unused slot).
+  !> Slots of one item appear in increasing slot order.
   subroutine build_gather_list(node_count, slot_node, list)
     integer, intent(in) :: node_count
     integer, intent(in) :: slot_node(:)
