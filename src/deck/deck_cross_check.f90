@@ -16,6 +16,7 @@ module deck_cross_check
   use deck_id_index, only: id_index_t, build_id_index, find_id, lower_bound
   use deck_element_check, only: check_hexahedron, shape_inside_out, shape_flat
   use deck_efg_cards, only: elform_efg
+  use deck_material_curves, only: resolve_material_curves, apply_material_bulk_viscosity
   implicit none
   private
 
@@ -45,6 +46,7 @@ contains
     call index_definitions(deck, input, indices, log)
     call resolve_solids(deck, input, indices, mesh_resolved, log)
     call resolve_parts(deck, input, indices, log)
+    call resolve_material_curves(deck, input%model, input%material_lines, input%part_lines, log)
     call resolve_node_sets(deck, input, indices, log)
     call resolve_part_sets(deck, input, indices, log)
     call resolve_segment_sets(deck, input, indices, log)
@@ -59,6 +61,7 @@ contains
     call check_controls(deck, input, log)
     call check_implicit_solution(deck, input, log, warnings)
     call set_effective_hourglass(input)
+    call apply_material_bulk_viscosity(input%model)
     if (has_problems(log)) return
     model = input%model
   end subroutine check_and_build

@@ -7,6 +7,7 @@ module deck_input
   use deck_keywords, only: keyword_count, keyword_node, keyword_element_solid, keyword_part, &
     keyword_section_solid, keyword_section_solid_efg, keyword_mat_elastic, &
     keyword_mat_plastic_kinematic, keyword_hourglass, keyword_define_curve, &
+    keyword_mat_honeycomb, keyword_mat_modified_honeycomb, keyword_mat_low_density_foam, &
     keyword_set_node_list, keyword_set_node_list_generate, keyword_set_part_list, &
     keyword_spc_node, keyword_spc_set, keyword_motion_node, keyword_motion_set, &
     keyword_load_node_point, keyword_load_node_set, keyword_initial_velocity, &
@@ -168,7 +169,8 @@ contains
     allocate (input%model%parts(n), input%part_lines(n))
     n = lines(keyword_section_solid) + lines(keyword_section_solid_efg)
     allocate (input%model%sections(n), input%section_lines(n))
-    n = lines(keyword_mat_elastic) + lines(keyword_mat_plastic_kinematic)
+    n = lines(keyword_mat_elastic) + lines(keyword_mat_plastic_kinematic) + lines(keyword_mat_honeycomb) &
+        + lines(keyword_mat_modified_honeycomb) + lines(keyword_mat_low_density_foam)
     allocate (input%model%materials(n), input%material_lines(n))
     n = lines(keyword_hourglass)
     allocate (input%model%hourglasses(n), input%hourglass_lines(n))

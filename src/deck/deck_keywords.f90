@@ -21,9 +21,10 @@ module deck_keywords
     keyword_rwforc = 33, keyword_history_node = 34, keyword_history_node_set = 35, &
     keyword_control_implicit_general = 36, keyword_control_implicit_solution = 37, &
     keyword_load_segment = 38, keyword_load_segment_set = 39, &
-    keyword_load_segment_nonuniform = 40, keyword_set_segment = 41
+    keyword_load_segment_nonuniform = 40, keyword_set_segment = 41, keyword_mat_honeycomb = 42, &
+    keyword_mat_modified_honeycomb = 43, keyword_mat_low_density_foam = 44
   !> Number of keyword codes.
-  integer, parameter, public :: keyword_count = 41
+  integer, parameter, public :: keyword_count = 44
 
   !> A keyword name taken apart: its code and the options given with it.
   type :: keyword_t
@@ -35,7 +36,7 @@ module deck_keywords
     logical :: forces = .false.    !< *RIGIDWALL_PLANAR_FORCES
   end type keyword_t
 
-  integer, parameter :: entry_count = 48
+  integer, parameter :: entry_count = 54
   character(len=*), parameter :: base_names(entry_count) = [character(len=36) :: &
     "TITLE", "NODE", "ELEMENT_SOLID", "PART", "SECTION_SOLID", "SECTION_SOLID_EFG", &
     "MAT_ELASTIC", "MAT_001", "MAT_PLASTIC_KINEMATIC", "MAT_003", "HOURGLASS", &
@@ -48,6 +49,7 @@ module deck_keywords
     "DATABASE_RWFORC", "DATABASE_HISTORY_NODE", "DATABASE_HISTORY_NODE_SET", &
     "CONTROL_IMPLICIT_GENERAL", "CONTROL_IMPLICIT_SOLUTION", "LOAD_SEGMENT", &
     "LOAD_SEGMENT_SET", "LOAD_SEGMENT_NONUNIFORM", "SET_SEGMENT", &
+    "MAT_HONEYCOMB", "MAT_026", "MAT_MODIFIED_HONEYCOMB", "MAT_126", "MAT_LOW_DENSITY_FOAM", "MAT_057", &
     "KEYWORD", "INCLUDE", "PARAMETER", "COMMENT", "END"]
   integer, parameter :: base_codes(entry_count) = [keyword_title, keyword_node, &
     keyword_element_solid, keyword_part, keyword_section_solid, keyword_section_solid_efg, &
@@ -62,6 +64,8 @@ module deck_keywords
     keyword_rwforc, keyword_history_node, keyword_history_node_set, &
     keyword_control_implicit_general, keyword_control_implicit_solution, keyword_load_segment, &
     keyword_load_segment_set, keyword_load_segment_nonuniform, keyword_set_segment, &
+    keyword_mat_honeycomb, keyword_mat_honeycomb, keyword_mat_modified_honeycomb, &
+    keyword_mat_modified_honeycomb, keyword_mat_low_density_foam, keyword_mat_low_density_foam, &
     keyword_unknown, keyword_unknown, keyword_unknown, keyword_unknown, keyword_unknown]
   !> Options each entry accepts (blank-separated).
   character(len=*), parameter :: base_options(entry_count) = [character(len=28) :: &
@@ -76,6 +80,7 @@ module deck_keywords
     "", "ID", "", &
     "", "", "ID", &
     "ID", "ID", "TITLE", &
+    "TITLE", "TITLE", "TITLE", "TITLE", "TITLE", "TITLE", &
     "", "", "", "", ""]
 
 contains

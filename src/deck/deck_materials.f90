@@ -1,20 +1,25 @@
-!> *MAT_ELASTIC (*MAT_001) and *MAT_PLASTIC_KINEMATIC (*MAT_003), with the checks that catch
-!> physically impossible values before they become a NaN in the first cycle.
+!> *MAT_ELASTIC (*MAT_001), *MAT_PLASTIC_KINEMATIC (*MAT_003), *MAT_HONEYCOMB (*MAT_026),
+!> *MAT_MODIFIED_HONEYCOMB (*MAT_126) and *MAT_LOW_DENSITY_FOAM (*MAT_057), with the checks
+!> that catch physically impossible values before they become a NaN in the first cycle, and
+!> errors naming each field whose LS-DYNA feature crashfree does not build (docs/materials.md).
+!> Curve ids are resolved by deck_material_curves after all keywords are read.
 module deck_materials
   use kinds, only: wp
   use error_handling, only: error_list_t
-  use model, only: material_t, law_elastic, law_plastic_kinematic
+  use model, only: material_t, law_elastic, law_plastic_kinematic, law_honeycomb, law_modified_honeycomb, &
+                   law_low_density_foam
   use deck_problems, only: problem_log_t
   use deck_numbers, only: integer_text, real_text
   use deck_lexer, only: deck_t
   use deck_keywords, only: keyword_t
   use deck_fields, only: card_t, require_card, next_definition, get_integer, get_real, &
-                         card_problem, field_is_blank, warn_if_set
+                         card_problem, field_is_blank, warn_if_set, next_line, open_card
   use deck_input, only: deck_input_t
   implicit none
   private
 
-  public :: read_elastic_materials, read_plastic_kinematic_materials
+  public :: read_elastic_materials, read_plastic_kinematic_materials, read_honeycomb_materials
+  public :: read_low_density_foam_materials
 
   integer, parameter :: standard_widths(8) = 10
 
@@ -82,6 +87,252 @@ contains
       call warn_if_set(deck, card, 3, "FS", "elements do not erode", warnings)
     end do
   end subroutine read_plastic_kinematic_materials
+
+  !> *MAT_HONEYCOMB (026, `modified` false) and *MAT_MODIFIED_HONEYCOMB (126): cards 1-5
+  !> (126: 1-8, cards 6-8 optional; a 126 keyword therefore holds one material).
+  !> C1 MID RO E PR SIGY VF MU BULK; C2 LCA LCB LCC LCS LCAB LCBC LCCA LCSR;
+  !> C3 EAAU EBBU ECCU GABU GBCU GCAU AOPT MACF; C4 XP YP ZP A1 A2 A3 (126: RFAC PRU);
+  !> C5 D1 D2 D3 TSEF SSEF (026: V1 V2 V3; 126: VREF TREF SHDFLG); 126: C6 V1 V2 V3,
+  !> C7 LCSRA ... LCSRCA, C8 PRUAB ... PRUCB.
+  subroutine read_honeycomb_materials(deck, block, keyword, modified, input, log)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    logical, intent(in) :: modified
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(card_t) :: card
+    integer :: line, n, k, ids(8), macf
+    real(wp) :: value, aopt
+    character(len=:), allocatable :: title
+    character(len=4), parameter :: curve_names(8) = ["LCA ", "LCB ", "LCC ", "LCS ", "LCAB", "LCBC", "LCCA", "LCSR"]
+    character(len=4), parameter :: modulus_names(6) = ["EAAU", "EBBU", "ECCU", "GABU", "GBCU", "GCAU"]
+    character(len=6), parameter :: rate_names(6) = ["LCSRA ", "LCSRB ", "LCSRC ", "LCSRAB", "LCSRBC", "LCSRCA"]
+    character(len=5), parameter :: poisson_names(6) = ["PRUAB", "PRUAC", "PRUBC", "PRUBA", "PRUCA", "PRUCB"]
+
+    line = 0
+    do while (next_definition(deck, block, keyword%title, line, standard_widths, card, title, &
+                              log, "card 1 (MID RO E PR SIGY VF MU BULK)", "MID"))
+      n = input%material_count + 1
+      input%material_count = n
+      input%material_lines(n) = line
+      associate (material => input%model%materials(n))
+        material%law = merge(law_modified_honeycomb, law_honeycomb, modified)
+        material%title = title
+        call read_elastic_constants(deck, card, material, log)
+        call get_real(deck, card, 5, "SIGY", material%yield_stress, log)
+        call get_real(deck, card, 6, "VF", material%compaction_volume, log)
+        call get_real(deck, card, 7, "MU", material%viscosity, log, default=0.05_wp)
+        call get_real(deck, card, 8, "BULK", value, log)
+        if (.not. card%failed) then
+          if (material%yield_stress < 0.0_wp) call card_problem(deck, log, card, "SIGY", "yield stress of the "// &
+            "compacted material must be >= 0, found "//real_text(material%yield_stress))
+          if (material%compaction_volume <= 0.0_wp .or. material%compaction_volume > 1.0_wp) &
+            call card_problem(deck, log, card, "VF", "relative volume at full compaction must lie in (0, 1], "// &
+                              "found "//shown(deck, card, 6, material%compaction_volume))
+          if (material%viscosity < 0.0_wp) call card_problem(deck, log, card, "MU", "viscosity coefficient "// &
+            "must be >= 0, found "//real_text(material%viscosity))
+          if (value /= 0.0_wp .and. value /= 1.0_wp) call card_problem(deck, log, card, "BULK", "must be 0 "// &
+            "or 1, found "//real_text(value))
+          material%bulk_viscosity = value == 1.0_wp
+        end if
+
+        if (.not. require_card(deck, block, line, standard_widths, card, log, &
+                               "card 2 (LCA LCB LCC LCS LCAB LCBC LCCA LCSR)", "LCA")) exit
+        do k = 1, 8
+          call get_integer(deck, card, k, trim(curve_names(k)), ids(k), log)
+        end do
+        if (.not. card%failed) then
+          if (ids(1) < 0 .and. modified) then
+            call card_problem(deck, log, card, "LCA", "LCA < 0 (the alternative formulation with yield "// &
+                              "against the angle off the material axis) is not available; give LCA > 0")
+          else if (ids(1) <= 0) then
+            call card_problem(deck, log, card, "LCA", "a yield curve id > 0 is required, found "// &
+                              integer_text(ids(1)))
+          end if
+          do k = 2, 7
+            if (ids(k) < 0) call card_problem(deck, log, card, trim(curve_names(k)), "curve id must be >= 0 "// &
+              "(0: the default curve), found "//integer_text(ids(k)))
+          end do
+          if (ids(8) == -1 .and. modified) then
+            call card_problem(deck, log, card, "LCSR", "LCSR = -1 (per-direction rate curves on card 7) is "// &
+                              "not available; give one scale-factor curve or 0")
+          else if (ids(8) < 0) then
+            call card_problem(deck, log, card, "LCSR", "curve id must be >= 0, found "//integer_text(ids(8)))
+          end if
+        end if
+        ! LS-DYNA's defaults: LCB, LCC, LCS -> LCA; LCAB, LCBC, LCCA -> LCS.
+        if (ids(2) == 0) ids(2) = ids(1)
+        if (ids(3) == 0) ids(3) = ids(1)
+        if (ids(4) == 0) ids(4) = ids(1)
+        do k = 5, 7
+          if (ids(k) == 0) ids(k) = ids(4)
+        end do
+        material%curve_ids = [ids(1:3), ids(5:7), max(ids(8), 0)]
+
+        if (.not. require_card(deck, block, line, standard_widths, card, log, &
+                               "card 3 (EAAU EBBU ECCU GABU GBCU GCAU AOPT MACF)", "EAAU")) exit
+        do k = 1, 6
+          call get_real(deck, card, k, trim(modulus_names(k)), material%uncompacted_moduli(k), log)
+        end do
+        call get_real(deck, card, 7, "AOPT", aopt, log)
+        call get_integer(deck, card, 8, "MACF", macf, log, default=1)
+        if (.not. card%failed) then
+          do k = 1, 6
+            if (material%uncompacted_moduli(k) <= 0.0_wp) call card_problem(deck, log, card, &
+              trim(modulus_names(k)), "uncompacted modulus must be > 0, found "// &
+              shown(deck, card, k, material%uncompacted_moduli(k)))
+          end do
+          if (aopt /= 0.0_wp .and. aopt /= 2.0_wp) call card_problem(deck, log, card, "AOPT", "material "// &
+            "axes option "//real_text(aopt)//" is not available: use 0 (element nodes 1-2-4) or 2 "// &
+            "(global vectors a and d)")
+          material%axes_option = nint(aopt)
+          if (macf /= 1 .and. macf /= 0) call card_problem(deck, log, card, "MACF", "axis swaps are not "// &
+            "available: MACF must be 1 (none), found "//integer_text(macf))
+        end if
+
+        if (.not. require_card(deck, block, line, standard_widths, card, log, &
+                               "card 4 (XP YP ZP A1 A2 A3)", "XP")) exit
+        do k = 1, 3
+          call get_real(deck, card, 3 + k, "A"//achar(iachar("0") + k), material%axis_a(k), log)
+        end do
+        if (modified) then
+          call require_zero(deck, card, 7, "RFAC", "strain-rate filtering is not available", log)
+          call require_zero(deck, card, 8, "PRU", "the uncompacted Poisson effect is not available "// &
+                            "(the uncompacted components are uncoupled)", log)
+        end if
+
+        if (.not. require_card(deck, block, line, standard_widths, card, log, &
+                               "card 5 (D1 D2 D3 TSEF SSEF ...)", "D1")) exit
+        do k = 1, 3
+          call get_real(deck, card, k, "D"//achar(iachar("0") + k), material%axis_d(k), log)
+        end do
+        call require_zero(deck, card, 4, "TSEF", "elements do not erode (tensile failure strain)", log)
+        call require_zero(deck, card, 5, "SSEF", "elements do not erode (shear failure strain)", log)
+        if (modified) then
+          call require_zero(deck, card, 6, "VREF", "the reference-geometry update is not available", log)
+          call require_zero(deck, card, 7, "TREF", "the reference-geometry update is not available", log)
+          call require_zero(deck, card, 8, "SHDFLG", "shear damage belongs to LCA < 0, not available", log)
+        end if
+        if (material%axes_option == 2 .and. .not. card%failed) then
+          if (norm2(material%axis_a) == 0.0_wp) then
+            call card_problem(deck, log, card, "A1", "AOPT 2 needs a non-zero vector a (A1 A2 A3 on card 4)")
+          else if (norm2(cross(material%axis_a, material%axis_d)) <= 1.0e-10_wp*norm2(material%axis_a)* &
+                   norm2(material%axis_d)) then
+            call card_problem(deck, log, card, "D1", "AOPT 2 needs a vector d (D1 D2 D3) not parallel to a")
+          end if
+        end if
+
+        if (modified) then
+          ! Optional cards 6 (V1 V2 V3: AOPT 3, 4 only), 7 (rate curves), 8 (Poisson's ratios).
+          if (.not. next_line(deck, block, line, .false.)) exit
+          call open_card(deck, block, line, standard_widths, card, log)
+          if (.not. next_line(deck, block, line, .false.)) exit
+          call open_card(deck, block, line, standard_widths, card, log)
+          do k = 1, 6
+            call require_zero(deck, card, k, trim(rate_names(k)), "per-direction rate curves belong to "// &
+                              "LCSR = -1, not available", log)
+          end do
+          if (.not. next_line(deck, block, line, .false.)) exit
+          call open_card(deck, block, line, standard_widths, card, log)
+          do k = 1, 6
+            call require_zero(deck, card, k, trim(poisson_names(k)), "user uncompacted Poisson's ratios "// &
+                              "belong to PRU = 2, not available", log)
+          end do
+        end if
+      end associate
+    end do
+  end subroutine read_honeycomb_materials
+
+  !> *MAT_LOW_DENSITY_FOAM: C1 MID RO E LCID TC HU BETA DAMP; C2 (optional; a keyword with
+  !> card 2 holds one material) SHAPE FAIL BVFLAG ED BETA1 KCON REF.
+  subroutine read_low_density_foam_materials(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    integer :: line, n, curve
+    real(wp) :: value
+    character(len=:), allocatable :: title
+
+    line = 0
+    do while (next_definition(deck, block, keyword%title, line, standard_widths, card, title, &
+                              log, "card 1 (MID RO E LCID TC HU BETA DAMP)", "MID"))
+      n = input%material_count + 1
+      input%material_count = n
+      input%material_lines(n) = line
+      associate (material => input%model%materials(n))
+        material%law = law_low_density_foam
+        material%title = title
+        material%bulk_viscosity = .false.
+        call get_integer(deck, card, 1, "MID", material%id, log)
+        call get_real(deck, card, 2, "RO", material%density, log)
+        call get_real(deck, card, 3, "E", material%youngs_modulus, log)
+        call get_integer(deck, card, 4, "LCID", curve, log)
+        call get_real(deck, card, 5, "TC", material%tension_cutoff, log, default=1.0e20_wp)
+        call get_real(deck, card, 6, "HU", material%hysteretic_unloading, log, default=1.0_wp)
+        call require_zero(deck, card, 7, "BETA", "unloading creep (rate effects) is not available", log)
+        call get_real(deck, card, 8, "DAMP", material%viscosity, log)
+        material%curve_ids = [max(curve, 0)]
+        if (.not. card%failed) then
+          if (material%id <= 0) call card_problem(deck, log, card, "MID", "material id must be "// &
+                                                  "> 0, found "//integer_text(material%id))
+          if (material%density <= 0.0_wp) call card_problem(deck, log, card, "RO", "density must "// &
+            "be > 0, found "//shown(deck, card, 2, material%density))
+          if (material%youngs_modulus <= 0.0_wp) call card_problem(deck, log, card, "E", "Young's "// &
+            "modulus (tension, unloading) must be > 0, found "//shown(deck, card, 3, material%youngs_modulus))
+          if (curve <= 0) call card_problem(deck, log, card, "LCID", "a loading curve id > 0 is required, "// &
+                                            "found "//integer_text(curve))
+          if (material%tension_cutoff == 0.0_wp) material%tension_cutoff = 1.0e20_wp
+          if (material%tension_cutoff < 0.0_wp) call card_problem(deck, log, card, "TC", "tension cut-off "// &
+            "must be > 0 (blank or 0: 1e20), found "//real_text(material%tension_cutoff))
+          if (material%hysteretic_unloading < 0.0_wp .or. material%hysteretic_unloading > 1.0_wp) &
+            call card_problem(deck, log, card, "HU", "hysteretic unloading factor must lie in [0, 1], found "// &
+                              real_text(material%hysteretic_unloading))
+          if (material%viscosity < 0.0_wp) call card_problem(deck, log, card, "DAMP", "viscous coefficient "// &
+            "must be >= 0, found "//real_text(material%viscosity))
+        end if
+        if (.not. next_line(deck, block, line, .false.)) exit
+        call open_card(deck, block, line, standard_widths, card, log)
+        call get_real(deck, card, 1, "SHAPE", material%unloading_shape, log, default=1.0_wp)
+        if (material%unloading_shape == 0.0_wp) material%unloading_shape = 1.0_wp
+        if (material%unloading_shape < 0.0_wp .and. .not. card%failed) call card_problem(deck, log, card, &
+          "SHAPE", "unloading shape factor must be > 0, found "//real_text(material%unloading_shape))
+        call require_zero(deck, card, 2, "FAIL", "resetting the stress after the tension cut-off is not "// &
+                          "available (the stress is held at TC)", log)
+        call get_real(deck, card, 3, "BVFLAG", value, log)
+        if (value /= 0.0_wp .and. value /= 1.0_wp .and. .not. card%failed) call card_problem(deck, log, card, &
+          "BVFLAG", "must be 0 or 1, found "//real_text(value))
+        material%bulk_viscosity = value == 1.0_wp
+        call require_zero(deck, card, 4, "ED", "relaxation (rate effects) is not available", log)
+        call require_zero(deck, card, 5, "BETA1", "relaxation (rate effects) is not available", log)
+        call require_zero(deck, card, 7, "REF", "initialisation from a reference geometry is not available", log)
+      end associate
+      call warn_if_set(deck, card, 6, "KCON", "contact stiffness comes from the contact definition", warnings)
+    end do
+  end subroutine read_low_density_foam_materials
+
+  !> An error naming field `k` when it holds anything but blank or 0: the feature is not built.
+  subroutine require_zero(deck, card, k, name, reason, log)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(inout) :: card
+    integer, intent(in) :: k
+    character(len=*), intent(in) :: name, reason
+    type(problem_log_t), intent(inout) :: log
+    real(wp) :: value
+    call get_real(deck, card, k, name, value, log)
+    if (value /= 0.0_wp .and. .not. card%failed) call card_problem(deck, log, card, name, &
+      "must be blank or 0, found "//real_text(value)//": "//reason)
+  end subroutine require_zero
+
+  pure function cross(u, v) result(w)
+    real(wp), intent(in) :: u(3), v(3)
+    real(wp) :: w(3)
+    w = [u(2)*v(3) - u(3)*v(2), u(3)*v(1) - u(1)*v(3), u(1)*v(2) - u(2)*v(1)]
+  end function cross
 
   !> MID RO E PR (fields 1-4 of card 1 of both laws) and their physical limits.
   subroutine read_elastic_constants(deck, card, material, log)

@@ -28,11 +28,13 @@ module deck_reader
     keyword_rigidwall_planar, keyword_d3plot, keyword_glstat, keyword_matsum, keyword_nodout, &
     keyword_rwforc, keyword_history_node, keyword_history_node_set, &
     keyword_control_implicit_general, keyword_control_implicit_solution, keyword_load_segment, &
-    keyword_load_segment_set, keyword_load_segment_nonuniform, keyword_set_segment
+    keyword_load_segment_set, keyword_load_segment_nonuniform, keyword_set_segment, &
+    keyword_mat_honeycomb, keyword_mat_modified_honeycomb, keyword_mat_low_density_foam
   use deck_input, only: deck_input_t, prepare_input
   use deck_nodes_elements, only: read_nodes, read_solid_elements
   use deck_parts_sections, only: read_parts, read_solid_sections, read_hourglasses
-  use deck_materials, only: read_elastic_materials, read_plastic_kinematic_materials
+  use deck_materials, only: read_elastic_materials, read_plastic_kinematic_materials, &
+    read_honeycomb_materials, read_low_density_foam_materials
   use deck_sets_curves, only: read_node_set, read_part_set, read_segment_set, read_curve
   use deck_loads_bcs, only: read_spcs, read_motions, read_loads, read_initial_velocities, &
     read_initial_velocity_nodes, read_velocity_generations, read_planar_walls, &
@@ -150,6 +152,11 @@ contains
       call read_elastic_materials(deck, block, keyword, input, log)
     case (keyword_mat_plastic_kinematic)
       call read_plastic_kinematic_materials(deck, block, keyword, input, log, warnings)
+    case (keyword_mat_honeycomb, keyword_mat_modified_honeycomb)
+      call read_honeycomb_materials(deck, block, keyword, keyword%code == keyword_mat_modified_honeycomb, &
+                                    input, log)
+    case (keyword_mat_low_density_foam)
+      call read_low_density_foam_materials(deck, block, keyword, input, log, warnings)
     case (keyword_hourglass)
       call read_hourglasses(deck, block, keyword, input, log)
     case (keyword_control_hourglass)

@@ -175,7 +175,7 @@ contains
     real(wp) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
     real(wp) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8)
     real(wp) :: dndx(block_size, 8), dndy(block_size, 8), dndz(block_size, 8)
-    real(wp) :: natural(8, 3, 8)
+    real(wp) :: natural(8, 3, 8), element_edges(block_size, 6)
     integer :: nel, point, history_count
 
     nel = block%element_count
@@ -189,12 +189,16 @@ contains
     else
       allocate (block%hourglass_force(block_size, 3, 0))
     end if
-    do point = 1, block%point_count
-      call initialize_material_history(model%materials(block%material), nel, block%history(:, :, point))
-    end do
-
     block%density(1:nel) = model%materials(block%material)%density
     call gather_coordinates(nel, block%nodes, model%coordinates, x, y, z)
+    ! Element edges 1-2 and 1-4: the material axes of AOPT 0 (honeycombs).
+    element_edges(1:nel, :) = reshape([x(1:nel, 2) - x(1:nel, 1), y(1:nel, 2) - y(1:nel, 1), &
+                                       z(1:nel, 2) - z(1:nel, 1), x(1:nel, 4) - x(1:nel, 1), &
+                                       y(1:nel, 4) - y(1:nel, 1), z(1:nel, 4) - z(1:nel, 1)], [nel, 6])
+    do point = 1, block%point_count
+      call initialize_material_history(model%materials(block%material), nel, block%history(:, :, point), &
+                                       element_edges)
+    end do
     call hex8_volume_derivatives(nel, x, y, z, bx, by, bz, block%reference_volume)
     block%volume(1:nel) = block%reference_volume(1:nel)
     if (block%point_count == 1) then

@@ -14,11 +14,16 @@
 !>   time step, the linear bulk viscosity and the hourglass stiffness (lambda + 2 mu).
 module material_dispatch
   use kinds, only: wp, block_size
-  use model, only: material_t, law_elastic, law_plastic_kinematic
+  use model, only: material_t, law_elastic, law_plastic_kinematic, law_honeycomb, law_modified_honeycomb, &
+                   law_low_density_foam, honeycomb_rate_curve, foam_loading_curve
   use material_elastic, only: elastic_update
   use material_plastic_kinematic, only: plastic_kinematic_update, plastic_kinematic_history_count, &
                                         plastic_strain_slot, back_stress_first_slot
-  use objective_rotation, only: rotate_symmetric_tensors
+  use material_honeycomb, only: honeycomb_update, honeycomb_initialize_axes, honeycomb_history_count, &
+                                honeycomb_axes_first_slot
+  use material_low_density_foam, only: low_density_foam_update, low_density_foam_initialize, foam_history_count, &
+                                       foam_left_cauchy_green_first_slot
+  use objective_rotation, only: rotate_symmetric_tensors, rotate_vectors
   implicit none
   private
 
@@ -35,17 +40,45 @@ contains
     select case (material%law)
     case (law_plastic_kinematic)
       count = plastic_kinematic_history_count
+    case (law_honeycomb, law_modified_honeycomb)
+      count = honeycomb_history_count
+    case (law_low_density_foam)
+      count = foam_history_count
     case default
       count = 0
     end select
   end function material_history_count
 
   !> Initial history of lanes 1..nel (virgin material: no plastic strain, no back stress).
-  subroutine initialize_material_history(material, nel, history)
+  !> `element_edges` (x2 - x1, x4 - x1 of each hexahedron, block_size x 6) gives the material
+  !> axes of AOPT 0 (LS-DYNA: a along nodes 1-2, d along 1-4); without it AOPT 0 takes the
+  !> global axes (the deck check admits the honeycombs on hexahedron parts only).
+  subroutine initialize_material_history(material, nel, history, element_edges)
     type(material_t), intent(in) :: material
     integer, intent(in) :: nel
     real(wp), intent(inout), contiguous :: history(:, :)
+    real(wp), intent(in), optional :: element_edges(block_size, 6)
+    real(wp) :: first(block_size, 3), second(block_size, 3)
+    integer :: k
     select case (material%law)
+    case (law_honeycomb, law_modified_honeycomb)
+      history(1:nel, :) = 0.0_wp
+      if (material%axes_option == 2) then
+        do k = 1, 3
+          first(1:nel, k) = material%axis_a(k)
+          second(1:nel, k) = material%axis_d(k)
+        end do
+      else if (present(element_edges)) then
+        first(1:nel, :) = element_edges(1:nel, 1:3)
+        second(1:nel, :) = element_edges(1:nel, 4:6)
+      else
+        first(1:nel, :) = 0.0_wp
+        second(1:nel, :) = 0.0_wp
+      end if
+      call honeycomb_initialize_axes(nel, first, second, &
+                                     history(:, honeycomb_axes_first_slot:honeycomb_axes_first_slot + 8))
+    case (law_low_density_foam)
+      call low_density_foam_initialize(nel, history)
     case default
       ! Every law so far starts from zero history.
       if (size(history, 2) > 0) history(1:nel, :) = 0.0_wp
@@ -94,6 +127,17 @@ contains
                                     material%rate_c, material%rate_p, material%rate_formulation > 0.5_wp, &
                                     time_step, strain_increment, stress, history(:, plastic_strain_slot), &
                                     history(:, back_stress_first_slot:back_stress_first_slot + 5))
+    case (law_honeycomb, law_modified_honeycomb)
+      call honeycomb_update(nel, material%law == law_modified_honeycomb, material%youngs_modulus, &
+                            material%poissons_ratio, material%yield_stress, material%compaction_volume, &
+                            material%viscosity, material%uncompacted_moduli, material%curves(1:6), &
+                            material%curve_ids(honeycomb_rate_curve) > 0, material%curves(honeycomb_rate_curve), &
+                            time_step, strain_increment, stress, history)
+    case (law_low_density_foam)
+      call low_density_foam_update(nel, material%youngs_modulus, material%curves(foam_loading_curve), &
+                                   material%tension_cutoff, material%hysteretic_unloading, &
+                                   material%unloading_shape, material%viscosity, foam_stiffness_bound(material), &
+                                   strain_increment, stress, history)
     case default
       ! Unknown laws are rejected by the deck check; keep the stress as it is.
       continue
@@ -110,22 +154,52 @@ contains
     select case (material%law)
     case (law_plastic_kinematic)
       call rotate_symmetric_tensors(nel, rotation, history(:, back_stress_first_slot:back_stress_first_slot + 5))
+    case (law_honeycomb, law_modified_honeycomb)
+      ! The material axes a, b, c turn with the material.
+      call rotate_vectors(nel, 3, rotation, history(:, honeycomb_axes_first_slot:honeycomb_axes_first_slot + 8))
+    case (law_low_density_foam)
+      ! B's Jaumann rate is D B + B D: the spin part is this rotation.
+      call rotate_symmetric_tensors(nel, rotation, &
+                                    history(:, foam_left_cauchy_green_first_slot:foam_left_cauchy_green_first_slot + 5))
     case default
       continue
     end select
   end subroutine rotate_material_history
 
-  !> Dilatational wave modulus rho c^2 = K + 4G/3 = lambda + 2 mu of lanes 1..nel (both laws
-  !> use their elastic moduli, as LS-DYNA does for the time step). A law whose stiffness
-  !> depends on its state would add its history here.
+  !> Dilatational wave modulus rho c^2 = K + 4G/3 = lambda + 2 mu of lanes 1..nel (the elastic
+  !> and plastic laws use their elastic moduli, as LS-DYNA does for the time step). The
+  !> honeycombs use the largest modulus they can reach, that of the compacted material (or an
+  !> uncompacted normal modulus if larger), so that the time step needs no history; the foam
+  !> uses max(E, steepest slope of its loading curve).
   subroutine material_wave_modulus(material, nel, wave_modulus)
     type(material_t), intent(in) :: material
     integer, intent(in) :: nel
     real(wp), intent(out) :: wave_modulus(block_size)
     real(wp) :: bulk_modulus, shear_modulus
-    call elastic_moduli(material, bulk_modulus, shear_modulus)
-    wave_modulus(1:nel) = bulk_modulus + 4.0_wp*shear_modulus/3.0_wp
+    select case (material%law)
+    case (law_low_density_foam)
+      wave_modulus(1:nel) = foam_stiffness_bound(material)
+    case default
+      call elastic_moduli(material, bulk_modulus, shear_modulus)
+      wave_modulus(1:nel) = bulk_modulus + 4.0_wp*shear_modulus/3.0_wp
+      if (material%law == law_honeycomb .or. material%law == law_modified_honeycomb) &
+        wave_modulus(1:nel) = max(wave_modulus(1:nel), maxval(material%uncompacted_moduli(1:3)))
+    end select
   end subroutine material_wave_modulus
+
+  !> Stiffness bound of *MAT_LOW_DENSITY_FOAM: max(E, largest slope of the loading curve).
+  pure function foam_stiffness_bound(material) result(modulus)
+    type(material_t), intent(in) :: material
+    real(wp) :: modulus
+    integer :: k
+    modulus = material%youngs_modulus
+    associate (curve => material%curves(foam_loading_curve))
+      do k = 1, size(curve%abscissa) - 1
+        if (curve%abscissa(k + 1) > curve%abscissa(k)) modulus = max(modulus, &
+          (curve%ordinate(k + 1) - curve%ordinate(k))/(curve%abscissa(k + 1) - curve%abscissa(k)))
+      end do
+    end associate
+  end function foam_stiffness_bound
 
   !> Effective plastic strain of lanes 1..nel (0 for laws without plasticity), from the history
   !> of a material of law `law` (material_t%law; the law alone fixes the history layout).

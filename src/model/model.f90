@@ -15,6 +15,14 @@ module model
   !> Material laws, numbered as LS-DYNA numbers them.
   integer, parameter, public :: law_elastic = 1
   integer, parameter, public :: law_plastic_kinematic = 3
+  integer, parameter, public :: law_honeycomb = 26            !< *MAT_HONEYCOMB
+  integer, parameter, public :: law_low_density_foam = 57     !< *MAT_LOW_DENSITY_FOAM
+  integer, parameter, public :: law_modified_honeycomb = 126  !< *MAT_MODIFIED_HONEYCOMB
+
+  !> Curve slots of the crushable laws in material_t%curves (after the deck's defaults, such as
+  !> LCB = 0 -> LCA, are applied): the six yield curves in stress order aa, bb, cc, ab, bc, ca,
+  !> then the strain-rate scale curve LCSR (honeycombs); the loading curve LCID (foam).
+  integer, parameter, public :: honeycomb_rate_curve = 7, foam_loading_curve = 1
 
   !> How a part is discretised (`/mesh/parts/formulation`: "fe", "efg", "rigid").
   integer, parameter, public :: formulation_fe = 1, formulation_efg = 2, formulation_rigid = 3
@@ -38,6 +46,26 @@ module model
     real(wp) :: rate_p = 0.0_wp             !< SRP, Cowper-Symonds P (0: no rate effect)
     real(wp) :: failure_strain = 0.0_wp     !< FS (read and kept; erosion is not modelled)
     real(wp) :: rate_formulation = 0.0_wp   !< VP: 0 scale yield stress, 1 viscoplastic
+    ! *MAT_HONEYCOMB, *MAT_MODIFIED_HONEYCOMB (E, PR, SIGY above: the fully compacted material)
+    real(wp) :: compaction_volume = 0.0_wp  !< VF: relative volume at full compaction, (0, 1]
+    real(wp) :: viscosity = 0.0_wp          !< MU (honeycombs), DAMP (foam): viscous coefficient
+    !> BULK (honeycombs) / BVFLAG (foam) = 1: the element bulk viscosity acts. LS-DYNA's default
+    !> 0 switches it off for these laws (their own MU / DAMP replaces it).
+    logical :: bulk_viscosity = .true.
+    real(wp) :: uncompacted_moduli(6) = 0.0_wp !< EAAU EBBU ECCU GABU GBCU GCAU
+    integer :: axes_option = 0              !< AOPT: 0 element nodes 1-2-4, 2 global vectors a, d
+    real(wp) :: axis_a(3) = 0.0_wp          !< A1 A2 A3 (AOPT 2)
+    real(wp) :: axis_d(3) = 0.0_wp          !< D1 D2 D3 (AOPT 2)
+    ! *MAT_LOW_DENSITY_FOAM (E above: tension modulus)
+    real(wp) :: tension_cutoff = 1.0e20_wp  !< TC: largest tensile (nominal) stress
+    real(wp) :: hysteretic_unloading = 1.0_wp !< HU: 1 no dissipation ... 0 most
+    real(wp) :: unloading_shape = 1.0_wp    !< SHAPE: exponent of the unloading factor
+    !> Curve ids as given on the cards with LS-DYNA's defaults applied (0: none); the slots are
+    !> honeycomb_rate_curve, foam_loading_curve, ... above.
+    integer, allocatable :: curve_ids(:)
+    !> Copies of those curves, resolved by the deck's cross-check (same slots; a slot whose id
+    !> is 0 holds an empty curve). The law kernels read them through the material dispatch.
+    type(curve_t), allocatable :: curves(:)
   end type material_t
 
   !> EFG kernels (ISPLINE) and boundary treatments (IEBT) and domain integrations (IDIM).

@@ -8,6 +8,7 @@ program test_deck
   use testing, only: test_suite_t, check, check_close, finish_suite
   use error_handling, only: error_t, error_list_t
   use model, only: model_t, formulation_fe, formulation_efg, law_elastic, law_plastic_kinematic, &
+                   law_honeycomb, law_modified_honeycomb, law_low_density_foam, &
                    motion_displacement, motion_velocity, kernel_cubic_box, kernel_cubic_sphere, &
                    boundary_coupled, boundary_full_transformation, integration_local_boundary, &
                    integration_gauss, integration_gauss_conventional
@@ -47,6 +48,8 @@ program test_deck
   call test_segment_loads()
   call test_segment_load_errors()
   call test_segment_load_structure()
+  call test_crushable_materials()
+  call test_crushable_material_errors()
   call execute_command_line("rm -rf "//directory)
   call finish_suite(suite)
 
@@ -1186,4 +1189,90 @@ contains
       "segment: a card of nodes N1-N8 and a card of nodal values P1-P8 must follow card 1"], &
       message_lines=1)
   end subroutine test_segment_load_structure
+  ! ---------------------------------------------------------------- crushable materials
+
+  !> *MAT_126 (with _TITLE) used by the cube's part, *MAT_026 and *MAT_057 beside it: values,
+  !> LS-DYNA's curve defaults and the curves copied into the materials.
+  subroutine test_crushable_materials()
+    type(model_t) :: model
+    type(error_list_t) :: warnings
+    character(len=8), parameter :: c = ""
+    call read_good("crushable.k", replaced(19, fixed([character(len=8) :: "1", "1", "2"], 10), [character(len=line_length) :: &
+      "*MAT_MODIFIED_HONEYCOMB_TITLE", "aluminium honeycomb", &
+      fixed([character(len=8) :: "2", "6.0e-11", "70000.", "0.3", "300.", "0.1"], 10), &
+      fixed([character(len=8) :: "10", "11", c, c, c, c, "12", c], 10), &
+      fixed([character(len=8) :: "1000.", "500.", "500.", "200.", "200.", "200.", "2", c], 10), &
+      fixed([character(len=8) :: c, c, c, "0.0", "0.0", "1.0"], 10), &
+      fixed([character(len=8) :: "0.0", "1.0", "0.0"], 10), &
+      "*MAT_026", fixed([character(len=8) :: "3", "6.0e-11", "70000.", "0.3", "300.", "0.2", "0.0"], 10), &
+      fixed([character(len=8) :: "11", c, c, "12", c, c, c, "10"], 10), &
+      fixed([character(len=8) :: "1000.", "500.", "500.", "200.", "200.", "200."], 10), &
+      fixed([character(len=8) :: "0.0"], 10), fixed([character(len=8) :: "0.0"], 10), &
+      "*MAT_LOW_DENSITY_FOAM", fixed([character(len=8) :: "4", "3.0e-11", "5.0", "12", c, "0.1", c, "0.2"], 10), &
+      fixed([character(len=8) :: "3.0"], 10), &
+      "*DEFINE_CURVE", fixed([character(len=8) :: "10"], 10), "0.0,1.0", "1.0,2.0", &
+      "*DEFINE_CURVE", fixed([character(len=8) :: "11"], 10), "0.0,0.5", "1.0,0.7", &
+      "*DEFINE_CURVE", fixed([character(len=8) :: "12"], 10), "0.0,0.0", "0.5,0.2"]), model, warnings)
+    if (.not. allocated(model%materials)) return
+    if (size(model%materials) /= 4) then
+      call check(suite, "crushable: four materials", .false.)
+      return
+    end if
+    associate (m => model%materials(2))
+      call check(suite, "126: law, title, part", m%law == law_modified_honeycomb .and. m%title == &
+                 "aluminium honeycomb" .and. model%parts(1)%material == 2)
+      call check_close(suite, "126: RO E PR SIGY VF MU(default)", [m%density, m%youngs_modulus, m%poissons_ratio, &
+                       m%yield_stress, m%compaction_volume, m%viscosity], &
+                       [6.0e-11_wp, 70000.0_wp, 0.3_wp, 300.0_wp, 0.1_wp, 0.05_wp], rel=1e-15_wp)
+      call check(suite, "126: curve defaults LCC -> LCA, LCAB LCBC -> LCS -> LCA", &
+                 all(m%curve_ids == [10, 11, 10, 10, 10, 12, 0]))
+      call check(suite, "126: curves copied", m%curves(2)%id == 11 .and. m%curves(6)%id == 12 .and. &
+                 size(m%curves(1)%abscissa) == 2)
+      call check_close(suite, "126: moduli, axes", [m%uncompacted_moduli, m%axis_a, m%axis_d], &
+        [1000.0_wp, 500.0_wp, 500.0_wp, 200.0_wp, 200.0_wp, 200.0_wp, 0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, 1.0_wp, &
+         0.0_wp], thr=0.0_wp)
+      call check(suite, "126: AOPT 2", m%axes_option == 2)
+      call check(suite, "126: BULK 0 switches the part's bulk viscosity off", .not. m%bulk_viscosity .and. &
+                 model%parts(1)%bulk_linear == 0.0_wp .and. model%parts(1)%bulk_quadratic == 0.0_wp)
+    end associate
+    associate (m => model%materials(3))
+      call check(suite, "026: law, MU 0, LCSR, AOPT 0", m%law == law_honeycomb .and. m%viscosity == 0.0_wp &
+                 .and. all(m%curve_ids == [11, 11, 11, 12, 12, 12, 10]) .and. m%axes_option == 0)
+    end associate
+    associate (m => model%materials(4))
+      call check(suite, "057: law and curve", m%law == law_low_density_foam .and. m%curves(1)%id == 12)
+      call check_close(suite, "057: E TC(default) HU DAMP SHAPE", [m%youngs_modulus, m%tension_cutoff, &
+        m%hysteretic_unloading, m%viscosity, m%unloading_shape], [5.0_wp, 1.0e20_wp, 0.1_wp, 0.2_wp, 3.0_wp], &
+        rel=1e-15_wp)
+    end associate
+  end subroutine test_crushable_materials
+
+  !> Impossible values, features not built and undefined curves, each naming its field.
+  subroutine test_crushable_material_errors()
+    character(len=8), parameter :: c = ""
+    call read_bad("crushable_bad.k", cube_deck([character(len=line_length) :: &
+      "*MAT_126", fixed([character(len=8) :: "5", "0.0", "70000.", "0.3", "300.", "1.5"], 10), &
+      fixed([character(len=8) :: "99"], 10), &
+      fixed([character(len=8) :: "1000.", "500.", "500.", "200.", "200.", "200.", "3"], 10), &
+      fixed([character(len=8) :: c, c, c, "1.0", "0.0", "0.0", c, "1"], 10), &
+      fixed([character(len=8) :: "0.0", "1.0", "0.0", "0.5"], 10), &
+      "*MAT_LOW_DENSITY_FOAM", fixed([character(len=8) :: "6", "1.0e-10", "1.0", "0", c, "2.0", "1.0"], 10), &
+      "*MAT_026", fixed([character(len=8) :: "7", "1.0e-10", "70000.", "0.3", "300.", "0.2"], 10), &
+      fixed([character(len=8) :: "8", c, c, c, c, c, c, c], 10), &
+      fixed([character(len=8) :: "1000.", "0.0", "500.", "200.", "200.", "200.", "2"], 10), &
+      fixed([character(len=8) :: c, c, c, "1.0", "0.0", "0.0"], 10), &
+      fixed([character(len=8) :: "2.0", "0.0", "0.0"], 10)]), [character(len=140) :: &
+      "@:25: *MAT_126: field RO: density must be > 0, found 0.0", &
+      "@:25: *MAT_126: field VF: relative volume at full compaction must lie in (0, 1], found 1.5", &
+      "@:27: *MAT_126: field AOPT: material axes option 3.0 is not available", &
+      "@:28: *MAT_126: field PRU: must be blank or 0, found 1.0", &
+      "@:29: *MAT_126: field TSEF: must be blank or 0, found 0.5", &
+      "@:26: *MAT_126: field LCA: curve 99 of material 5 is not defined", &
+      "@:31: *MAT_LOW_DENSITY_FOAM: field LCID: a loading curve id > 0 is required", &
+      "@:31: *MAT_LOW_DENSITY_FOAM: field HU: hysteretic unloading factor must lie in [0, 1], found 2.0", &
+      "@:31: *MAT_LOW_DENSITY_FOAM: field BETA: must be blank or 0, found 1.0", &
+      "@:35: *MAT_026: field EBBU: uncompacted modulus must be > 0, found 0.0", &
+      "@:37: *MAT_026: field D1: AOPT 2 needs a vector d (D1 D2 D3) not parallel to a", &
+      "@:34: *MAT_026: field LCA: curve 8 of material 7 is not defined"], message_lines=12)
+  end subroutine test_crushable_material_errors
 end program test_deck

@@ -1,9 +1,16 @@
 !> Unit tests of the material laws through the block dispatch: *MAT_ELASTIC increments,
 !> *MAT_PLASTIC_KINEMATIC uniaxial-stress paths (bilinear curve, isotropic and kinematic
-!> reverse yield), Cowper-Symonds factors (VP = 0 and VP = 1), history rotation and layout.
+!> reverse yield), Cowper-Symonds factors (VP = 0 and VP = 1), history rotation and layout;
+!> *MAT_HONEYCOMB / *MAT_MODIFIED_HONEYCOMB single-point crush along each material axis (yield
+!> curves, compaction, unloading modulus, uncoupled shear, rotating axes) and
+!> *MAT_LOW_DENSITY_FOAM loading / hysteretic unloading.
 program test_materials
   use kinds, only: wp, block_size
-  use model, only: material_t, law_elastic, law_plastic_kinematic
+  use model, only: material_t, law_elastic, law_plastic_kinematic, law_honeycomb, law_modified_honeycomb, &
+                   law_low_density_foam
+  use curves, only: curve_t, curve_value
+  use material_dispatch, only: material_wave_modulus
+  use material_honeycomb, only: honeycomb_log_volume_slot, honeycomb_compacted_slot, honeycomb_axes_first_slot
   use material_dispatch, only: material_history_count, initialize_material_history, update_material_block, &
                                rotate_material_history, material_plastic_strain, elastic_moduli, &
                                plastic_hardening_modulus
@@ -23,6 +30,12 @@ program test_materials
   call test_cowper_symonds_scaled_yield()
   call test_cowper_symonds_viscoplastic()
   call test_back_stress_rotation()
+  call test_honeycomb_axes_crush()
+  call test_honeycomb_compaction_and_unloading()
+  call test_honeycomb_shear_uncoupled()
+  call test_modified_honeycomb_strain_abscissa()
+  call test_honeycomb_axes_rotate()
+  call test_foam_loading_unloading()
   call finish_suite(suite)
 
 contains
@@ -301,4 +314,286 @@ contains
     call check_close(suite, "back stress rotates with the element (quarter turn about z)", history(1, :), &
                      [0.5_wp, 20.0_wp, 10.0_wp, -30.0_wp, -4.0_wp, 6.0_wp, -5.0_wp], thr=1e-13_wp)
   end subroutine test_back_stress_rotation
+  function make_curve(id, abscissa, ordinate) result(curve)
+    integer, intent(in) :: id
+    real(wp), intent(in) :: abscissa(:), ordinate(:)
+    type(curve_t) :: curve
+    curve%id = id
+    allocate (curve%abscissa, source=abscissa)
+    allocate (curve%ordinate, source=ordinate)
+  end function make_curve
+
+  !> Honeycomb with distinct yield curves per axis (plateaus 1.0, 0.5, 2.0 rising towards
+  !> compaction; shear 0.3, 0.2, 0.1), compacted E = 1000, PR = 0.3, VF = 0.2, material axes
+  !> a = (1, 1, 0)/sqrt 2, b = (-1, 1, 0)/sqrt 2, c = z (AOPT 2).
+  function honeycomb(law) result(material)
+    integer, intent(in) :: law
+    type(material_t) :: material
+    real(wp), parameter :: strain(4) = [0.0_wp, 0.3_wp, 0.7_wp, 1.0_wp]
+    real(wp), parameter :: shape(4) = [1.0_wp, 1.1_wp, 1.5_wp, 3.0_wp]
+    material%law = law
+    material%density = 1.0e-10_wp
+    material%youngs_modulus = 1000.0_wp
+    material%poissons_ratio = 0.3_wp
+    material%yield_stress = 1.0e6_wp
+    material%compaction_volume = 0.2_wp
+    material%viscosity = 0.0_wp
+    material%uncompacted_moduli = [100.0_wp, 80.0_wp, 120.0_wp, 40.0_wp, 30.0_wp, 20.0_wp]
+    material%axes_option = 2
+    material%axis_a = [1.0_wp, 1.0_wp, 0.0_wp]
+    material%axis_d = [-1.0_wp, 1.0_wp, 0.0_wp]
+    material%curve_ids = [1, 2, 3, 4, 5, 6, 0]
+    allocate (material%curves(7))
+    material%curves(1) = make_curve(1, strain, 1.0_wp*shape)
+    material%curves(2) = make_curve(2, strain, 0.5_wp*shape)
+    material%curves(3) = make_curve(3, strain, 2.0_wp*shape)
+    material%curves(4) = make_curve(4, strain, 0.3_wp*shape)
+    material%curves(5) = make_curve(5, strain, 0.2_wp*shape)
+    material%curves(6) = make_curve(6, strain, 0.1_wp*shape)
+  end function honeycomb
+
+  !> Global strain increment of the material-axis tensor `local` (aa bb cc ab bc ca, tensor shear).
+  function global_increment(local) result(increment)
+    real(wp), intent(in) :: local(6)
+    real(wp) :: increment(6)
+    real(wp) :: q(3, 3), m(3, 3)
+    q(1, :) = [1.0_wp, 1.0_wp, 0.0_wp]/sqrt(2.0_wp)
+    q(2, :) = [-1.0_wp, 1.0_wp, 0.0_wp]/sqrt(2.0_wp)
+    q(3, :) = [0.0_wp, 0.0_wp, 1.0_wp]
+    m = reshape([local(1), local(4), local(6), local(4), local(2), local(5), local(6), local(5), local(3)], [3, 3])
+    m = matmul(transpose(q), matmul(m, q))
+    increment = [m(1, 1), m(2, 2), m(3, 3), m(1, 2), m(2, 3), m(3, 1)]
+  end function global_increment
+
+  !> Stress in the material axes of the test honeycomb.
+  function local_stress(stress) result(local)
+    real(wp), intent(in) :: stress(:)
+    real(wp) :: local(6)
+    real(wp) :: q(3, 3), m(3, 3)
+    q(1, :) = [1.0_wp, 1.0_wp, 0.0_wp]/sqrt(2.0_wp)
+    q(2, :) = [-1.0_wp, 1.0_wp, 0.0_wp]/sqrt(2.0_wp)
+    q(3, :) = [0.0_wp, 0.0_wp, 1.0_wp]
+    m = reshape([stress(1), stress(4), stress(6), stress(4), stress(2), stress(5), stress(6), stress(5), stress(3)], &
+                [3, 3])
+    m = matmul(q, matmul(m, transpose(q)))
+    local = [m(1, 1), m(2, 2), m(3, 3), m(1, 2), m(2, 3), m(3, 1)]
+  end function local_stress
+
+  !> One step of the test honeycomb with the material-axis increment `local`.
+  subroutine honeycomb_step(material, local, stress, history)
+    type(material_t), intent(in) :: material
+    real(wp), intent(in) :: local(6)
+    real(wp), intent(inout) :: stress(block_size, 6), history(block_size, 23)
+    real(wp) :: increment(block_size, 6), wave(block_size)
+    increment = 0.0_wp
+    increment(1, :) = global_increment(local)
+    call update_material_block(material, 1, 1.0e-6_wp, increment, stress, history, wave)
+  end subroutine honeycomb_step
+
+  !> Uniaxial-strain crush along a, b and c in turn: the crushed component follows that axis'
+  !> curve at the volumetric strain 1 - V/V0 within 1%, the others stay zero.
+  subroutine test_honeycomb_axes_crush()
+    type(material_t) :: material
+    real(wp) :: stress(block_size, 6), history(block_size, 23), local(6), increment(6), worst, expected
+    real(wp) :: others
+    integer :: axis, step
+    character(len=1), parameter :: names(3) = ["a", "b", "c"]
+    material = honeycomb(law_honeycomb)
+    call check(suite, "honeycomb: 23 history variables", material_history_count(material) == 23)
+    do axis = 1, 3
+      stress = 0.0_wp
+      call initialize_material_history(material, 1, history)
+      increment = 0.0_wp
+      increment(axis) = -1.0e-3_wp
+      worst = 0.0_wp
+      others = 0.0_wp
+      do step = 1, 1000       ! to V/V0 = exp(-1) = 0.37 > VF
+        call honeycomb_step(material, increment, stress, history)
+        local = local_stress(stress(1, :))
+        if (step >= 100) then
+          expected = -curve_value(material%curves(axis), 1.0_wp - exp(history(1, honeycomb_log_volume_slot)))
+          worst = max(worst, abs(local(axis)/expected - 1.0_wp))
+        end if
+        others = max(others, sum(abs(local)) - abs(local(axis)))
+      end do
+      call check(suite, "honeycomb 026: sigma_"//names(axis)//names(axis)//" follows its curve within 1%", &
+                 worst < 0.01_wp, "worst relative difference "//real_image(worst))
+      call check(suite, "honeycomb 026: crush along "//names(axis)//" leaves the other components zero", &
+                 others < 1.0e-12_wp, "largest other "//real_image(others))
+    end do
+  end subroutine test_honeycomb_axes_crush
+
+  !> Unloading before compaction with E_aa(V); past VF the compacted moduli (uniaxial strain:
+  !> K + 4G/3 on the crushed axis, lambda on the others).
+  subroutine test_honeycomb_compaction_and_unloading()
+    type(material_t) :: material
+    real(wp) :: stress(block_size, 6), history(block_size, 23), increment(6), before(6), after(6)
+    real(wp) :: relative_volume, beta, bulk, shear, wave(block_size)
+    integer :: step
+    material = honeycomb(law_honeycomb)
+    stress = 0.0_wp
+    call initialize_material_history(material, 1, history)
+    increment = [-1.0e-3_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
+    do step = 1, 600
+      call honeycomb_step(material, increment, stress, history)
+    end do
+    ! unload one step
+    before = local_stress(stress(1, :))
+    call honeycomb_step(material, -increment, stress, history)
+    after = local_stress(stress(1, :))
+    relative_volume = exp(history(1, honeycomb_log_volume_slot))
+    beta = (1.0_wp - relative_volume)/(1.0_wp - 0.2_wp)
+    call check_close(suite, "honeycomb: unloads with E_aa(V) = EAAU + beta (E - EAAU)", &
+                     (after(1) - before(1))/1.0e-3_wp, 100.0_wp + beta*(1000.0_wp - 100.0_wp), rel=1e-9_wp)
+    call check(suite, "honeycomb: not compacted at V/V0 = 0.55", history(1, honeycomb_compacted_slot) == 0.0_wp)
+    ! crush on to past VF = 0.2 (ln 0.2 = -1.609)
+    do step = 1, 1100
+      call honeycomb_step(material, increment, stress, history)
+    end do
+    call check(suite, "honeycomb: compacted past VF", history(1, honeycomb_compacted_slot) == 1.0_wp)
+    before = local_stress(stress(1, :))
+    call honeycomb_step(material, increment, stress, history)
+    after = local_stress(stress(1, :))
+    call elastic_moduli(material, bulk, shear)
+    call check_close(suite, "honeycomb compacted: d sigma_aa / d eps = K + 4G/3", &
+                     (after(1) - before(1))/(-1.0e-3_wp), bulk + 4.0_wp*shear/3.0_wp, rel=1e-9_wp)
+    call check_close(suite, "honeycomb compacted: d sigma_bb / d eps = lambda", &
+                     (after(2) - before(2))/(-1.0e-3_wp), bulk - 2.0_wp*shear/3.0_wp, rel=1e-9_wp)
+    call check_close(suite, "honeycomb compacted: unloads with K + 4G/3 too", &
+                     compacted_unload_slope(material, stress, history), bulk + 4.0_wp*shear/3.0_wp, rel=1e-9_wp)
+    call material_wave_modulus(material, 1, wave)
+    call check_close(suite, "honeycomb: wave modulus of the compacted material", wave(1), &
+                     bulk + 4.0_wp*shear/3.0_wp, rel=1e-14_wp)
+  end subroutine test_honeycomb_compaction_and_unloading
+
+  function compacted_unload_slope(material, stress, history) result(slope)
+    type(material_t), intent(in) :: material
+    real(wp), intent(inout) :: stress(block_size, 6), history(block_size, 23)
+    real(wp) :: slope, before(6), after(6)
+    before = local_stress(stress(1, :))
+    call honeycomb_step(material, [1.0e-3_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp], stress, history)
+    after = local_stress(stress(1, :))
+    slope = (after(1) - before(1))/1.0e-3_wp
+  end function compacted_unload_slope
+
+  !> Pure shear in each material plane: elastic with 2 G_u up to its shear curve, then held
+  !> there; no normal stress, the other shear components stay zero.
+  subroutine test_honeycomb_shear_uncoupled()
+    type(material_t) :: material
+    real(wp) :: stress(block_size, 6), history(block_size, 23), increment(6), local(6), first(6)
+    integer :: component, step
+    character(len=2), parameter :: names(3) = ["ab", "bc", "ca"]
+    real(wp), parameter :: shear_moduli(3) = [40.0_wp, 30.0_wp, 20.0_wp], limits(3) = [0.3_wp, 0.2_wp, 0.1_wp]
+    material = honeycomb(law_honeycomb)
+    do component = 4, 6
+      stress = 0.0_wp
+      call initialize_material_history(material, 1, history)
+      increment = 0.0_wp
+      increment(component) = 1.0e-4_wp
+      call honeycomb_step(material, increment, stress, history)
+      first = local_stress(stress(1, :))
+      do step = 2, 400
+        call honeycomb_step(material, increment, stress, history)
+      end do
+      local = local_stress(stress(1, :))
+      call check_close(suite, "honeycomb shear "//names(component - 3)//": elastic with 2 G_u", &
+                       first(component)/1.0e-4_wp, 2.0_wp*shear_moduli(component - 3), rel=1e-9_wp)
+      call check_close(suite, "honeycomb shear "//names(component - 3)//": held at its curve", &
+                       local(component), limits(component - 3), rel=1e-9_wp)
+      call check(suite, "honeycomb shear "//names(component - 3)//": uncoupled", &
+                 sum(abs(local)) - abs(local(component)) < 1.0e-12_wp)
+    end do
+  end subroutine test_honeycomb_shear_uncoupled
+
+  !> *MAT_126 (LCA > 0): the curves are read at the component's own logarithmic strain.
+  subroutine test_modified_honeycomb_strain_abscissa()
+    type(material_t) :: material
+    real(wp) :: stress(block_size, 6), history(block_size, 23), increment(6), local(6), worst, expected
+    integer :: step
+    material = honeycomb(law_modified_honeycomb)
+    stress = 0.0_wp
+    call initialize_material_history(material, 1, history)
+    increment = [0.0_wp, 0.0_wp, -1.0e-3_wp, 0.0_wp, 0.0_wp, 0.0_wp]
+    worst = 0.0_wp
+    do step = 1, 900
+      call honeycomb_step(material, increment, stress, history)
+      local = local_stress(stress(1, :))
+      if (step >= 100) then
+        expected = -curve_value(material%curves(3), 1.0e-3_wp*step)
+        worst = max(worst, abs(local(3)/expected - 1.0_wp))
+      end if
+    end do
+    call check(suite, "honeycomb 126: sigma_cc follows LCC at |eps_cc| within 1%", worst < 0.01_wp, &
+               "worst relative difference "//real_image(worst))
+  end subroutine test_modified_honeycomb_strain_abscissa
+
+  !> The material axes turn with the element: after a quarter turn about z, a = (-1, 1, 0)/sqrt 2.
+  subroutine test_honeycomb_axes_rotate()
+    type(material_t) :: material
+    real(wp) :: history(block_size, 23), spin(block_size, 3), rotation(block_size, 9)
+    material = honeycomb(law_honeycomb)
+    call initialize_material_history(material, 1, history)
+    spin = 0.0_wp
+    spin(1, 3) = 2.0_wp*tan(acos(-1.0_wp)/4.0_wp)
+    call incremental_rotation(1, spin, rotation)
+    call rotate_material_history(material, 1, rotation, history)
+    call check_close(suite, "honeycomb: axes a, b, c rotate with the element", &
+                     history(1, honeycomb_axes_first_slot:honeycomb_axes_first_slot + 8), &
+                     [-1.0_wp, 1.0_wp, 0.0_wp, -1.0_wp, -1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, sqrt(2.0_wp)]/sqrt(2.0_wp), &
+                     thr=1e-14_wp)
+  end subroutine test_honeycomb_axes_rotate
+
+  !> Uniaxial-strain compression to 60% nominal strain and back: loading on the curve within
+  !> 1%, unloading below it (HU = 0.2, SHAPE = 2), zero stress at zero strain.
+  subroutine test_foam_loading_unloading()
+    type(material_t) :: material
+    real(wp) :: stress(block_size, 6), history(block_size, 7), increment(block_size, 6), wave(block_size)
+    real(wp) :: loading(0:600), nominal, worst, below, largest_lateral
+    integer :: step
+    material%law = law_low_density_foam
+    material%density = 1.0e-10_wp
+    material%youngs_modulus = 1.0_wp
+    material%hysteretic_unloading = 0.2_wp
+    material%unloading_shape = 2.0_wp
+    material%curve_ids = [1]
+    allocate (material%curves(1))
+    material%curves(1) = make_curve(1, [0.0_wp, 0.05_wp, 0.5_wp, 0.7_wp], [0.0_wp, 0.1_wp, 0.15_wp, 1.0_wp])
+    call check(suite, "foam: 7 history variables", material_history_count(material) == 7)
+    call initialize_material_history(material, 1, history)
+    stress = 0.0_wp
+    increment = 0.0_wp
+    worst = 0.0_wp
+    largest_lateral = 0.0_wp
+    loading(0) = 0.0_wp
+    do step = 1, 600
+      nominal = -1.0e-3_wp*step
+      increment(1, 1) = log((1.0_wp + nominal)/(1.0_wp - 1.0e-3_wp*(step - 1)))
+      call update_material_block(material, 1, 1.0e-6_wp, increment, stress, history, wave)
+      loading(step) = stress(1, 1)
+      worst = max(worst, abs(stress(1, 1) + curve_value(material%curves(1), -nominal)) &
+                  /curve_value(material%curves(1), -nominal))
+      largest_lateral = max(largest_lateral, maxval(abs(stress(1, 2:6))))
+    end do
+    call check(suite, "foam: loading follows the curve within 1%", worst < 0.01_wp, &
+               "worst relative difference "//real_image(worst))
+    call check(suite, "foam: Poisson's ratio zero (no lateral stress)", largest_lateral < 1.0e-12_wp)
+    below = huge(1.0_wp)
+    do step = 599, 0, -1
+      nominal = -1.0e-3_wp*step
+      increment(1, 1) = log((1.0_wp + nominal)/(1.0_wp - 1.0e-3_wp*(step + 1)))
+      call update_material_block(material, 1, 1.0e-6_wp, increment, stress, history, wave)
+      if (step > 0 .and. step < 590) below = min(below, abs(loading(step)) - abs(stress(1, 1)))
+    end do
+    call check(suite, "foam: unloading lies below loading", below > 0.0_wp, "smallest gap "//real_image(below))
+    call check_close(suite, "foam: unloading ends at zero stress", stress(1, 1), 0.0_wp, thr=1.0e-9_wp)
+    call check_close(suite, "foam: wave modulus = steepest curve slope", wave(1), 0.85_wp/0.2_wp, rel=1e-12_wp)
+  end subroutine test_foam_loading_unloading
+
+  function real_image(value) result(text)
+    real(wp), intent(in) :: value
+    character(len=:), allocatable :: text
+    character(len=24) :: buffer
+    write (buffer, '(es12.4)') value
+    text = trim(adjustl(buffer))
+  end function real_image
 end program test_materials

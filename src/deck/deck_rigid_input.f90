@@ -1,0 +1,56 @@
+!> What the rigid-body keywords collect before the cross-check: *MAT_RIGID constraint cards,
+!> *BOUNDARY_PRESCRIBED_MOTION_RIGID lines, *CONSTRAINED_NODAL_RIGID_BODY lines and
+!> *ELEMENT_MASS lines, as written (ids, not indices), with the deck line of each.
+!> The readers are in deck_rigid_bodies; this module only holds the lists so that
+!> deck_input can keep them beside the rest of the input.
+module deck_rigid_input
+  use kinds, only: wp
+  implicit none
+  private
+
+  public :: rigid_input_t, rigid_material_input_t, rigid_motion_input_t, nodal_rigid_input_t
+  public :: element_mass_input_t
+
+  !> Card 2 of one *MAT_RIGID: the constraint codes, and the position of the material in
+  !> the input's material list.
+  type :: rigid_material_input_t
+    integer :: material = 0          !< position in input%model%materials
+    integer :: constraint_mode = 0   !< CMO: 0 none, 1 global (the only mode built)
+    integer :: translations = 0      !< CON1: 0-7 (0 none, 1 x, 2 y, 3 z, 4 xy, 5 yz, 6 zx, 7 xyz)
+    integer :: rotations = 0         !< CON2: same codes for the rotations
+    integer :: line = 0              !< card 2 (0: not given)
+  end type rigid_material_input_t
+
+  !> One *BOUNDARY_PRESCRIBED_MOTION_RIGID line.
+  type :: rigid_motion_input_t
+    integer :: part_id = 0
+    integer :: dof = 0               !< 1-3 translations, 5-7 rotations (as written)
+    integer :: kind = 0              !< VAD
+    integer :: curve_id = 0
+    real(wp) :: scale = 1.0_wp, birth = 0.0_wp, death = 1.0e28_wp
+    integer :: line = 0
+  end type rigid_motion_input_t
+
+  !> One *CONSTRAINED_NODAL_RIGID_BODY line.
+  type :: nodal_rigid_input_t
+    integer :: id = 0                !< PID
+    integer :: node_set = 0          !< NSID (PID when blank)
+    integer :: line = 0
+  end type nodal_rigid_input_t
+
+  !> One *ELEMENT_MASS line.
+  type :: element_mass_input_t
+    integer :: id = 0, node_id = 0
+    real(wp) :: mass = 0.0_wp
+    integer :: line = 0
+  end type element_mass_input_t
+
+  !> All rigid-body input; each list holds `*_count` entries and grows by doubling.
+  type :: rigid_input_t
+    integer :: material_count = 0, motion_count = 0, nodal_count = 0, mass_count = 0
+    type(rigid_material_input_t), allocatable :: materials(:)
+    type(rigid_motion_input_t), allocatable :: motions(:)
+    type(nodal_rigid_input_t), allocatable :: nodal(:)
+    type(element_mass_input_t), allocatable :: masses(:)
+  end type rigid_input_t
+end module deck_rigid_input

@@ -1,0 +1,165 @@
+!> *MAT_LOW_DENSITY_FOAM (LS-DYNA material 57) for solids: a hyperelastic-like foam whose
+!> principal stresses are uncoupled functions of the principal nominal strains (Poisson's
+!> ratio zero), with hysteretic unloading (LS-DYNA Keyword User's Manual Vol. II,
+!> *MAT_LOW_DENSITY_FOAM; LS-DYNA Theory Manual, "Material Model 57: Low Density Urethane
+!> Foam", after Storakers 1986 and Chang et al. 1995).
+!>
+!> What is computed (crashfree's reading of the manuals; see docs/materials.md):
+!> - the left Cauchy-Green tensor B = F F^T is tracked in the history: its Jaumann rate is
+!>   exactly D B + B D, so the element's objective rotation (rotate_material_history) and
+!>   B <- A B A^T with A = (I - D dt / 2)^-1 (I + D dt / 2) update it from the strain
+!>   increments alone;
+!> - principal stretches lambda_i = sqrt(eig(B)) with directions n_i, nominal strains
+!>   e_i = lambda_i - 1 (negative in compression);
+!> - nominal stresses: compression t_i = -h_i LCID(-e_i), tension t_i = min(E e_i, TC);
+!> - hysteretic unloading (HU < 1): h_i = 1 - (1 - HU) (1 - (-e_i / e_max)^SHAPE) when
+!>   -e_i < e_max, e_max the largest compressive principal nominal strain reached; h_i = 1 on
+!>   the loading curve (HU = 1: no dissipation);
+!> - Cauchy stress sigma = sum_i t_i / (lambda_j lambda_k) n_i n_i^T (t_i per unit reference
+!>   area; 1 for the lateral stretches of a uniaxial test with Poisson's ratio zero);
+!> - viscous damping DAMP: sigma += DAMP M D dt with M the stiffness bound of the wave speed
+!>   (LS-DYNA's q = DAMP rho c L D with L / c replaced by the time step). Being recomputed from
+!>   B every step, the stress carries no memory of it.
+module material_low_density_foam
+  use kinds, only: wp, block_size
+  use curves, only: curve_t, curve_value
+  implicit none
+  private
+
+  public :: low_density_foam_update, low_density_foam_initialize
+
+  !> History variables per integration point: B (6, xx yy zz xy yz zx), then e_max.
+  integer, parameter, public :: foam_history_count = 7
+  integer, parameter, public :: foam_left_cauchy_green_first_slot = 1
+  integer, parameter, public :: foam_largest_compression_slot = 7
+
+  integer, parameter :: jacobi_sweeps = 12
+
+contains
+
+  !> Undeformed state: B = I, no compression reached.
+  subroutine low_density_foam_initialize(nel, history)
+    integer, intent(in) :: nel
+    real(wp), intent(inout), contiguous :: history(:, :)
+    history(1:nel, :) = 0.0_wp
+    history(1:nel, 1:3) = 1.0_wp
+  end subroutine low_density_foam_initialize
+
+  !> Update of lanes 1..nel (stress is recomputed in total from B; see the module notes).
+  subroutine low_density_foam_update(nel, youngs_modulus, loading_curve, tension_cutoff, hysteretic_unloading, &
+                                     unloading_shape, damping, damping_modulus, strain_increment, stress, history)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: youngs_modulus
+    type(curve_t), intent(in) :: loading_curve
+    real(wp), intent(in) :: tension_cutoff, hysteretic_unloading, unloading_shape, damping, damping_modulus
+    real(wp), intent(in) :: strain_increment(block_size, 6)
+    real(wp), intent(inout) :: stress(block_size, 6)
+    real(wp), intent(inout), contiguous :: history(:, :)
+    real(wp) :: identity(3, 3), half_step(3, 3), update(3, 3), b(3, 3), vectors(3, 3), values(3)
+    real(wp) :: stretch(3), nominal_strain(3), nominal_stress(3), cauchy(3), largest, compression, factor
+    real(wp) :: result(3, 3), lane(6)
+    integer :: i, k
+
+    identity = reshape([1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [3, 3])
+    do i = 1, nel
+      lane = strain_increment(i, :)
+      half_step = 0.5_wp*unpacked(lane)
+      update = matmul(inverse3(identity - half_step), identity + half_step)
+      lane = history(i, 1:6)
+      b = matmul(update, matmul(unpacked(lane), transpose(update)))
+      history(i, 1:6) = packed(b)
+      call symmetric_eigen(b, values, vectors)
+      stretch = sqrt(max(values, tiny(1.0_wp)))
+      nominal_strain = stretch - 1.0_wp
+      largest = max(history(i, foam_largest_compression_slot), maxval(-nominal_strain))
+      history(i, foam_largest_compression_slot) = largest
+      do k = 1, 3
+        if (nominal_strain(k) < 0.0_wp) then
+          compression = -nominal_strain(k)
+          factor = 1.0_wp
+          if (hysteretic_unloading < 1.0_wp .and. compression < largest) &
+            factor = 1.0_wp - (1.0_wp - hysteretic_unloading)*(1.0_wp - (compression/largest)**unloading_shape)
+          nominal_stress(k) = -factor*curve_value(loading_curve, compression)
+        else
+          nominal_stress(k) = min(youngs_modulus*nominal_strain(k), tension_cutoff)
+        end if
+      end do
+      cauchy(1) = nominal_stress(1)/(stretch(2)*stretch(3))
+      cauchy(2) = nominal_stress(2)/(stretch(3)*stretch(1))
+      cauchy(3) = nominal_stress(3)/(stretch(1)*stretch(2))
+      result = 0.0_wp
+      do k = 1, 3
+        result = result + cauchy(k)*spread(vectors(:, k), 2, 3)*spread(vectors(:, k), 1, 3)
+      end do
+      stress(i, :) = packed(result) + damping*damping_modulus*strain_increment(i, :)
+    end do
+  end subroutine low_density_foam_update
+
+  !> Eigenvalues and eigenvectors (columns) of a symmetric 3x3 matrix by cyclic Jacobi
+  !> rotations (converges quadratically; a fixed sweep count keeps the kernel branch-light).
+  pure subroutine symmetric_eigen(matrix, values, vectors)
+    real(wp), intent(in) :: matrix(3, 3)
+    real(wp), intent(out) :: values(3), vectors(3, 3)
+    real(wp) :: a(3, 3), theta, t, c, s, rotation(3, 3), scale
+    integer :: sweep, p, q
+    a = matrix
+    vectors = 0.0_wp
+    vectors(1, 1) = 1.0_wp
+    vectors(2, 2) = 1.0_wp
+    vectors(3, 3) = 1.0_wp
+    scale = max(maxval(abs(matrix)), tiny(1.0_wp))
+    do sweep = 1, jacobi_sweeps
+      if (abs(a(1, 2)) + abs(a(2, 3)) + abs(a(1, 3)) <= 1.0e-15_wp*scale) exit
+      do p = 1, 2
+        do q = p + 1, 3
+          if (abs(a(p, q)) <= 1.0e-300_wp) cycle
+          theta = (a(q, q) - a(p, p))/(2.0_wp*a(p, q))
+          t = sign(1.0_wp, theta)/(abs(theta) + sqrt(theta*theta + 1.0_wp))
+          c = 1.0_wp/sqrt(t*t + 1.0_wp)
+          s = t*c
+          rotation = 0.0_wp
+          rotation(1, 1) = 1.0_wp
+          rotation(2, 2) = 1.0_wp
+          rotation(3, 3) = 1.0_wp
+          rotation(p, p) = c
+          rotation(q, q) = c
+          rotation(p, q) = s
+          rotation(q, p) = -s
+          a = matmul(transpose(rotation), matmul(a, rotation))
+          vectors = matmul(vectors, rotation)
+        end do
+      end do
+    end do
+    values = [a(1, 1), a(2, 2), a(3, 3)]
+  end subroutine symmetric_eigen
+
+  pure function inverse3(m) result(inverse)
+    real(wp), intent(in) :: m(3, 3)
+    real(wp) :: inverse(3, 3), determinant
+    inverse(1, 1) = m(2, 2)*m(3, 3) - m(2, 3)*m(3, 2)
+    inverse(1, 2) = m(1, 3)*m(3, 2) - m(1, 2)*m(3, 3)
+    inverse(1, 3) = m(1, 2)*m(2, 3) - m(1, 3)*m(2, 2)
+    inverse(2, 1) = m(2, 3)*m(3, 1) - m(2, 1)*m(3, 3)
+    inverse(2, 2) = m(1, 1)*m(3, 3) - m(1, 3)*m(3, 1)
+    inverse(2, 3) = m(1, 3)*m(2, 1) - m(1, 1)*m(2, 3)
+    inverse(3, 1) = m(2, 1)*m(3, 2) - m(2, 2)*m(3, 1)
+    inverse(3, 2) = m(1, 2)*m(3, 1) - m(1, 1)*m(3, 2)
+    inverse(3, 3) = m(1, 1)*m(2, 2) - m(1, 2)*m(2, 1)
+    determinant = m(1, 1)*inverse(1, 1) + m(1, 2)*inverse(2, 1) + m(1, 3)*inverse(3, 1)
+    inverse = inverse/determinant
+  end function inverse3
+
+  pure function unpacked(tensor) result(matrix)
+    real(wp), intent(in) :: tensor(6)
+    real(wp) :: matrix(3, 3)
+    matrix = reshape([tensor(1), tensor(4), tensor(6), tensor(4), tensor(2), tensor(5), &
+                      tensor(6), tensor(5), tensor(3)], [3, 3])
+  end function unpacked
+
+  pure function packed(matrix) result(tensor)
+    real(wp), intent(in) :: matrix(3, 3)
+    real(wp) :: tensor(6)
+    tensor = [matrix(1, 1), matrix(2, 2), matrix(3, 3), 0.5_wp*(matrix(1, 2) + matrix(2, 1)), &
+              0.5_wp*(matrix(2, 3) + matrix(3, 2)), 0.5_wp*(matrix(3, 1) + matrix(1, 3))]
+  end function packed
+end module material_low_density_foam
