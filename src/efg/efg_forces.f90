@@ -175,7 +175,7 @@ contains
     type(efg_block_t), intent(inout) :: block
     real(wp), intent(in) :: displacement(:, :), velocity(:, :)
     real(wp), intent(in) :: dt
-    real(wp), intent(inout) :: point_stress(:, :)
+    real(wp), intent(inout), contiguous :: point_stress(:, :)
     real(wp), intent(out) :: critical_time_step
     integer, intent(out) :: critical_point, inverted_point
     real(wp) :: gradient(block_size, 9), volumetric_rate(block_size), strain_increment(block_size, 6)
@@ -184,7 +184,7 @@ contains
     real(wp) :: current_density(block_size), sound_speed(block_size), cell_volume(block_size)
     real(wp) :: bulk_viscosity(block_size), length(block_size), unit_area(block_size)
     real(wp) :: point_time_step(block_size), deformation(3, 3, block_size), reference_density(block_size)
-    real(wp) :: rate(3, 3, block_size), point_gradient(9), mean_step, old_power, new_power
+    real(wp) :: rate(3, 3, block_size), point_gradient(9), mean_step, old_power, new_power, lane_stress(6)
     integer :: nel, i, g
 
     nel = block%point_count
@@ -223,7 +223,9 @@ contains
     do i = 1, nel
       g = block%first_point + i - 1
       old_power = stress_power(point_stress(:, g), rate(:, :, i))
-      call store_point_stress(geometry%point_volume(g), deformation(:, :, i), jacobian(i), block%stress(i, :), &
+      ! a contiguous copy of the lane's stress: no array temporary in the hot loop
+      lane_stress = block%stress(i, :)
+      call store_point_stress(geometry%point_volume(g), deformation(:, :, i), jacobian(i), lane_stress, &
                               bulk_viscosity(i), point_stress(:, g))
       new_power = stress_power(point_stress(:, g), rate(:, :, i))
       block%internal_energy(i) = block%internal_energy(i) + 0.5_wp*mean_step*(block%force_power(i) + old_power) &
