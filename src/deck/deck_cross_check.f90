@@ -17,6 +17,7 @@ module deck_cross_check
   use deck_element_check, only: check_hexahedron, shape_inside_out, shape_flat
   use deck_efg_cards, only: elform_efg
   use deck_material_curves, only: resolve_material_curves, apply_material_bulk_viscosity
+  use deck_rigid_bodies, only: build_rigid_bodies
   implicit none
   private
 
@@ -56,6 +57,7 @@ contains
     call build_segment_loads(deck, input, indices, log)
     call build_initial_velocities(deck, input, indices, log)
     call build_walls(deck, input, indices, log)
+    call build_rigid_bodies(deck, input, log)
     call build_history_nodes(deck, input, indices, log, warnings)
     call check_mesh(deck, input, mesh_resolved, log)
     call check_controls(deck, input, log)

@@ -44,6 +44,8 @@ module deck_reader
     read_implicit_solution
   use deck_database, only: read_plot_output, read_history_output, read_history_nodes
   use deck_cross_check, only: check_and_build
+  use deck_rigid_bodies, only: identify_rigid_keyword, read_rigid_block, rigid_keyword_first, &
+    rigid_keyword_last
   implicit none
   private
 
@@ -71,6 +73,8 @@ contains
     allocate (keywords(deck%block_count))
     do block = 1, deck%block_count
       keywords(block) = identify_keyword(deck%blocks(block)%name)
+      if (keywords(block)%code == keyword_unknown) keywords(block) = &
+        identify_rigid_keyword(deck%blocks(block)%name)
       if (keywords(block)%code == keyword_unknown) call report_unknown(deck, block, &
         ignore_unknown, log, warnings)
     end do
@@ -120,7 +124,7 @@ contains
     blocks = 0
     do block = 1, deck%block_count
       code = keywords(block)%code
-      if (code == keyword_unknown) cycle
+      if (code == keyword_unknown .or. code > keyword_count) cycle
       blocks(code) = blocks(code) + 1
       lines(code) = lines(code) + max(0, deck%blocks(block)%last_line - &
                                       deck%blocks(block)%first_line + 1)
@@ -209,6 +213,8 @@ contains
     case (keyword_history_node, keyword_history_node_set)
       call read_history_nodes(deck, block, keyword, keyword%code == keyword_history_node_set, &
                               input, log)
+    case (rigid_keyword_first:rigid_keyword_last)
+      call read_rigid_block(deck, block, keyword, input, log, warnings)
     end select
   end subroutine read_block
 end module deck_reader

@@ -11,6 +11,7 @@ module model
 
   public :: model_t, material_t, section_t, hourglass_t, part_t, node_set_t, part_set_t
   public :: spc_t, prescribed_motion_t, nodal_load_t, segment_load_t, rigid_wall_t, output_control_t
+  public :: rigid_body_t, rigid_motion_t
 
   !> Material laws, numbered as LS-DYNA numbers them.
   integer, parameter, public :: law_elastic = 1
@@ -18,6 +19,7 @@ module model
   integer, parameter, public :: law_honeycomb = 26            !< *MAT_HONEYCOMB
   integer, parameter, public :: law_low_density_foam = 57     !< *MAT_LOW_DENSITY_FOAM
   integer, parameter, public :: law_modified_honeycomb = 126  !< *MAT_MODIFIED_HONEYCOMB
+  integer, parameter, public :: law_rigid = 20                !< *MAT_RIGID (parts become rigid bodies)
 
   !> Curve slots of the crushable laws in material_t%curves (after the deck's defaults, such as
   !> LCB = 0 -> LCA, are applied): the six yield curves in stress order aa, bb, cc, ab, bc, ca,
@@ -189,6 +191,27 @@ module model
     logical :: forces_requested = .false.     !< _FORCES option
   end type rigid_wall_t
 
+  !> One rigid body: a *MAT_RIGID part (its elements' nodes) or a *CONSTRAINED_NODAL_RIGID_BODY
+  !> (its node set's nodes). A node belongs to at most one body.
+  type :: rigid_body_t
+    integer :: id = 0                        !< part id (PID of a nodal rigid body): rbdout/<id>
+    integer :: part = 0                      !< part index; 0 for a nodal rigid body
+    integer, allocatable :: nodes(:)         !< node indices, ascending
+    logical :: fixed(6) = .false.            !< CMO = 1: x, y, z (CON1), rx, ry, rz (CON2), global axes
+  end type rigid_body_t
+
+  !> One prescribed motion of a rigid body (*BOUNDARY_PRESCRIBED_MOTION_RIGID) at its centre
+  !> of mass, in global axes.
+  type :: rigid_motion_t
+    integer :: body = 0                      !< index into model%rigid_bodies
+    integer :: dof = 0                       !< 1-3 translation x, y, z; 4-6 rotation about x, y, z
+    integer :: kind = motion_velocity        !< VAD
+    integer :: curve = 0                     !< index into model%curves
+    real(wp) :: scale = 1.0_wp               !< SF
+    real(wp) :: birth = 0.0_wp
+    real(wp) :: death = 1.0e28_wp
+  end type rigid_motion_t
+
   !> Output intervals and requests (*DATABASE_...). An interval of 0 means "not requested".
   type :: output_control_t
     real(wp) :: state_interval = 0.0_wp      !< *DATABASE_BINARY_D3PLOT DT (or ENDTIM/NPLTC)
@@ -225,6 +248,10 @@ module model
     type(nodal_load_t), allocatable :: loads(:)
     type(segment_load_t), allocatable :: segment_loads(:)
     type(rigid_wall_t), allocatable :: walls(:)
+    ! rigid bodies and lumped masses (deck_rigid_bodies)
+    type(rigid_body_t), allocatable :: rigid_bodies(:)
+    type(rigid_motion_t), allocatable :: rigid_motions(:)
+    real(wp), allocatable :: node_masses(:)          !< *ELEMENT_MASS per node (nodes)
     ! controls
     logical :: implicit_static = .false.             !< *CONTROL_IMPLICIT_GENERAL IMFLAG = 1: linear static
     real(wp) :: end_time = 0.0_wp                    !< ENDTIM

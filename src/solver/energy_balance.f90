@@ -1,7 +1,9 @@
 !> Energies of the whole model and of each part (glstat, matsum), summed in a fixed order.
 module energy_balance
   use kinds, only: wp, block_size
+  use model, only: model_t
   use explicit_state, only: explicit_state_t
+  use rigid_bodies, only: rigid_body_energy
   implicit none
   private
 
@@ -20,8 +22,10 @@ contains
   !> a linear system, whereas 1/2 m (v^n)^2 overstates the energy of high-frequency modes by up to
   !> (omega dt)^2 / 4 and looks like a drift (Belytschko, Liu & Moran, Nonlinear Finite Elements,
   !> section 6.2.3).
-  subroutine update_energy_totals(state)
+  subroutine update_energy_totals(model, state)
+    type(model_t), intent(in) :: model
     type(explicit_state_t), intent(inout) :: state
+    real(wp) :: body_kinetic, body_momentum(3), body_angular_momentum(3), body_velocity(3)
     integer :: chunk_count, chunk, first, last, node, b, k
     real(wp) :: partial(4, max(1, (state%node_count + chunk_size - 1)/chunk_size)), velocity(3), next_velocity(3)
     real(wp) :: half_step, average_step, step_correction
@@ -38,6 +42,7 @@ contains
       last = min(chunk*chunk_size, state%node_count)
       partial(:, chunk) = 0.0_wp
       do node = first, last
+        if (state%is_rigid_node(node)) cycle   ! moves with its body (below)
         next_velocity = state%velocity(:, node) + average_step*state%acceleration(:, node)
         partial(1, chunk) = partial(1, chunk) + state%mass(node)*dot_product(state%velocity(:, node), next_velocity)
         velocity = state%velocity(:, node) + half_step*state%acceleration(:, node)
@@ -50,6 +55,13 @@ contains
     do chunk = 1, chunk_count
       state%energy%kinetic = state%energy%kinetic + 0.5_wp*partial(1, chunk)
       state%energy%momentum = state%energy%momentum + partial(2:4, chunk)
+    end do
+    ! rigid bodies: translation and rotation of each body
+    do b = 1, size(state%rigid)
+      call rigid_body_energy(model, b, state%rigid(b), state%acceleration, state%mass, half_step, average_step, &
+                             body_kinetic, body_momentum, body_angular_momentum, body_velocity)
+      state%energy%kinetic = state%energy%kinetic + body_kinetic
+      state%energy%momentum = state%energy%momentum + body_momentum
     end do
     ! moving rigid walls are bodies of the model
     do b = 1, size(state%walls)
@@ -81,8 +93,10 @@ contains
   !> Kinetic, internal and hourglass energy of each part (indexed like model%parts), measured
   !> as the totals are. A node's kinetic energy is shared among parts in proportion to the
   !> mass each element gives it.
-  subroutine part_energies(state, part_count, kinetic, internal, hourglass)
+  subroutine part_energies(model, state, part_count, kinetic, internal, hourglass)
+    type(model_t), intent(in) :: model
     type(explicit_state_t), intent(in) :: state
+    real(wp) :: body_kinetic, body_momentum(3), body_angular_momentum(3), body_velocity(3)
     integer, intent(in) :: part_count
     real(wp), intent(out) :: kinetic(part_count), internal(part_count), hourglass(part_count)
     integer :: b, k, corner, lane, node
@@ -108,6 +122,14 @@ contains
           end do
         end do
       end associate
+    end do
+    ! a rigid part's kinetic energy is its body's (the corner masses of deformable elements at
+    ! the body's nodes move with the body and count in both parts)
+    do b = 1, size(state%rigid)
+      if (model%rigid_bodies(b)%part == 0) cycle
+      call rigid_body_energy(model, b, state%rigid(b), state%acceleration, state%mass, 0.5_wp*state%time_step, &
+                             average_step, body_kinetic, body_momentum, body_angular_momentum, body_velocity)
+      kinetic(model%rigid_bodies(b)%part) = kinetic(model%rigid_bodies(b)%part) + body_kinetic
     end do
     do k = 1, size(state%efg)
       associate (efg => state%efg(k), part => state%efg(k)%geometry%part)

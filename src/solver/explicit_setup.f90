@@ -13,6 +13,7 @@ module explicit_setup
   use explicit_state, only: explicit_state_t
   use boundary_conditions, only: fixed_dof_mask
   use planar_rigid_walls, only: initialise_wall_states
+  use rigid_bodies, only: set_up_rigid_bodies, add_node_masses
   implicit none
   private
 
@@ -57,6 +58,7 @@ contains
     call lump_nodal_masses(state)
     call set_up_meshfree_parts(model, state, error)
     if (allocated(error)) return
+    call set_up_rigid_state(model, state)
     call initialise_wall_states(model%walls, state%walls)
     if (sum(state%mass) <= 0.0_wp) then
       call make_error(error, "model: the elements give no mass (check densities and element volumes)")
@@ -169,6 +171,25 @@ contains
       end do
     end do
   end subroutine lump_nodal_masses
+
+  !> *ELEMENT_MASS and the rigid bodies: their mass properties, stable step and initial motion
+  !> (rigid_bodies), once the elements have lumped their masses.
+  subroutine set_up_rigid_state(model, state)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(inout) :: state
+    real(wp) :: rigid_mass
+    integer :: b
+    call add_node_masses(model, state%mass)
+    if (allocated(model%node_masses)) state%physical_mass = state%physical_mass + sum(model%node_masses)
+    allocate (state%is_rigid_node(state%node_count))
+    call set_up_rigid_bodies(model, state%reference, state%mass, state%velocity, state%is_rigid_node, &
+                             state%rigid, rigid_mass)
+    state%physical_mass = state%physical_mass + rigid_mass
+    state%rigid_time_step = huge(1.0_wp)
+    do b = 1, size(state%rigid)
+      state%rigid_time_step = min(state%rigid_time_step, state%rigid(b)%time_step)
+    end do
+  end subroutine set_up_rigid_state
 
   !> Shape functions, smoothed gradients and row-sum masses of every EFG part (formulation
   !> sections 2-5), once, on the undeformed mesh.

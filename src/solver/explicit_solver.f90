@@ -10,6 +10,7 @@ module explicit_solver
   use boundary_conditions, only: assemble_nodal_loads, load_work, impose_kinematic_conditions, &
                                  hold_prescribed_accelerations
   use planar_rigid_walls, only: enforce_planar_walls
+  use rigid_bodies, only: advance_rigid_bodies
   use energy_balance, only: update_energy_totals, total_energy
   use run_output, only: output_plan_t, plan_output, write_due_output
   use history_buffer, only: history_set_t
@@ -53,7 +54,7 @@ contains
     call compute_accelerations(state)
     call hold_prescribed_accelerations(model, 0.0_wp, state%acceleration, state%free_acceleration)
     call select_time_step(model, state, is_first=.true.)
-    call update_energy_totals(state)
+    call update_energy_totals(model, state)
     state%energy%initial_total = total_energy(state)
     call check_state(model, state, error)
     finished = allocated(error) .or. model%end_time <= 0.0_wp .and. model%end_cycle <= 0
@@ -82,6 +83,11 @@ contains
                                   state%velocity, work)
         call stop_phase(contact_timer)
         state%energy%rigid_wall = state%energy%rigid_wall + work
+      end if
+      if (size(state%rigid) > 0) then
+        call advance_rigid_bodies(model, state%rigid, state%time, step, 0.5_wp*(previous_step + step), &
+                                  state%coordinates, state%velocity, work)
+        state%energy%external_work = state%energy%external_work + work
       end if
       call update_positions(state, step)
       state%energy%external_work = state%energy%external_work + &
@@ -189,6 +195,11 @@ contains
         end if
       end do
     end do
+    ! rigid elements: the step of an elastic element with their E, PR and RO (constant)
+    if (state%rigid_time_step < smallest) then
+      smallest = state%rigid_time_step
+      critical = 0
+    end if
     state%next_time_step = model%time_step_scale*smallest
     state%controlling_element = critical
     if (is_first .and. model%initial_time_step > 0.0_wp) &

@@ -11,6 +11,7 @@ module explicit_state
   use gather_list, only: gather_list_t
   use solid_block, only: solid_block_t
   use efg_forces, only: efg_solver_t
+  use rigid_body_state, only: rigid_body_state_t
   implicit none
   private
 
@@ -70,6 +71,10 @@ module explicit_state
     logical, allocatable :: is_particle(:)               !< interior particle of an EFG part
     ! walls
     type(wall_state_t), allocatable :: walls(:)
+    ! rigid bodies (indexed like model%rigid_bodies); their nodes move with them
+    type(rigid_body_state_t), allocatable :: rigid(:)
+    logical, allocatable :: is_rigid_node(:)
+    real(wp) :: rigid_time_step = huge(1.0_wp)           !< smallest stable step of the rigid elements
     ! bookkeeping
     type(energy_totals_t) :: energy
     real(wp) :: added_mass = 0.0_wp                      !< by mass scaling

@@ -14,6 +14,7 @@ module run_output
   use solid_block, only: solid_block_element_results
   use efg_forces, only: efg_point_results, transform_to_physical
   use results_file, only: results_file_t, write_state, write_histories
+  use rigid_bodies, only: rigid_body_history_row
   implicit none
   private
 
@@ -28,11 +29,13 @@ module run_output
 
   !> Clocks and the positions of the history series.
   type :: output_plan_t
-    type(output_clock_t) :: states, glstat, matsum, nodout, rwforc
+    type(output_clock_t) :: states, glstat, matsum, nodout, rwforc, rbdout
     integer :: glstat_series = 0
     integer, allocatable :: matsum_series(:)     !< per part
     integer, allocatable :: nodout_series(:)     !< per history node
     integer, allocatable :: rwforc_series(:)     !< per wall
+    integer, allocatable :: rbdout_series(:)     !< per rigid body
+    real(wp) :: last_rbdout_time = 0.0_wp
     real(wp) :: last_rwforc_time = 0.0_wp
     ! work arrays for the element results of a state, allocated once
     real(wp), allocatable :: solid_stress(:, :), solid_plastic_strain(:)
@@ -101,6 +104,22 @@ contains
                                 [1, 3], capacity, plan%rwforc_series(k))
       end do
     end if
+    ! rbdout: every rigid body, at the glstat interval
+    allocate (plan%rbdout_series(0))
+    if (allocated(model%rigid_bodies)) then
+      call set_clock(plan%rbdout, 0.0_wp, plan%glstat%interval, size(model%rigid_bodies) > 0)
+      if (plan%rbdout%active) then
+        capacity = expected_rows(model, plan%rbdout)
+        deallocate (plan%rbdout_series)
+        allocate (plan%rbdout_series(size(model%rigid_bodies)))
+        do k = 1, size(model%rigid_bodies)
+          write (label, '(i0)') model%rigid_bodies(k)%id
+          call add_history_series(histories, "rbdout/"//trim(label), [character(len=32) :: "time", &
+                                  "displacement", "velocity", "force", "angular_momentum"], [1, 3, 3, 3, 3], &
+                                  capacity, plan%rbdout_series(k))
+        end do
+      end if
+    end if
     allocate (plan%solid_stress(6, size(model%solid_ids)), plan%solid_plastic_strain(size(model%solid_ids)))
     allocate (plan%node_velocity(3, size(model%node_ids)), plan%node_displacement(3, size(model%node_ids)), &
               plan%generalized_velocity(3, size(model%node_ids)), plan%node_acceleration(3, size(model%node_ids)))
@@ -162,7 +181,7 @@ contains
     wrote_state = .false.
     glstat_due = clock_due(plan%glstat, state%time, last)
     matsum_due = clock_due(plan%matsum, state%time, last)
-    if (glstat_due .or. matsum_due) call update_energy_totals(state)
+    if (glstat_due .or. matsum_due) call update_energy_totals(model, state)
     if (glstat_due) then
       call append_history_row(histories%series(plan%glstat_series), [state%time, &
         merge(state%next_time_step, state%time_step, state%cycle == 0), &
@@ -171,7 +190,7 @@ contains
         state%added_mass, state%energy%momentum])
     end if
     if (matsum_due) then
-      call part_energies(state, size(model%parts), plan%part_kinetic, plan%part_internal, plan%part_hourglass)
+      call part_energies(model, state, size(model%parts), plan%part_kinetic, plan%part_internal, plan%part_hourglass)
       do k = 1, size(model%parts)
         call append_history_row(histories%series(plan%matsum_series(k)), [state%time, plan%part_kinetic(k), &
                                 plan%part_internal(k), plan%part_hourglass(k)])
@@ -189,6 +208,7 @@ contains
       end do
     end if
     if (clock_due(plan%rwforc, state%time, last)) call record_wall_forces(state, plan, histories)
+    if (clock_due(plan%rbdout, state%time, last)) call record_rigid_bodies(model, state, plan, histories)
     if (states_due) then
       call write_current_state(model, state, plan, results, error)
       if (allocated(error)) return
@@ -214,6 +234,22 @@ contains
     end do
     plan%last_rwforc_time = state%time
   end subroutine record_wall_forces
+
+  !> One rbdout row per rigid body (the force is the impulse since the last row / interval).
+  subroutine record_rigid_bodies(model, state, plan, histories)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(inout) :: state
+    type(output_plan_t), intent(inout) :: plan
+    type(history_set_t), intent(inout) :: histories
+    real(wp) :: row(13)
+    integer :: k
+    do k = 1, size(plan%rbdout_series)
+      call rigid_body_history_row(model, k, state%rigid(k), state%acceleration, state%mass, state%time, &
+                                  0.5_wp*state%time_step, state%time - plan%last_rbdout_time, row)
+      call append_history_row(histories%series(plan%rbdout_series(k)), row)
+    end do
+    plan%last_rbdout_time = state%time
+  end subroutine record_rigid_bodies
 
   !> Physical nodal displacements, integer-step velocities and accelerations: the solver's values, with the
   !> interior particles of meshfree parts transformed (eq. 16) so that the output shows the

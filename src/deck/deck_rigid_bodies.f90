@@ -1,0 +1,613 @@
+!> Rigid bodies in the deck: *MAT_RIGID (*MAT_020), *BOUNDARY_PRESCRIBED_MOTION_RIGID,
+!> *CONSTRAINED_NODAL_RIGID_BODY and *ELEMENT_MASS: the readers, and the cross-check step that
+!> turns them into `model%rigid_bodies`, `model%rigid_motions` and `model%node_masses`.
+!>
+!> A part whose material is *MAT_RIGID gets `formulation_rigid`: its elements give the body
+!> its mass and inertia and get no finite-element block (LS-DYNA Keyword Manual, *MAT_RIGID;
+!> LS-DYNA Theory Manual, "Rigid Body Dynamics"). The keywords are identified here, not in
+!> deck_keywords, so that their codes (`rigid_keyword_first`..) stay out of the per-keyword
+!> line counts; deck_reader hands their blocks to `read_rigid_block`.
+module deck_rigid_bodies
+  use kinds, only: wp
+  use error_handling, only: error_list_t
+  use model, only: material_t, rigid_body_t, rigid_motion_t, law_rigid, formulation_rigid, &
+                   motion_velocity, motion_acceleration, motion_displacement
+  use deck_problems, only: problem_log_t, report_problem
+  use deck_numbers, only: integer_text, real_text
+  use deck_lexer, only: deck_t
+  use deck_keywords, only: keyword_t, keyword_unknown
+  use deck_fields, only: card_t, next_definition, next_line, open_card, get_integer, get_real, &
+                         card_problem, field_is_blank, warn_if_set, id_heading, located_problem
+  use deck_id_index, only: id_index_t, build_id_index, find_id
+  use deck_input, only: deck_input_t
+  use deck_rigid_input, only: rigid_material_input_t, rigid_motion_input_t, nodal_rigid_input_t, &
+                              element_mass_input_t
+  implicit none
+  private
+
+  public :: identify_rigid_keyword, read_rigid_block, build_rigid_bodies
+
+  !> Codes of the rigid-body keywords (beyond deck_keywords' range).
+  integer, parameter, public :: keyword_mat_rigid = 1001, keyword_motion_rigid = 1002, &
+    keyword_nodal_rigid_body = 1003, keyword_element_mass = 1004
+  integer, parameter, public :: rigid_keyword_first = 1001, rigid_keyword_last = 1004
+
+  integer, parameter :: standard_widths(8) = 10
+  integer, parameter :: mass_widths(4) = [8, 8, 16, 8]
+  !> Dofs switched on by the CON1 / CON2 codes 0-7 (x, y, z).
+  logical, parameter :: code_dofs(3, 0:7) = reshape([ &
+    .false., .false., .false., .true., .false., .false., .false., .true., .false., &
+    .false., .false., .true., .true., .true., .false., .false., .true., .true., &
+    .true., .false., .true., .true., .true., .true.], [3, 8])
+  character(len=2), parameter :: dof_names(6) = ["x ", "y ", "z ", "rx", "ry", "rz"]
+
+contains
+
+  !> The rigid-body keyword `name` (upper case, no `*`) with its options, or code
+  !> `keyword_unknown`.
+  pure function identify_rigid_keyword(name) result(keyword)
+    character(len=*), intent(in) :: name
+    type(keyword_t) :: keyword
+    select case (name)
+    case ("MAT_RIGID", "MAT_020")
+      keyword%code = keyword_mat_rigid
+    case ("MAT_RIGID_TITLE", "MAT_020_TITLE")
+      keyword%code = keyword_mat_rigid
+      keyword%title = .true.
+    case ("BOUNDARY_PRESCRIBED_MOTION_RIGID")
+      keyword%code = keyword_motion_rigid
+    case ("BOUNDARY_PRESCRIBED_MOTION_RIGID_ID")
+      keyword%code = keyword_motion_rigid
+      keyword%id = .true.
+    case ("CONSTRAINED_NODAL_RIGID_BODY")
+      keyword%code = keyword_nodal_rigid_body
+    case ("CONSTRAINED_NODAL_RIGID_BODY_TITLE")
+      keyword%code = keyword_nodal_rigid_body
+      keyword%title = .true.
+    case ("ELEMENT_MASS")
+      keyword%code = keyword_element_mass
+    case default
+      keyword%code = keyword_unknown
+    end select
+  end function identify_rigid_keyword
+
+  !> Read one block of a rigid-body keyword.
+  subroutine read_rigid_block(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    select case (keyword%code)
+    case (keyword_mat_rigid)
+      call read_rigid_materials(deck, block, keyword, input, log, warnings)
+    case (keyword_motion_rigid)
+      call read_rigid_motions(deck, block, keyword, input, log)
+    case (keyword_nodal_rigid_body)
+      call read_nodal_rigid_bodies(deck, block, keyword, input, log, warnings)
+    case (keyword_element_mass)
+      call read_element_masses(deck, block, input, log, warnings)
+    end select
+  end subroutine read_rigid_block
+
+  !> *MAT_RIGID: card 1 MID RO E PR N COUPLE M ALIAS; card 2 CMO CON1 CON2 SPCNID XSPC YSPC
+  !> ZSPC; card 3 LCO/A1 A2 A3 V1 V2 V3 BNDLCO (read over: output axes only). Cards 2 and 3
+  !> may be left out at the end of the keyword. E and PR give the time step of the rigid
+  !> elements (LS-DYNA uses them for contact stiffness).
+  subroutine read_rigid_materials(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    type(rigid_material_input_t) :: entry
+    integer :: line, n, spc_node
+    real(wp) :: mode, translations, rotations
+    character(len=:), allocatable :: title
+
+    line = 0
+    do while (next_definition(deck, block, keyword%title, line, standard_widths, card, title, &
+                              log, "card 1 (MID RO E PR N COUPLE M ALIAS)", "MID"))
+      call reserve_material(input)
+      n = input%material_count + 1
+      input%material_count = n
+      input%material_lines(n) = line
+      entry = rigid_material_input_t(material=n)
+      associate (material => input%model%materials(n))
+        material%law = law_rigid
+        material%title = title
+        call get_integer(deck, card, 1, "MID", material%id, log)
+        call get_real(deck, card, 2, "RO", material%density, log)
+        call get_real(deck, card, 3, "E", material%youngs_modulus, log)
+        call get_real(deck, card, 4, "PR", material%poissons_ratio, log)
+        if (.not. card%failed) then
+          if (material%id <= 0) call card_problem(deck, log, card, "MID", "must be a positive id, found "// &
+                                                  integer_text(material%id))
+          if (.not. material%density > 0.0_wp) call card_problem(deck, log, card, "RO", &
+            "the density must be positive (it gives the rigid body its mass), found "//real_text(material%density))
+          if (.not. material%youngs_modulus > 0.0_wp) call card_problem(deck, log, card, "E", &
+            "must be positive (it sets the time step of the rigid elements; give a realistic value), found "// &
+            real_text(material%youngs_modulus))
+          if (.not. (material%poissons_ratio >= 0.0_wp .and. material%poissons_ratio < 0.5_wp)) &
+            call card_problem(deck, log, card, "PR", "must lie in [0, 0.5), found "// &
+                              real_text(material%poissons_ratio))
+        end if
+        if (.not. field_is_blank(deck, card, 5)) call no_coupling("N")
+        if (.not. field_is_blank(deck, card, 6)) call no_coupling("COUPLE")
+        if (.not. field_is_blank(deck, card, 7)) call no_coupling("M")
+      end associate
+      ! card 2 (optional at the end of the keyword)
+      if (next_line(deck, block, line, .false.)) then
+        call open_card(deck, block, line, standard_widths, card, log)
+        entry%line = line
+        call get_real(deck, card, 1, "CMO", mode, log)
+        call get_real(deck, card, 2, "CON1", translations, log)
+        call get_real(deck, card, 3, "CON2", rotations, log)
+        call get_integer(deck, card, 4, "SPCNID", spc_node, log)
+        if (.not. card%failed) then
+          entry%constraint_mode = nint(mode)
+          select case (entry%constraint_mode)
+          case (0)
+          case (1)
+            entry%translations = check_code(translations, "CON1")
+            entry%rotations = check_code(rotations, "CON2")
+          case (-1)
+            call card_problem(deck, log, card, "CMO", "-1 (constraints in a local coordinate system CON1 "// &
+              "with the mask CON2) is not available; use CMO = 1 with global codes in CON1 and CON2")
+          case (2, -2)
+            if (spc_node /= 0) then
+              call card_problem(deck, log, card, "SPCNID", "constraints at a node (|CMO| = 2) are not "// &
+                "available; use CMO = 1 (constraints at the centre of mass)")
+            else
+              call card_problem(deck, log, card, "XSPC", "constraints at a point (|CMO| = 2, XSPC YSPC "// &
+                "ZSPC) are not available; use CMO = 1 (constraints at the centre of mass)")
+            end if
+          case default
+            call card_problem(deck, log, card, "CMO", "must be 0 (no constraint) or 1 (global "// &
+                              "constraints), found "//real_text(mode))
+          end select
+        end if
+        ! card 3: output axes and airbag vectors only
+        if (next_line(deck, block, line, .false.)) then
+          call open_card(deck, block, line, standard_widths, card, log)
+          call warn_if_set(deck, card, 8, "BNDLCO", "bndout is not written", warnings)
+        end if
+      end if
+      call append_rigid_material(input, entry)
+    end do
+  contains
+    subroutine no_coupling(name)
+      character(len=*), intent(in) :: name
+      call card_problem(deck, log, card, name, "MADYMO/CAL3D coupling is not available; leave "// &
+                        name//" blank")
+    end subroutine no_coupling
+
+    integer function check_code(value, name)
+      real(wp), intent(in) :: value
+      character(len=*), intent(in) :: name
+      check_code = nint(value)
+      if (check_code < 0 .or. check_code > 7 .or. real(check_code, wp) /= value) then
+        call card_problem(deck, log, card, name, "must be a code 0-7 (0 none, 1 x, 2 y, 3 z, 4 xy, "// &
+                          "5 yz, 6 zx, 7 xyz), found "//real_text(value))
+        check_code = 0
+      end if
+    end function check_code
+  end subroutine read_rigid_materials
+
+  !> *BOUNDARY_PRESCRIBED_MOTION_RIGID(_ID): PID DOF VAD LCID SF VID DEATH BIRTH per line.
+  subroutine read_rigid_motions(deck, block, keyword, input, log)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(card_t) :: card
+    type(rigid_motion_input_t) :: motion
+    integer :: line, vector, id
+    character(len=:), allocatable :: heading
+
+    line = 0
+    if (keyword%id) then
+      if (.not. next_line(deck, block, line, .false.)) return
+      call id_heading(deck, block, line, "ID", id, heading, log)
+    end if
+    do while (next_line(deck, block, line, .true.))
+      call open_card(deck, block, line, standard_widths, card, log)
+      motion = rigid_motion_input_t(line=line)
+      call get_integer(deck, card, 1, "PID", motion%part_id, log)
+      call get_integer(deck, card, 2, "DOF", motion%dof, log)
+      call get_integer(deck, card, 3, "VAD", motion%kind, log)
+      call get_integer(deck, card, 4, "LCID", motion%curve_id, log)
+      call get_real(deck, card, 5, "SF", motion%scale, log)
+      call get_integer(deck, card, 6, "VID", vector, log)
+      call get_real(deck, card, 7, "DEATH", motion%death, log)
+      call get_real(deck, card, 8, "BIRTH", motion%birth, log)
+      if (motion%scale == 0.0_wp) motion%scale = 1.0_wp
+      if (motion%death == 0.0_wp) motion%death = 1.0e28_wp
+      if (card%failed) cycle
+      if (motion%part_id <= 0) call card_problem(deck, log, card, "PID", "must be the id of a rigid part, found "// &
+                                                 integer_text(motion%part_id))
+      select case (motion%dof)
+      case (1:3, 5:7)
+      case (4, -4, 8, -8)
+        call card_problem(deck, log, card, "DOF", integer_text(motion%dof)//" (motion along or about a "// &
+          "vector VID) is not available; use DOF 1-3 (x, y, z translation) or 5-7 (rotation about x, y, z)")
+      case default
+        call card_problem(deck, log, card, "DOF", "must be 1, 2, 3 (x, y, z translation) or 5, 6, 7 "// &
+          "(rotation about x, y, z through the centre of mass), found "//integer_text(motion%dof))
+      end select
+      select case (motion%kind)
+      case (motion_velocity, motion_acceleration, motion_displacement)
+      case (3, 4)
+        call card_problem(deck, log, card, "VAD", integer_text(motion%kind)//" (velocity against "// &
+          "displacement, relative displacement) is not available; use 0 (velocity), 1 (acceleration) "// &
+          "or 2 (displacement)")
+      case default
+        call card_problem(deck, log, card, "VAD", "must be 0 (velocity), 1 (acceleration) or 2 "// &
+                          "(displacement), found "//integer_text(motion%kind))
+      end select
+      if (motion%curve_id <= 0) call card_problem(deck, log, card, "LCID", "a load curve id is required, found "// &
+                                                  integer_text(motion%curve_id))
+      if (vector /= 0) call card_problem(deck, log, card, "VID", "vectors and local coordinate systems "// &
+                                         "are not available; leave VID blank")
+      if (motion%death <= motion%birth) call card_problem(deck, log, card, "DEATH", "death time "// &
+        real_text(motion%death)//" must be later than the birth time "//real_text(motion%birth))
+      call append_rigid_motion(input, motion)
+    end do
+  end subroutine read_rigid_motions
+
+  !> *CONSTRAINED_NODAL_RIGID_BODY(_TITLE): PID CID NSID PNODE IPRT DRFLAG RRFLAG per body.
+  subroutine read_nodal_rigid_bodies(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    type(nodal_rigid_input_t) :: body
+    integer :: line, release
+    character(len=:), allocatable :: title
+
+    line = 0
+    do while (next_definition(deck, block, keyword%title, line, standard_widths, card, title, &
+                              log, "card 1 (PID CID NSID PNODE IPRT DRFLAG RRFLAG)", "PID"))
+      body = nodal_rigid_input_t(line=line)
+      call get_integer(deck, card, 1, "PID", body%id, log)
+      call get_integer(deck, card, 3, "NSID", body%node_set, log)
+      call warn_if_set(deck, card, 2, "CID", "rbdout is written in global axes", warnings)
+      call warn_if_set(deck, card, 4, "PNODE", "rbdout is written at the centre of mass", warnings)
+      call warn_if_set(deck, card, 5, "IPRT", "rbdout is always written", warnings)
+      call get_integer(deck, card, 6, "DRFLAG", release, log)
+      if (release /= 0) call card_problem(deck, log, card, "DRFLAG", "displacement release is not "// &
+                                          "available; leave DRFLAG blank")
+      call get_integer(deck, card, 7, "RRFLAG", release, log)
+      if (release /= 0) call card_problem(deck, log, card, "RRFLAG", "rotation release is not "// &
+                                          "available; leave RRFLAG blank")
+      if (card%failed) cycle
+      if (body%id <= 0) then
+        call card_problem(deck, log, card, "PID", "must be a positive rigid body id, found "// &
+                          integer_text(body%id))
+        cycle
+      end if
+      if (body%node_set == 0) body%node_set = body%id
+      call append_nodal_body(input, body)
+    end do
+  end subroutine read_nodal_rigid_bodies
+
+  !> *ELEMENT_MASS: EID (8) NID (8) MASS (16) PID (8) per line.
+  subroutine read_element_masses(deck, block, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    type(element_mass_input_t) :: mass
+    integer :: line
+    line = 0
+    do while (next_line(deck, block, line, .true.))
+      call open_card(deck, block, line, mass_widths, card, log)
+      mass = element_mass_input_t(line=line)
+      call get_integer(deck, card, 1, "EID", mass%id, log)
+      call get_integer(deck, card, 2, "NID", mass%node_id, log)
+      call get_real(deck, card, 3, "MASS", mass%mass, log)
+      call warn_if_set(deck, card, 4, "PID", "the mass counts in no part's matsum", warnings)
+      if (card%failed) cycle
+      if (.not. mass%mass >= 0.0_wp) then
+        call card_problem(deck, log, card, "MASS", "must not be negative, found "//real_text(mass%mass))
+        cycle
+      end if
+      call append_element_mass(input, mass)
+    end do
+  end subroutine read_element_masses
+
+  !> Cross-check: rigid parts, nodal rigid bodies, their constraints and prescribed motions,
+  !> and lumped masses. Call after parts, node sets and curves are resolved.
+  subroutine build_rigid_bodies(deck, input, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    integer, allocatable :: owner(:), body_lines(:)
+    type(rigid_body_t), allocatable :: bodies(:)
+    integer :: k, part, body_count, node_count
+
+    node_count = input%node_count
+    associate (model => input%model)
+      ! rigid parts
+      body_count = 0
+      do part = 1, size(model%parts)
+        if (is_rigid_part(part)) then
+          model%parts(part)%formulation = formulation_rigid
+          body_count = body_count + 1
+        end if
+      end do
+      allocate (bodies(body_count + input%rigid%nodal_count), body_lines(body_count + input%rigid%nodal_count))
+      allocate (owner(node_count))
+      owner = 0
+      body_count = 0
+      do part = 1, size(model%parts)
+        if (model%parts(part)%formulation /= formulation_rigid) cycle
+        body_count = body_count + 1
+        bodies(body_count)%id = model%parts(part)%id
+        bodies(body_count)%part = part
+        body_lines(body_count) = input%part_lines(part)
+        call set_constraints(part, bodies(body_count))
+        call collect_part_nodes(part, body_count)
+      end do
+      do k = 1, input%rigid%nodal_count
+        call add_nodal_body(input%rigid%nodal(k))
+      end do
+      call move_alloc(bodies, model%rigid_bodies)
+      model%rigid_bodies = model%rigid_bodies(1:body_count)
+      call build_rigid_motions()
+      allocate (model%node_masses(node_count))
+      model%node_masses = 0.0_wp
+      call apply_element_masses()
+      if (model%implicit_static .and. body_count > 0) call located_problem(deck, log, body_lines(1), "MID", &
+        "rigid bodies are not available in the linear static analysis (*CONTROL_IMPLICIT_GENERAL IMFLAG = 1)")
+    end associate
+  contains
+    logical function is_rigid_part(part)
+      integer, intent(in) :: part
+      integer :: material
+      material = input%model%parts(part)%material
+      is_rigid_part = .false.
+      if (material > 0) is_rigid_part = input%model%materials(material)%law == law_rigid
+    end function is_rigid_part
+
+    subroutine set_constraints(part, body)
+      integer, intent(in) :: part
+      type(rigid_body_t), intent(inout) :: body
+      integer :: m
+      do m = 1, input%rigid%material_count
+        if (input%rigid%materials(m)%material /= input%model%parts(part)%material) cycle
+        if (input%rigid%materials(m)%constraint_mode /= 1) cycle
+        body%fixed(1:3) = code_dofs(:, input%rigid%materials(m)%translations)
+        body%fixed(4:6) = code_dofs(:, input%rigid%materials(m)%rotations)
+      end do
+    end subroutine set_constraints
+
+    !> The nodes of the part's solids, ascending; a node already in another body is reported.
+    subroutine collect_part_nodes(part, body)
+      integer, intent(in) :: part, body
+      integer :: solid, corner, node, count
+      count = 0
+      do solid = 1, size(input%model%solid_part)
+        if (input%model%solid_part(solid) /= part) cycle
+        do corner = 1, 8
+          node = input%model%solid_nodes(corner, solid)
+          if (node <= 0) cycle
+          if (owner(node) == body) cycle
+          if (owner(node) /= 0) then
+            call shared_node(node, owner(node), body)
+            cycle
+          end if
+          owner(node) = body
+          count = count + 1
+        end do
+      end do
+      if (count == 0) call located_problem(deck, log, body_lines(body), "PID", "rigid part "// &
+        integer_text(bodies(body)%id)//" has no elements (a rigid body needs mass)")
+      bodies(body)%nodes = pack([(node, node=1, node_count)], owner == body)
+    end subroutine collect_part_nodes
+
+    subroutine shared_node(node, first, second)
+      integer, intent(in) :: node, first, second
+      call located_problem(deck, log, body_lines(second), "PID", "node "// &
+        integer_text(input%model%node_ids(node))//" belongs to rigid body "//integer_text(bodies(first)%id)// &
+        " and to rigid body "//integer_text(bodies(second)%id)//"; merging rigid bodies is not available")
+    end subroutine shared_node
+
+    subroutine add_nodal_body(given)
+      type(nodal_rigid_input_t), intent(in) :: given
+      integer :: set, j, node, body
+      do j = 1, body_count
+        if (bodies(j)%id == given%id) then
+          call located_problem(deck, log, given%line, "PID", "rigid body "//integer_text(given%id)// &
+            " is already defined (a rigid part or another *CONSTRAINED_NODAL_RIGID_BODY has this id)")
+          return
+        end if
+      end do
+      set = 0
+      do j = 1, size(input%model%node_sets)
+        if (input%model%node_sets(j)%id == given%node_set) then
+          set = j
+          exit
+        end if
+      end do
+      if (set == 0) then
+        call located_problem(deck, log, given%line, "NSID", "node set "//integer_text(given%node_set)// &
+                             " is not defined")
+        return
+      end if
+      if (size(input%model%node_sets(set)%nodes) == 0) then
+        call located_problem(deck, log, given%line, "NSID", "node set "//integer_text(given%node_set)// &
+                             " has no nodes")
+        return
+      end if
+      body_count = body_count + 1
+      body = body_count
+      bodies(body)%id = given%id
+      bodies(body)%part = 0
+      body_lines(body) = given%line
+      do j = 1, size(input%model%node_sets(set)%nodes)
+        node = input%model%node_sets(set)%nodes(j)
+        if (owner(node) == body) cycle
+        if (owner(node) /= 0) then
+          call shared_node(node, owner(node), body)
+          cycle
+        end if
+        owner(node) = body
+      end do
+      bodies(body)%nodes = pack([(node, node=1, node_count)], owner == body)
+    end subroutine add_nodal_body
+
+    subroutine build_rigid_motions()
+      type(rigid_motion_t), allocatable :: motions(:)
+      integer :: k, j, body, curve, dof, count, other
+      allocate (motions(input%rigid%motion_count))
+      count = 0
+      do k = 1, input%rigid%motion_count
+        associate (given => input%rigid%motions(k), model => input%model)
+          body = 0
+          do j = 1, size(model%rigid_bodies)
+            if (model%rigid_bodies(j)%id == given%part_id) body = j
+          end do
+          if (body == 0) then
+            if (any([(model%parts(j)%id, j=1, size(model%parts))] == given%part_id)) then
+              call located_problem(deck, log, given%line, "PID", "part "//integer_text(given%part_id)// &
+                " is not rigid (its material is not *MAT_RIGID)")
+            else
+              call located_problem(deck, log, given%line, "PID", "rigid part "//integer_text(given%part_id)// &
+                " is not defined")
+            end if
+            cycle
+          end if
+          curve = 0
+          do j = 1, size(model%curves)
+            if (model%curves(j)%id == given%curve_id) curve = j
+          end do
+          if (curve == 0) then
+            call located_problem(deck, log, given%line, "LCID", "curve "//integer_text(given%curve_id)// &
+                                 " is not defined")
+            cycle
+          end if
+          dof = merge(given%dof, given%dof - 1, given%dof <= 3)
+          if (model%rigid_bodies(body)%fixed(dof)) then
+            call located_problem(deck, log, given%line, "DOF", "rigid part "//integer_text(given%part_id)// &
+              " is constrained twice: its "//trim(dof_names(dof))//" dof is already fixed by CMO/CON1/CON2 "// &
+              "of its *MAT_RIGID")
+            cycle
+          end if
+          other = 0
+          do j = 1, count
+            if (motions(j)%body == body .and. motions(j)%dof == dof) other = j
+          end do
+          if (other > 0) then
+            call located_problem(deck, log, given%line, "DOF", "rigid part "//integer_text(given%part_id)// &
+              " is constrained twice: its "//trim(dof_names(dof))//" dof already has a prescribed motion")
+            cycle
+          end if
+          count = count + 1
+          motions(count) = rigid_motion_t(body=body, dof=dof, kind=given%kind, curve=curve, &
+                                          scale=given%scale, birth=given%birth, death=given%death)
+        end associate
+      end do
+      input%model%rigid_motions = motions(1:count)
+    end subroutine build_rigid_motions
+
+    subroutine apply_element_masses()
+      type(id_index_t) :: nodes
+      integer :: k, node
+      if (input%rigid%mass_count == 0) return
+      call build_id_index(input%model%node_ids, nodes)
+      do k = 1, input%rigid%mass_count
+        associate (given => input%rigid%masses(k))
+          node = find_id(nodes, given%node_id)
+          if (node == 0) then
+            call located_problem(deck, log, given%line, "NID", "node "//integer_text(given%node_id)// &
+                                 " is not defined")
+            cycle
+          end if
+          input%model%node_masses(node) = input%model%node_masses(node) + given%mass
+        end associate
+      end do
+    end subroutine apply_element_masses
+  end subroutine build_rigid_bodies
+
+  !> Room for one more material (the materials list is sized for the other material keywords).
+  subroutine reserve_material(input)
+    type(deck_input_t), intent(inout) :: input
+    type(material_t), allocatable :: materials(:)
+    integer, allocatable :: lines(:)
+    integer :: n
+    n = input%material_count
+    if (n < size(input%model%materials)) return
+    allocate (materials(n + 4), lines(n + 4))
+    materials(1:n) = input%model%materials(1:n)
+    lines(1:n) = input%material_lines(1:n)
+    lines(n + 1:) = 0
+    call move_alloc(materials, input%model%materials)
+    call move_alloc(lines, input%material_lines)
+  end subroutine reserve_material
+
+  subroutine append_rigid_material(input, entry)
+    type(deck_input_t), intent(inout) :: input
+    type(rigid_material_input_t), intent(in) :: entry
+    type(rigid_material_input_t), allocatable :: larger(:)
+    if (.not. allocated(input%rigid%materials)) allocate (input%rigid%materials(4))
+    if (input%rigid%material_count == size(input%rigid%materials)) then
+      allocate (larger(2*size(input%rigid%materials)))
+      larger(1:input%rigid%material_count) = input%rigid%materials
+      call move_alloc(larger, input%rigid%materials)
+    end if
+    input%rigid%material_count = input%rigid%material_count + 1
+    input%rigid%materials(input%rigid%material_count) = entry
+  end subroutine append_rigid_material
+
+  subroutine append_rigid_motion(input, entry)
+    type(deck_input_t), intent(inout) :: input
+    type(rigid_motion_input_t), intent(in) :: entry
+    type(rigid_motion_input_t), allocatable :: larger(:)
+    if (.not. allocated(input%rigid%motions)) allocate (input%rigid%motions(4))
+    if (input%rigid%motion_count == size(input%rigid%motions)) then
+      allocate (larger(2*size(input%rigid%motions)))
+      larger(1:input%rigid%motion_count) = input%rigid%motions
+      call move_alloc(larger, input%rigid%motions)
+    end if
+    input%rigid%motion_count = input%rigid%motion_count + 1
+    input%rigid%motions(input%rigid%motion_count) = entry
+  end subroutine append_rigid_motion
+
+  subroutine append_nodal_body(input, entry)
+    type(deck_input_t), intent(inout) :: input
+    type(nodal_rigid_input_t), intent(in) :: entry
+    type(nodal_rigid_input_t), allocatable :: larger(:)
+    if (.not. allocated(input%rigid%nodal)) allocate (input%rigid%nodal(4))
+    if (input%rigid%nodal_count == size(input%rigid%nodal)) then
+      allocate (larger(2*size(input%rigid%nodal)))
+      larger(1:input%rigid%nodal_count) = input%rigid%nodal
+      call move_alloc(larger, input%rigid%nodal)
+    end if
+    input%rigid%nodal_count = input%rigid%nodal_count + 1
+    input%rigid%nodal(input%rigid%nodal_count) = entry
+  end subroutine append_nodal_body
+
+  subroutine append_element_mass(input, entry)
+    type(deck_input_t), intent(inout) :: input
+    type(element_mass_input_t), intent(in) :: entry
+    type(element_mass_input_t), allocatable :: larger(:)
+    if (.not. allocated(input%rigid%masses)) allocate (input%rigid%masses(16))
+    if (input%rigid%mass_count == size(input%rigid%masses)) then
+      allocate (larger(2*size(input%rigid%masses)))
+      larger(1:input%rigid%mass_count) = input%rigid%masses
+      call move_alloc(larger, input%rigid%masses)
+    end if
+    input%rigid%mass_count = input%rigid%mass_count + 1
+    input%rigid%masses(input%rigid%mass_count) = entry
+  end subroutine append_element_mass
+end module deck_rigid_bodies
