@@ -26,8 +26,11 @@ def section_polygons(path, axis, value, state_index):
     """Deformed quadrilaterals (k, 4, 2) of the faces on the plane, the state time, and the
     plastic strain of each face's element."""
     with cr.open_results(path) as results:
-        coordinates = results["mesh/nodes/coordinates"][...]
-        connectivity = results["mesh/solids/connectivity_index"][...]
+        mesh = cr.read_mesh(results)
+        coordinates = mesh["coordinates"]
+        # node ids -> rows of the node arrays (the contract's connectivity holds ids)
+        order = np.argsort(mesh["node_ids"])
+        connectivity = order[np.searchsorted(mesh["node_ids"], mesh["connectivity"], sorter=order)]
         names = sorted(results["states"])
         state = results["states"][names[state_index]]
         current = coordinates + state["displacement"][...]

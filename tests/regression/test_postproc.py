@@ -373,6 +373,19 @@ def test_taylor_bar_command_line(results_file, tmp_path):
 # Every script: --help, and importable without side effects
 
 
+def test_plot_section_draws_the_faces_of_a_plane(results_file, tmp_path):
+    sys.path.insert(0, str(POSTPROC))
+    import plot_section
+    # the synthetic bar: a 3 x 3 x 5 grid along z with unit spacing; the plane x = 0 holds
+    # 2 x 4 faces (one column of cells on each side shares it)
+    polygons, values, time, others = plot_section.section_polygons(results_file, 0, 0.0, -1)
+    assert polygons.shape == (8, 4, 2) and others == [1, 2] and time == 1.0
+    output = tmp_path / "section.png"
+    completed = run_script("plot_section.py", results_file, "--axis", "x", "--value", "0", "-o", output)
+    assert completed.returncode == 0, completed.stderr
+    assert is_png(output)
+
+
 @pytest.mark.parametrize("script", ["plot_energy.py", "plot_history.py", "summary_table.py",
                                     "taylor_bar.py", "crashfree_results.py"])
 def test_scripts_run_and_explain_themselves(script, tmp_path):
