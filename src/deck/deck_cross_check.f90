@@ -18,6 +18,7 @@ module deck_cross_check
   use deck_efg_cards, only: elform_efg
   use deck_material_curves, only: resolve_material_curves, apply_material_bulk_viscosity
   use deck_rigid_bodies, only: build_rigid_bodies
+  use deck_contact, only: build_contacts
   implicit none
   private
 
@@ -58,6 +59,7 @@ contains
     call build_initial_velocities(deck, input, indices, log)
     call build_walls(deck, input, indices, log)
     call build_rigid_bodies(deck, input, log)
+    call build_contacts(deck, input, log)
     call build_history_nodes(deck, input, indices, log, warnings)
     call check_mesh(deck, input, mesh_resolved, log)
     call check_controls(deck, input, log)

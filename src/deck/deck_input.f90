@@ -5,6 +5,7 @@ module deck_input
   use kinds, only: wp
   use model, only: model_t, rigid_wall_t, segment_load_t
   use deck_rigid_input, only: rigid_input_t
+  use deck_contact_input, only: contact_input_t
   use deck_keywords, only: keyword_count, keyword_node, keyword_element_solid, keyword_part, &
     keyword_section_solid, keyword_section_solid_efg, keyword_mat_elastic, &
     keyword_mat_plastic_kinematic, keyword_hourglass, keyword_define_curve, &
@@ -138,6 +139,7 @@ module deck_input
     type(segment_set_input_t), allocatable :: segment_sets(:)
     type(segment_load_input_t), allocatable :: segment_loads(:)
     type(rigid_input_t) :: rigid           !< *MAT_RIGID, rigid motions, nodal rigid bodies, masses
+    type(contact_input_t) :: contact       !< *CONTACT_AUTOMATIC_... definitions
     !> *DATABASE_HISTORY_NODE(_SET) requests in deck order; a node set id is stored with a
     !> negative field number (-k for field IDk) so that nodes and sets keep their order.
     type(id_list_t) :: history_requests

@@ -46,6 +46,8 @@ module deck_reader
   use deck_cross_check, only: check_and_build
   use deck_rigid_bodies, only: identify_rigid_keyword, read_rigid_block, rigid_keyword_first, &
     rigid_keyword_last
+  use deck_contact, only: identify_contact_keyword, read_contact_block, contact_keyword_first, &
+    contact_keyword_last
   implicit none
   private
 
@@ -75,6 +77,8 @@ contains
       keywords(block) = identify_keyword(deck%blocks(block)%name)
       if (keywords(block)%code == keyword_unknown) keywords(block) = &
         identify_rigid_keyword(deck%blocks(block)%name)
+      if (keywords(block)%code == keyword_unknown) keywords(block) = &
+        identify_contact_keyword(deck%blocks(block)%name)
       if (keywords(block)%code == keyword_unknown) call report_unknown(deck, block, &
         ignore_unknown, log, warnings)
     end do
@@ -215,6 +219,8 @@ contains
                               input, log)
     case (rigid_keyword_first:rigid_keyword_last)
       call read_rigid_block(deck, block, keyword, input, log, warnings)
+    case (contact_keyword_first:contact_keyword_last)
+      call read_contact_block(deck, block, keyword, input, log, warnings)
     end select
   end subroutine read_block
 end module deck_reader

@@ -12,6 +12,7 @@ module model
   public :: model_t, material_t, section_t, hourglass_t, part_t, node_set_t, part_set_t
   public :: spc_t, prescribed_motion_t, nodal_load_t, segment_load_t, rigid_wall_t, output_control_t
   public :: rigid_body_t, rigid_motion_t
+  public :: segment_set_t, contact_t, contact_surface_t
 
   !> Material laws, numbered as LS-DYNA numbers them.
   integer, parameter, public :: law_elastic = 1
@@ -212,6 +213,51 @@ module model
     real(wp) :: death = 1.0e28_wp
   end type rigid_motion_t
 
+  !> *SET_SEGMENT, node indices (a triangle repeats node 3); segments with a reported problem
+  !> are left out.
+  type :: segment_set_t
+    integer :: id = 0
+    character(len=:), allocatable :: title
+    integer, allocatable :: nodes(:, :)      !< (4, segments)
+  end type segment_set_t
+
+  !> Contact kinds (*CONTACT_AUTOMATIC_...).
+  integer, parameter, public :: contact_nodes_to_surface = 1, contact_surface_to_surface = 2, &
+                                contact_single_surface = 3
+  !> Surface types (SURFATYP / SURFBTYP) as LS-DYNA numbers them.
+  integer, parameter, public :: surface_segment_set = 0, surface_part_set = 2, surface_part = 3, &
+                                surface_node_set = 4, surface_all_parts = 5
+
+  !> One side of a contact: what SURFA or SURFB names, resolved to indices.
+  type :: contact_surface_t
+    integer :: kind = surface_part           !< surface_segment_set ... surface_all_parts
+    integer :: id = 0                        !< the set or part id as given
+    integer, allocatable :: parts(:)         !< part indices (part, part set, all parts)
+    integer, allocatable :: segments(:, :)   !< (4, n) node indices (segment set)
+    integer, allocatable :: nodes(:)         !< node indices (node set)
+  end type contact_surface_t
+
+  !> One penalty contact (*CONTACT_AUTOMATIC_NODES_TO_SURFACE / _SURFACE_TO_SURFACE /
+  !> _SINGLE_SURFACE).
+  type :: contact_t
+    integer :: id = 0                        !< CID (contacts without _ID: 1, 2, ... in deck order)
+    character(len=:), allocatable :: title
+    integer :: kind = contact_surface_to_surface
+    type(contact_surface_t) :: side_a, side_b !< SURFA (secondary), SURFB (primary)
+    real(wp) :: static_friction = 0.0_wp     !< FS
+    real(wp) :: dynamic_friction = 0.0_wp    !< FD
+    real(wp) :: decay = 0.0_wp               !< DC
+    real(wp) :: viscous_friction = 0.0_wp    !< VC
+    real(wp) :: viscous_damping = 0.0_wp     !< VDC, percent of critical
+    real(wp) :: birth = 0.0_wp, death = 1.0e20_wp
+    real(wp) :: scale_a = 1.0_wp, scale_b = 1.0_wp !< SFSA, SFSB
+    real(wp) :: friction_scale = 1.0_wp      !< FSF
+    real(wp) :: viscous_scale = 1.0_wp       !< VSF
+    integer :: soft = 0                      !< SOFT: 0 penalty, 1 soft constraint
+    real(wp) :: soft_scale = 0.1_wp          !< SOFSCL
+    integer :: bucket_interval = 0           !< BSORT (0: automatic)
+  end type contact_t
+
   !> Output intervals and requests (*DATABASE_...). An interval of 0 means "not requested".
   type :: output_control_t
     real(wp) :: state_interval = 0.0_wp      !< *DATABASE_BINARY_D3PLOT DT (or ENDTIM/NPLTC)
@@ -219,6 +265,7 @@ module model
     real(wp) :: matsum_interval = 0.0_wp
     real(wp) :: nodout_interval = 0.0_wp
     real(wp) :: rwforc_interval = 0.0_wp
+    real(wp) :: rcforc_interval = 0.0_wp     !< *DATABASE_RCFORC
     integer, allocatable :: history_nodes(:) !< node indices for nodout
   end type output_control_t
 
@@ -263,6 +310,10 @@ module model
     real(wp) :: default_hourglass_coefficient = 0.1_wp !< *CONTROL_HOURGLASS QH
     logical :: hourglass_energy_in_balance = .false. !< *CONTROL_ENERGY HGEN = 2
     logical :: wall_energy_in_balance = .true.       !< *CONTROL_ENERGY RWEN = 2
+    ! contact
+    type(segment_set_t), allocatable :: segment_sets(:)
+    type(contact_t), allocatable :: contacts(:)
+    real(wp) :: contact_penalty_scale = 0.1_wp       !< *CONTROL_CONTACT SLSFAC
     type(output_control_t) :: output
   end type model_t
 end module model

@@ -13,6 +13,7 @@ module explicit_setup
   use explicit_state, only: explicit_state_t
   use boundary_conditions, only: fixed_dof_mask
   use planar_rigid_walls, only: initialise_wall_states
+  use penalty_contact, only: set_up_contacts
   use rigid_bodies, only: set_up_rigid_bodies, add_node_masses
   implicit none
   private
@@ -60,6 +61,10 @@ contains
     if (allocated(error)) return
     call set_up_rigid_state(model, state)
     call initialise_wall_states(model%walls, state%walls)
+    allocate (state%contact_force(3, node_count))
+    state%contact_force = 0.0_wp
+    call set_up_contacts(model, state%is_particle, state%contacts, error)
+    if (allocated(error)) return
     if (sum(state%mass) <= 0.0_wp) then
       call make_error(error, "model: the elements give no mass (check densities and element volumes)")
       return

@@ -1,6 +1,6 @@
 !> The explicit time loop (central difference), as a short sequence of named steps:
-!> velocities -> kinematic conditions and walls -> positions -> element forces -> external
-!> loads -> accelerations -> next time step -> output.
+!> velocities -> kinematic conditions and walls -> positions -> element forces -> contact ->
+!> external loads -> accelerations -> next time step -> output.
 module explicit_solver
   use kinds, only: wp
   use error_handling, only: error_t, make_error
@@ -11,6 +11,7 @@ module explicit_solver
                                  hold_prescribed_accelerations
   use planar_rigid_walls, only: enforce_planar_walls
   use rigid_bodies, only: advance_rigid_bodies
+  use penalty_contact, only: compute_contact_forces
   use energy_balance, only: update_energy_totals, total_energy
   use run_output, only: output_plan_t, plan_output, write_due_output
   use history_buffer, only: history_set_t
@@ -103,6 +104,13 @@ contains
       call start_phase(meshfree_timer)
       call compute_meshfree_forces(model, state, step)
       call stop_phase(meshfree_timer)
+      if (size(state%contacts) > 0) then
+        call start_phase(contact_timer)
+        call compute_contact_forces(model, state%contacts, state%time, step, state%coordinates, state%velocity, &
+                                    state%mass, state%contact_force, work)
+        call stop_phase(contact_timer)
+        state%energy%contact = state%energy%contact + work
+      end if
       call assemble_nodal_loads(model, state%time, state%external_force)
       state%energy%external_work = state%energy%external_work + &
                                    0.5_wp*load_work(model, state%external_force, state%velocity, step)
@@ -136,7 +144,8 @@ contains
     !$omp parallel do schedule(static) default(shared) private(node)
     do node = 1, state%node_count
       if (state%mass(node) > 0.0_wp) then
-        state%acceleration(:, node) = (state%external_force(:, node) - state%internal_force(:, node))/state%mass(node)
+        state%acceleration(:, node) = (state%external_force(:, node) - state%internal_force(:, node) + &
+                                       state%contact_force(:, node))/state%mass(node)
       else
         state%acceleration(:, node) = 0.0_wp
       end if

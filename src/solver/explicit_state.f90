@@ -12,6 +12,7 @@ module explicit_state
   use solid_block, only: solid_block_t
   use efg_forces, only: efg_solver_t
   use rigid_body_state, only: rigid_body_state_t
+  use penalty_contact, only: contact_state_t
   implicit none
   private
 
@@ -71,6 +72,9 @@ module explicit_state
     logical, allocatable :: is_particle(:)               !< interior particle of an EFG part
     ! walls
     type(wall_state_t), allocatable :: walls(:)
+    ! penalty contacts (indexed like model%contacts) and their nodal forces (3, nodes)
+    type(contact_state_t), allocatable :: contacts(:)
+    real(wp), allocatable :: contact_force(:, :)
     ! rigid bodies (indexed like model%rigid_bodies); their nodes move with them
     type(rigid_body_state_t), allocatable :: rigid(:)
     logical, allocatable :: is_rigid_node(:)

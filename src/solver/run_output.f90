@@ -29,12 +29,14 @@ module run_output
 
   !> Clocks and the positions of the history series.
   type :: output_plan_t
-    type(output_clock_t) :: states, glstat, matsum, nodout, rwforc, rbdout
+    type(output_clock_t) :: states, glstat, matsum, nodout, rwforc, rbdout, rcforc
     integer :: glstat_series = 0
     integer, allocatable :: matsum_series(:)     !< per part
     integer, allocatable :: nodout_series(:)     !< per history node
     integer, allocatable :: rwforc_series(:)     !< per wall
     integer, allocatable :: rbdout_series(:)     !< per rigid body
+    integer, allocatable :: rcforc_series(:)     !< per contact
+    real(wp) :: last_rcforc_time = 0.0_wp
     real(wp) :: last_rbdout_time = 0.0_wp
     real(wp) :: last_rwforc_time = 0.0_wp
     ! work arrays for the element results of a state, allocated once
@@ -103,6 +105,21 @@ contains
         call add_history_series(histories, "rwforc/"//trim(label), [character(len=32) :: "time", "force"], &
                                 [1, 3], capacity, plan%rwforc_series(k))
       end do
+    end if
+    ! rcforc: every contact, at the *DATABASE_RCFORC interval (else the glstat one)
+    allocate (plan%rcforc_series(0))
+    if (allocated(model%contacts)) then
+      call set_clock(plan%rcforc, model%output%rcforc_interval, plan%glstat%interval, size(model%contacts) > 0)
+      if (plan%rcforc%active) then
+        capacity = expected_rows(model, plan%rcforc)
+        deallocate (plan%rcforc_series)
+        allocate (plan%rcforc_series(size(model%contacts)))
+        do k = 1, size(model%contacts)
+          write (label, '(i0)') model%contacts(k)%id
+          call add_history_series(histories, "rcforc/"//trim(label), [character(len=32) :: "time", "force"], &
+                                  [1, 3], capacity, plan%rcforc_series(k))
+        end do
+      end if
     end if
     ! rbdout: every rigid body, at the glstat interval
     allocate (plan%rbdout_series(0))
@@ -208,6 +225,7 @@ contains
       end do
     end if
     if (clock_due(plan%rwforc, state%time, last)) call record_wall_forces(state, plan, histories)
+    if (clock_due(plan%rcforc, state%time, last)) call record_contact_forces(state, plan, histories)
     if (clock_due(plan%rbdout, state%time, last)) call record_rigid_bodies(model, state, plan, histories)
     if (states_due) then
       call write_current_state(model, state, plan, results, error)
@@ -234,6 +252,24 @@ contains
     end do
     plan%last_rwforc_time = state%time
   end subroutine record_wall_forces
+
+  !> Contact force on the SURFA side averaged over the sampling interval (impulse / interval),
+  !> as rwforc; at t = 0 the force is 0.
+  subroutine record_contact_forces(state, plan, histories)
+    type(explicit_state_t), intent(inout) :: state
+    type(output_plan_t), intent(inout) :: plan
+    type(history_set_t), intent(inout) :: histories
+    integer :: k
+    real(wp) :: interval, force(3)
+    interval = state%time - plan%last_rcforc_time
+    do k = 1, size(plan%rcforc_series)
+      force = 0.0_wp
+      if (interval > 0.0_wp) force = state%contacts(k)%impulse/interval
+      call append_history_row(histories%series(plan%rcforc_series(k)), [state%time, force])
+      state%contacts(k)%impulse = 0.0_wp
+    end do
+    plan%last_rcforc_time = state%time
+  end subroutine record_contact_forces
 
   !> One rbdout row per rigid body (the force is the impulse since the last row / interval).
   subroutine record_rigid_bodies(model, state, plan, histories)

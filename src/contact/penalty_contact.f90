@@ -1,0 +1,680 @@
+!> Penalty contact between solid faces: node-to-segment search and forces for
+!> *CONTACT_AUTOMATIC_NODES_TO_SURFACE, _SURFACE_TO_SURFACE (both ways, symmetric) and
+!> _SINGLE_SURFACE (LS-DYNA Theory Manual, "Contact-Impact Algorithm": penalty method,
+!> sections on the standard penalty formulation and the soft constraint formulation).
+!>
+!> Each contact is done in one or two passes; a pass checks the secondary nodes against the
+!> primary segments. The neighbour search is a bucket sort: the segments, with their bounding
+!> boxes grown by a margin, are sorted into a uniform grid, and every secondary node keeps the
+!> segments of its cell whose box holds it. The lists stay valid until some node of the pass
+!> has moved half the margin since they were built (or BSORT cycles have passed), then they are
+!> rebuilt: cost linear in the surface size. Arrays grow only at rebuilds.
+!>
+!> Penetration is measured from the closest point of the (bilinear) segment to the node along
+!> the segment normal at that point. Normal force `k d` with LS-DYNA's stiffness for solid
+!> segments `k = SLSFAC SFS K A^2 / V` (K bulk modulus of the segment's element, A the
+!> segment area, V the element volume); SOFT = 1 takes the larger of that and the soft
+!> constraint stiffness `0.5 SOFSCL m* / dt^2` (m* = m_node m_seg / (m_node + m_seg)). The
+!> reaction goes to the segment's nodes with the shape-function weights of the contact point,
+!> so every pair is in equilibrium and momentum is conserved to round-off. Coulomb friction
+!> (FS, FD, DC; VC limit) uses an elastic tangential spring of stiffness k whose force is
+!> capped at mu times the normal force (the theory manual's friction return mapping).
+!>
+!> Determinism: the secondary nodes are processed in parallel, each writing only its own pair
+!> result (segment, weights, force); the forces are then added to the nodes in one serial loop
+!> in pair order. Results are bit-identical for any thread count; no atomics.
+module penalty_contact
+  use kinds, only: wp
+  use error_handling, only: error_t, make_error
+  use model, only: model_t, contact_t, contact_surface_t, contact_nodes_to_surface, &
+                   contact_surface_to_surface, contact_single_surface, surface_segment_set, &
+                   surface_node_set
+  use contact_surfaces, only: append_exterior_faces, find_segment_owners, surface_node_list, &
+                              hexahedron_volume, segment_area
+  implicit none
+  private
+
+  public :: contact_state_t, contact_pass_t, set_up_contacts, compute_contact_forces
+
+  !> Parametric tolerance of the projection (LS-DYNA's MAXPAR default 1.025).
+  real(wp), parameter :: parametric_limit = 1.025_wp
+  !> Largest pair stiffness as a fraction of m* / dt^2 (a lone pair spring is stable up to 4).
+  real(wp), parameter :: stable_fraction = 0.25_wp
+
+  !> Secondary nodes against primary segments.
+  type :: contact_pass_t
+    integer :: node_count = 0, segment_count = 0
+    logical :: single = .false.                   !< single surface: skip a node's own neighbourhood
+    integer, allocatable :: nodes(:)              !< secondary node indices
+    real(wp), allocatable :: node_normal(:, :)    !< (3, nodes) outward normal on the secondary side (0: none)
+    integer, allocatable :: segments(:, :)        !< (4, segments) primary segments, outward
+    real(wp), allocatable :: stiffness(:)         !< SLSFAC SFS K A^2 / V per segment
+    real(wp), allocatable :: depth(:)             !< deepest penetration still taken as contact: V / (2 A)
+    real(wp), allocatable :: area(:)
+    ! single surface: node -> its own segments (CSR over the pass nodes)
+    integer, allocatable :: own_first(:), own_segments(:)
+    ! bucket search
+    integer, allocatable :: tracked(:)            !< every node of the pass
+    real(wp), allocatable :: tracked_at_build(:, :)
+    real(wp) :: margin = 0.0_wp
+    integer :: cycles_since_build = 0
+    logical :: built = .false.
+    integer, allocatable :: candidate_first(:), candidates(:)
+    integer, allocatable :: cell_first(:), cell_segments(:)
+    real(wp), allocatable :: box(:, :)            !< (6, segments) grown bounding boxes
+    ! pair results, one per secondary node
+    integer, allocatable :: pair_segment(:)
+    real(wp), allocatable :: pair_weights(:, :), pair_force(:, :), tangential(:, :)
+    real(wp) :: side_sign = 1.0_wp                !< +1: secondary is SURFA; -1: the B -> A pass
+  end type contact_pass_t
+
+  !> One contact during the run.
+  type :: contact_state_t
+    integer :: pass_count = 0
+    type(contact_pass_t) :: passes(2)
+    real(wp) :: force(3) = 0.0_wp                 !< force on the SURFA side in the last cycle
+    real(wp) :: impulse(3) = 0.0_wp               !< since the last rcforc sample
+  end type contact_state_t
+
+contains
+
+  !> Build the passes of every contact from the model (reference configuration).
+  subroutine set_up_contacts(model, is_particle, contacts, error)
+    type(model_t), intent(in) :: model
+    logical, intent(in) :: is_particle(:)
+    type(contact_state_t), allocatable, intent(out) :: contacts(:)
+    type(error_t), allocatable, intent(out) :: error
+    integer :: k
+    integer, allocatable :: segments_a(:, :), owners_a(:), segments_b(:, :), owners_b(:), nodes(:)
+    if (.not. allocated(model%contacts)) then
+      allocate (contacts(0))
+      return
+    end if
+    allocate (contacts(size(model%contacts)))
+    do k = 1, size(model%contacts)
+      associate (contact => model%contacts(k), state => contacts(k))
+        call side_segments(contact%side_a, segments_a, owners_a)
+        if (allocated(error)) return
+        if (contact%kind /= contact_single_surface) then
+          call side_segments(contact%side_b, segments_b, owners_b)
+          if (allocated(error)) return
+        end if
+        select case (contact%kind)
+        case (contact_nodes_to_surface, contact_surface_to_surface)
+          if (contact%side_a%kind == surface_node_set) then
+            nodes = pack(contact%side_a%nodes, .not. is_particle(contact%side_a%nodes))
+          else
+            call surface_node_list(segments_a, is_particle, nodes)
+          end if
+          state%pass_count = 1
+          call build_pass(state%passes(1), nodes, segments_a, segments_b, owners_b, contact%scale_b, .false.)
+          state%passes(1)%side_sign = 1.0_wp
+          if (contact%kind == contact_surface_to_surface) then
+            call surface_node_list(segments_b, is_particle, nodes)
+            state%pass_count = 2
+            call build_pass(state%passes(2), nodes, segments_b, segments_a, owners_a, contact%scale_a, .false.)
+            state%passes(2)%side_sign = -1.0_wp
+          end if
+        case (contact_single_surface)
+          call surface_node_list(segments_a, is_particle, nodes)
+          state%pass_count = 1
+          call build_pass(state%passes(1), nodes, segments_a, segments_a, owners_a, contact%scale_a, .true.)
+        end select
+      end associate
+    end do
+  contains
+    !> Segments (outward) and owning solids of one side.
+    subroutine side_segments(side, segments, owners)
+      type(contact_surface_t), intent(in) :: side
+      integer, allocatable, intent(out) :: segments(:, :), owners(:)
+      integer :: count, p, s
+      character(len=160) :: text
+      count = 0
+      select case (side%kind)
+      case (surface_node_set)
+        allocate (segments(4, 0), owners(0))
+      case (surface_segment_set)
+        segments = side%segments
+        allocate (owners(size(segments, 2)))
+        call find_segment_owners(model%solid_nodes, size(model%node_ids), model%coordinates, segments, owners)
+        do s = 1, size(owners)
+          if (owners(s) /= 0) cycle
+          write (text, '(a,i0,a,4(1x,i0),a)') "contact: segment set ", side%id, " has a segment (nodes", &
+            model%node_ids(segments(:, s)), ") that is not a face of a solid element"
+          call make_error(error, trim(text))
+          return
+        end do
+      case default
+        do p = 1, size(side%parts)
+          call append_exterior_faces(model%solid_nodes, model%solid_part, side%parts(p), size(model%node_ids), &
+                                     segments, owners, count)
+        end do
+        if (.not. allocated(segments)) allocate (segments(4, 0), owners(0))
+        segments = segments(:, 1:count)
+        owners = owners(1:count)
+      end select
+    end subroutine side_segments
+
+    !> One pass: secondary nodes (with their normals from `secondary_segments`), primary
+    !> segments with their stiffness, and the search and pair arrays.
+    subroutine build_pass(pass, secondary_nodes, secondary_segments, primary, owners, scale, single)
+      type(contact_pass_t), intent(out) :: pass
+      integer, intent(in) :: secondary_nodes(:), secondary_segments(:, :), primary(:, :), owners(:)
+      real(wp), intent(in) :: scale
+      logical, intent(in) :: single
+      integer :: s, j, n, position
+      integer, allocatable :: slot(:), fill(:)
+      real(wp) :: bulk, volume, normal(3), longest
+      logical, allocatable :: used(:)
+      pass%single = single
+      pass%node_count = size(secondary_nodes)
+      pass%segment_count = size(primary, 2)
+      pass%nodes = secondary_nodes
+      pass%segments = primary
+      allocate (pass%stiffness(pass%segment_count), pass%depth(pass%segment_count), pass%area(pass%segment_count))
+      longest = 0.0_wp
+      do s = 1, pass%segment_count
+        associate (x => model%coordinates(:, primary(:, s)), owner => owners(s))
+          associate (material => model%materials(model%parts(model%solid_part(owner))%material))
+            bulk = material%youngs_modulus/(3.0_wp*max(1.0e-6_wp, 1.0_wp - 2.0_wp*material%poissons_ratio))
+          end associate
+          volume = abs(hexahedron_volume(model%coordinates(:, model%solid_nodes(:, owner))))
+          pass%area(s) = segment_area(x)
+          pass%stiffness(s) = model%contact_penalty_scale*scale*bulk*pass%area(s)**2/max(volume, tiny(1.0_wp))
+          pass%depth(s) = 0.5_wp*volume/max(pass%area(s), tiny(1.0_wp))
+          do j = 1, 4
+            longest = max(longest, norm2(x(:, mod(j, 4) + 1) - x(:, j)))
+          end do
+        end associate
+      end do
+      pass%margin = 0.5_wp*longest
+      ! node normals: sum of the area vectors of the secondary segments at each node
+      allocate (slot(size(model%node_ids)))
+      slot = 0
+      do n = 1, pass%node_count
+        slot(secondary_nodes(n)) = n
+      end do
+      allocate (pass%node_normal(3, pass%node_count))
+      pass%node_normal = 0.0_wp
+      do s = 1, size(secondary_segments, 2)
+        associate (x => model%coordinates(:, secondary_segments(:, s)))
+          normal = cross(x(:, 3) - x(:, 1), x(:, 4) - x(:, 2))
+        end associate
+        do j = 1, 4
+          if (j == 4 .and. secondary_segments(4, s) == secondary_segments(3, s)) cycle
+          position = slot(secondary_segments(j, s))
+          if (position > 0) pass%node_normal(:, position) = pass%node_normal(:, position) + normal
+        end do
+      end do
+      do n = 1, pass%node_count
+        if (norm2(pass%node_normal(:, n)) > 0.0_wp) pass%node_normal(:, n) = pass%node_normal(:, n)/ &
+                                                                            norm2(pass%node_normal(:, n))
+      end do
+      if (single) then
+        ! node -> own segments (CSR)
+        allocate (pass%own_first(pass%node_count + 1))
+        pass%own_first = 0
+        do s = 1, pass%segment_count
+          do j = 1, 4
+            if (j == 4 .and. primary(4, s) == primary(3, s)) cycle
+            position = slot(primary(j, s))
+            if (position > 0) pass%own_first(position + 1) = pass%own_first(position + 1) + 1
+          end do
+        end do
+        pass%own_first(1) = 1
+        do n = 1, pass%node_count
+          pass%own_first(n + 1) = pass%own_first(n + 1) + pass%own_first(n)
+        end do
+        allocate (pass%own_segments(pass%own_first(pass%node_count + 1) - 1))
+        fill = pass%own_first(1:pass%node_count)
+        do s = 1, pass%segment_count
+          do j = 1, 4
+            if (j == 4 .and. primary(4, s) == primary(3, s)) cycle
+            position = slot(primary(j, s))
+            if (position == 0) cycle
+            pass%own_segments(fill(position)) = s
+            fill(position) = fill(position) + 1
+          end do
+        end do
+      end if
+      ! every node of the pass, for the rebuild test
+      allocate (used(size(model%node_ids)))
+      used = .false.
+      used(secondary_nodes) = .true.
+      do s = 1, pass%segment_count
+        used(primary(:, s)) = .true.
+      end do
+      pass%tracked = pack([(n, n=1, size(used))], used)
+      allocate (pass%tracked_at_build(3, size(pass%tracked)), pass%box(6, pass%segment_count), &
+                pass%candidate_first(pass%node_count + 1), pass%candidates(max(16, 4*pass%node_count)), &
+                pass%cell_first(1), pass%cell_segments(max(16, 8*pass%segment_count)))
+      allocate (pass%pair_segment(pass%node_count), pass%pair_weights(4, pass%node_count), &
+                pass%pair_force(3, pass%node_count), pass%tangential(3, pass%node_count))
+      pass%pair_segment = 0
+      pass%pair_weights = 0.0_wp
+      pass%pair_force = 0.0_wp
+      pass%tangential = 0.0_wp
+    end subroutine build_pass
+  end subroutine set_up_contacts
+
+  !> Contact forces of every contact at the current configuration (added into
+  !> `contact_force`, which is zeroed first) and the contact energy increment: minus the work
+  !> of the contact forces over the step, by the trapezoidal rule
+  !> `-dt/2 (f^n + f^{n+1}) . v^{n+1/2}`. For a linear spring this is exactly the change of
+  !> its stored energy; friction adds its (positive) dissipation.
+  subroutine compute_contact_forces(model, contacts, time, step, coordinates, velocity, mass, &
+                                    contact_force, energy_increment)
+    type(model_t), intent(in) :: model
+    type(contact_state_t), intent(inout) :: contacts(:)
+    real(wp), intent(in) :: time, step
+    real(wp), intent(in) :: coordinates(:, :), velocity(:, :), mass(:)
+    real(wp), intent(inout) :: contact_force(:, :)
+    real(wp), intent(out) :: energy_increment
+    integer :: k, p, i, j, node
+    real(wp) :: work_before, work_after, total(3)
+    logical :: active
+
+    work_before = 0.0_wp
+    do k = 1, size(contacts)
+      do p = 1, contacts(k)%pass_count
+        work_before = work_before + pass_work(contacts(k)%passes(p), velocity)
+      end do
+    end do
+    !$omp parallel do schedule(static) default(shared) private(node)
+    do node = 1, size(contact_force, 2)
+      contact_force(:, node) = 0.0_wp
+    end do
+    !$omp end parallel do
+    work_after = 0.0_wp
+    do k = 1, size(contacts)
+      associate (contact => model%contacts(k), state => contacts(k))
+        active = time >= contact%birth .and. time <= contact%death
+        state%force = 0.0_wp
+        do p = 1, state%pass_count
+          associate (pass => state%passes(p))
+            if (.not. active) then
+              pass%pair_segment = 0
+              pass%pair_force = 0.0_wp
+              pass%tangential = 0.0_wp
+              cycle
+            end if
+            call update_search(pass, coordinates, contact%bucket_interval)
+            call pair_forces(contact, pass, step, coordinates, velocity, mass)
+            ! serial, in pair order: the same sums for any thread count
+            total = 0.0_wp
+            do i = 1, pass%node_count
+              if (pass%pair_segment(i) == 0) cycle
+              node = pass%nodes(i)
+              contact_force(:, node) = contact_force(:, node) + pass%pair_force(:, i)
+              do j = 1, 4
+                if (j == 4 .and. pass%segments(4, pass%pair_segment(i)) == pass%segments(3, pass%pair_segment(i))) &
+                  cycle
+                associate (other => pass%segments(j, pass%pair_segment(i)))
+                  contact_force(:, other) = contact_force(:, other) - pass%pair_weights(j, i)*pass%pair_force(:, i)
+                end associate
+              end do
+              total = total + pass%pair_force(:, i)
+            end do
+            state%force = state%force + pass%side_sign*total
+            work_after = work_after + pass_work(pass, velocity)
+          end associate
+        end do
+        state%impulse = state%impulse + step*state%force
+      end associate
+    end do
+    energy_increment = -0.5_wp*step*(work_before + work_after)
+  end subroutine compute_contact_forces
+
+  !> Power of the pair forces of a pass with `velocity`: sum of f . (v_node - sum_j w_j v_j).
+  real(wp) function pass_work(pass, velocity)
+    type(contact_pass_t), intent(in) :: pass
+    real(wp), intent(in) :: velocity(:, :)
+    integer :: i, j
+    real(wp) :: relative(3)
+    pass_work = 0.0_wp
+    do i = 1, pass%node_count
+      if (pass%pair_segment(i) == 0) cycle
+      relative = velocity(:, pass%nodes(i))
+      do j = 1, 4
+        relative = relative - pass%pair_weights(j, i)*velocity(:, pass%segments(j, pass%pair_segment(i)))
+      end do
+      pass_work = pass_work + dot_product(pass%pair_force(:, i), relative)
+    end do
+  end function pass_work
+
+  !> Rebuild the candidate lists when a node of the pass has moved half the margin since the
+  !> last build (two surfaces then approached by at most the margin), or after BSORT cycles.
+  subroutine update_search(pass, coordinates, bucket_interval)
+    type(contact_pass_t), intent(inout) :: pass
+    real(wp), intent(in) :: coordinates(:, :)
+    integer, intent(in) :: bucket_interval
+    real(wp) :: moved
+    integer :: n
+    pass%cycles_since_build = pass%cycles_since_build + 1
+    moved = 0.0_wp
+    if (pass%built) then
+      !$omp parallel do schedule(static) default(shared) private(n) reduction(max:moved)
+      do n = 1, size(pass%tracked)
+        moved = max(moved, norm2(coordinates(:, pass%tracked(n)) - pass%tracked_at_build(:, n)))
+      end do
+      !$omp end parallel do
+    end if
+    if (pass%built .and. moved < 0.5_wp*pass%margin .and. &
+        (bucket_interval <= 0 .or. pass%cycles_since_build < bucket_interval)) return
+    call build_candidates(pass, coordinates)
+  end subroutine update_search
+
+  !> Bucket sort: segment boxes (grown by the margin and the contact depth) into a uniform
+  !> grid of about as many cells as segments, then each node's candidates from its cell.
+  subroutine build_candidates(pass, coordinates)
+    type(contact_pass_t), intent(inout) :: pass
+    real(wp), intent(in) :: coordinates(:, :)
+    real(wp) :: low(3), high(3), cell, extent(3)
+    integer :: dims(3), s, i, c, total, lo(3), hi(3), ix, iy, iz, cell_count, own
+    integer, allocatable :: counts(:)
+    pass%built = .true.
+    pass%cycles_since_build = 0
+    do i = 1, size(pass%tracked)
+      pass%tracked_at_build(:, i) = coordinates(:, pass%tracked(i))
+    end do
+    pass%candidate_first(1) = 1
+    if (pass%segment_count == 0 .or. pass%node_count == 0) then
+      pass%candidate_first = 1
+      return
+    end if
+    cell = 0.0_wp
+    do s = 1, pass%segment_count
+      associate (x => coordinates(:, pass%segments(:, s)))
+        pass%box(1:3, s) = minval(x, dim=2) - (pass%margin + pass%depth(s))
+        pass%box(4:6, s) = maxval(x, dim=2) + (pass%margin + pass%depth(s))
+      end associate
+      cell = max(cell, maxval(pass%box(4:6, s) - pass%box(1:3, s)))
+    end do
+    low = minval(pass%box(1:3, :), dim=2)
+    high = maxval(pass%box(4:6, :), dim=2)
+    extent = high - low
+    do
+      dims = max(1, ceiling(extent/cell))
+      if (real(dims(1), wp)*dims(2)*dims(3) <= 2.0_wp*pass%segment_count + 8.0_wp) exit
+      cell = 1.26_wp*cell
+    end do
+    cell_count = dims(1)*dims(2)*dims(3)
+    ! segments into cells (each box spans at most two cells per direction)
+    if (size(pass%cell_first) < cell_count + 1) then
+      deallocate (pass%cell_first)
+      allocate (pass%cell_first(cell_count + 1))
+    end if
+    pass%cell_first(1:cell_count + 1) = 0
+    do s = 1, pass%segment_count
+      call box_cells(pass%box(:, s), lo, hi)
+      do iz = lo(3), hi(3)
+        do iy = lo(2), hi(2)
+          do ix = lo(1), hi(1)
+            c = ix + dims(1)*(iy - 1 + dims(2)*(iz - 1))
+            pass%cell_first(c + 1) = pass%cell_first(c + 1) + 1
+          end do
+        end do
+      end do
+    end do
+    pass%cell_first(1) = 1
+    do c = 1, cell_count
+      pass%cell_first(c + 1) = pass%cell_first(c + 1) + pass%cell_first(c)
+    end do
+    total = pass%cell_first(cell_count + 1) - 1
+    if (size(pass%cell_segments) < total) then
+      deallocate (pass%cell_segments)
+      allocate (pass%cell_segments(2*total))
+    end if
+    allocate (counts(cell_count))
+    counts = pass%cell_first(1:cell_count)
+    do s = 1, pass%segment_count
+      call box_cells(pass%box(:, s), lo, hi)
+      do iz = lo(3), hi(3)
+        do iy = lo(2), hi(2)
+          do ix = lo(1), hi(1)
+            c = ix + dims(1)*(iy - 1 + dims(2)*(iz - 1))
+            pass%cell_segments(counts(c)) = s
+            counts(c) = counts(c) + 1
+          end do
+        end do
+      end do
+    end do
+    ! candidates per node: count, offsets, fill (each node writes only its own range)
+    !$omp parallel do schedule(static) default(shared) private(i)
+    do i = 1, pass%node_count
+      pass%candidate_first(i + 1) = candidate_count(i, .false.)
+    end do
+    !$omp end parallel do
+    pass%candidate_first(1) = 1
+    do i = 1, pass%node_count
+      pass%candidate_first(i + 1) = pass%candidate_first(i + 1) + pass%candidate_first(i)
+    end do
+    total = pass%candidate_first(pass%node_count + 1) - 1
+    if (size(pass%candidates) < total) then
+      deallocate (pass%candidates)
+      allocate (pass%candidates(2*total))
+    end if
+    !$omp parallel do schedule(static) default(shared) private(i, own)
+    do i = 1, pass%node_count
+      own = candidate_count(i, .true.)
+    end do
+    !$omp end parallel do
+  contains
+    subroutine box_cells(box, first, last)
+      real(wp), intent(in) :: box(6)
+      integer, intent(out) :: first(3), last(3)
+      first = min(dims, max(1, int((box(1:3) - low)/cell) + 1))
+      last = min(dims, max(1, int((box(4:6) - low)/cell) + 1))
+    end subroutine box_cells
+
+    !> Candidates of secondary node `i` (segments of its cell whose box holds it, less its own
+    !> neighbourhood in single-surface contact); with `fill`, written to its list range.
+    integer function candidate_count(i, fill)
+      integer, intent(in) :: i
+      logical, intent(in) :: fill
+      integer :: cell_index(3), m, seg, slot, c
+      real(wp) :: x(3)
+      candidate_count = 0
+      x = coordinates(:, pass%nodes(i))
+      if (any(x < low) .or. any(x > high)) return
+      cell_index = min(dims, max(1, int((x - low)/cell) + 1))
+      m = cell_index(1) + dims(1)*(cell_index(2) - 1 + dims(2)*(cell_index(3) - 1))
+      slot = pass%candidate_first(i)
+      do c = pass%cell_first(m), pass%cell_first(m + 1) - 1
+        seg = pass%cell_segments(c)
+        if (any(x < pass%box(1:3, seg)) .or. any(x > pass%box(4:6, seg))) cycle
+        if (pass%single) then
+          if (excluded(i, seg)) cycle
+        end if
+        candidate_count = candidate_count + 1
+        if (fill) then
+          pass%candidates(slot) = seg
+          slot = slot + 1
+        end if
+      end do
+    end function candidate_count
+
+    !> Single surface: a node does not contact its own segments nor segments sharing a node
+    !> with them.
+    logical function excluded(i, seg)
+      integer, intent(in) :: i, seg
+      integer :: q, r
+      excluded = any(pass%segments(:, seg) == pass%nodes(i))
+      if (excluded) return
+      do q = pass%own_first(i), pass%own_first(i + 1) - 1
+        do r = 1, 4
+          if (any(pass%segments(:, seg) == pass%segments(r, pass%own_segments(q)))) then
+            excluded = .true.
+            return
+          end if
+        end do
+      end do
+    end function excluded
+  end subroutine build_candidates
+
+  !> The pair of each secondary node: the penetrated candidate with the least penetration,
+  !> and its force (normal penalty, optional VDC damping, Coulomb friction).
+  subroutine pair_forces(contact, pass, step, coordinates, velocity, mass)
+    type(contact_t), intent(in) :: contact
+    type(contact_pass_t), intent(inout) :: pass
+    real(wp), intent(in) :: step, coordinates(:, :), velocity(:, :), mass(:)
+    integer :: i, c, seg, best, j
+    real(wp) :: x(3), corners(3, 4), weights(4), normal(3), gap, best_depth, best_weights(4), best_normal(3)
+    real(wp) :: relative(3), stiffness, node_mass, segment_mass, reduced_mass, normal_force, damping
+    real(wp) :: tangential(3), sliding(3), friction, limit, size_t
+    logical :: inside
+    !$omp parallel do schedule(static) default(shared) private(i, c, seg, best, j, x, corners, weights, &
+    !$omp& normal, gap, best_depth, best_weights, best_normal, relative, stiffness, node_mass, segment_mass, &
+    !$omp& reduced_mass, normal_force, damping, tangential, sliding, friction, limit, size_t, inside)
+    do i = 1, pass%node_count
+      x = coordinates(:, pass%nodes(i))
+      best = 0
+      best_depth = huge(1.0_wp)
+      do c = pass%candidate_first(i), pass%candidate_first(i + 1) - 1
+        seg = pass%candidates(c)
+        corners = coordinates(:, pass%segments(:, seg))
+        call project_on_segment(x, corners, pass%segments(3, seg) == pass%segments(4, seg), weights, normal, &
+                                gap, inside)
+        if (.not. inside) cycle
+        if (gap >= 0.0_wp .or. -gap > pass%depth(seg)) cycle
+        ! the node's own surface must face the segment (an edge or corner node touching a
+        ! side face it is level with is not in contact with it)
+        if (dot_product(pass%node_normal(:, i), normal) >= 0.0_wp .and. &
+            any(pass%node_normal(:, i) /= 0.0_wp)) cycle
+        if (-gap < best_depth) then
+          best = seg
+          best_depth = -gap
+          best_weights = weights
+          best_normal = normal
+        end if
+      end do
+      if (best == 0) then
+        pass%pair_segment(i) = 0
+        pass%pair_force(:, i) = 0.0_wp
+        pass%tangential(:, i) = 0.0_wp
+        cycle
+      end if
+      relative = velocity(:, pass%nodes(i))
+      segment_mass = 0.0_wp
+      do j = 1, 4
+        relative = relative - best_weights(j)*velocity(:, pass%segments(j, best))
+        segment_mass = segment_mass + best_weights(j)*mass(pass%segments(j, best))
+      end do
+      node_mass = mass(pass%nodes(i))
+      reduced_mass = node_mass*segment_mass/max(node_mass + segment_mass, tiny(1.0_wp))
+      stiffness = pass%stiffness(best)
+      ! a pair spring must not set a shorter stable step than the elements: cap it at
+      ! stable_fraction m* / dt^2 (coarse solids with SLSFAC 0.1 and both passes otherwise
+      ! exceed the step TSSFAC leaves them)
+      if (step > 0.0_wp) stiffness = min(stiffness, stable_fraction*reduced_mass/step**2)
+      if (contact%soft == 1 .and. step > 0.0_wp) &
+        stiffness = max(stiffness, 0.5_wp*contact%soft_scale*reduced_mass/step**2)
+      normal_force = stiffness*best_depth
+      if (contact%viscous_damping > 0.0_wp) then
+        damping = 0.01_wp*contact%viscous_damping*2.0_wp*sqrt(stiffness*reduced_mass)
+        normal_force = max(0.0_wp, normal_force - damping*dot_product(relative, best_normal))
+      end if
+      tangential = 0.0_wp
+      if (contact%static_friction > 0.0_wp .or. contact%dynamic_friction > 0.0_wp) then
+        ! elastic slip: the spring force of the last cycle, turned into the current tangent
+        ! plane, plus k times the tangential slip increment; capped at mu |f_n|
+        tangential = pass%tangential(:, i) - dot_product(pass%tangential(:, i), best_normal)*best_normal
+        sliding = relative - dot_product(relative, best_normal)*best_normal
+        tangential = tangential - stiffness*step*sliding
+        friction = contact%friction_scale*(contact%dynamic_friction + (contact%static_friction - &
+                   contact%dynamic_friction)*exp(-contact%decay*norm2(sliding)))
+        limit = friction*normal_force
+        if (contact%viscous_friction > 0.0_wp) &
+          limit = min(limit, contact%viscous_scale*contact%viscous_friction*pass%area(best))
+        size_t = norm2(tangential)
+        if (size_t > limit) tangential = tangential*(limit/size_t)
+      end if
+      pass%tangential(:, i) = tangential
+      pass%pair_segment(i) = best
+      pass%pair_weights(:, i) = best_weights
+      if (pass%segments(3, best) == pass%segments(4, best)) pass%pair_weights(4, i) = 0.0_wp
+      pass%pair_force(:, i) = normal_force*best_normal + tangential
+    end do
+    !$omp end parallel do
+  end subroutine pair_forces
+
+  !> Closest point of a segment to `x`: weights of the corners (bilinear shape functions at
+  !> the point; barycentric for a triangle), the unit outward normal there and the signed gap
+  !> along it. `inside`: the point lies on the segment within the parametric tolerance.
+  pure subroutine project_on_segment(x, corners, triangle, weights, normal, gap, inside)
+    real(wp), intent(in) :: x(3), corners(3, 4)
+    logical, intent(in) :: triangle
+    real(wp), intent(out) :: weights(4), normal(3), gap
+    logical, intent(out) :: inside
+    real(wp) :: xi, eta, point(3), d_xi(3), d_eta(3), residual(3), a11, a12, a22, b1, b2, det, area
+    real(wp) :: edge1(3), edge2(3), tolerance
+    integer :: iteration
+    inside = .false.
+    gap = 0.0_wp
+    weights = 0.0_wp
+    normal = 0.0_wp
+    tolerance = parametric_limit - 1.0_wp
+    if (triangle) then
+      edge1 = corners(:, 2) - corners(:, 1)
+      edge2 = corners(:, 3) - corners(:, 1)
+      normal = cross(edge1, edge2)
+      area = norm2(normal)
+      if (area <= 0.0_wp) return
+      normal = normal/area
+      residual = x - corners(:, 1)
+      a11 = dot_product(edge1, edge1)
+      a12 = dot_product(edge1, edge2)
+      a22 = dot_product(edge2, edge2)
+      b1 = dot_product(edge1, residual)
+      b2 = dot_product(edge2, residual)
+      det = a11*a22 - a12*a12
+      xi = (a22*b1 - a12*b2)/det
+      eta = (a11*b2 - a12*b1)/det
+      weights(1:3) = [1.0_wp - xi - eta, xi, eta]
+      inside = all(weights(1:3) >= -0.5_wp*tolerance)
+      gap = dot_product(residual, normal)
+      return
+    end if
+    xi = 0.0_wp
+    eta = 0.0_wp
+    do iteration = 1, 6
+      call bilinear(xi, eta, point, d_xi, d_eta)
+      residual = x - point
+      a11 = dot_product(d_xi, d_xi)
+      a12 = dot_product(d_xi, d_eta)
+      a22 = dot_product(d_eta, d_eta)
+      b1 = dot_product(d_xi, residual)
+      b2 = dot_product(d_eta, residual)
+      det = a11*a22 - a12*a12
+      if (det <= 0.0_wp) return
+      xi = max(-2.0_wp, min(2.0_wp, xi + (a22*b1 - a12*b2)/det))
+      eta = max(-2.0_wp, min(2.0_wp, eta + (a11*b2 - a12*b1)/det))
+    end do
+    call bilinear(xi, eta, point, d_xi, d_eta)
+    normal = cross(d_xi, d_eta)
+    area = norm2(normal)
+    if (area <= 0.0_wp) return
+    normal = normal/area
+    weights = 0.25_wp*[(1.0_wp - xi)*(1.0_wp - eta), (1.0_wp + xi)*(1.0_wp - eta), &
+                       (1.0_wp + xi)*(1.0_wp + eta), (1.0_wp - xi)*(1.0_wp + eta)]
+    gap = dot_product(x - point, normal)
+    inside = abs(xi) <= parametric_limit .and. abs(eta) <= parametric_limit
+  contains
+    pure subroutine bilinear(s, t, position, ds, dt)
+      real(wp), intent(in) :: s, t
+      real(wp), intent(out) :: position(3), ds(3), dt(3)
+      position = 0.25_wp*((1.0_wp - s)*(1.0_wp - t)*corners(:, 1) + (1.0_wp + s)*(1.0_wp - t)*corners(:, 2) + &
+                          (1.0_wp + s)*(1.0_wp + t)*corners(:, 3) + (1.0_wp - s)*(1.0_wp + t)*corners(:, 4))
+      ds = 0.25_wp*(-(1.0_wp - t)*corners(:, 1) + (1.0_wp - t)*corners(:, 2) + (1.0_wp + t)*corners(:, 3) - &
+                    (1.0_wp + t)*corners(:, 4))
+      dt = 0.25_wp*(-(1.0_wp - s)*corners(:, 1) - (1.0_wp + s)*corners(:, 2) + (1.0_wp + s)*corners(:, 3) + &
+                    (1.0_wp - s)*corners(:, 4))
+    end subroutine bilinear
+  end subroutine project_on_segment
+
+  pure function cross(a, b) result(c)
+    real(wp), intent(in) :: a(3), b(3)
+    real(wp) :: c(3)
+    c = [a(2)*b(3) - a(3)*b(2), a(3)*b(1) - a(1)*b(3), a(1)*b(2) - a(2)*b(1)]
+  end function cross
+end module penalty_contact
