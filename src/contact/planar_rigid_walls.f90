@@ -11,12 +11,12 @@
 !> rests on the wall.
 module planar_rigid_walls
   use kinds, only: wp
-  use model, only: rigid_wall_t
+  use model, only: rigid_wall_t, wall_planar
   use explicit_state, only: wall_state_t
   implicit none
   private
 
-  public :: initialise_wall_states, enforce_planar_walls
+  public :: initialise_wall_states, enforce_planar_walls, apply_wall_friction
 
 contains
 
@@ -53,6 +53,7 @@ contains
 
     energy_removed = 0.0_wp
     do w = 1, size(walls)
+      if (walls(w)%kind /= wall_planar) cycle   ! cylinders: cylinder_walls
       states(w)%force = 0.0_wp
       if (time < walls(w)%birth .or. time > walls(w)%death) cycle
       normal = walls(w)%normal

@@ -802,7 +802,8 @@ contains
     generation_nodes = .true.
   end function generation_nodes
 
-  !> Rigid walls: tracked nodes (NSID 0: all) without the exempted set, ids (walls without
+  !> Rigid walls (planar and cylinders): tracked nodes (NSID 0: all) without the exempted set,
+  !> the motion curve of a moving cylinder, ids (walls without
   !> _ID are numbered by their place among the walls, as LS-DYNA numbers them).
   subroutine build_walls(deck, input, indices, log)
     type(deck_t), intent(in) :: deck
@@ -829,6 +830,9 @@ contains
           nodes = pack(nodes, keep(nodes))
         end if
         given%wall%nodes = nodes
+        ! a moving cylinder's curve (the reader has reported LCID <= 0)
+        if (given%wall%motion_curve_id > 0) given%wall%motion_curve = find_curve(deck, indices, &
+          given%wall%motion_curve_id, given%motion_line, log)
         input%model%walls(k) = given%wall
       end associate
     end do

@@ -14,6 +14,7 @@ module deck_input
     keyword_spc_node, keyword_spc_set, keyword_motion_node, keyword_motion_set, &
     keyword_load_node_point, keyword_load_node_set, keyword_initial_velocity, &
     keyword_initial_velocity_node, keyword_initial_velocity_generation, keyword_rigidwall_planar, &
+    keyword_rigidwall_cylinder, &
     keyword_load_segment, keyword_load_segment_set, keyword_load_segment_nonuniform, &
     keyword_set_segment
   implicit none
@@ -109,12 +110,13 @@ module deck_input
     integer :: axis_line = 0          !< card with the axis
   end type velocity_input_t
 
-  !> *RIGIDWALL_PLANAR definition; its node sets are resolved later.
+  !> *RIGIDWALL_PLANAR or *RIGIDWALL_GEOMETRIC_CYLINDER definition; its node sets (and curve) are resolved later.
   type :: wall_input_t
     type(rigid_wall_t) :: wall
     integer :: node_set = 0, exempt_set = 0
     logical :: id_given = .false.
     integer :: line = 0               !< card 1 (NSID)
+    integer :: motion_line = 0        !< the MOTION card of a cylinder (LCID)
   end type wall_input_t
 
   !> Everything read, before ids are resolved. Arrays are sized from line counts and hold
@@ -189,7 +191,7 @@ contains
     allocate (input%velocities(lines(keyword_initial_velocity) + &
                                lines(keyword_initial_velocity_node) + &
                                lines(keyword_initial_velocity_generation)))
-    allocate (input%walls(lines(keyword_rigidwall_planar)))
+    allocate (input%walls(lines(keyword_rigidwall_planar) + lines(keyword_rigidwall_cylinder)))
     allocate (input%segment_sets(blocks(keyword_set_segment)))
     allocate (input%segment_loads(lines(keyword_load_segment) + lines(keyword_load_segment_set) + &
                                   lines(keyword_load_segment_nonuniform)))

@@ -22,9 +22,10 @@ module deck_keywords
     keyword_control_implicit_general = 36, keyword_control_implicit_solution = 37, &
     keyword_load_segment = 38, keyword_load_segment_set = 39, &
     keyword_load_segment_nonuniform = 40, keyword_set_segment = 41, keyword_mat_honeycomb = 42, &
-    keyword_mat_modified_honeycomb = 43, keyword_mat_low_density_foam = 44
+    keyword_mat_modified_honeycomb = 43, keyword_mat_low_density_foam = 44, &
+    keyword_rigidwall_cylinder = 45
   !> Number of keyword codes.
-  integer, parameter, public :: keyword_count = 44
+  integer, parameter, public :: keyword_count = 45
 
   !> A keyword name taken apart: its code and the options given with it.
   type :: keyword_t
@@ -34,9 +35,10 @@ module deck_keywords
     logical :: finite = .false.    !< *RIGIDWALL_PLANAR_FINITE
     logical :: moving = .false.    !< *RIGIDWALL_PLANAR_MOVING
     logical :: forces = .false.    !< *RIGIDWALL_PLANAR_FORCES
+    logical :: motion = .false.    !< *RIGIDWALL_GEOMETRIC_CYLINDER_MOTION
   end type keyword_t
 
-  integer, parameter :: entry_count = 54
+  integer, parameter :: entry_count = 55
   character(len=*), parameter :: base_names(entry_count) = [character(len=36) :: &
     "TITLE", "NODE", "ELEMENT_SOLID", "PART", "SECTION_SOLID", "SECTION_SOLID_EFG", &
     "MAT_ELASTIC", "MAT_001", "MAT_PLASTIC_KINEMATIC", "MAT_003", "HOURGLASS", &
@@ -50,7 +52,7 @@ module deck_keywords
     "CONTROL_IMPLICIT_GENERAL", "CONTROL_IMPLICIT_SOLUTION", "LOAD_SEGMENT", &
     "LOAD_SEGMENT_SET", "LOAD_SEGMENT_NONUNIFORM", "SET_SEGMENT", &
     "MAT_HONEYCOMB", "MAT_026", "MAT_MODIFIED_HONEYCOMB", "MAT_126", "MAT_LOW_DENSITY_FOAM", "MAT_057", &
-    "KEYWORD", "INCLUDE", "PARAMETER", "COMMENT", "END"]
+    "RIGIDWALL_GEOMETRIC_CYLINDER", "KEYWORD", "INCLUDE", "PARAMETER", "COMMENT", "END"]
   integer, parameter :: base_codes(entry_count) = [keyword_title, keyword_node, &
     keyword_element_solid, keyword_part, keyword_section_solid, keyword_section_solid_efg, &
     keyword_mat_elastic, keyword_mat_elastic, keyword_mat_plastic_kinematic, &
@@ -66,7 +68,7 @@ module deck_keywords
     keyword_load_segment_set, keyword_load_segment_nonuniform, keyword_set_segment, &
     keyword_mat_honeycomb, keyword_mat_honeycomb, keyword_mat_modified_honeycomb, &
     keyword_mat_modified_honeycomb, keyword_mat_low_density_foam, keyword_mat_low_density_foam, &
-    keyword_unknown, keyword_unknown, keyword_unknown, keyword_unknown, keyword_unknown]
+    keyword_rigidwall_cylinder, keyword_unknown, keyword_unknown, keyword_unknown, keyword_unknown, keyword_unknown]
   !> Options each entry accepts (blank-separated).
   character(len=*), parameter :: base_options(entry_count) = [character(len=28) :: &
     "", "", "", "", "TITLE", "TITLE", &
@@ -81,7 +83,7 @@ module deck_keywords
     "", "", "ID", &
     "ID", "ID", "TITLE", &
     "TITLE", "TITLE", "TITLE", "TITLE", "TITLE", "TITLE", &
-    "", "", "", "", ""]
+    "MOTION ID", "", "", "", "", ""]
 
 contains
 
@@ -153,6 +155,9 @@ contains
       case ("FORCES")
         if (keyword%forces) return
         keyword%forces = .true.
+      case ("MOTION")
+        if (keyword%motion) return
+        keyword%motion = .true.
       end select
     end do
     fits = text(len(text):) /= "_"

@@ -1,11 +1,12 @@
 !> Boundary conditions, loads, initial velocities and rigid walls: *BOUNDARY_SPC_NODE/_SET,
 !> *BOUNDARY_PRESCRIBED_MOTION_NODE/_SET, *LOAD_NODE_POINT/_SET, *LOAD_SEGMENT(_SET,
-!> _NONUNIFORM), *INITIAL_VELOCITY(_NODE, _GENERATION) and *RIGIDWALL_PLANAR. They are kept as
+!> _NONUNIFORM), *INITIAL_VELOCITY(_NODE, _GENERATION), *RIGIDWALL_PLANAR and
+!> *RIGIDWALL_GEOMETRIC_CYLINDER. They are kept as
 !> written (by node, segment or set id); the cross-check expands them per node or segment.
 module deck_loads_bcs
   use kinds, only: wp
   use error_handling, only: error_list_t
-  use model, only: rigid_wall_t, motion_velocity, motion_acceleration, motion_displacement
+  use model, only: rigid_wall_t, wall_cylinder, motion_velocity, motion_acceleration, motion_displacement
   use deck_problems, only: problem_log_t
   use deck_numbers, only: integer_text, real_text
   use deck_lexer, only: deck_t
@@ -21,6 +22,7 @@ module deck_loads_bcs
 
   public :: read_spcs, read_motions, read_loads, read_initial_velocities
   public :: read_initial_velocity_nodes, read_velocity_generations, read_planar_walls
+  public :: read_cylinder_walls
   public :: read_segment_loads, read_segment_set_loads, read_nonuniform_segment_loads
 
   integer, parameter :: standard_widths(8) = 10
@@ -600,6 +602,96 @@ contains
       end associate
     end do
   end subroutine read_planar_walls
+
+  !> *RIGIDWALL_GEOMETRIC_CYLINDER(_MOTION)(_ID): [RWID heading], card 1 NSID NSIDEX BOXID
+  !> BIRTH DEATH, card 2 XT YT ZT XH YH ZH FRIC (tail and head of the axis), card 3 RADCYL
+  !> LENCYL NSEGS, then the MOTION card LCID OPT VX VY VZ. Subsections (NSEGS > 0, whose
+  !> VL HEIGHT cards are skipped) and boxes are reported as not available.
+  subroutine read_cylinder_walls(deck, block, keyword, input, log)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(card_t) :: card
+    integer :: line, n, box, segments, k
+    real(wp) :: length
+
+    line = 0
+    if (.not. has_data(deck, block, log, "card 1 (NSID NSIDEX BOXID BIRTH DEATH)", "NSID")) return
+    do while (next_line(deck, block, line, .false.))
+      n = input%wall_count + 1
+      input%wall_count = n
+      associate (entry => input%walls(n), wall => input%walls(n)%wall)
+        entry%id_given = keyword%id
+        wall%title = ""
+        wall%kind = wall_cylinder
+        if (keyword%id) then
+          call id_heading(deck, block, line, "RWID", wall%id, wall%title, log)
+          if (wall%id <= 0) call line_problem(deck, log, line, block, "RWID", "wall id must "// &
+                                              "be > 0, found "//integer_text(wall%id))
+          if (.not. require_card(deck, block, line, standard_widths, card, log, "card 1 (NSID "// &
+                                 "NSIDEX BOXID BIRTH DEATH)", "NSID")) exit
+        else
+          call open_card(deck, block, line, standard_widths, card, log)
+        end if
+        entry%line = line
+        call get_integer(deck, card, 1, "NSID", entry%node_set, log)
+        call get_integer(deck, card, 2, "NSIDEX", entry%exempt_set, log)
+        call get_integer(deck, card, 3, "BOXID", box, log)
+        call get_real(deck, card, 4, "BIRTH", wall%birth, log)
+        call get_real(deck, card, 5, "DEATH", wall%death, log)
+        if (wall%death == 0.0_wp) wall%death = 1.0e20_wp
+        call check_set_id(deck, card, 1, "NSID", entry%node_set, log)
+        call check_set_id(deck, card, 2, "NSIDEX", entry%exempt_set, log)
+        if (box /= 0) call card_problem(deck, log, card, "BOXID", "boxes (*DEFINE_BOX) are "// &
+                                        "not available; use a node set")
+        if (wall%death <= wall%birth) call card_problem(deck, log, card, "DEATH", "death "// &
+          "time "//real_text(wall%death)//" must be later than the birth time "// &
+          real_text(wall%birth))
+        if (.not. require_card(deck, block, line, standard_widths, card, log, &
+                               "card 2 (XT YT ZT XH YH ZH FRIC)", "XT")) exit
+        call read_wall_plane(deck, card, entry%wall, log)
+        if (.not. require_card(deck, block, line, standard_widths, card, log, &
+                               "card 3 (RADCYL LENCYL NSEGS)", "RADCYL")) exit
+        call get_real(deck, card, 1, "RADCYL", wall%radius, log)
+        call get_real(deck, card, 2, "LENCYL", wall%length, log)
+        call get_integer(deck, card, 3, "NSEGS", segments, log)
+        if (.not. card%failed .and. wall%radius <= 0.0_wp) call card_problem(deck, log, card, &
+          "RADCYL", "the cylinder radius must be > 0, found "//real_text(wall%radius))
+        if (wall%length < 0.0_wp) wall%length = 0.0_wp
+        if (segments > 0) then
+          call card_problem(deck, log, card, "NSEGS", "cylinder subsections (NSEGS > 0) are "// &
+                            "not available; use NSEGS = 0, found "//integer_text(segments))
+          ! skip the VL HEIGHT cards so that the next wall is read from its own card 1
+          do k = 1, segments
+            if (.not. require_card(deck, block, line, standard_widths, card, log, &
+                                   "the subsection card (VL HEIGHT)", "VL")) exit
+          end do
+        end if
+        if (keyword%motion) then
+          if (.not. require_card(deck, block, line, standard_widths, card, log, &
+                                 "the MOTION card (LCID OPT VX VY VZ)", "LCID")) exit
+          entry%motion_line = line
+          call get_integer(deck, card, 1, "LCID", wall%motion_curve_id, log)
+          call get_integer(deck, card, 2, "OPT", wall%motion_option, log)
+          call read_vector(deck, card, 3, ["VX", "VY", "VZ"], wall%motion_direction, log)
+          if (card%failed) cycle
+          if (wall%motion_curve_id <= 0) call card_problem(deck, log, card, "LCID", "the "// &
+            "motion needs a curve (LCID > 0), found "//integer_text(wall%motion_curve_id))
+          if (wall%motion_option /= 0 .and. wall%motion_option /= 1) call card_problem(deck, log, &
+            card, "OPT", "must be 0 (velocity) or 1 (displacement), found "// &
+            integer_text(wall%motion_option))
+          length = norm2(wall%motion_direction)
+          if (length == 0.0_wp) then
+            call card_problem(deck, log, card, "VX", "the motion direction (VX VY VZ) has zero length")
+          else
+            wall%motion_direction = wall%motion_direction/length
+          end if
+        end if
+      end associate
+    end do
+  end subroutine read_cylinder_walls
 
   !> Card 2: tail (a point of the wall) and head of the normal, friction.
   subroutine read_wall_plane(deck, card, wall, log)

@@ -25,7 +25,8 @@ module deck_reader
     keyword_set_part_list, keyword_spc_node, keyword_spc_set, keyword_initial_velocity, &
     keyword_initial_velocity_node, keyword_initial_velocity_generation, keyword_define_curve, &
     keyword_motion_node, keyword_motion_set, keyword_load_node_point, keyword_load_node_set, &
-    keyword_rigidwall_planar, keyword_d3plot, keyword_glstat, keyword_matsum, keyword_nodout, &
+    keyword_rigidwall_planar, keyword_rigidwall_cylinder, keyword_d3plot, keyword_glstat, &
+    keyword_matsum, keyword_nodout, &
     keyword_rwforc, keyword_history_node, keyword_history_node_set, &
     keyword_control_implicit_general, keyword_control_implicit_solution, keyword_load_segment, &
     keyword_load_segment_set, keyword_load_segment_nonuniform, keyword_set_segment, &
@@ -38,6 +39,7 @@ module deck_reader
   use deck_sets_curves, only: read_node_set, read_part_set, read_segment_set, read_curve
   use deck_loads_bcs, only: read_spcs, read_motions, read_loads, read_initial_velocities, &
     read_initial_velocity_nodes, read_velocity_generations, read_planar_walls, &
+    read_cylinder_walls, &
     read_segment_loads, read_segment_set_loads, read_nonuniform_segment_loads
   use deck_controls, only: read_title, read_termination, read_time_step, &
     read_hourglass_control, read_bulk_viscosity, read_energy_control, read_implicit_general, &
@@ -210,6 +212,8 @@ contains
       call read_velocity_generations(deck, block, input, log, warnings)
     case (keyword_rigidwall_planar)
       call read_planar_walls(deck, block, keyword, input, log, warnings)
+    case (keyword_rigidwall_cylinder)
+      call read_cylinder_walls(deck, block, keyword, input, log)
     case (keyword_d3plot)
       call read_plot_output(deck, block, input, log, warnings)
     case (keyword_glstat, keyword_matsum, keyword_nodout, keyword_rwforc)

@@ -174,7 +174,11 @@ module model
     real(wp) :: direction(3) = 0.0_wp        !< unit direction of a traction
   end type segment_load_t
 
-  !> A planar rigid wall (*RIGIDWALL_PLANAR with its options).
+  !> Rigid-wall kinds (rigid_wall_t%kind).
+  integer, parameter, public :: wall_planar = 1, wall_cylinder = 2
+
+  !> A rigid wall: planar (*RIGIDWALL_PLANAR with its options) or a geometric cylinder
+  !> (*RIGIDWALL_GEOMETRIC_CYLINDER(_MOTION)).
   type :: rigid_wall_t
     integer :: id = 0
     character(len=:), allocatable :: title
@@ -190,6 +194,14 @@ module model
     logical :: moving = .false.
     real(wp) :: mass = 0.0_wp, initial_speed = 0.0_wp
     logical :: forces_requested = .false.     !< _FORCES option
+    ! *RIGIDWALL_GEOMETRIC_CYLINDER(_MOTION): `point` is the axis tail, `normal` the unit axis
+    integer :: kind = wall_planar             !< wall_planar or wall_cylinder
+    real(wp) :: radius = 0.0_wp               !< RADCYL
+    real(wp) :: length = 0.0_wp               !< LENCYL (<= 0: infinite)
+    integer :: motion_curve = 0               !< curve index of _MOTION (0: the cylinder stands still)
+    integer :: motion_curve_id = 0            !< its LCID as given
+    integer :: motion_option = 0              !< OPT: 0 velocity, 1 displacement
+    real(wp) :: motion_direction(3) = 0.0_wp  !< unit direction (VX VY VZ) of the motion
   end type rigid_wall_t
 
   !> One rigid body: a *MAT_RIGID part (its elements' nodes) or a *CONSTRAINED_NODAL_RIGID_BODY

@@ -10,6 +10,7 @@ module explicit_solver
   use boundary_conditions, only: assemble_nodal_loads, load_work, impose_kinematic_conditions, &
                                  hold_prescribed_accelerations
   use planar_rigid_walls, only: enforce_planar_walls
+  use cylinder_walls, only: enforce_cylinder_walls
   use rigid_bodies, only: advance_rigid_bodies
   use penalty_contact, only: compute_contact_forces
   use energy_balance, only: update_energy_totals, total_energy
@@ -39,7 +40,7 @@ contains
     type(progress_t) :: progress
     type(phase_timer_t) :: element_timer, meshfree_timer, output_timer, contact_timer
     type(error_t), allocatable :: output_error
-    real(wp) :: previous_step, step, work
+    real(wp) :: previous_step, step, work, cylinder_work
     logical :: finished, wrote_state
 
     call plan_output(model, histories, plan)
@@ -82,8 +83,13 @@ contains
         call enforce_planar_walls(model%walls, state%walls, state%time, step, 0.5_wp*(previous_step + step), &
                                   state%coordinates, state%acceleration, state%mass, state%is_particle, &
                                   state%velocity, work)
+        state%energy%rigid_wall = state%energy%rigid_wall + work
+        call enforce_cylinder_walls(model%walls, model%curves, state%walls, state%time, step, &
+                                    0.5_wp*(previous_step + step), state%coordinates, state%acceleration, &
+                                    state%mass, state%is_particle, state%velocity, work, cylinder_work)
         call stop_phase(contact_timer)
         state%energy%rigid_wall = state%energy%rigid_wall + work
+        state%energy%external_work = state%energy%external_work + cylinder_work
       end if
       if (size(state%rigid) > 0) then
         call advance_rigid_bodies(model, state%rigid, state%time, step, 0.5_wp*(previous_step + step), &

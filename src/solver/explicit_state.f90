@@ -30,7 +30,8 @@ module explicit_state
     real(wp) :: momentum(3) = 0.0_wp         !< linear momentum of all nodes
   end type energy_totals_t
 
-  !> Motion and accumulated force of one planar rigid wall.
+  !> Motion and accumulated force of one rigid wall (planar, or cylinder: `displacement` and
+  !> `speed` then along its motion direction, and `mass` stays 0 as the motion is prescribed).
   type :: wall_state_t
     real(wp) :: displacement = 0.0_wp        !< along the normal (moving walls)
     real(wp) :: speed = 0.0_wp               !< along the normal (moving walls)

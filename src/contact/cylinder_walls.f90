@@ -1,0 +1,185 @@
+!> Geometric cylinder rigid walls (*RIGIDWALL_GEOMETRIC_CYLINDER, _MOTION): the constraint
+!> method of the planar walls (planar_rigid_walls) applied to a rigid solid cylinder.
+!>
+!> The cylinder has radius RADCYL about the axis from the tail (XT YT ZT) toward the head and
+!> length LENCYL from the tail (LENCYL <= 0: infinite). A tracked node that would end the step
+!> inside the cylinder gets the velocity that puts it on the surface at the end of the step:
+!> on the side (radially outward) or on an end cap, whichever surface is closest to the node's
+!> position at the start of the step (the largest of the signed distances rho - R, -h, h - L).
+!> The velocity change is along that surface's normal; friction (FRIC) then acts on the
+!> tangential velocity relative to the wall as for planar walls. The sum of the impulses is the
+!> (negated) force on the wall.
+!>
+!> `_MOTION` moves the cylinder along the unit direction (VX VY VZ) with the curve LCID as its
+!> speed (OPT 0, evaluated at the half step) or its displacement (OPT 1, relative to the
+!> curve's value at t = 0). The motion is prescribed: the wall has infinite mass and the nodes
+!> do not change it.
+!>
+!> Energy (central-difference form, as for planar walls): an impulse J applied at t^n changes
+!> a node's kinetic energy by W = J . (v^{n-1/2} + v^{n+1/2}) / 2. A wall moving with velocity
+!> v_w does the work E = J . v_w on the nodes; that is external work (the prescribed motion
+!> feeds it). The rigid-wall energy is what the walls took out, E - W (the energy dissipated by
+!> the inelastic constraint; for a stationary wall E = 0 and it is -W as for planar walls).
+!> The balance kinetic + internal + rigid-wall = initial + external work then closes.
+module cylinder_walls
+  use kinds, only: wp
+  use curves, only: curve_t, curve_value
+  use model, only: rigid_wall_t, wall_cylinder
+  use explicit_state, only: wall_state_t
+  use planar_rigid_walls, only: apply_wall_friction
+  implicit none
+  private
+
+  public :: enforce_cylinder_walls
+
+  integer, parameter :: surface_side = 1, surface_bottom = 2, surface_top = 3
+
+contains
+
+  !> Correct the half-step velocities of the nodes that would end the step `dt` starting at
+  !> `time` inside a cylinder wall, and advance the cylinders' prescribed motion. `velocity`
+  !> holds v^{n+1/2} computed from `acceleration` a^n with the step `average_dt`. Returns the
+  !> rigid-wall energy increment (energy dissipated) and the work the moving walls did on the
+  !> nodes (external work).
+  subroutine enforce_cylinder_walls(walls, curves, states, time, dt, average_dt, coordinates, acceleration, &
+                                    mass, is_particle, velocity, energy_removed, wall_work)
+    type(rigid_wall_t), intent(in) :: walls(:)
+    type(curve_t), intent(in) :: curves(:)
+    type(wall_state_t), intent(inout) :: states(:)
+    real(wp), intent(in) :: time, dt, average_dt
+    real(wp), intent(in) :: coordinates(:, :)   !< x^n
+    real(wp), intent(in) :: acceleration(:, :)  !< a^n
+    real(wp), intent(in) :: mass(:)
+    logical, intent(in) :: is_particle(:)       !< interior EFG particles: not on a surface
+    real(wp), intent(inout) :: velocity(:, :)   !< v^{n+1/2}
+    real(wp), intent(out) :: energy_removed     !< rigid-wall (dissipated) energy increment
+    real(wp), intent(out) :: wall_work          !< work of the moving walls on the nodes
+    integer :: w, k, node
+    real(wp) :: start_shift, end_shift, speed, wall_velocity(3), tail_start(3), tail_end(3)
+    real(wp) :: old_velocity(3), impulse(3), total_impulse(3), normal(3), depth, work
+
+    energy_removed = 0.0_wp
+    wall_work = 0.0_wp
+    do w = 1, size(walls)
+      if (walls(w)%kind /= wall_cylinder) cycle
+      states(w)%force = 0.0_wp
+      ! the prescribed motion over the step (it goes on before the birth and after the death)
+      start_shift = states(w)%displacement
+      speed = 0.0_wp
+      end_shift = start_shift
+      if (walls(w)%motion_curve > 0) then
+        associate (curve => curves(walls(w)%motion_curve))
+          if (walls(w)%motion_option == 1) then
+            end_shift = curve_value(curve, time + dt) - curve_value(curve, 0.0_wp)
+            speed = (end_shift - start_shift)/dt
+          else
+            speed = curve_value(curve, time + 0.5_wp*dt)
+            end_shift = start_shift + speed*dt
+          end if
+        end associate
+      end if
+      wall_velocity = speed*walls(w)%motion_direction
+      tail_start = walls(w)%point + start_shift*walls(w)%motion_direction
+      tail_end = walls(w)%point + end_shift*walls(w)%motion_direction
+      states(w)%displacement = end_shift
+      states(w)%speed = speed
+      if (time < walls(w)%birth .or. time > walls(w)%death) cycle
+      total_impulse = 0.0_wp
+      do k = 1, size(walls(w)%nodes)
+        node = walls(w)%nodes(k)
+        if (is_particle(node)) cycle
+        call surface_correction(walls(w), tail_start, tail_end, coordinates(:, node), &
+                                coordinates(:, node) + velocity(:, node)*dt, normal, depth)
+        if (depth <= 0.0_wp) cycle
+        old_velocity = velocity(:, node)
+        velocity(:, node) = old_velocity + (depth/dt)*normal
+        ! friction on the velocity relative to the wall
+        velocity(:, node) = velocity(:, node) - wall_velocity
+        call apply_wall_friction(walls(w)%friction, normal, old_velocity - wall_velocity, velocity(:, node))
+        velocity(:, node) = velocity(:, node) + wall_velocity
+        impulse = mass(node)*(velocity(:, node) - old_velocity)
+        total_impulse = total_impulse + impulse
+        work = dot_product(impulse, wall_velocity)
+        wall_work = wall_work + work
+        energy_removed = energy_removed + work - 0.5_wp*dot_product(impulse, velocity(:, node) + old_velocity &
+                                                                    - average_dt*acceleration(:, node))
+      end do
+      ! the wall receives the opposite impulse; its prescribed motion does not change
+      states(w)%force = -total_impulse/dt
+      states(w)%impulse = states(w)%impulse - total_impulse
+    end do
+  end subroutine enforce_cylinder_walls
+
+  !> Whether `end_point` lies inside the cylinder placed at `tail_end`; if so, the outward unit
+  !> `normal` of the surface the node is pushed to and the `depth` to move along it (depth <= 0:
+  !> outside). The surface is the one closest to `start_point` relative to the cylinder placed
+  !> at `tail_start`.
+  pure subroutine surface_correction(wall, tail_start, tail_end, start_point, end_point, normal, depth)
+    type(rigid_wall_t), intent(in) :: wall
+    real(wp), intent(in) :: tail_start(3), tail_end(3), start_point(3), end_point(3)
+    real(wp), intent(out) :: normal(3), depth
+    real(wp) :: axis(3), relative(3), radial(3), height, rho, start_radial(3), start_height
+    real(wp) :: start_rho, distance, best
+    integer :: surface
+    logical :: finite
+
+    normal = 0.0_wp
+    depth = 0.0_wp
+    axis = wall%normal
+    finite = wall%length > 0.0_wp
+    relative = end_point - tail_end
+    height = dot_product(relative, axis)
+    radial = relative - height*axis
+    rho = norm2(radial)
+    if (rho >= wall%radius) return
+    if (finite) then
+      if (height <= 0.0_wp .or. height >= wall%length) return
+    end if
+    ! the surface closest to the start position: the largest signed distance
+    relative = start_point - tail_start
+    start_height = dot_product(relative, axis)
+    start_radial = relative - start_height*axis
+    start_rho = norm2(start_radial)
+    surface = surface_side
+    best = start_rho - wall%radius
+    if (finite) then
+      distance = -start_height
+      if (distance > best) then
+        surface = surface_bottom
+        best = distance
+      end if
+      distance = start_height - wall%length
+      if (distance > best) surface = surface_top
+    end if
+    select case (surface)
+    case (surface_bottom)
+      normal = -axis
+      depth = height
+    case (surface_top)
+      normal = axis
+      depth = wall%length - height
+    case default
+      if (rho > 0.0_wp) then
+        normal = radial/rho
+      else if (start_rho > 0.0_wp) then
+        normal = start_radial/start_rho
+      else
+        normal = any_perpendicular(axis)
+      end if
+      depth = wall%radius - rho
+    end select
+  end subroutine surface_correction
+
+  !> A unit vector perpendicular to the unit vector `axis`.
+  pure function any_perpendicular(axis) result(perpendicular)
+    real(wp), intent(in) :: axis(3)
+    real(wp) :: perpendicular(3)
+    if (abs(axis(1)) < 0.9_wp) then
+      perpendicular = [0.0_wp, axis(3), -axis(2)]
+    else
+      perpendicular = [-axis(3), 0.0_wp, axis(1)]
+    end if
+    perpendicular = perpendicular - dot_product(perpendicular, axis)*axis
+    perpendicular = perpendicular/norm2(perpendicular)
+  end function any_perpendicular
+end module cylinder_walls
