@@ -55,6 +55,7 @@ module efg_forces
     real(wp) :: bulk_quadratic = 1.5_wp, bulk_linear = 0.06_wp
     type(efg_block_t), allocatable :: blocks(:)
     real(wp), allocatable :: point_stress(:, :)   !< (9, points): W_g P_g, column-major 3x3
+    real(wp), allocatable :: point_cell_volume(:) !< reference volume of each point's cell (bulk viscosity)
     integer, allocatable :: nodes(:)              !< the part's nodes that receive forces
     integer, allocatable :: node_offsets(:)       !< pairs of nodes(j): node_offsets(j) : node_offsets(j+1)-1
     integer, allocatable :: node_pair_point(:)    !< the point of each pair, in node order
@@ -93,6 +94,7 @@ contains
     end associate
     allocate (solver%point_stress(9, point_count))
     solver%point_stress = 0.0_wp
+    call sum_cell_volumes(geometry, solver%point_cell_volume)
     allocate (solver%block_time_step(block_count), solver%block_critical_point(block_count), &
               solver%block_inverted_point(block_count))
     solver%block_time_step = huge(1.0_wp)
@@ -120,6 +122,27 @@ contains
     solver%node_pair_gradient = geometry%pair_gradient(:, node_pairs%corners)
   end subroutine set_up_efg_solver
 
+  !> The reference volume of each point's background cell: the sum of the volumes of the
+  !> points that share the cell (consecutive in the point lists). The sub-cells of a distorted
+  !> cell differ in size, so 8 W_g is not the cell's volume.
+  subroutine sum_cell_volumes(geometry, cell_volume)
+    type(efg_part_t), intent(in) :: geometry
+    real(wp), allocatable, intent(out) :: cell_volume(:)
+    integer :: first, last, point_count
+    point_count = size(geometry%point_volume)
+    allocate (cell_volume(point_count))
+    first = 1
+    do while (first <= point_count)
+      last = first
+      do while (last < point_count)
+        if (geometry%point_cell(last + 1) /= geometry%point_cell(first)) exit
+        last = last + 1
+      end do
+      cell_volume(first:last) = sum(geometry%point_volume(first:last))
+      first = last + 1
+    end do
+  end subroutine sum_cell_volumes
+
   !> Stresses (W P) and stable steps of every point of one part. `dt` is the step just
   !> taken (0 at the start); displacement and velocity are the solver's d^{n+1} and v^{n+1/2}.
   subroutine compute_efg_forces(material, solver, displacement, velocity, dt)
@@ -130,8 +153,9 @@ contains
     integer :: b
     !$omp parallel do schedule(dynamic, 2) default(shared) private(b)
     do b = 1, size(solver%blocks)
-      call compute_efg_block(material, solver%geometry, solver%density, solver%bulk_quadratic, &
-                             solver%bulk_linear, solver%blocks(b), displacement, velocity, dt, solver%point_stress, &
+      call compute_efg_block(material, solver%geometry, solver%point_cell_volume, solver%density, &
+                             solver%bulk_quadratic, solver%bulk_linear, solver%blocks(b), displacement, velocity, dt, &
+                             solver%point_stress, &
                              solver%block_time_step(b), solver%block_critical_point(b), &
                              solver%block_inverted_point(b))
     end do
@@ -166,11 +190,12 @@ contains
   end subroutine add_efg_forces
 
   !> One block of integration points.
-  subroutine compute_efg_block(material, geometry, density, bulk_quadratic, bulk_linear, block, &
-                               displacement, velocity, dt, point_stress, critical_time_step, critical_point, &
+  subroutine compute_efg_block(material, geometry, point_cell_volume, density, bulk_quadratic, bulk_linear, &
+                               block, displacement, velocity, dt, point_stress, critical_time_step, critical_point, &
                                inverted_point)
     type(material_t), intent(in) :: material
     type(efg_part_t), intent(in) :: geometry
+    real(wp), intent(in) :: point_cell_volume(:)
     real(wp), intent(in) :: density, bulk_quadratic, bulk_linear
     type(efg_block_t), intent(inout) :: block
     real(wp), intent(in) :: displacement(:, :), velocity(:, :)
@@ -210,7 +235,7 @@ contains
       if (jacobian(i) <= 0.0_wp .and. inverted_point == 0) inverted_point = g
       current_density(i) = density/max(jacobian(i), tiny(1.0_wp))
       sound_speed(i) = sqrt(max(wave_modulus(i), 0.0_wp)/density)
-      cell_volume(i) = 8.0_wp*geometry%point_volume(g)*max(jacobian(i), 0.0_wp)
+      cell_volume(i) = point_cell_volume(g)*max(jacobian(i), 0.0_wp)
       ! the cell's length shrinks with the smallest principal stretch of Fbar (a cell squeezed
       ! flat keeps its volume but not its thickness)
       length(i) = geometry%point_length(g)*smallest_stretch(deformation(:, :, i))
