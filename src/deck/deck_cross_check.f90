@@ -5,7 +5,8 @@ module deck_cross_check
   use kinds, only: wp
   use error_handling, only: error_list_t, add_error
   use model, only: model_t, spc_t, prescribed_motion_t, nodal_load_t, segment_load_t, &
-                   rigid_wall_t, formulation_fe, formulation_efg
+                   rigid_wall_t, formulation_fe, formulation_efg, boundary_full_transformation, &
+                   integration_gauss_conventional
   use deck_problems, only: problem_log_t, report_problem, has_problems
   use deck_numbers, only: integer_text, real_text
   use deck_lexer, only: deck_t, line_location
@@ -231,6 +232,19 @@ contains
         if (part%section > 0) then
           if (input%model%sections(part%section)%element_formulation == elform_efg) &
             part%formulation = formulation_efg
+          ! the verification variants of Table 1 exist in the linear static analysis only
+          if (part%formulation == formulation_efg .and. .not. input%model%implicit_static) then
+            associate (section => input%model%sections(part%section))
+              if (section%boundary_treatment == boundary_full_transformation) &
+                call located_problem(deck, log, line, "SECID", "section "//integer_text(section%id)// &
+                  " of "//part_name//" has IEBT = 1 (full transformation), a verification variant of the "// &
+                  "linear static analysis (*CONTROL_IMPLICIT_GENERAL IMFLAG 1); explicit runs need IEBT = 3")
+              if (section%domain_integration == integration_gauss_conventional) &
+                call located_problem(deck, log, line, "SECID", "section "//integer_text(section%id)// &
+                  " of "//part_name//" has IDIM = 4 (conventional EFG), a verification variant of the "// &
+                  "linear static analysis (*CONTROL_IMPLICIT_GENERAL IMFLAG 1); explicit runs use IDIM 1 or 2")
+            end associate
+          end if
         end if
         if (part%material_id == 0) then
           call located_problem(deck, log, line, "MID", part_name//" has no material (MID is "// &

@@ -95,3 +95,13 @@ def test_gauss_integration_is_not_exact(tmp_path, run_deck):
     # measured 1.3e-2 (percents, as Table 1 of the paper reports for Gauss integration), against
     # 1e-14 for the local boundary integration above
     assert error > 1e-6, f"Gauss integration unexpectedly exact ({error:.3e})"
+
+
+@pytest.mark.parametrize("boundary_treatment, integration, field", [(1, 1, "IEBT = 1"), (3, 4, "IDIM = 4")])
+def test_verification_variants_are_rejected_in_explicit_runs(tmp_path, run_deck, boundary_treatment,
+                                                             integration, field):
+    # IEBT 1 and IDIM 4 are the other columns of Table 1: linear static analysis only
+    deck, _ = patch_deck(tmp_path / "patch.k", efg_section(1, 1.5, 0, boundary_treatment, integration), False)
+    run = run_deck(deck)
+    assert run.status == 2
+    assert "patch.k:8: *PART: field SECID" in run.stderr and field in run.stderr, run.stderr

@@ -776,13 +776,15 @@ contains
   subroutine test_efg_section_keyword()
     type(model_t) :: model
     type(error_list_t) :: warnings
+    ! IEBT 1 and IDIM 4 are verification variants: read in a linear static deck
     call read_good("efg_keyword.k", deck_with_sections([character(len=line_length) :: &
       "*SECTION_SOLID_EFG_TITLE", &
       "meshfree block", &
       fixed(["1 ", "41"], 10), &
       fixed(["1.2", "1.3", "1.4", "2  ", "0  ", "1  ", "2  ", "0.0"], 10), &
       fixed(["0      ", "1.0E+20", "0      ", "0.0    ", "0      ", "1      ", "0.01   ", &
-             "1.0e-2 "], 10)]), model, warnings)
+             "1.0e-2 "], 10), &
+      "*CONTROL_IMPLICIT_GENERAL", fixed(["1"], 10)]), model, warnings)
     if (allocated(model%sections)) then
       associate (section => model%sections(1))
         call check(suite, "efg keyword: one section, title, ELFORM 41", size(model%sections) == &
@@ -851,7 +853,8 @@ contains
       "*PART", "fe", fixed(["2", "2", "1"], 10), &
       "*PART", "efg", fixed(["3", "3", "1"], 10), &
       "*PART", "efg titled", fixed(["4", "5", "1"], 10), &
-      "*PART", "fe titled", fixed(["5", "6", "1"], 10)]), model, warnings)
+      "*PART", "fe titled", fixed(["5", "6", "1"], 10), &
+      "*CONTROL_IMPLICIT_GENERAL", fixed(["1"], 10)]), model, warnings)
     if (.not. allocated(model%sections)) return
     call check(suite, "efg sets: six sections", size(model%sections) == 6)
     if (size(model%sections) /= 6) return
@@ -1004,7 +1007,8 @@ contains
     call read_good("efg_conventional.k", deck_with_sections([character(len=line_length) :: &
       "*SECTION_SOLID_EFG", "1,41", fixed(["1.2", "   ", "   ", "   ", "   ", "   ", "4  "], 10), &
       "*SECTION_SOLID", "2,41", "1.3,1.3,1.3,0,0,1,4", &
-      "*PART", "second", fixed(["2", "2", "1"], 10)]), model, warnings)
+      "*PART", "second", fixed(["2", "2", "1"], 10), &
+      "*CONTROL_IMPLICIT_GENERAL", fixed(["1"], 10)]), model, warnings)
     if (.not. allocated(model%sections)) return
     call check(suite, "IDIM 4: conventional Gauss integration", all([model%sections(1)% &
       domain_integration, model%sections(2)%domain_integration] == integration_gauss_conventional))
