@@ -15,7 +15,7 @@ module deck_loads_bcs
                          get_real, card_problem, warn_if_set, id_heading, line_problem, &
                          card_is_empty, field_is_blank, located_warning
   use deck_input, only: deck_input_t, velocity_input_t, velocity_by_set, velocity_by_node, &
-                        velocity_generation, segment_load_input_t
+                        velocity_generation, segment_load_input_t, wall_input_t
   use deck_segments, only: read_segment_nodes
   implicit none
   private
@@ -532,6 +532,50 @@ contains
     end if
   end subroutine prepare_axis
 
+  !> The start of one rigid wall, shared by every kind: the RWID heading line (`_ID`), then card 1
+  !> with NSID NSIDEX BOXID and BIRTH DEATH at fields `birth_field` and `birth_field + 1`, checked
+  !> (DEATH 0 means never). False when card 1 is missing (reported).
+  logical function read_wall_card_one(deck, block, keyword, line, card, entry, birth_field, card_name, log) &
+    result(found)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    integer, intent(inout) :: line
+    type(card_t), intent(inout) :: card
+    type(wall_input_t), intent(inout) :: entry
+    integer, intent(in) :: birth_field
+    character(len=*), intent(in) :: card_name
+    type(problem_log_t), intent(inout) :: log
+    integer :: box
+
+    found = .true.
+    entry%id_given = keyword%id
+    entry%wall%title = ""
+    if (keyword%id) then
+      call id_heading(deck, block, line, "RWID", entry%wall%id, entry%wall%title, log)
+      if (entry%wall%id <= 0) call line_problem(deck, log, line, block, "RWID", "wall id must "// &
+                                                "be > 0, found "//integer_text(entry%wall%id))
+      found = require_card(deck, block, line, standard_widths, card, log, card_name, "NSID")
+      if (.not. found) return
+    else
+      call open_card(deck, block, line, standard_widths, card, log)
+    end if
+    entry%line = line
+    call get_integer(deck, card, 1, "NSID", entry%node_set, log)
+    call get_integer(deck, card, 2, "NSIDEX", entry%exempt_set, log)
+    call get_integer(deck, card, 3, "BOXID", box, log)
+    call get_real(deck, card, birth_field, "BIRTH", entry%wall%birth, log)
+    call get_real(deck, card, birth_field + 1, "DEATH", entry%wall%death, log)
+    if (entry%wall%death == 0.0_wp) entry%wall%death = 1.0e20_wp
+    call check_set_id(deck, card, 1, "NSID", entry%node_set, log)
+    call check_set_id(deck, card, 2, "NSIDEX", entry%exempt_set, log)
+    if (box /= 0) call card_problem(deck, log, card, "BOXID", "boxes (*DEFINE_BOX) are "// &
+                                    "not available; use a node set")
+    if (entry%wall%death <= entry%wall%birth) call card_problem(deck, log, card, "DEATH", "death "// &
+      "time "//real_text(entry%wall%death)//" must be later than the birth time "// &
+      real_text(entry%wall%birth))
+  end function read_wall_card_one
+
   !> *RIGIDWALL_PLANAR(_FINITE)(_MOVING)(_FORCES)(_ID): [RWID heading], card 1 NSID NSIDEX
   !> BOXID OFFSET BIRTH DEATH RWKSF, card 2 XT YT ZT XH YH ZH FRIC WVEL, then the option cards
   !> in the order FINITE, MOVING, FORCES.
@@ -543,7 +587,7 @@ contains
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
-    integer :: line, n, box
+    integer :: line, n
 
     line = 0
     if (.not. has_data(deck, block, log, "card 1 (NSID NSIDEX BOXID OFFSET BIRTH DEATH RWKSF)", &
@@ -552,34 +596,11 @@ contains
       n = input%wall_count + 1
       input%wall_count = n
       associate (entry => input%walls(n), wall => input%walls(n)%wall)
-        entry%id_given = keyword%id
-        wall%title = ""
-        if (keyword%id) then
-          call id_heading(deck, block, line, "RWID", wall%id, wall%title, log)
-          if (wall%id <= 0) call line_problem(deck, log, line, block, "RWID", "wall id must "// &
-                                              "be > 0, found "//integer_text(wall%id))
-          if (.not. require_card(deck, block, line, standard_widths, card, log, "card 1 (NSID "// &
-                                 "NSIDEX BOXID OFFSET BIRTH DEATH RWKSF)", "NSID")) exit
-        else
-          call open_card(deck, block, line, standard_widths, card, log)
-        end if
-        entry%line = line
-        call get_integer(deck, card, 1, "NSID", entry%node_set, log)
-        call get_integer(deck, card, 2, "NSIDEX", entry%exempt_set, log)
-        call get_integer(deck, card, 3, "BOXID", box, log)
+        if (.not. read_wall_card_one(deck, block, keyword, line, card, entry, 5, "card 1 (NSID "// &
+                                     "NSIDEX BOXID OFFSET BIRTH DEATH RWKSF)", log)) exit
         call get_real(deck, card, 4, "OFFSET", wall%offset, log)
-        call get_real(deck, card, 5, "BIRTH", wall%birth, log)
-        call get_real(deck, card, 6, "DEATH", wall%death, log)
-        if (wall%death == 0.0_wp) wall%death = 1.0e20_wp
-        call check_set_id(deck, card, 1, "NSID", entry%node_set, log)
-        call check_set_id(deck, card, 2, "NSIDEX", entry%exempt_set, log)
-        if (box /= 0) call card_problem(deck, log, card, "BOXID", "boxes (*DEFINE_BOX) are "// &
-                                        "not available; use a node set")
         if (wall%offset < 0.0_wp) call card_problem(deck, log, card, "OFFSET", "must be >= 0, "// &
                                                     "found "//real_text(wall%offset))
-        if (wall%death <= wall%birth) call card_problem(deck, log, card, "DEATH", "death "// &
-          "time "//real_text(wall%death)//" must be later than the birth time "// &
-          real_text(wall%birth))
         if (.not. require_card(deck, block, line, standard_widths, card, log, &
                                "card 2 (XT YT ZT XH YH ZH FRIC WVEL)", "XT")) exit
         call read_wall_plane(deck, card, entry%wall, log)
@@ -614,7 +635,7 @@ contains
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
     type(card_t) :: card
-    integer :: line, n, box, segments, k
+    integer :: line, n, segments, k
     real(wp) :: length
 
     line = 0
@@ -623,32 +644,9 @@ contains
       n = input%wall_count + 1
       input%wall_count = n
       associate (entry => input%walls(n), wall => input%walls(n)%wall)
-        entry%id_given = keyword%id
-        wall%title = ""
         wall%kind = wall_cylinder
-        if (keyword%id) then
-          call id_heading(deck, block, line, "RWID", wall%id, wall%title, log)
-          if (wall%id <= 0) call line_problem(deck, log, line, block, "RWID", "wall id must "// &
-                                              "be > 0, found "//integer_text(wall%id))
-          if (.not. require_card(deck, block, line, standard_widths, card, log, "card 1 (NSID "// &
-                                 "NSIDEX BOXID BIRTH DEATH)", "NSID")) exit
-        else
-          call open_card(deck, block, line, standard_widths, card, log)
-        end if
-        entry%line = line
-        call get_integer(deck, card, 1, "NSID", entry%node_set, log)
-        call get_integer(deck, card, 2, "NSIDEX", entry%exempt_set, log)
-        call get_integer(deck, card, 3, "BOXID", box, log)
-        call get_real(deck, card, 4, "BIRTH", wall%birth, log)
-        call get_real(deck, card, 5, "DEATH", wall%death, log)
-        if (wall%death == 0.0_wp) wall%death = 1.0e20_wp
-        call check_set_id(deck, card, 1, "NSID", entry%node_set, log)
-        call check_set_id(deck, card, 2, "NSIDEX", entry%exempt_set, log)
-        if (box /= 0) call card_problem(deck, log, card, "BOXID", "boxes (*DEFINE_BOX) are "// &
-                                        "not available; use a node set")
-        if (wall%death <= wall%birth) call card_problem(deck, log, card, "DEATH", "death "// &
-          "time "//real_text(wall%death)//" must be later than the birth time "// &
-          real_text(wall%birth))
+        if (.not. read_wall_card_one(deck, block, keyword, line, card, entry, 4, "card 1 (NSID "// &
+                                     "NSIDEX BOXID BIRTH DEATH)", log)) exit
         if (.not. require_card(deck, block, line, standard_widths, card, log, &
                                "card 2 (XT YT ZT XH YH ZH FRIC)", "XT")) exit
         call read_wall_plane(deck, card, entry%wall, log)
