@@ -21,11 +21,17 @@ module model
   integer, parameter, public :: law_low_density_foam = 57     !< *MAT_LOW_DENSITY_FOAM
   integer, parameter, public :: law_modified_honeycomb = 126  !< *MAT_MODIFIED_HONEYCOMB
   integer, parameter, public :: law_rigid = 20                !< *MAT_RIGID (parts become rigid bodies)
+  integer, parameter, public :: law_null = 9                  !< *MAT_NULL (shells: contact surface only)
+  integer, parameter, public :: law_piecewise_linear = 24     !< *MAT_PIECEWISE_LINEAR_PLASTICITY
 
   !> Curve slots of the crushable laws in material_t%curves (after the deck's defaults, such as
   !> LCB = 0 -> LCA, are applied): the six yield curves in stress order aa, bb, cc, ab, bc, ca,
   !> then the strain-rate scale curve LCSR (honeycombs); the loading curve LCID (foam).
   integer, parameter, public :: honeycomb_rate_curve = 7, foam_loading_curve = 1
+  !> Curve slots of *MAT_PIECEWISE_LINEAR_PLASTICITY: the hardening curve (yield stress against
+  !> effective plastic strain: LCSS, or the EPS1-8 / ES1-8 table turned into a curve; empty when
+  !> SIGY and ETAN define bilinear hardening) and the strain-rate scale curve LCSR.
+  integer, parameter, public :: piecewise_hardening_curve = 1, piecewise_rate_curve = 2
 
   !> How a part is discretised (`/mesh/parts/formulation`: "fe", "efg", "rigid").
   integer, parameter, public :: formulation_fe = 1, formulation_efg = 2, formulation_rigid = 3
@@ -49,6 +55,11 @@ module model
     real(wp) :: rate_p = 0.0_wp             !< SRP, Cowper-Symonds P (0: no rate effect)
     real(wp) :: failure_strain = 0.0_wp     !< FS (read and kept; erosion is not modelled)
     real(wp) :: rate_formulation = 0.0_wp   !< VP: 0 scale yield stress, 1 viscoplastic
+    ! *MAT_PIECEWISE_LINEAR_PLASTICITY (SIGY, ETAN, FAIL, C, P, VP above; curves in the slots
+    ! piecewise_hardening_curve and piecewise_rate_curve)
+    real(wp) :: failure_time_step = 0.0_wp  !< TDEL (read and kept; erosion is not modelled)
+    ! *MAT_NULL
+    real(wp) :: pressure_cutoff = 0.0_wp    !< PC (read and kept)
     ! *MAT_HONEYCOMB, *MAT_MODIFIED_HONEYCOMB (E, PR, SIGY above: the fully compacted material)
     real(wp) :: compaction_volume = 0.0_wp  !< VF: relative volume at full compaction, (0, 1]
     real(wp) :: viscosity = 0.0_wp          !< MU (honeycombs), DAMP (foam): viscous coefficient
@@ -79,11 +90,21 @@ module model
   !> crashfree extension for the verification of Table 1 of the paper).
   integer, parameter, public :: integration_gauss_conventional = 4
 
-  !> One solid section (*SECTION_SOLID, *SECTION_SOLID_EFG).
+  !> Section kinds (section_t%kind).
+  integer, parameter, public :: section_solid = 1, section_shell = 2
+
+  !> One section: solid (*SECTION_SOLID, *SECTION_SOLID_EFG) or shell (*SECTION_SHELL).
   type :: section_t
     integer :: id = 0
     character(len=:), allocatable :: title
-    integer :: element_formulation = 1     !< ELFORM: 1 one-point, 2 fully integrated S/R, 41 EFG
+    integer :: kind = section_solid        !< section_solid or section_shell
+    integer :: element_formulation = 1     !< ELFORM: 1 one-point, 2 fully integrated S/R, 41 EFG;
+                                           !< shells: 2 Belytschko-Tsay
+    ! *SECTION_SHELL
+    real(wp) :: shear_factor = 1.0_wp      !< SHRF: transverse shear correction (5/6 is usual)
+    integer :: integration_points = 2      !< NIP through the thickness (1-10)
+    real(wp) :: thickness(4) = 0.0_wp      !< T1-T4 at the element's nodes (T2-T4 default T1)
+    real(wp) :: reference_surface = 0.0_wp !< NLOC: 0 mid surface, 1 top, -1 bottom
     ! EFG card (ELFORM 41), meaningful only for meshfree sections
     real(wp) :: support_scale(3) = 1.01_wp !< DX, DY, DZ: normalized support (> 1)
     integer :: kernel = kernel_cubic_box   !< ISPLINE: 0 cubic spline, box; 2 cubic spline, sphere
@@ -135,7 +156,8 @@ module model
   !> One constrained node (*BOUNDARY_SPC_NODE/_SET, expanded per node).
   type :: spc_t
     integer :: node = 0
-    logical :: fixed(3) = .false.           !< x, y, z translations (rotations do not apply to solids)
+    logical :: fixed(3) = .false.           !< x, y, z translations
+    logical :: fixed_rotation(3) = .false.  !< rotations about x, y, z (act on shell nodes only)
   end type spc_t
 
   !> One prescribed motion of one node and one translational direction.
@@ -293,6 +315,11 @@ module model
     integer, allocatable :: solid_ids(:)
     integer, allocatable :: solid_part(:)            !< part index of each solid
     integer, allocatable :: solid_nodes(:, :)        !< (8, solids) node indices
+    ! shell elements (a triangle repeats its third node)
+    integer, allocatable :: shell_ids(:)
+    integer, allocatable :: shell_part(:)            !< part index of each shell
+    integer, allocatable :: shell_nodes(:, :)        !< (4, shells) node indices
+    real(wp), allocatable :: shell_thickness(:, :)   !< (4, shells): *ELEMENT_SHELL_THICKNESS, else the section's
     ! properties
     type(part_t), allocatable :: parts(:)
     type(section_t), allocatable :: sections(:)
