@@ -1,13 +1,15 @@
-!> Contact surfaces made of solid element faces: the exterior faces of a part (faces of its
-!> elements that no other element of the part shares), the solid element that owns a given
-!> segment (for its stiffness and outward orientation), and the geometry contact needs of
-!> one segment (area, owner volume).
+!> Contact surfaces made of solid element faces and shells: the exterior faces of a part (faces
+!> of its elements that no other element of the part shares), the shells of a part (each shell
+!> is a two-sided segment), the element that owns a given segment (for its stiffness and
+!> orientation; owners are solid indices, or minus the shell index), and the geometry contact
+!> needs of one segment (area, owner volume).
 module contact_surfaces
   use kinds, only: wp
   implicit none
   private
 
-  public :: append_exterior_faces, find_segment_owners, surface_node_list, hexahedron_volume, segment_area
+  public :: append_exterior_faces, append_part_shells, find_segment_owners, find_shell_owners, surface_node_list
+  public :: hexahedron_volume, segment_area
 
   !> The six faces of a hexahedron, numbered so that the right-hand rule over 1-2-3-4 points
   !> out of an element of positive volume (LS-DYNA's node order).
@@ -104,6 +106,71 @@ contains
       call move_alloc(grown_owners, owners)
     end subroutine reserve
   end subroutine append_exterior_faces
+
+  !> Append the shells of part `part` as segments, owners minus the shell index.
+  subroutine append_part_shells(shell_nodes, shell_part, part, segments, owners, count)
+    integer, intent(in) :: shell_nodes(:, :), shell_part(:), part
+    integer, allocatable, intent(inout) :: segments(:, :), owners(:)
+    integer, intent(inout) :: count
+    integer, allocatable :: grown_segments(:, :), grown_owners(:)
+    integer :: shell, needed
+    needed = count + count_part(shell_part, part)
+    if (.not. allocated(segments)) then
+      allocate (segments(4, max(16, needed)), owners(max(16, needed)))
+    else if (size(owners) < needed) then
+      allocate (grown_segments(4, max(needed, 2*size(owners))), grown_owners(max(needed, 2*size(owners))))
+      grown_segments(:, 1:count) = segments(:, 1:count)
+      grown_owners(1:count) = owners(1:count)
+      call move_alloc(grown_segments, segments)
+      call move_alloc(grown_owners, owners)
+    end if
+    do shell = 1, size(shell_part)
+      if (shell_part(shell) /= part) cycle
+      count = count + 1
+      segments(:, count) = shell_nodes(:, shell)
+      owners(count) = -shell
+    end do
+  end subroutine append_part_shells
+
+  !> Segments of a segment set that no solid owns (owner 0): the shell with the same corners,
+  !> as minus its index (0 stays when there is none). Shells are grouped by their smallest
+  !> node, so the cost is linear.
+  subroutine find_shell_owners(shell_nodes, node_count, segments, owners)
+    integer, intent(in) :: shell_nodes(:, :), node_count, segments(:, :)
+    integer, intent(inout) :: owners(:)
+    integer, allocatable :: first(:), members(:)
+    integer :: shell, n, s, k, key(4)
+    allocate (first(node_count + 1), members(size(shell_nodes, 2)))
+    first = 0
+    do shell = 1, size(shell_nodes, 2)
+      n = minval(shell_nodes(:, shell))
+      first(n + 1) = first(n + 1) + 1
+    end do
+    first(1) = 1
+    do n = 1, node_count
+      first(n + 1) = first(n + 1) + first(n)
+    end do
+    do shell = 1, size(shell_nodes, 2)
+      n = minval(shell_nodes(:, shell))
+      members(first(n)) = shell
+      first(n) = first(n) + 1
+    end do
+    do n = node_count, 1, -1
+      first(n + 1) = first(n)
+    end do
+    first(1) = 1
+    do s = 1, size(segments, 2)
+      if (owners(s) /= 0) cycle
+      key = sorted4(segments(:, s))
+      n = key(1)
+      do k = first(n), first(n + 1) - 1
+        if (all(sorted4(shell_nodes(:, members(k))) == key)) then
+          owners(s) = -members(k)
+          exit
+        end if
+      end do
+    end do
+  end subroutine find_shell_owners
 
   pure integer function count_part(solid_part, part)
     integer, intent(in) :: solid_part(:), part

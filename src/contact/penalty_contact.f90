@@ -29,12 +29,12 @@ module penalty_contact
   use model, only: model_t, contact_t, contact_surface_t, contact_nodes_to_surface, &
                    contact_surface_to_surface, contact_single_surface, surface_segment_set, &
                    surface_node_set
-  use contact_surfaces, only: append_exterior_faces, find_segment_owners, surface_node_list, &
-                              hexahedron_volume, segment_area
+  use contact_surfaces, only: append_exterior_faces, append_part_shells, find_segment_owners, find_shell_owners, &
+                              surface_node_list, hexahedron_volume, segment_area
   implicit none
   private
 
-  public :: contact_state_t, contact_pass_t, set_up_contacts, compute_contact_forces
+  public :: contact_state_t, contact_pass_t, set_up_contacts, compute_contact_forces, report_initial_penetrations
 
   !> Parametric tolerance of the projection (LS-DYNA's MAXPAR default 1.025).
   real(wp), parameter :: parametric_limit = 1.025_wp
@@ -51,6 +51,17 @@ module penalty_contact
     real(wp), allocatable :: stiffness(:)         !< SLSFAC SFS K A^2 / V per segment
     real(wp), allocatable :: depth(:)             !< deepest penetration still taken as contact: V / (2 A)
     real(wp), allocatable :: area(:)
+    ! shells: contact surfaces at half the thickness on either side of the mid-surface
+    real(wp), allocatable :: segment_offset(:)    !< t/2 of a shell segment, 0 for a solid face
+    real(wp), allocatable :: node_offset(:)       !< t/2 of the thickest shell of the secondary side at the node
+    real(wp) :: largest_node_offset = 0.0_wp
+    ! initial penetrations (measured at the first evaluation) are ignored, as LS-DYNA's IGNORE = 1
+    logical :: initial_checked = .false.
+    real(wp), allocatable :: initial_depth(:)     !< per secondary node, shrinks as the node backs out
+    integer :: initial_count = 0                  !< nodes found penetrating at the first evaluation
+    real(wp) :: initial_deepest = 0.0_wp
+    integer :: initial_node = 0                   !< node index of the deepest one
+    logical :: initial_reported = .false.
     ! single surface: node -> its own segments (CSR over the pass nodes)
     integer, allocatable :: own_first(:), own_segments(:)
     ! bucket search
@@ -64,6 +75,7 @@ module penalty_contact
     real(wp), allocatable :: box(:, :)            !< (6, segments) grown bounding boxes
     ! pair results, one per secondary node
     integer, allocatable :: pair_segment(:)
+    real(wp), allocatable :: pair_side(:)          !< shells: +1 / -1, the side of the segment the node is on
     real(wp), allocatable :: pair_weights(:, :), pair_force(:, :), tangential(:, :)
     real(wp) :: side_sign = 1.0_wp                !< +1: secondary is SURFA; -1: the B -> A pass
   end type contact_pass_t
@@ -107,18 +119,19 @@ contains
             call surface_node_list(segments_a, is_particle, nodes)
           end if
           state%pass_count = 1
-          call build_pass(state%passes(1), nodes, segments_a, segments_b, owners_b, contact%scale_b, .false.)
+          call build_pass(state%passes(1), nodes, segments_a, owners_a, segments_b, owners_b, contact%scale_b, .false.)
           state%passes(1)%side_sign = 1.0_wp
           if (contact%kind == contact_surface_to_surface) then
             call surface_node_list(segments_b, is_particle, nodes)
             state%pass_count = 2
-            call build_pass(state%passes(2), nodes, segments_b, segments_a, owners_a, contact%scale_a, .false.)
+            call build_pass(state%passes(2), nodes, segments_b, owners_b, segments_a, owners_a, contact%scale_a, &
+                            .false.)
             state%passes(2)%side_sign = -1.0_wp
           end if
         case (contact_single_surface)
           call surface_node_list(segments_a, is_particle, nodes)
           state%pass_count = 1
-          call build_pass(state%passes(1), nodes, segments_a, segments_a, owners_a, contact%scale_a, .true.)
+          call build_pass(state%passes(1), nodes, segments_a, owners_a, segments_a, owners_a, contact%scale_a, .true.)
         end select
       end associate
     end do
@@ -137,10 +150,11 @@ contains
         segments = side%segments
         allocate (owners(size(segments, 2)))
         call find_segment_owners(model%solid_nodes, size(model%node_ids), model%coordinates, segments, owners)
+        call find_shell_owners(model%shell_nodes, size(model%node_ids), segments, owners)
         do s = 1, size(owners)
           if (owners(s) /= 0) cycle
           write (text, '(a,i0,a,4(1x,i0),a)') "contact: segment set ", side%id, " has a segment (nodes", &
-            model%node_ids(segments(:, s)), ") that is not a face of a solid element"
+            model%node_ids(segments(:, s)), ") that is neither a face of a solid element nor a shell"
           call make_error(error, trim(text))
           return
         end do
@@ -148,6 +162,7 @@ contains
         do p = 1, size(side%parts)
           call append_exterior_faces(model%solid_nodes, model%solid_part, side%parts(p), size(model%node_ids), &
                                      segments, owners, count)
+          call append_part_shells(model%shell_nodes, model%shell_part, side%parts(p), segments, owners, count)
         end do
         if (.not. allocated(segments)) allocate (segments(4, 0), owners(0))
         segments = segments(:, 1:count)
@@ -155,11 +170,14 @@ contains
       end select
     end subroutine side_segments
 
-    !> One pass: secondary nodes (with their normals from `secondary_segments`), primary
-    !> segments with their stiffness, and the search and pair arrays.
-    subroutine build_pass(pass, secondary_nodes, secondary_segments, primary, owners, scale, single)
+    !> One pass: secondary nodes (with their normals and shell offsets from
+    !> `secondary_segments`), primary segments with their stiffness and offsets, and the search
+    !> and pair arrays. A solid face's stiffness is SLSFAC SFS K A^2 / V; a shell's is
+    !> SLSFAC SFS K A / (longest diagonal), LS-DYNA's rule for shell segments.
+    subroutine build_pass(pass, secondary_nodes, secondary_segments, secondary_owners, primary, owners, scale, single)
       type(contact_pass_t), intent(out) :: pass
-      integer, intent(in) :: secondary_nodes(:), secondary_segments(:, :), primary(:, :), owners(:)
+      integer, intent(in) :: secondary_nodes(:), secondary_segments(:, :), secondary_owners(:), primary(:, :)
+      integer, intent(in) :: owners(:)
       real(wp), intent(in) :: scale
       logical, intent(in) :: single
       integer :: s, j, n, position
@@ -171,31 +189,46 @@ contains
       pass%segment_count = size(primary, 2)
       pass%nodes = secondary_nodes
       pass%segments = primary
-      allocate (pass%stiffness(pass%segment_count), pass%depth(pass%segment_count), pass%area(pass%segment_count))
+      allocate (pass%stiffness(pass%segment_count), pass%depth(pass%segment_count), pass%area(pass%segment_count), &
+                pass%segment_offset(pass%segment_count))
       longest = 0.0_wp
       do s = 1, pass%segment_count
         associate (x => model%coordinates(:, primary(:, s)), owner => owners(s))
-          associate (material => model%materials(model%parts(model%solid_part(owner))%material))
+          associate (material => model%materials(model%parts(owner_part(owner))%material))
             bulk = material%youngs_modulus/(3.0_wp*max(1.0e-6_wp, 1.0_wp - 2.0_wp*material%poissons_ratio))
           end associate
-          volume = abs(hexahedron_volume(model%coordinates(:, model%solid_nodes(:, owner))))
           pass%area(s) = segment_area(x)
-          pass%stiffness(s) = model%contact_penalty_scale*scale*bulk*pass%area(s)**2/max(volume, tiny(1.0_wp))
-          pass%depth(s) = 0.5_wp*volume/max(pass%area(s), tiny(1.0_wp))
+          if (owner > 0) then
+            volume = abs(hexahedron_volume(model%coordinates(:, model%solid_nodes(:, owner))))
+            pass%stiffness(s) = model%contact_penalty_scale*scale*bulk*pass%area(s)**2/max(volume, tiny(1.0_wp))
+            pass%depth(s) = 0.5_wp*volume/max(pass%area(s), tiny(1.0_wp))
+            pass%segment_offset(s) = 0.0_wp
+          else
+            pass%stiffness(s) = model%contact_penalty_scale*scale*bulk*pass%area(s)/ &
+                                max(norm2(x(:, 3) - x(:, 1)), norm2(x(:, 4) - x(:, 2)), tiny(1.0_wp))
+            pass%segment_offset(s) = 0.5_wp*shell_thickness(-owner)
+            pass%depth(s) = pass%segment_offset(s)
+          end if
           do j = 1, 4
             longest = max(longest, norm2(x(:, mod(j, 4) + 1) - x(:, j)))
           end do
         end associate
       end do
       pass%margin = 0.5_wp*longest
-      ! node normals: sum of the area vectors of the secondary segments at each node
+      ! node normals: sum of the area vectors of the secondary solid faces at each node; a node
+      ! of a (two-sided) shell has none, and its offset is half its thickest shell
       allocate (slot(size(model%node_ids)))
       slot = 0
       do n = 1, pass%node_count
         slot(secondary_nodes(n)) = n
       end do
-      allocate (pass%node_normal(3, pass%node_count))
+      allocate (pass%node_normal(3, pass%node_count), pass%node_offset(pass%node_count), &
+                pass%initial_depth(pass%node_count))
       pass%node_normal = 0.0_wp
+      pass%node_offset = 0.0_wp
+      pass%initial_depth = 0.0_wp
+      allocate (used(pass%node_count))
+      used = .false.
       do s = 1, size(secondary_segments, 2)
         associate (x => model%coordinates(:, secondary_segments(:, s)))
           normal = cross(x(:, 3) - x(:, 1), x(:, 4) - x(:, 2))
@@ -203,13 +236,22 @@ contains
         do j = 1, 4
           if (j == 4 .and. secondary_segments(4, s) == secondary_segments(3, s)) cycle
           position = slot(secondary_segments(j, s))
-          if (position > 0) pass%node_normal(:, position) = pass%node_normal(:, position) + normal
+          if (position == 0) cycle
+          if (secondary_owners(s) < 0) then
+            used(position) = .true.
+            pass%node_offset(position) = max(pass%node_offset(position), 0.5_wp*shell_thickness(-secondary_owners(s)))
+          else
+            pass%node_normal(:, position) = pass%node_normal(:, position) + normal
+          end if
         end do
       end do
       do n = 1, pass%node_count
+        if (used(n)) pass%node_normal(:, n) = 0.0_wp
         if (norm2(pass%node_normal(:, n)) > 0.0_wp) pass%node_normal(:, n) = pass%node_normal(:, n)/ &
                                                                             norm2(pass%node_normal(:, n))
       end do
+      deallocate (used)
+      if (pass%node_count > 0) pass%largest_node_offset = maxval(pass%node_offset)
       if (single) then
         ! node -> own segments (CSR)
         allocate (pass%own_first(pass%node_count + 1))
@@ -251,10 +293,32 @@ contains
       allocate (pass%pair_segment(pass%node_count), pass%pair_weights(4, pass%node_count), &
                 pass%pair_force(3, pass%node_count), pass%tangential(3, pass%node_count))
       pass%pair_segment = 0
+      allocate (pass%pair_side(pass%node_count))
+      pass%pair_side = 1.0_wp
       pass%pair_weights = 0.0_wp
       pass%pair_force = 0.0_wp
       pass%tangential = 0.0_wp
     end subroutine build_pass
+
+    !> Part of a segment owner (a solid index, or minus a shell index).
+    integer function owner_part(owner)
+      integer, intent(in) :: owner
+      if (owner > 0) then
+        owner_part = model%solid_part(owner)
+      else
+        owner_part = model%shell_part(-owner)
+      end if
+    end function owner_part
+
+    !> Mean thickness of a shell (a triangle: of its three corners).
+    real(wp) function shell_thickness(shell)
+      integer, intent(in) :: shell
+      if (model%shell_nodes(3, shell) == model%shell_nodes(4, shell)) then
+        shell_thickness = sum(model%shell_thickness(1:3, shell))/3.0_wp
+      else
+        shell_thickness = 0.25_wp*sum(model%shell_thickness(:, shell))
+      end if
+    end function shell_thickness
   end subroutine set_up_contacts
 
   !> Contact forces of every contact at the current configuration (added into
@@ -325,6 +389,30 @@ contains
     energy_increment = -0.5_wp*step*(work_before + work_after)
   end subroutine compute_contact_forces
 
+  !> One warning line per pass whose first evaluation found penetrating nodes (then never
+  !> again): how many, the deepest and where. Their initial penetration is ignored.
+  subroutine report_initial_penetrations(model, contacts, time)
+    type(model_t), intent(in) :: model
+    type(contact_state_t), intent(inout) :: contacts(:)
+    real(wp), intent(in) :: time
+    character(len=300) :: text
+    integer :: k, p
+    do k = 1, size(contacts)
+      do p = 1, contacts(k)%pass_count
+        associate (pass => contacts(k)%passes(p))
+          if (.not. pass%initial_checked .or. pass%initial_reported) cycle
+          pass%initial_reported = .true.
+          if (pass%initial_count == 0) cycle
+          write (text, '(a,i0,a,i0,a,es10.3,a,i0,a,es10.3,a)') "warning: contact ", model%contacts(k)%id, ": ", &
+            pass%initial_count, " node(s) penetrate at the first contact check (t = ", time, &
+            "), the deepest node ", model%node_ids(pass%initial_node), " by ", pass%initial_deepest, &
+            "; these initial penetrations are ignored (as LS-DYNA's IGNORE = 1)"
+          write (*, '(a)') trim(text)
+        end associate
+      end do
+    end do
+  end subroutine report_initial_penetrations
+
   !> Power of the pair forces of a pass with `velocity`: sum of f . (v_node - sum_j w_j v_j).
   real(wp) function pass_work(pass, velocity)
     type(contact_pass_t), intent(in) :: pass
@@ -385,8 +473,8 @@ contains
     cell = 0.0_wp
     do s = 1, pass%segment_count
       associate (x => coordinates(:, pass%segments(:, s)))
-        pass%box(1:3, s) = minval(x, dim=2) - (pass%margin + pass%depth(s))
-        pass%box(4:6, s) = maxval(x, dim=2) + (pass%margin + pass%depth(s))
+        pass%box(1:3, s) = minval(x, dim=2) - (pass%margin + pass%depth(s) + pass%largest_node_offset)
+        pass%box(4:6, s) = maxval(x, dim=2) + (pass%margin + pass%depth(s) + pass%largest_node_offset)
       end associate
       cell = max(cell, maxval(pass%box(4:6, s) - pass%box(1:3, s)))
     end do
@@ -521,33 +609,70 @@ contains
     integer :: i, c, seg, best, j
     real(wp) :: x(3), corners(3, 4), weights(4), normal(3), gap, best_depth, best_weights(4), best_normal(3)
     real(wp) :: relative(3), stiffness, node_mass, segment_mass, reduced_mass, normal_force, damping
-    real(wp) :: tangential(3), sliding(3), friction, limit, size_t
+    real(wp) :: tangential(3), sliding(3), friction, limit, size_t, penetration, side, best_side
     logical :: inside
     !$omp parallel do schedule(static) default(shared) private(i, c, seg, best, j, x, corners, weights, &
     !$omp& normal, gap, best_depth, best_weights, best_normal, relative, stiffness, node_mass, segment_mass, &
-    !$omp& reduced_mass, normal_force, damping, tangential, sliding, friction, limit, size_t, inside)
+    !$omp& reduced_mass, normal_force, damping, tangential, sliding, friction, limit, size_t, inside, penetration, &
+    !$omp& side, best_side)
     do i = 1, pass%node_count
       x = coordinates(:, pass%nodes(i))
       best = 0
       best_depth = huge(1.0_wp)
+      best_side = 1.0_wp
       do c = pass%candidate_first(i), pass%candidate_first(i + 1) - 1
         seg = pass%candidates(c)
         corners = coordinates(:, pass%segments(:, seg))
         call project_on_segment(x, corners, pass%segments(3, seg) == pass%segments(4, seg), weights, normal, &
                                 gap, inside)
         if (.not. inside) cycle
-        if (gap >= 0.0_wp .or. -gap > pass%depth(seg)) cycle
+        ! penetration of the node's contact surface (its shell offset) into the segment's: a
+        ! solid face is one-sided; a shell is two-sided, with surfaces t/2 on either side, and
+        ! pushes the node back to the side it is on
+        if (pass%segment_offset(seg) > 0.0_wp) then
+          ! the side is the one the node was on when the pair formed; a new pair deeper than
+          ! half the contact thickness is a node arriving past the segment's edge or through
+          ! it, not a contact (LS-DYNA likewise drops pairs beyond its largest penetration)
+          if (seg == pass%pair_segment(i)) then
+            side = pass%pair_side(i)
+          else
+            side = sign(1.0_wp, gap)
+          end if
+          penetration = pass%node_offset(i) + pass%segment_offset(seg) - side*gap
+          if (seg /= pass%pair_segment(i) .and. &
+              penetration > 0.5_wp*(pass%node_offset(i) + pass%segment_offset(seg))) cycle
+          normal = side*normal
+        else
+          side = 1.0_wp
+          penetration = pass%node_offset(i) - gap
+          if (penetration > pass%depth(seg) + pass%node_offset(i)) cycle
+        end if
+        if (penetration <= 0.0_wp) cycle
         ! the node's own surface must face the segment (an edge or corner node touching a
         ! side face it is level with is not in contact with it)
         if (dot_product(pass%node_normal(:, i), normal) >= 0.0_wp .and. &
             any(pass%node_normal(:, i) /= 0.0_wp)) cycle
-        if (-gap < best_depth) then
+        if (penetration < best_depth) then
           best = seg
-          best_depth = -gap
+          best_depth = penetration
           best_weights = weights
           best_normal = normal
+          best_side = side
         end if
       end do
+      ! initial penetrations are ignored (IGNORE = 1): the first evaluation records them, and
+      ! a node that backs out keeps only what is left
+      if (.not. pass%initial_checked) then
+        if (best > 0) pass%initial_depth(i) = best_depth
+      else if (best > 0) then
+        pass%initial_depth(i) = min(pass%initial_depth(i), best_depth)
+      else
+        pass%initial_depth(i) = 0.0_wp
+      end if
+      if (best > 0) then
+        best_depth = best_depth - pass%initial_depth(i)
+        if (best_depth <= 0.0_wp) best = 0
+      end if
       if (best == 0) then
         pass%pair_segment(i) = 0
         pass%pair_force(:, i) = 0.0_wp
@@ -591,11 +716,21 @@ contains
       end if
       pass%tangential(:, i) = tangential
       pass%pair_segment(i) = best
+      pass%pair_side(i) = best_side
       pass%pair_weights(:, i) = best_weights
       if (pass%segments(3, best) == pass%segments(4, best)) pass%pair_weights(4, i) = 0.0_wp
       pass%pair_force(:, i) = normal_force*best_normal + tangential
     end do
     !$omp end parallel do
+    if (.not. pass%initial_checked) then
+      pass%initial_checked = .true.
+      pass%initial_count = count(pass%initial_depth > 0.0_wp)
+      if (pass%initial_count > 0) then
+        i = maxloc(pass%initial_depth, dim=1)
+        pass%initial_deepest = pass%initial_depth(i)
+        pass%initial_node = pass%nodes(i)
+      end if
+    end if
   end subroutine pair_forces
 
   !> Closest point of a segment to `x`: weights of the corners (bilinear shape functions at

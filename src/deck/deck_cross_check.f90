@@ -8,7 +8,7 @@ module deck_cross_check
                    rigid_wall_t, formulation_fe, formulation_efg, boundary_full_transformation, &
                    integration_gauss_conventional
   use deck_problems, only: problem_log_t, report_problem, has_problems
-  use deck_numbers, only: integer_text, real_text
+  use deck_numbers, only: integer_text, real_text, digit
   use deck_lexer, only: deck_t, line_location
   use deck_fields, only: located_problem, located_warning
   use deck_input, only: deck_input_t, set_input_t, velocity_input_t, velocity_by_set, &
@@ -20,6 +20,8 @@ module deck_cross_check
   use deck_material_curves, only: resolve_material_curves, apply_material_bulk_viscosity
   use deck_rigid_bodies, only: build_rigid_bodies
   use deck_contact, only: build_contacts
+  use deck_shell_check, only: check_element_sections, build_shell_thickness, &
+                              check_static_shells
   implicit none
   private
 
@@ -27,7 +29,7 @@ module deck_cross_check
 
   !> Sorted ids of everything that can be referenced.
   type :: deck_indices_t
-    type(id_index_t) :: nodes, solids, parts, sections, materials, hourglasses, curves
+    type(id_index_t) :: nodes, solids, shells, parts, sections, materials, hourglasses, curves
     type(id_index_t) :: node_sets, part_sets, segment_sets
   end type deck_indices_t
 
@@ -43,17 +45,22 @@ contains
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
     type(deck_indices_t) :: indices
-    logical :: mesh_resolved
+    logical :: mesh_resolved, shells_resolved
 
     call trim_to_counts(input)
     call index_definitions(deck, input, indices, log)
     call resolve_solids(deck, input, indices, mesh_resolved, log)
+    call resolve_shells(deck, input, indices, shells_resolved, log)
+    mesh_resolved = mesh_resolved .and. shells_resolved
     call resolve_parts(deck, input, indices, log)
+    call check_element_sections(deck, input, log)
+    call build_shell_thickness(deck, input, log)
+    call check_static_shells(deck, input, log)
     call resolve_material_curves(deck, input%model, input%material_lines, input%part_lines, log)
     call resolve_node_sets(deck, input, indices, log)
     call resolve_part_sets(deck, input, indices, log)
     call resolve_segment_sets(deck, input, indices, log)
-    call build_constraints(deck, input, indices, log)
+    call build_constraints(deck, input, indices, log, warnings)
     call build_motions(deck, input, indices, log)
     call build_loads(deck, input, indices, log)
     call build_segment_loads(deck, input, indices, log)
@@ -80,6 +87,10 @@ contains
       model%solid_ids = model%solid_ids(1:input%solid_count)
       model%solid_part = model%solid_part(1:input%solid_count)
       model%solid_nodes = model%solid_nodes(:, 1:input%solid_count)
+      model%shell_ids = model%shell_ids(1:input%shell_count)
+      model%shell_part = model%shell_part(1:input%shell_count)
+      model%shell_nodes = model%shell_nodes(:, 1:input%shell_count)
+      model%shell_thickness = model%shell_thickness(:, 1:input%shell_count)
       model%parts = model%parts(1:input%part_count)
       model%sections = model%sections(1:input%section_count)
       model%materials = model%materials(1:input%material_count)
@@ -99,6 +110,8 @@ contains
     associate (model => input%model)
       call index_ids(deck, model%node_ids, input%node_lines, "NID", "node", indices%nodes, log)
       call index_ids(deck, model%solid_ids, input%solid_lines, "EID", "element", indices%solids, &
+                     log)
+      call index_ids(deck, model%shell_ids, input%shell_lines, "EID", "shell", indices%shells, &
                      log)
       call index_ids(deck, [(model%parts(k)%id, k=1, input%part_count)], input%part_lines, &
                      "PID", "part", indices%parts, log)
@@ -174,22 +187,68 @@ contains
           model%solid_nodes(corner, element) = index
         end do
       end do
-      call report_unknown_parts(deck, input, unknown_part(1:missing), log)
+      call report_unknown_parts(deck, model%solid_part, model%solid_ids, input%solid_lines, &
+                                unknown_part(1:missing), "element", log)
       model%solid_part(unknown_part(1:missing)) = 0
     end associate
   end subroutine resolve_solids
 
-  !> One message per undefined part id, at its first element, with the number of elements
-  !> naming it (a mesh include without its *PART would otherwise fill the report).
-  subroutine report_unknown_parts(deck, input, elements, log)
+  !> Shell part ids and node ids to indices. Node ids <= 0 were reported by the reader.
+  subroutine resolve_shells(deck, input, indices, resolved, log)
     type(deck_t), intent(in) :: deck
-    type(deck_input_t), intent(in) :: input
-    integer, intent(in) :: elements(:)
+    type(deck_input_t), intent(inout) :: input
+    type(deck_indices_t), intent(in) :: indices
+    logical, intent(out) :: resolved
+    type(problem_log_t), intent(inout) :: log
+    integer, allocatable :: unknown_part(:)
+    integer :: element, corner, index, missing
+    logical :: triangle
+    resolved = .true.
+    allocate (unknown_part(input%shell_count))
+    missing = 0
+    associate (model => input%model)
+      do element = 1, input%shell_count
+        index = find_id(indices%parts, model%shell_part(element))
+        if (index == 0) then
+          missing = missing + 1
+          unknown_part(missing) = element
+        end if
+        if (index > 0) model%shell_part(element) = index
+        ! (a triangle's N4 repeats N3, whose id is reported once)
+        triangle = model%shell_nodes(4, element) == model%shell_nodes(3, element)
+        do corner = 1, 4
+          index = 0
+          if (model%shell_nodes(corner, element) > 0) &
+            index = find_id(indices%nodes, model%shell_nodes(corner, element))
+          if (index == 0) then
+            resolved = .false.
+            if (model%shell_nodes(corner, element) > 0 .and. .not. (corner == 4 .and. triangle)) &
+              call located_problem(deck, log, input%shell_lines(element), "N"//digit(corner), &
+                "node "//integer_text(model%shell_nodes(corner, element))//" of shell "// &
+                integer_text(model%shell_ids(element))//" is not defined")
+          end if
+          model%shell_nodes(corner, element) = index
+        end do
+      end do
+      call report_unknown_parts(deck, model%shell_part, model%shell_ids, input%shell_lines, &
+                                unknown_part(1:missing), "shell", log)
+      model%shell_part(unknown_part(1:missing)) = 0
+    end associate
+  end subroutine resolve_shells
+
+  !> One message per undefined part id, at its first element, with the number of elements
+  !> naming it (a mesh include without its *PART would otherwise fill the report). `parts`,
+  !> `ids` and `lines` are the part ids, element ids and cards of all elements of one kind
+  !> (`noun`: "element", "shell"), `elements` those whose part is undefined.
+  subroutine report_unknown_parts(deck, parts, ids, lines, elements, noun, log)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: parts(:), ids(:), lines(:), elements(:)
+    character(len=*), intent(in) :: noun
     type(problem_log_t), intent(inout) :: log
     type(id_index_t) :: by_part
     integer :: k, first, element
     character(len=:), allocatable :: others
-    call build_id_index(input%model%solid_part(elements), by_part)
+    call build_id_index(parts(elements), by_part)
     first = 1
     do k = 1, size(elements)
       if (k < size(elements)) then
@@ -199,10 +258,9 @@ contains
       others = ""
       if (k - first == 1) others = "; 1 more element names it"
       if (k - first > 1) others = "; "//integer_text(k - first)//" more elements name it"
-      call located_problem(deck, log, input%solid_lines(element), "PID", "part "// &
-        integer_text(input%model%solid_part(element))//" of element "// &
-        integer_text(input%model%solid_ids(element))//" is not defined (no *PART with this "// &
-        "PID)"//others)
+      call located_problem(deck, log, lines(element), "PID", "part "// &
+        integer_text(parts(element))//" of "//noun//" "//integer_text(ids(element))// &
+        " is not defined (no *PART with this PID)"//others)
       first = k + 1
     end do
   end subroutine report_unknown_parts
@@ -481,40 +539,89 @@ contains
     nodes = input%model%node_sets(position)%nodes
   end function set_or_all
 
-  !> *BOUNDARY_SPC_* and *NODE TC codes merged into one spc_t per constrained node.
-  subroutine build_constraints(deck, input, indices, log)
+  !> *BOUNDARY_SPC_* and *NODE TC / RC codes merged into one spc_t per constrained node.
+  !> Rotations act on shell nodes only: a rotation fixed on a node of no shell is dropped with
+  !> one warning per card (per *NODE block for RC codes, at the first such node).
+  subroutine build_constraints(deck, input, indices, log, warnings)
     type(deck_t), intent(in) :: deck
     type(deck_input_t), intent(inout) :: input
     type(deck_indices_t), intent(in) :: indices
     type(problem_log_t), intent(inout) :: log
-    logical, allocatable :: fixed(:, :)
+    type(error_list_t), intent(inout) :: warnings
+    logical, allocatable :: fixed(:, :), on_shell(:)
     integer, allocatable :: nodes(:)
-    integer :: k, node, constrained
-    ! TC codes: 1 x, 2 y, 3 z, 4 xy, 5 yz, 6 zx, 7 xyz
+    integer :: k, node, constrained, first, others
+    character(len=:), allocatable :: more
+    ! TC and RC codes: 1 x, 2 y, 3 z, 4 xy, 5 yz, 6 zx, 7 xyz
     logical, parameter :: by_code(3, 0:7) = reshape([.false., .false., .false., &
       .true., .false., .false., .false., .true., .false., .false., .false., .true., &
       .true., .true., .false., .false., .true., .true., .true., .false., .true., &
       .true., .true., .true.], [3, 8])
+    character(len=5), parameter :: rotation_names(3) = ["DOFRX", "DOFRY", "DOFRZ"]
+    character(len=*), parameter :: no_rotations = "solid nodes have no rotations"
 
-    allocate (fixed(3, input%node_count))
-    do node = 1, input%node_count
-      fixed(:, node) = by_code(:, input%node_constraints(node))
+    allocate (fixed(6, input%node_count), on_shell(input%node_count))
+    on_shell = .false.
+    do k = 1, input%shell_count
+      do node = 1, 4
+        if (input%model%shell_nodes(node, k) > 0) &
+          on_shell(input%model%shell_nodes(node, k)) = .true.
+      end do
     end do
+    first = 0
+    others = 0
+    do node = 1, input%node_count
+      fixed(1:3, node) = by_code(:, input%node_constraints(node))
+      fixed(4:6, node) = by_code(:, input%node_rotation_constraints(node))
+      if (.not. any(fixed(4:6, node)) .or. on_shell(node)) cycle
+      if (first == 0) then
+        first = node
+      else
+        others = others + 1
+      end if
+    end do
+    if (first > 0) then
+      more = ""
+      if (others == 1) more = "; 1 more node alike"
+      if (others > 1) more = "; "//integer_text(others)//" more nodes alike"
+      call located_warning(deck, warnings, input%node_lines(first), "RC", "ignored on node "// &
+        integer_text(input%model%node_ids(first))//", which belongs to no shell ("// &
+        no_rotations//")"//more)
+    end if
     do k = 1, input%spc_count
       associate (spc => input%spcs(k))
         if (.not. target_nodes(deck, input, indices, spc%target, spc%is_set, spc%line, nodes, &
                                log)) cycle
         do node = 1, size(nodes)
-          fixed(:, nodes(node)) = fixed(:, nodes(node)) .or. spc%fixed
+          fixed(1:3, nodes(node)) = fixed(1:3, nodes(node)) .or. spc%fixed
+          fixed(4:6, nodes(node)) = fixed(4:6, nodes(node)) .or. spc%fixed_rotation
         end do
+        if (.not. any(spc%fixed_rotation) .or. size(nodes) == 0) cycle
+        if (any(on_shell(nodes))) cycle
+        do first = 1, 3
+          if (spc%fixed_rotation(first)) exit
+        end do
+        if (spc%is_set) then
+          call located_warning(deck, warnings, spc%line, trim(rotation_names(first)), &
+            "ignored: no node of set "//integer_text(spc%target)//" belongs to a shell ("// &
+            no_rotations//")")
+        else
+          call located_warning(deck, warnings, spc%line, trim(rotation_names(first)), &
+            "ignored: node "//integer_text(spc%target)//" belongs to no shell ("// &
+            no_rotations//")")
+        end if
       end associate
+    end do
+    do node = 1, input%node_count
+      if (.not. on_shell(node)) fixed(4:6, node) = .false.
     end do
     allocate (input%model%spcs(count(any(fixed, dim=1))))
     constrained = 0
     do node = 1, input%node_count
       if (.not. any(fixed(:, node))) cycle
       constrained = constrained + 1
-      input%model%spcs(constrained) = spc_t(node=node, fixed=fixed(:, node))
+      input%model%spcs(constrained) = spc_t(node=node, fixed=fixed(1:3, node), &
+                                            fixed_rotation=fixed(4:6, node))
     end do
   end subroutine build_constraints
 
@@ -812,6 +919,12 @@ contains
       if (chosen_part(k)) chosen_node(pack(input%model%solid_nodes(:, element), &
                                            input%model%solid_nodes(:, element) > 0)) = .true.
     end do
+    do element = 1, input%shell_count
+      k = input%model%shell_part(element)
+      if (k == 0) cycle
+      if (chosen_part(k)) chosen_node(pack(input%model%shell_nodes(:, element), &
+                                           input%model%shell_nodes(:, element) > 0)) = .true.
+    end do
     nodes = pack([(k, k=1, input%node_count)], chosen_node)
     generation_nodes = .true.
   end function generation_nodes
@@ -910,8 +1023,8 @@ contains
       "nodes are given but *DATABASE_NODOUT has no interval (DT), so no nodout is written")
   end subroutine build_history_nodes
 
-  !> At least one node and one element, every element with a valid shape, and the elements
-  !> of EFG parts proper hexahedra.
+  !> At least one node and one element (solid or shell), every element with a valid shape (a
+  !> shell with an area), and the elements of EFG parts proper hexahedra.
   subroutine check_mesh(deck, input, resolved, log)
     type(deck_t), intent(in) :: deck
     type(deck_input_t), intent(in) :: input
@@ -923,10 +1036,19 @@ contains
 
     if (input%node_count == 0) call report_problem(log, deck%files(1)%path// &
       ": *NODE: field NID: the deck defines no nodes")
-    if (input%solid_count == 0) call report_problem(log, deck%files(1)%path// &
-      ": *ELEMENT_SOLID: field EID: the deck defines no solid elements")
+    if (input%solid_count == 0 .and. input%shell_count == 0) call report_problem(log, &
+      deck%files(1)%path//": *ELEMENT_SOLID: field EID: the deck defines no elements (no "// &
+      "*ELEMENT_SOLID or *ELEMENT_SHELL)")
     if (.not. resolved) return
     associate (model => input%model)
+      do element = 1, input%shell_count
+        if (.not. segment_has_no_area(model%coordinates(:, model%shell_nodes(:, element)))) cycle
+        part = model%shell_part(element)
+        name = "shell "//integer_text(model%shell_ids(element))
+        if (part > 0) name = name//" of part "//integer_text(model%parts(part)%id)
+        call located_problem(deck, log, input%shell_lines(element), "N1-N4", name// &
+          " has no area: its corners coincide or lie on one line")
+      end do
       do element = 1, input%solid_count
         do corner = 1, 8
           corners(:, corner) = model%coordinates(:, model%solid_nodes(corner, element))

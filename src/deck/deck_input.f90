@@ -16,7 +16,8 @@ module deck_input
     keyword_initial_velocity_node, keyword_initial_velocity_generation, keyword_rigidwall_planar, &
     keyword_rigidwall_cylinder, &
     keyword_load_segment, keyword_load_segment_set, keyword_load_segment_nonuniform, &
-    keyword_set_segment
+    keyword_set_segment, keyword_element_shell, keyword_element_shell_thickness, &
+    keyword_section_shell
   implicit none
   private
 
@@ -73,6 +74,7 @@ module deck_input
     integer :: target = 0
     logical :: is_set = .false.
     logical :: fixed(3) = .false.
+    logical :: fixed_rotation(3) = .false.  !< DOFRX DOFRY DOFRZ
     integer :: line = 0
   end type spc_input_t
 
@@ -129,7 +131,12 @@ module deck_input
     integer :: load_count = 0, velocity_count = 0, wall_count = 0
     integer :: segment_set_count = 0, segment_load_count = 0
     integer, allocatable :: node_lines(:), node_constraints(:)     !< TC code of each node
+    integer, allocatable :: node_rotation_constraints(:)           !< RC code of each node
     integer, allocatable :: solid_lines(:), solid_node_lines(:)   !< PID card, node card
+    !> *ELEMENT_SHELL(_THICKNESS): the element card and the THIC card (the element card for
+    !> *ELEMENT_SHELL). model%shell_thickness holds THIC1-4 as read (0: the section's).
+    integer :: shell_count = 0
+    integer, allocatable :: shell_lines(:), shell_thickness_lines(:)
     integer, allocatable :: part_lines(:), section_lines(:), material_lines(:)
     integer, allocatable :: hourglass_lines(:), curve_lines(:)
     type(set_input_t), allocatable :: node_sets(:), part_sets(:)
@@ -167,13 +174,18 @@ contains
 
     n = lines(keyword_node)
     allocate (input%model%node_ids(n), input%model%coordinates(3, n), input%node_lines(n), &
-              input%node_constraints(n))
+              input%node_constraints(n), input%node_rotation_constraints(n))
     n = lines(keyword_element_solid)
     allocate (input%model%solid_ids(n), input%model%solid_part(n), input%model%solid_nodes(8, n), &
               input%solid_lines(n), input%solid_node_lines(n))
+    ! *ELEMENT_SHELL_THICKNESS: two lines per element, but for the last one of a block
+    n = lines(keyword_element_shell) + (lines(keyword_element_shell_thickness) + &
+                                        blocks(keyword_element_shell_thickness))/2
+    allocate (input%model%shell_ids(n), input%model%shell_part(n), input%model%shell_nodes(4, n), &
+              input%model%shell_thickness(4, n), input%shell_lines(n), input%shell_thickness_lines(n))
     n = lines(keyword_part)
     allocate (input%model%parts(n), input%part_lines(n))
-    n = lines(keyword_section_solid) + lines(keyword_section_solid_efg)
+    n = lines(keyword_section_solid) + lines(keyword_section_solid_efg) + lines(keyword_section_shell)
     allocate (input%model%sections(n), input%section_lines(n))
     n = lines(keyword_mat_elastic) + lines(keyword_mat_plastic_kinematic) + lines(keyword_mat_honeycomb) &
         + lines(keyword_mat_modified_honeycomb) + lines(keyword_mat_low_density_foam)

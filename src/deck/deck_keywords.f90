@@ -24,8 +24,11 @@ module deck_keywords
     keyword_load_segment_nonuniform = 40, keyword_set_segment = 41, keyword_mat_honeycomb = 42, &
     keyword_mat_modified_honeycomb = 43, keyword_mat_low_density_foam = 44, &
     keyword_rigidwall_cylinder = 45
+  !> Shell elements and sections.
+  integer, parameter, public :: keyword_element_shell = 46, keyword_element_shell_thickness = 47, &
+    keyword_section_shell = 48
   !> Number of keyword codes.
-  integer, parameter, public :: keyword_count = 45
+  integer, parameter, public :: keyword_count = 48
 
   !> A keyword name taken apart: its code and the options given with it.
   type :: keyword_t
@@ -38,7 +41,7 @@ module deck_keywords
     logical :: motion = .false.    !< *RIGIDWALL_GEOMETRIC_CYLINDER_MOTION
   end type keyword_t
 
-  integer, parameter :: entry_count = 55
+  integer, parameter :: entry_count = 58
   character(len=*), parameter :: base_names(entry_count) = [character(len=36) :: &
     "TITLE", "NODE", "ELEMENT_SOLID", "PART", "SECTION_SOLID", "SECTION_SOLID_EFG", &
     "MAT_ELASTIC", "MAT_001", "MAT_PLASTIC_KINEMATIC", "MAT_003", "HOURGLASS", &
@@ -52,7 +55,8 @@ module deck_keywords
     "CONTROL_IMPLICIT_GENERAL", "CONTROL_IMPLICIT_SOLUTION", "LOAD_SEGMENT", &
     "LOAD_SEGMENT_SET", "LOAD_SEGMENT_NONUNIFORM", "SET_SEGMENT", &
     "MAT_HONEYCOMB", "MAT_026", "MAT_MODIFIED_HONEYCOMB", "MAT_126", "MAT_LOW_DENSITY_FOAM", "MAT_057", &
-    "RIGIDWALL_GEOMETRIC_CYLINDER", "KEYWORD", "INCLUDE", "PARAMETER", "COMMENT", "END"]
+    "RIGIDWALL_GEOMETRIC_CYLINDER", "ELEMENT_SHELL", "ELEMENT_SHELL_THICKNESS", "SECTION_SHELL", &
+    "KEYWORD", "INCLUDE", "PARAMETER", "COMMENT", "END"]
   integer, parameter :: base_codes(entry_count) = [keyword_title, keyword_node, &
     keyword_element_solid, keyword_part, keyword_section_solid, keyword_section_solid_efg, &
     keyword_mat_elastic, keyword_mat_elastic, keyword_mat_plastic_kinematic, &
@@ -68,7 +72,8 @@ module deck_keywords
     keyword_load_segment_set, keyword_load_segment_nonuniform, keyword_set_segment, &
     keyword_mat_honeycomb, keyword_mat_honeycomb, keyword_mat_modified_honeycomb, &
     keyword_mat_modified_honeycomb, keyword_mat_low_density_foam, keyword_mat_low_density_foam, &
-    keyword_rigidwall_cylinder, keyword_unknown, keyword_unknown, keyword_unknown, keyword_unknown, keyword_unknown]
+    keyword_rigidwall_cylinder, keyword_element_shell, keyword_element_shell_thickness, &
+    keyword_section_shell, keyword_unknown, keyword_unknown, keyword_unknown, keyword_unknown, keyword_unknown]
   !> Options each entry accepts (blank-separated).
   character(len=*), parameter :: base_options(entry_count) = [character(len=28) :: &
     "", "", "", "", "TITLE", "TITLE", &
@@ -83,7 +88,7 @@ module deck_keywords
     "", "", "ID", &
     "ID", "ID", "TITLE", &
     "TITLE", "TITLE", "TITLE", "TITLE", "TITLE", "TITLE", &
-    "MOTION ID", "", "", "", "", ""]
+    "MOTION ID", "", "", "TITLE", "", "", "", "", ""]
 
 contains
 

@@ -32,15 +32,15 @@ module deck_loads_bcs
 
 contains
 
-  !> *BOUNDARY_SPC_NODE / _SET: NID|NSID CID DOFX DOFY DOFZ DOFRX DOFRY DOFRZ per line.
-  subroutine read_spcs(deck, block, keyword, by_set, input, log, warnings)
+  !> *BOUNDARY_SPC_NODE / _SET: NID|NSID CID DOFX DOFY DOFZ DOFRX DOFRY DOFRZ per line. The
+  !> rotations act on shell nodes; the cross-check warns when they name no shell node.
+  subroutine read_spcs(deck, block, keyword, by_set, input, log)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
     type(keyword_t), intent(in) :: keyword
     logical, intent(in) :: by_set
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
-    type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
     integer :: line, n, k, system, flag
     logical :: fixed(6)
@@ -65,10 +65,10 @@ contains
                               "(fixed), found "//integer_text(flag))
             flag = 0
           end if
-          if (k > 3) call warn_if_set(deck, card, k + 2, trim(names(k)), no_rotations, warnings)
           fixed(k) = flag == 1
         end do
         spc%fixed = fixed(1:3)
+        spc%fixed_rotation = fixed(4:6)
       end associate
     end do
   end subroutine read_spcs

@@ -1,17 +1,23 @@
 !> *MAT_ELASTIC (*MAT_001), *MAT_PLASTIC_KINEMATIC (*MAT_003), *MAT_HONEYCOMB (*MAT_026),
-!> *MAT_MODIFIED_HONEYCOMB (*MAT_126) and *MAT_LOW_DENSITY_FOAM (*MAT_057), with the checks
+!> *MAT_MODIFIED_HONEYCOMB (*MAT_126), *MAT_LOW_DENSITY_FOAM (*MAT_057),
+!> *MAT_PIECEWISE_LINEAR_PLASTICITY (*MAT_024) and *MAT_NULL (*MAT_009), with the checks
 !> that catch physically impossible values before they become a NaN in the first cycle, and
 !> errors naming each field whose LS-DYNA feature crashfree does not build (docs/materials.md).
 !> Curve ids are resolved by deck_material_curves after all keywords are read.
+!>
+!> *MAT_024 and *MAT_009 are identified here (codes `material_keyword_first`..), not in
+!> deck_keywords, as the rigid-body and contact keywords are: their codes stay out of the
+!> per-keyword line counts, and their materials are appended with `reserve_material`.
 module deck_materials
   use kinds, only: wp
   use error_handling, only: error_list_t
   use model, only: material_t, law_elastic, law_plastic_kinematic, law_honeycomb, law_modified_honeycomb, &
-                   law_low_density_foam
+                   law_low_density_foam, law_piecewise_linear, law_null, piecewise_hardening_curve
+  use curves, only: curve_t
   use deck_problems, only: problem_log_t
   use deck_numbers, only: integer_text, real_text
   use deck_lexer, only: deck_t
-  use deck_keywords, only: keyword_t
+  use deck_keywords, only: keyword_t, keyword_unknown
   use deck_fields, only: card_t, require_card, next_definition, get_integer, get_real, &
                          card_problem, field_is_blank, warn_if_set, next_line, open_card
   use deck_input, only: deck_input_t
@@ -19,11 +25,285 @@ module deck_materials
   private
 
   public :: read_elastic_materials, read_plastic_kinematic_materials, read_honeycomb_materials
-  public :: read_low_density_foam_materials
+  public :: read_low_density_foam_materials, read_piecewise_linear_materials, read_null_materials
+  public :: identify_material_keyword, read_material_block, reserve_material
+
+  !> Codes of *MAT_PIECEWISE_LINEAR_PLASTICITY and *MAT_NULL (beyond deck_keywords' range).
+  integer, parameter, public :: keyword_mat_piecewise_linear = 1201, keyword_mat_null = 1202
+  integer, parameter, public :: material_keyword_first = 1201, material_keyword_last = 1202
 
   integer, parameter :: standard_widths(8) = 10
+  !> Largest FAIL that still means "no failure" (LS-DYNA's default is 1e21).
+  real(wp), parameter :: no_failure_strain = 1.0e20_wp
 
 contains
+
+  !> The material keyword `name` (upper case, no `*`) read here with its options, or code
+  !> `keyword_unknown`: *MAT_PIECEWISE_LINEAR_PLASTICITY / *MAT_024 and *MAT_NULL / *MAT_009,
+  !> each also with _TITLE.
+  pure function identify_material_keyword(name) result(keyword)
+    character(len=*), intent(in) :: name
+    type(keyword_t) :: keyword
+    select case (name)
+    case ("MAT_PIECEWISE_LINEAR_PLASTICITY", "MAT_024")
+      keyword%code = keyword_mat_piecewise_linear
+    case ("MAT_PIECEWISE_LINEAR_PLASTICITY_TITLE", "MAT_024_TITLE")
+      keyword%code = keyword_mat_piecewise_linear
+      keyword%title = .true.
+    case ("MAT_NULL", "MAT_009")
+      keyword%code = keyword_mat_null
+    case ("MAT_NULL_TITLE", "MAT_009_TITLE")
+      keyword%code = keyword_mat_null
+      keyword%title = .true.
+    case default
+      keyword%code = keyword_unknown
+    end select
+  end function identify_material_keyword
+
+  !> Read one block of a keyword identified by identify_material_keyword.
+  subroutine read_material_block(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    select case (keyword%code)
+    case (keyword_mat_piecewise_linear)
+      call read_piecewise_linear_materials(deck, block, keyword, input, log, warnings)
+    case (keyword_mat_null)
+      call read_null_materials(deck, block, keyword, input, log, warnings)
+    end select
+  end subroutine read_material_block
+
+  !> Room for one more material: the lists are sized from the line counts of deck_keywords'
+  !> material keywords, so the keywords read here grow them (by a few entries at a time).
+  subroutine reserve_material(input)
+    type(deck_input_t), intent(inout) :: input
+    type(material_t), allocatable :: materials(:)
+    integer, allocatable :: lines(:)
+    integer :: n
+    n = input%material_count
+    if (n < size(input%model%materials)) return
+    allocate (materials(n + 8), lines(n + 8))
+    materials(1:n) = input%model%materials(1:n)
+    lines(1:n) = input%material_lines(1:n)
+    lines(n + 1:) = 0
+    call move_alloc(materials, input%model%materials)
+    call move_alloc(lines, input%material_lines)
+  end subroutine reserve_material
+
+  !> Index of a new material of law `law` whose card 1 is at `line` (lists grown as needed).
+  integer function append_material(input, line, law, title) result(n)
+    type(deck_input_t), intent(inout) :: input
+    integer, intent(in) :: line, law
+    character(len=*), intent(in) :: title
+    call reserve_material(input)
+    n = input%material_count + 1
+    input%material_count = n
+    input%material_lines(n) = line
+    input%model%materials(n)%law = law
+    input%model%materials(n)%title = title
+  end function append_material
+
+  !> *MAT_PIECEWISE_LINEAR_PLASTICITY: C1 MID RO E PR SIGY ETAN FAIL TDEL; C2 C P LCSS LCSR VP
+  !> (unused) RFILTF; C3 EPS1-EPS8; C4 ES1-ES8. Cards 3 and 4 may be left out at the end of the
+  !> keyword (no table). LS-DYNA's precedence: LCSS overrides EPS/ES, which override SIGY and
+  !> ETAN; LCSR overrides C and P. The EPS/ES table becomes the curve in slot
+  !> piecewise_hardening_curve (curve id 0); LCSS and LCSR are resolved by the cross-check.
+  subroutine read_piecewise_linear_materials(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card, first_card, strain_card, stress_card
+    integer :: line, n, k, hardening_curve, rate_curve, points
+    real(wp) :: strains(8), stresses(8)
+    logical :: has_table, table_cards
+    character(len=:), allocatable :: title
+
+    line = 0
+    do while (next_definition(deck, block, keyword%title, line, standard_widths, card, title, &
+                              log, "card 1 (MID RO E PR SIGY ETAN FAIL TDEL)", "MID"))
+      n = append_material(input, line, law_piecewise_linear, title)
+      associate (material => input%model%materials(n))
+        call read_elastic_constants(deck, card, material, log)
+        call get_real(deck, card, 5, "SIGY", material%yield_stress, log)
+        call get_real(deck, card, 6, "ETAN", material%tangent_modulus, log)
+        call get_real(deck, card, 7, "FAIL", material%failure_strain, log, default=1.0e21_wp)
+        call get_real(deck, card, 8, "TDEL", material%failure_time_step, log)
+        if (material%failure_strain == 0.0_wp) material%failure_strain = 1.0e21_wp
+        if (material%failure_strain < 0.0_wp .and. .not. card%failed) call card_problem(deck, log, card, "FAIL", &
+          "FAIL < 0 (a user failure subroutine) is not available; give 0 or a plastic failure strain, found "// &
+          real_text(material%failure_strain))
+        if (material%failure_strain > 0.0_wp .and. material%failure_strain < no_failure_strain) &
+          call warn_if_set(deck, card, 7, "FAIL", "elements do not erode", warnings)
+        call warn_if_set(deck, card, 8, "TDEL", "elements do not erode", warnings)
+        first_card = card
+
+        if (.not. require_card(deck, block, line, standard_widths, card, log, &
+                               "card 2 (C P LCSS LCSR VP)", "C")) exit
+        call get_real(deck, card, 1, "C", material%rate_c, log)
+        call get_real(deck, card, 2, "P", material%rate_p, log)
+        call get_integer(deck, card, 3, "LCSS", hardening_curve, log)
+        call get_integer(deck, card, 4, "LCSR", rate_curve, log)
+        call get_real(deck, card, 5, "VP", material%rate_formulation, log)
+        call warn_if_set(deck, card, 7, "RFILTF", "rate filtering belongs to VP = 4, not available", warnings)
+        if (.not. card%failed) then
+          if (hardening_curve < 0) call card_problem(deck, log, card, "LCSS", "curve id must be >= 0 (0: "// &
+            "EPS1-8 / ES1-8 or SIGY, ETAN), found "//integer_text(hardening_curve))
+          if (rate_curve < 0) call card_problem(deck, log, card, "LCSR", "curve id must be >= 0 (0: C, P), "// &
+            "found "//integer_text(rate_curve))
+          if (rate_curve > 0) then
+            call warn_if_set(deck, card, 1, "C", "LCSR overrides C and P", warnings)
+            call warn_if_set(deck, card, 2, "P", "LCSR overrides C and P", warnings)
+          else
+            call check_rate(deck, card, material, log, "C", "P")
+          end if
+          if (material%rate_formulation /= 0.0_wp .and. material%rate_formulation /= 1.0_wp) &
+            call card_problem(deck, log, card, "VP", "must be 0 (scale the yield stress) or 1 (viscoplastic), "// &
+              "found "//real_text(material%rate_formulation)//"; VP = -1 (deviatoric rate), 3 and 4 "// &
+              "(filtered rates) are not available")
+        end if
+        material%curve_ids = [max(hardening_curve, 0), max(rate_curve, 0)]
+        allocate (material%curves(size(material%curve_ids)))
+
+        ! Cards 3 and 4: the EPS / ES table (optional at the end of the keyword).
+        strains = 0.0_wp
+        stresses = 0.0_wp
+        table_cards = next_line(deck, block, line, .false.)
+        if (table_cards) then
+          call open_card(deck, block, line, standard_widths, strain_card, log)
+          do k = 1, 8
+            call get_real(deck, strain_card, k, "EPS"//achar(iachar("0") + k), strains(k), log)
+          end do
+          if (.not. require_card(deck, block, line, standard_widths, stress_card, log, &
+                                 "card 4 (ES1 ... ES8)", "ES1")) exit
+          do k = 1, 8
+            call get_real(deck, stress_card, k, "ES"//achar(iachar("0") + k), stresses(k), log)
+          end do
+        end if
+        has_table = any(stresses /= 0.0_wp) .or. any(strains /= 0.0_wp)
+        if (has_table .and. hardening_curve > 0) then
+          do k = 1, 8
+            call warn_if_set(deck, strain_card, k, "EPS"//achar(iachar("0") + k), "LCSS overrides EPS1-8", warnings)
+            call warn_if_set(deck, stress_card, k, "ES"//achar(iachar("0") + k), "LCSS overrides ES1-8", warnings)
+          end do
+        else if (has_table .and. .not. (strain_card%failed .or. stress_card%failed)) then
+          call check_table(deck, strain_card, stress_card, strains, stresses, points, log)
+          if (points > 0) then
+            material%curves(piecewise_hardening_curve) = curve_t(id=0, title="EPS1-ES8 of material "// &
+              integer_text(material%id), abscissa=strains(1:points), ordinate=stresses(1:points))
+          end if
+        end if
+        if (.not. first_card%failed .and. hardening_curve <= 0 .and. .not. has_table) &
+          call check_bilinear(deck, first_card, material, log)
+      end associate
+    end do
+  end subroutine read_piecewise_linear_materials
+
+  !> The EPS1-8 / ES1-8 table: the points up to the last one given (a blank or zero pair ends
+  !> it), with ES1 > 0, increasing plastic strains from EPS1 >= 0 and positive yield stresses.
+  !> `points` is 0 when the table was rejected.
+  subroutine check_table(deck, strain_card, stress_card, strains, stresses, points, log)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(in) :: strain_card, stress_card
+    real(wp), intent(in) :: strains(8), stresses(8)
+    integer, intent(out) :: points
+    type(problem_log_t), intent(inout) :: log
+    integer :: k, problems
+    character(len=1) :: digit, previous
+
+    problems = log%total
+    points = 1
+    do k = 2, 8
+      if (strains(k) /= 0.0_wp .or. stresses(k) /= 0.0_wp) points = k
+    end do
+    if (stresses(1) <= 0.0_wp) call card_problem(deck, log, stress_card, "ES1", "the EPS / ES table needs "// &
+      "ES1 > 0 (the initial yield stress), found "//real_text(stresses(1))//"; without a table leave "// &
+      "EPS1-8 and ES1-8 blank and give SIGY and ETAN")
+    if (strains(1) < 0.0_wp) call card_problem(deck, log, strain_card, "EPS1", "effective plastic strain "// &
+      "must be >= 0, found "//real_text(strains(1)))
+    do k = 2, points
+      digit = achar(iachar("0") + k)
+      previous = achar(iachar("0") + k - 1)
+      if (strains(k) <= strains(k - 1)) call card_problem(deck, log, strain_card, "EPS"//digit, &
+        "effective plastic strains must increase: EPS"//digit//" = "//real_text(strains(k))// &
+        " is not above EPS"//previous//" = "//real_text(strains(k - 1)))
+      if (stresses(k) <= 0.0_wp .and. stresses(1) > 0.0_wp) call card_problem(deck, log, stress_card, &
+        "ES"//digit, "yield stress must be > 0, found "//real_text(stresses(k)))
+    end do
+    if (log%total > problems) points = 0
+  end subroutine check_table
+
+  !> SIGY > 0 and 0 <= ETAN < E when they define the hardening (no LCSS, no table).
+  subroutine check_bilinear(deck, card, material, log)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(in) :: card
+    type(material_t), intent(in) :: material
+    type(problem_log_t), intent(inout) :: log
+    if (material%yield_stress <= 0.0_wp) call card_problem(deck, log, card, "SIGY", "yield stress must be "// &
+      "> 0 when neither LCSS nor the EPS1-8 / ES1-8 table is given, found "// &
+      shown(deck, card, 5, material%yield_stress))
+    if (material%tangent_modulus < 0.0_wp) then
+      call card_problem(deck, log, card, "ETAN", "tangent modulus must be >= 0, found "// &
+                        real_text(material%tangent_modulus))
+    else if (material%tangent_modulus >= material%youngs_modulus .and. material%youngs_modulus > 0.0_wp) then
+      call card_problem(deck, log, card, "ETAN", "tangent modulus must be smaller than E = "// &
+        real_text(material%youngs_modulus)//", found "//real_text(material%tangent_modulus))
+    end if
+  end subroutine check_bilinear
+
+  !> *MAT_NULL: MID RO PC MU TEROD CEROD YM PR, one card per material. crashfree takes it on
+  !> shell parts (contact surfaces without stress); YM and PR give those shells their time step
+  !> and contact stiffness. PC and MU act through an equation of state, which is not read.
+  subroutine read_null_materials(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    integer :: line, n
+    character(len=:), allocatable :: title
+
+    line = 0
+    do while (next_definition(deck, block, keyword%title, line, standard_widths, card, title, &
+                              log, "card 1 (MID RO PC MU TEROD CEROD YM PR)", "MID"))
+      n = append_material(input, line, law_null, title)
+      associate (material => input%model%materials(n))
+        call get_integer(deck, card, 1, "MID", material%id, log)
+        call get_real(deck, card, 2, "RO", material%density, log)
+        call get_real(deck, card, 3, "PC", material%pressure_cutoff, log)
+        call get_real(deck, card, 4, "MU", material%viscosity, log)
+        call get_real(deck, card, 7, "YM", material%youngs_modulus, log)
+        call get_real(deck, card, 8, "PR", material%poissons_ratio, log)
+        if (.not. card%failed) then
+          if (material%id <= 0) call card_problem(deck, log, card, "MID", "material id must be "// &
+                                                  "> 0, found "//integer_text(material%id))
+          if (material%density <= 0.0_wp) call card_problem(deck, log, card, "RO", "density must "// &
+            "be > 0, found "//shown(deck, card, 2, material%density))
+          if (material%pressure_cutoff > 0.0_wp) call card_problem(deck, log, card, "PC", "pressure "// &
+            "cut-off must be <= 0, found "//real_text(material%pressure_cutoff))
+          if (material%viscosity < 0.0_wp) call card_problem(deck, log, card, "MU", "viscosity "// &
+            "coefficient must be >= 0, found "//real_text(material%viscosity))
+          if (material%youngs_modulus < 0.0_wp) call card_problem(deck, log, card, "YM", "Young's "// &
+            "modulus must be >= 0, found "//real_text(material%youngs_modulus))
+          if (material%poissons_ratio <= -1.0_wp .or. material%poissons_ratio >= 0.5_wp) &
+            call card_problem(deck, log, card, "PR", "Poisson's ratio must lie in (-1, 0.5), "// &
+                              "found "//real_text(material%poissons_ratio))
+        end if
+        call warn_if_set(deck, card, 3, "PC", "no equation of state: a null shell carries no pressure", warnings)
+        call warn_if_set(deck, card, 4, "MU", "no equation of state: a null shell carries no viscous stress", &
+                         warnings)
+        call warn_if_set(deck, card, 5, "TEROD", "elements do not erode", warnings)
+        call warn_if_set(deck, card, 6, "CEROD", "elements do not erode", warnings)
+      end associate
+    end do
+  end subroutine read_null_materials
 
   !> *MAT_ELASTIC: MID RO E PR DA DB K, one card per material (DA, DB: beams; K: fluids).
   subroutine read_elastic_materials(deck, block, keyword, input, log)
@@ -82,7 +362,12 @@ contains
         call get_real(deck, card, 2, "SRP", material%rate_p, log)
         call get_real(deck, card, 3, "FS", material%failure_strain, log)
         call get_real(deck, card, 4, "VP", material%rate_formulation, log)
-        if (.not. card%failed) call check_rate(deck, card, material, log)
+        if (.not. card%failed) then
+          call check_rate(deck, card, material, log, "SRC", "SRP")
+          if (material%rate_formulation /= 0.0_wp .and. material%rate_formulation /= 1.0_wp) &
+            call card_problem(deck, log, card, "VP", "must be 0 (scale the yield stress) or 1 "// &
+                              "(viscoplastic), found "//real_text(material%rate_formulation))
+        end if
       end associate
       call warn_if_set(deck, card, 3, "FS", "elements do not erode", warnings)
     end do
@@ -381,25 +666,30 @@ contains
         "(0 kinematic, 1 isotropic), found "//real_text(material%hardening_beta))
   end subroutine check_hardening
 
-  subroutine check_rate(deck, card, material, log)
+  !> Cowper-Symonds C and P (fields named `c_name`, `p_name`): both >= 0, and both > 0 or both 0.
+  subroutine check_rate(deck, card, material, log, c_name, p_name)
     type(deck_t), intent(in) :: deck
     type(card_t), intent(in) :: card
     type(material_t), intent(in) :: material
     type(problem_log_t), intent(inout) :: log
+    character(len=*), intent(in) :: c_name, p_name
     if (material%rate_c < 0.0_wp) then
-      call card_problem(deck, log, card, "SRC", "Cowper-Symonds C must be >= 0 (0: no rate "// &
+      call card_problem(deck, log, card, c_name, "Cowper-Symonds C must be >= 0 (0: no rate "// &
                         "effect), found "//real_text(material%rate_c))
     else if (material%rate_p < 0.0_wp) then
-      call card_problem(deck, log, card, "SRP", "Cowper-Symonds P must be >= 0 (0: no rate "// &
+      call card_problem(deck, log, card, p_name, "Cowper-Symonds P must be >= 0 (0: no rate "// &
                         "effect), found "//real_text(material%rate_p))
     else if ((material%rate_c > 0.0_wp) .neqv. (material%rate_p > 0.0_wp)) then
-      call card_problem(deck, log, card, trim(merge("SRP", "SRC", material%rate_c > 0.0_wp)), &
-        "Cowper-Symonds rate effects need both SRC and SRP > 0 (or both 0 for none), found "// &
-        "SRC = "//real_text(material%rate_c)//", SRP = "//real_text(material%rate_p))
+      if (material%rate_c > 0.0_wp) then
+        call card_problem(deck, log, card, p_name, "Cowper-Symonds rate effects need both "//c_name//" and "// &
+          p_name//" > 0 (or both 0 for none), found "//c_name//" = "//real_text(material%rate_c)//", "// &
+          p_name//" = "//real_text(material%rate_p))
+      else
+        call card_problem(deck, log, card, c_name, "Cowper-Symonds rate effects need both "//c_name//" and "// &
+          p_name//" > 0 (or both 0 for none), found "//c_name//" = "//real_text(material%rate_c)//", "// &
+          p_name//" = "//real_text(material%rate_p))
+      end if
     end if
-    if (material%rate_formulation /= 0.0_wp .and. material%rate_formulation /= 1.0_wp) &
-      call card_problem(deck, log, card, "VP", "must be 0 (scale the yield stress) or 1 "// &
-                        "(viscoplastic), found "//real_text(material%rate_formulation))
   end subroutine check_rate
 
   !> A value for a message, saying when it came from a blank field.

@@ -1,8 +1,9 @@
-!> *PART, *SECTION_SOLID(_EFG) and *HOURGLASS: what each part is made of and how it is integrated.
+!> *PART, *SECTION_SOLID(_EFG), *SECTION_SHELL and *HOURGLASS: what each part is made of and how
+!> it is integrated.
 module deck_parts_sections
   use kinds, only: wp
   use error_handling, only: error_list_t
-  use model, only: formulation_fe
+  use model, only: formulation_fe, section_solid, section_shell
   use deck_problems, only: problem_log_t
   use deck_numbers, only: integer_text, real_text
   use deck_lexer, only: deck_t
@@ -16,7 +17,7 @@ module deck_parts_sections
   implicit none
   private
 
-  public :: read_parts, read_solid_sections, read_hourglasses
+  public :: read_parts, read_solid_sections, read_shell_sections, read_hourglasses
 
   integer, parameter :: standard_widths(8) = 10
 
@@ -114,6 +115,7 @@ contains
       input%section_lines(n) = line
       input%model%sections(n)%id = id
       input%model%sections(n)%title = title
+      input%model%sections(n)%kind = section_solid
       input%model%sections(n)%element_formulation = formulation
       if (.not. card%failed) then
         if (id <= 0) call card_problem(deck, log, card, "SECID", "section id must be > 0, "// &
@@ -135,6 +137,102 @@ contains
       end if
     end do
   end subroutine read_solid_sections
+
+  !> *SECTION_SHELL (with _TITLE: a title line before each section). Sections repeat until the
+  !> next keyword; each is two cards:
+  !> card 1 SECID ELFORM SHRF NIP PROPT QR/IRID ICOMP SETYP, card 2 T1 T2 T3 T4 NLOC MAREA IDOF
+  !> EDGSET. Only what the Belytschko-Tsay shell models is accepted: ELFORM 2, Gauss
+  !> integration through the thickness (QR/IRID 0) with 1-10 points, no composite angles
+  !> (ICOMP 0), the mid surface as reference (NLOC 0) and no non-structural mass (MAREA 0,
+  !> rejected rather than ignored since it would change the mass). T2-T4 blank or 0 take T1,
+  !> as in LS-DYNA. PROPT and SETYP (printout, 2D solids) are not used.
+  subroutine read_shell_sections(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    integer :: line, n, k, rule, composite, angle_cards
+    real(wp) :: reference_surface, area_mass
+    character(len=:), allocatable :: title
+    character(len=2), parameter :: thickness_names(4) = ["T1", "T2", "T3", "T4"]
+
+    line = 0
+    do while (next_definition(deck, block, keyword%title, line, standard_widths, card, title, &
+                              log, "card 1 (SECID ELFORM SHRF NIP PROPT QR/IRID ICOMP SETYP)", &
+                              "SECID"))
+      n = input%section_count + 1
+      input%section_count = n
+      input%section_lines(n) = line
+      associate (section => input%model%sections(n))
+        section%kind = section_shell
+        section%title = title
+        call get_integer(deck, card, 1, "SECID", section%id, log)
+        call get_integer(deck, card, 2, "ELFORM", section%element_formulation, log, default=2)
+        call get_real(deck, card, 3, "SHRF", section%shear_factor, log)
+        call get_integer(deck, card, 4, "NIP", section%integration_points, log)
+        call get_integer(deck, card, 6, "QR/IRID", rule, log)
+        call get_integer(deck, card, 7, "ICOMP", composite, log)
+        if (.not. card%failed) then
+          if (section%id <= 0) call card_problem(deck, log, card, "SECID", "section id must "// &
+                                                 "be > 0, found "//integer_text(section%id))
+          if (section%element_formulation /= 2) call card_problem(deck, log, card, "ELFORM", &
+            "shell formulation "//integer_text(section%element_formulation)//" is not "// &
+            "available; ELFORM 2 (Belytschko-Tsay) is the one shell crashfree has")
+          if (section%shear_factor < 0.0_wp) call card_problem(deck, log, card, "SHRF", &
+            "shear factor must be > 0 (0 or blank: 1.0; 5/6 is usual), found "// &
+            real_text(section%shear_factor))
+          if (section%integration_points < 0 .or. section%integration_points > 10) &
+            call card_problem(deck, log, card, "NIP", "integration points through the "// &
+              "thickness must be 1-10 (0 or blank: 2), found "// &
+              integer_text(section%integration_points))
+          if (rule /= 0) call card_problem(deck, log, card, "QR/IRID", "only Gauss "// &
+            "integration through the thickness (0) is available; trapezoidal (1) and "// &
+            "*INTEGRATION_SHELL rules (< 0) are not, found "//integer_text(rule))
+          if (composite == 1) then
+            call card_problem(deck, log, card, "ICOMP", "composite layers with one material "// &
+              "angle per integration point (ICOMP 1) are not available; leave ICOMP blank or 0")
+          else if (composite /= 0) then
+            call card_problem(deck, log, card, "ICOMP", "must be 0 (or 1, composite angles, "// &
+                              "which are not available), found "//integer_text(composite))
+          end if
+        end if
+        if (section%shear_factor == 0.0_wp) section%shear_factor = 1.0_wp
+        ! (the angle cards of ICOMP 1, one angle per point and 8 per card, are stepped over)
+        angle_cards = 0
+        if (composite == 1) angle_cards = (max(section%integration_points, 2) + 7)/8
+        if (section%integration_points == 0) section%integration_points = 2
+        if (.not. require_card(deck, block, line, standard_widths, card, log, "card 2 (T1 T2 "// &
+            "T3 T4 NLOC MAREA IDOF EDGSET) of section "//integer_text(section%id), "T1")) exit
+        do k = 1, 4
+          call get_real(deck, card, k, thickness_names(k), section%thickness(k), log)
+          if (section%thickness(k) < 0.0_wp) then
+            call card_problem(deck, log, card, thickness_names(k), "thickness must be >= 0, "// &
+                              "found "//real_text(section%thickness(k)))
+            section%thickness(k) = 0.0_wp
+          end if
+        end do
+        where (section%thickness(2:4) == 0.0_wp) section%thickness(2:4) = section%thickness(1)
+        call get_real(deck, card, 5, "NLOC", reference_surface, log)
+        call get_real(deck, card, 6, "MAREA", area_mass, log)
+        section%reference_surface = reference_surface
+        if (reference_surface /= 0.0_wp) call card_problem(deck, log, card, "NLOC", &
+          "reference surface offsets are not available: shells lie on their mid surface "// &
+          "(NLOC 0 or blank), found "//real_text(reference_surface))
+        if (area_mass /= 0.0_wp) call card_problem(deck, log, card, "MAREA", "non-structural "// &
+          "mass per area is not available (add it with *ELEMENT_MASS or in the density), "// &
+          "found "//real_text(area_mass))
+        call warn_if_set(deck, card, 7, "IDOF", "thickness stretch belongs to other shell "// &
+                         "formulations", warnings)
+        call warn_if_set(deck, card, 8, "EDGSET", "seatbelt shells are not available", warnings)
+      end associate
+      do k = 1, angle_cards
+        if (.not. next_line(deck, block, line, .false.)) exit
+      end do
+    end do
+  end subroutine read_shell_sections
 
   !> ELFORM of a solid section: 1 and 2 (finite elements) and 41 (EFG); 41 only under
   !> *SECTION_SOLID_EFG.

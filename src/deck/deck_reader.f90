@@ -31,11 +31,15 @@ module deck_reader
     keyword_control_implicit_general, keyword_control_implicit_solution, keyword_load_segment, &
     keyword_load_segment_set, keyword_load_segment_nonuniform, keyword_set_segment, &
     keyword_mat_honeycomb, keyword_mat_modified_honeycomb, keyword_mat_low_density_foam
+  use deck_keywords, only: keyword_element_shell, keyword_element_shell_thickness, &
+    keyword_section_shell
   use deck_input, only: deck_input_t, prepare_input
-  use deck_nodes_elements, only: read_nodes, read_solid_elements
-  use deck_parts_sections, only: read_parts, read_solid_sections, read_hourglasses
+  use deck_nodes_elements, only: read_nodes, read_solid_elements, read_shell_elements
+  use deck_parts_sections, only: read_parts, read_solid_sections, read_hourglasses, &
+    read_shell_sections
   use deck_materials, only: read_elastic_materials, read_plastic_kinematic_materials, &
-    read_honeycomb_materials, read_low_density_foam_materials
+    read_honeycomb_materials, read_low_density_foam_materials, identify_material_keyword, &
+    read_material_block, material_keyword_first, material_keyword_last
   use deck_sets_curves, only: read_node_set, read_part_set, read_segment_set, read_curve
   use deck_loads_bcs, only: read_spcs, read_motions, read_loads, read_initial_velocities, &
     read_initial_velocity_nodes, read_velocity_generations, read_planar_walls, &
@@ -81,6 +85,8 @@ contains
         identify_rigid_keyword(deck%blocks(block)%name)
       if (keywords(block)%code == keyword_unknown) keywords(block) = &
         identify_contact_keyword(deck%blocks(block)%name)
+      if (keywords(block)%code == keyword_unknown) keywords(block) = &
+        identify_material_keyword(deck%blocks(block)%name)
       if (keywords(block)%code == keyword_unknown) call report_unknown(deck, block, &
         ignore_unknown, log, warnings)
     end do
@@ -150,9 +156,14 @@ contains
     case (keyword_title)
       call read_title(deck, block, input)
     case (keyword_node)
-      call read_nodes(deck, block, input, log, warnings)
+      call read_nodes(deck, block, input, log)
     case (keyword_element_solid)
       call read_solid_elements(deck, block, input, log)
+    case (keyword_element_shell, keyword_element_shell_thickness)
+      call read_shell_elements(deck, block, keyword%code == keyword_element_shell_thickness, &
+                               input, log)
+    case (keyword_section_shell)
+      call read_shell_sections(deck, block, keyword, input, log, warnings)
     case (keyword_part)
       call read_parts(deck, block, input, log, warnings)
     case (keyword_section_solid, keyword_section_solid_efg)
@@ -193,7 +204,7 @@ contains
     case (keyword_define_curve)
       call read_curve(deck, block, keyword, input, log)
     case (keyword_spc_node, keyword_spc_set)
-      call read_spcs(deck, block, keyword, keyword%code == keyword_spc_set, input, log, warnings)
+      call read_spcs(deck, block, keyword, keyword%code == keyword_spc_set, input, log)
     case (keyword_motion_node, keyword_motion_set)
       call read_motions(deck, block, keyword, keyword%code == keyword_motion_set, input, log)
     case (keyword_load_node_point, keyword_load_node_set)
@@ -225,6 +236,8 @@ contains
       call read_rigid_block(deck, block, keyword, input, log, warnings)
     case (contact_keyword_first:contact_keyword_last)
       call read_contact_block(deck, block, keyword, input, log, warnings)
+    case (material_keyword_first:material_keyword_last)
+      call read_material_block(deck, block, keyword, input, log, warnings)
     end select
   end subroutine read_block
 end module deck_reader

@@ -391,29 +391,42 @@ contains
       end do
     end subroutine set_constraints
 
-    !> The nodes of the part's solids, ascending; a node already in another body is reported.
+    !> The nodes of the part's solids and shells, ascending; a node already in another body is
+    !> reported.
     subroutine collect_part_nodes(part, body)
       integer, intent(in) :: part, body
-      integer :: solid, corner, node, count
+      integer :: element, corner, count
       count = 0
-      do solid = 1, size(input%model%solid_part)
-        if (input%model%solid_part(solid) /= part) cycle
+      do element = 1, size(input%model%solid_part)
+        if (input%model%solid_part(element) /= part) cycle
         do corner = 1, 8
-          node = input%model%solid_nodes(corner, solid)
-          if (node <= 0) cycle
-          if (owner(node) == body) cycle
-          if (owner(node) /= 0) then
-            call shared_node(node, owner(node), body)
-            cycle
-          end if
-          owner(node) = body
-          count = count + 1
+          call take_node(input%model%solid_nodes(corner, element), body, count)
+        end do
+      end do
+      do element = 1, size(input%model%shell_part)
+        if (input%model%shell_part(element) /= part) cycle
+        do corner = 1, 4
+          call take_node(input%model%shell_nodes(corner, element), body, count)
         end do
       end do
       if (count == 0) call located_problem(deck, log, body_lines(body), "PID", "rigid part "// &
         integer_text(bodies(body)%id)//" has no elements (a rigid body needs mass)")
-      bodies(body)%nodes = pack([(node, node=1, node_count)], owner == body)
+      bodies(body)%nodes = pack([(corner, corner=1, node_count)], owner == body)
     end subroutine collect_part_nodes
+
+    !> Node `node` (0: an unresolved one, skipped) joins body `body` unless another has it.
+    subroutine take_node(node, body, count)
+      integer, intent(in) :: node, body
+      integer, intent(inout) :: count
+      if (node <= 0) return
+      if (owner(node) == body) return
+      if (owner(node) /= 0) then
+        call shared_node(node, owner(node), body)
+        return
+      end if
+      owner(node) = body
+      count = count + 1
+    end subroutine take_node
 
     subroutine shared_node(node, first, second)
       integer, intent(in) :: node, first, second

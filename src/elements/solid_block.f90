@@ -41,6 +41,7 @@ module solid_block
                             hourglass_power
   use hex8_full, only: point_velocity_gradient, add_deviatoric_point_forces, add_mean_stress_forces, &
                        add_point_stress_power, corner_force_power
+  use element_work, only: add_force_work
   use element_time_step, only: bulk_viscosity_pressure, solid_element_time_steps
   implicit none
   private
@@ -558,26 +559,6 @@ contains
       sound_speed(i) = sqrt(max(wave_modulus(i), 0.0_wp)/max(block_density(i), tiny(1.0_wp)))
     end do
   end subroutine current_density_and_speed
-
-  !> Work of the forces of the previous call (power `last_power` against v(n-1/2) from that
-  !> call, `old_power` against v(n+1/2) now) completed with the mean step of those two steps,
-  !> minus the part of it booked by the previous call, plus the first half of the work of the
-  !> new forces with the current step: see the module comment. `last_power` becomes
-  !> `new_power` for the next call.
-  subroutine add_force_work(nel, time_step, previous_time_step, old_power, new_power, last_power, energy)
-    integer, intent(in) :: nel
-    real(wp), intent(in) :: time_step, previous_time_step
-    real(wp), intent(in) :: old_power(block_size), new_power(block_size)
-    real(wp), intent(inout) :: last_power(block_size), energy(block_size)
-    real(wp) :: mean_step
-    integer :: i
-    mean_step = 0.5_wp*(previous_time_step + time_step)
-    do i = 1, nel
-      energy(i) = energy(i) + 0.5_wp*mean_step*(last_power(i) + old_power(i)) &
-                  - 0.5_wp*previous_time_step*last_power(i) + 0.5_wp*time_step*new_power(i)
-      last_power(i) = new_power(i)
-    end do
-  end subroutine add_force_work
 
   !> Element stress (volume average over the integration points) into column elements(i) of
   !> stress(6, solids), and the effective plastic strain (mean over the points, 0 for elastic

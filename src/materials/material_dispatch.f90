@@ -15,12 +15,15 @@
 module material_dispatch
   use kinds, only: wp, block_size
   use model, only: material_t, law_elastic, law_plastic_kinematic, law_honeycomb, law_modified_honeycomb, &
-                   law_low_density_foam, honeycomb_rate_curve, foam_loading_curve
+                   law_low_density_foam, law_piecewise_linear, law_null, honeycomb_rate_curve, foam_loading_curve, &
+                   piecewise_hardening_curve, piecewise_rate_curve
   use material_elastic, only: elastic_update
   use material_plastic_kinematic, only: plastic_kinematic_update, plastic_kinematic_history_count, &
                                         plastic_strain_slot, back_stress_first_slot
   use material_honeycomb, only: honeycomb_update, honeycomb_initialize_axes, honeycomb_history_count, &
                                 honeycomb_axes_first_slot
+  use material_piecewise_linear, only: piecewise_linear_update, piecewise_linear_history_count, &
+                                       piecewise_plastic_strain_slot
   use material_low_density_foam, only: low_density_foam_update, low_density_foam_initialize, foam_history_count, &
                                        foam_left_cauchy_green_first_slot
   use objective_rotation, only: rotate_symmetric_tensors, rotate_vectors
@@ -44,6 +47,8 @@ contains
       count = honeycomb_history_count
     case (law_low_density_foam)
       count = foam_history_count
+    case (law_piecewise_linear)
+      count = piecewise_linear_history_count
     case default
       count = 0
     end select
@@ -93,7 +98,8 @@ contains
     shear_modulus = material%youngs_modulus/(2.0_wp*(1.0_wp + material%poissons_ratio))
   end subroutine elastic_moduli
 
-  !> Plastic hardening modulus of *MAT_PLASTIC_KINEMATIC, E_p = E Etan / (E - Etan)
+  !> Plastic hardening modulus of *MAT_PLASTIC_KINEMATIC (and of the bilinear
+  !> *MAT_PIECEWISE_LINEAR_PLASTICITY), E_p = E Etan / (E - Etan)
   !> (0 for Etan = 0, perfect plasticity; also 0 if Etan >= E, which the deck check rejects).
   pure function plastic_hardening_modulus(material) result(modulus)
     type(material_t), intent(in) :: material
@@ -106,7 +112,10 @@ contains
   end function plastic_hardening_modulus
 
   !> Constitutive update of lanes 1..nel over a step of length `time_step` (used for rates).
-  !> Returns the dilatational wave modulus rho c^2 of each lane.
+  !> Returns the dilatational wave modulus rho c^2 of each lane. *MAT_PIECEWISE_LINEAR_PLASTICITY
+  !> reads material%curves(piecewise_hardening_curve) and (piecewise_rate_curve), which the
+  !> deck's cross-check allocates (a curve without points: bilinear SIGY/ETAN, no LCSR).
+  !> *MAT_NULL carries no stress (the deck admits it on shell parts only).
   subroutine update_material_block(material, nel, time_step, strain_increment, stress, history, wave_modulus)
     type(material_t), intent(in) :: material
     integer, intent(in) :: nel
@@ -138,6 +147,14 @@ contains
                                    material%tension_cutoff, material%hysteretic_unloading, &
                                    material%unloading_shape, material%viscosity, foam_stiffness_bound(material), &
                                    strain_increment, stress, history)
+    case (law_piecewise_linear)
+      call piecewise_linear_update(nel, bulk_modulus, shear_modulus, material%curves(piecewise_hardening_curve), &
+                                   material%yield_stress, plastic_hardening_modulus(material), &
+                                   material%curves(piecewise_rate_curve), material%rate_c, material%rate_p, &
+                                   material%rate_formulation > 0.5_wp, time_step, strain_increment, stress, &
+                                   history(:, piecewise_plastic_strain_slot))
+    case (law_null)
+      stress(1:nel, :) = 0.0_wp
     case default
       ! Unknown laws are rejected by the deck check; keep the stress as it is.
       continue
@@ -211,6 +228,8 @@ contains
     select case (law)
     case (law_plastic_kinematic)
       plastic_strain(1:nel) = history(1:nel, plastic_strain_slot)
+    case (law_piecewise_linear)
+      plastic_strain(1:nel) = history(1:nel, piecewise_plastic_strain_slot)
     case default
       plastic_strain(1:nel) = 0.0_wp
     end select

@@ -22,5 +22,6 @@ module run_summary
     real(wp) :: efg_setup_s = 0.0_wp             !< part of setup_s: EFG neighbours, shape functions, gradients
     ! sizes
     integer :: fe_elements = 0, efg_particles = 0, dofs_total = 0, dofs_efg = 0
+    integer :: fe_solids = 0, fe_shells = 0      !< fe_elements = fe_solids + fe_shells
   end type run_summary_t
 end module run_summary

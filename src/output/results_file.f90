@@ -55,6 +55,7 @@ module results_file
     character(len=:), allocatable :: h5_name      !< JOBID.h5, as the XDMF refers to it
     integer :: node_count = 0                     !< n, rows of the nodal datasets
     integer :: solid_count = 0                    !< m, rows of the solid datasets
+    integer :: shell_count = 0                    !< k, rows of the shell datasets
     integer :: state_count = 0                    !< states written so far
     real(wp), allocatable :: state_times(:)       !< time of each state written (with spare room)
   end type results_file_t
@@ -88,6 +89,8 @@ contains
     if (allocated(model%node_ids)) results%node_count = size(model%node_ids)
     results%solid_count = 0
     if (allocated(model%solid_ids)) results%solid_count = size(model%solid_ids)
+    results%shell_count = 0
+    if (allocated(model%shell_ids)) results%shell_count = size(model%shell_ids)
     results%state_count = 0
     if (allocated(results%state_times)) deallocate (results%state_times)
     allocate (results%state_times(16))
@@ -129,8 +132,14 @@ contains
   end subroutine open_results
 
   !> Write the next state `/states/NNNNNN`, flush, and rewrite the XDMF file.
+  !> Shell results (global axes): `shell_stress` the mid-surface stress (mean over the
+  !> through-thickness points), `shell_plastic_strain` its mean plastic strain, and, as crashfree
+  !> extensions, `shell_stress_peak` / `shell_plastic_strain_peak` at the point with the largest
+  !> von Mises stress / plastic strain. Without shell arguments the shell datasets are empty
+  !> (a model without shells).
   subroutine write_state(results, time, displacement, velocity, solid_stress, &
-                         solid_plastic_strain, error)
+                         solid_plastic_strain, error, shell_stress, shell_plastic_strain, shell_stress_peak, &
+                         shell_plastic_strain_peak)
     type(results_file_t), intent(inout) :: results
     real(wp), intent(in) :: time
     ! Contiguous: the solver's whole arrays go to HDF5 without a copy.
@@ -139,6 +148,8 @@ contains
     real(wp), intent(in), contiguous :: solid_stress(:, :)       !< (6, solids) xx yy zz xy yz zx
     real(wp), intent(in), contiguous :: solid_plastic_strain(:)  !< (solids)
     type(error_t), allocatable, intent(out) :: error
+    real(wp), intent(in), contiguous, optional :: shell_stress(:, :), shell_stress_peak(:, :) !< (6, shells)
+    real(wp), intent(in), contiguous, optional :: shell_plastic_strain(:), shell_plastic_strain_peak(:) !< (shells)
     real(wp) :: no_shell_stress(6, 0), no_shell_strain(0)
     real(wp), allocatable :: grown(:)
     character(len=:), allocatable :: path
@@ -152,7 +163,8 @@ contains
     if (any(shape(displacement) /= [3, results%node_count]) .or. &
         any(shape(velocity) /= [3, results%node_count]) .or. &
         any(shape(solid_stress) /= [6, results%solid_count]) .or. &
-        size(solid_plastic_strain) /= results%solid_count) then
+        size(solid_plastic_strain) /= results%solid_count .or. &
+        (present(shell_stress) .neqv. results%shell_count > 0)) then
       call make_error(error, "results file "//results%h5_path//": state at time "// &
                       real_text(time)//": array sizes do not match the mesh ("// &
                       integer_text(results%node_count)//" nodes, "// &
@@ -171,9 +183,15 @@ contains
     call write_real_dataset_2d(group_id, path, "velocity", velocity, error)
     call write_real_dataset_2d(group_id, path, "solid_stress", solid_stress, error)
     call write_real_dataset_1d(group_id, path, "solid_plastic_strain", solid_plastic_strain, error)
-    ! Shells are not modelled yet; the empty datasets keep the contract's layout.
-    call write_real_dataset_2d(group_id, path, "shell_stress", no_shell_stress, error)
-    call write_real_dataset_1d(group_id, path, "shell_plastic_strain", no_shell_strain, error)
+    if (present(shell_stress)) then
+      call write_real_dataset_2d(group_id, path, "shell_stress", shell_stress, error)
+      call write_real_dataset_1d(group_id, path, "shell_plastic_strain", shell_plastic_strain, error)
+      call write_real_dataset_2d(group_id, path, "shell_stress_peak", shell_stress_peak, error)
+      call write_real_dataset_1d(group_id, path, "shell_plastic_strain_peak", shell_plastic_strain_peak, error)
+    else
+      call write_real_dataset_2d(group_id, path, "shell_stress", no_shell_stress, error)
+      call write_real_dataset_1d(group_id, path, "shell_plastic_strain", no_shell_strain, error)
+    end if
     call h5gclose_f(group_id, status)
     call flush_file(results%file_id, error)
     if (allocated(error)) then
@@ -269,8 +287,8 @@ contains
     integer, allocatable :: connectivity_index(:, :), part_ids(:), material_ids(:)
     real(wp), allocatable :: coordinates(:, :)
     character(len=8), allocatable :: formulations(:)
-    integer :: no_shell_ids(0), no_shell_connectivity(4, 0)
-    integer :: solid, part, solid_count, part_count
+    integer, allocatable :: shell_ids(:), shell_part_ids(:), shell_connectivity(:, :)
+    integer :: solid, part, solid_count, part_count, shell, shell_count
 
     if (allocated(error)) return
     ! Local copies, so that a model without nodes, solids or parts still gives the full layout.
@@ -289,6 +307,14 @@ contains
       solid_part_ids(solid) = model%parts(model%solid_part(solid))%id
       connectivity(:, solid) = model%node_ids(model%solid_nodes(:, solid))
       connectivity_index(:, solid) = model%solid_nodes(:, solid) - 1
+    end do
+    shell_count = 0
+    if (allocated(model%shell_ids)) shell_count = size(model%shell_ids)
+    allocate (shell_ids(shell_count), shell_part_ids(shell_count), shell_connectivity(4, shell_count))
+    do shell = 1, shell_count
+      shell_ids(shell) = model%shell_ids(shell)
+      shell_part_ids(shell) = model%parts(model%shell_part(shell))%id
+      shell_connectivity(:, shell) = model%node_ids(model%shell_nodes(:, shell))
     end do
     part_count = 0
     if (allocated(model%parts)) part_count = size(model%parts)
@@ -321,13 +347,22 @@ contains
     call write_integer_dataset_2d(file_id, "", "/mesh/solids/connectivity", connectivity, error)
     call write_integer_dataset_2d(file_id, "", "/mesh/solids/connectivity_index", &
                                   connectivity_index, error)
-    call write_integer_dataset_1d(file_id, "", "/mesh/shells/ids", no_shell_ids, error)
-    call write_integer_dataset_1d(file_id, "", "/mesh/shells/part_ids", no_shell_ids, error)
-    call write_integer_dataset_2d(file_id, "", "/mesh/shells/connectivity", &
-                                  no_shell_connectivity, error)
+    call write_integer_dataset_1d(file_id, "", "/mesh/shells/ids", shell_ids, error)
+    call write_integer_dataset_1d(file_id, "", "/mesh/shells/part_ids", shell_part_ids, error)
+    call write_integer_dataset_2d(file_id, "", "/mesh/shells/connectivity", shell_connectivity, error)
+    call write_integer_dataset_2d(file_id, "", "/mesh/shells/connectivity_index", shell_connectivity_index(), error)
     call write_integer_dataset_1d(file_id, "", "/mesh/parts/ids", part_ids, error)
     call write_string_dataset(file_id, "/mesh/parts/formulation", formulations, error)
     call write_integer_dataset_1d(file_id, "", "/mesh/parts/material_ids", material_ids, error)
+  contains
+    !> 0-based node rows of the shells (as connectivity_index of the solids, for the XDMF file).
+    function shell_connectivity_index() result(rows)
+      integer, allocatable :: rows(:, :)
+      allocate (rows(4, shell_count))
+      do shell = 1, shell_count
+        rows(:, shell) = model%shell_nodes(:, shell) - 1
+      end do
+    end function shell_connectivity_index
   end subroutine write_mesh
 
   !> `/run` at the start. Every attribute of the contract is there from the start; the status
@@ -391,10 +426,10 @@ contains
     type(error_t), allocatable, intent(inout) :: error
     character(len=*), parameter :: second_names(8) = [character(len=11) :: "wall_s", &
       "fe_solid_s", "fe_shell_s", "efg_s", "contact_s", "output_s", "setup_s", "efg_setup_s"]
-    character(len=*), parameter :: count_names(6) = [character(len=13) :: "cycles", "threads", &
-      "fe_elements", "efg_particles", "dofs_total", "dofs_efg"]
+    character(len=*), parameter :: count_names(8) = [character(len=13) :: "cycles", "threads", &
+      "fe_elements", "efg_particles", "dofs_total", "dofs_efg", "fe_solids", "fe_shells"]
     real(wp) :: seconds(8)
-    integer :: counts(6), entry, status
+    integer :: counts(8), entry, status
     integer(hid_t) :: group_id
 
     call create_group_path(file_id, "/timing", error)
@@ -407,7 +442,7 @@ contains
     seconds = [summary%wall_s, summary%fe_solid_s, summary%fe_shell_s, summary%efg_s, &
                summary%contact_s, summary%output_s, summary%setup_s, summary%efg_setup_s]
     counts = [summary%cycles, summary%threads, summary%fe_elements, summary%efg_particles, &
-              summary%dofs_total, summary%dofs_efg]
+              summary%dofs_total, summary%dofs_efg, summary%fe_solids, summary%fe_shells]
     do entry = 1, size(seconds)
       call write_real_attribute(group_id, "/timing", trim(second_names(entry)), seconds(entry), &
                                 error)

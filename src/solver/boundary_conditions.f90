@@ -13,7 +13,7 @@ module boundary_conditions
   private
 
   public :: assemble_nodal_loads, load_work, impose_kinematic_conditions, fixed_dof_mask, &
-            hold_prescribed_accelerations
+            hold_prescribed_accelerations, fixed_rotation_mask
 
 contains
 
@@ -27,6 +27,18 @@ contains
       fixed(:, model%spcs(k)%node) = fixed(:, model%spcs(k)%node) .or. model%spcs(k)%fixed
     end do
   end subroutine fixed_dof_mask
+
+  !> Which rotations are fixed by *BOUNDARY_SPC (about x, y, z per node; only shell nodes
+  !> carry rotations).
+  subroutine fixed_rotation_mask(model, fixed)
+    type(model_t), intent(in) :: model
+    logical, intent(out) :: fixed(:, :)
+    integer :: k
+    fixed = .false.
+    do k = 1, size(model%spcs)
+      fixed(:, model%spcs(k)%node) = fixed(:, model%spcs(k)%node) .or. model%spcs(k)%fixed_rotation
+    end do
+  end subroutine fixed_rotation_mask
 
   !> Prescribed dofs follow their motion, not the forces: their acceleration is the prescribed
   !> one (VAD = 1) or zero (velocity and displacement are imposed on the half-step velocities),

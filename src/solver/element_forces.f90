@@ -7,12 +7,13 @@ module element_forces
   use kinds, only: wp, block_size
   use model, only: model_t
   use solid_block, only: compute_solid_block
+  use shell_block, only: compute_shell_block
   use explicit_state, only: explicit_state_t
   use efg_forces, only: compute_efg_forces, add_efg_forces
   implicit none
   private
 
-  public :: compute_element_forces, compute_meshfree_forces
+  public :: compute_element_forces, compute_shell_forces, compute_meshfree_forces
 
 contains
 
@@ -44,6 +45,52 @@ contains
       !$omp end parallel do
     end do
   end subroutine compute_element_forces
+
+  !> Forces and moments of the shells, added after the solids' (same colouring scheme); called
+  !> after compute_element_forces, which cleared the nodal forces.
+  subroutine compute_shell_forces(model, state, dt)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(inout) :: state
+    real(wp), intent(in) :: dt
+    real(wp) :: shell_force(block_size, 4, 6)
+    integer :: colour, k, b, node
+
+    if (size(state%shells) == 0) return
+    !$omp parallel do schedule(static) default(shared) private(node)
+    do node = 1, state%node_count
+      state%internal_moment(:, node) = 0.0_wp
+    end do
+    !$omp end parallel do
+    do colour = 1, size(state%shell_colors%offsets) - 1
+      !$omp parallel do schedule(dynamic, 2) default(shared) private(k, b, shell_force)
+      do k = state%shell_colors%offsets(colour), state%shell_colors%offsets(colour + 1) - 1
+        b = state%shell_colors%corners(k)
+        call compute_shell_block(state%shells(b), model%materials(state%shells(b)%material), state%coordinates, &
+                                 state%velocity, state%angular_velocity, dt, shell_force, state%shell_time_step(b), &
+                                 state%shell_critical_element(b), state%shell_degenerate_element(b))
+        call add_shell_forces(state%shells(b)%element_count, state%shells(b)%nodes, shell_force, &
+                              state%internal_force, state%internal_moment)
+      end do
+      !$omp end parallel do
+    end do
+  end subroutine compute_shell_forces
+
+  !> internal_force and internal_moment of the block's nodes += the shells' nodal forces and
+  !> moments, corner by corner, lane by lane.
+  subroutine add_shell_forces(element_count, nodes, shell_force, internal_force, internal_moment)
+    integer, intent(in) :: element_count
+    integer, intent(in) :: nodes(block_size, 4)
+    real(wp), intent(in) :: shell_force(block_size, 4, 6)
+    real(wp), intent(inout) :: internal_force(:, :), internal_moment(:, :)
+    integer :: corner, lane, node
+    do corner = 1, 4
+      do lane = 1, element_count
+        node = nodes(lane, corner)
+        internal_force(:, node) = internal_force(:, node) + shell_force(lane, corner, 1:3)
+        internal_moment(:, node) = internal_moment(:, node) + shell_force(lane, corner, 4:6)
+      end do
+    end do
+  end subroutine add_shell_forces
 
   !> Forces of the meshfree parts, added after the finite elements' (a Gamma node shared with
   !> an FE part receives both, always in this order).

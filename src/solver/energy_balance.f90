@@ -45,6 +45,11 @@ contains
         if (state%is_rigid_node(node)) cycle   ! moves with its body (below)
         next_velocity = state%velocity(:, node) + average_step*state%acceleration(:, node)
         partial(1, chunk) = partial(1, chunk) + state%mass(node)*dot_product(state%velocity(:, node), next_velocity)
+        if (state%rotary_inertia(node) > 0.0_wp) then
+          next_velocity = state%angular_velocity(:, node) + average_step*state%angular_acceleration(:, node)
+          partial(1, chunk) = partial(1, chunk) + &
+                              state%rotary_inertia(node)*dot_product(state%angular_velocity(:, node), next_velocity)
+        end if
         velocity = state%velocity(:, node) + half_step*state%acceleration(:, node)
         partial(2:4, chunk) = partial(2:4, chunk) + state%mass(node)*velocity
       end do
@@ -78,6 +83,14 @@ contains
                                 + step_correction*sum(block%force_power(1:block%element_count))
         state%energy%hourglass = state%energy%hourglass + sum(block%hourglass_energy(1:block%element_count)) &
                                  + step_correction*sum(block%hourglass_power(1:block%element_count))
+      end associate
+    end do
+    do b = 1, size(state%shells)
+      associate (shell => state%shells(b))
+        state%energy%internal = state%energy%internal + sum(shell%internal_energy(1:shell%element_count)) &
+                                + step_correction*sum(shell%force_power(1:shell%element_count))
+        state%energy%hourglass = state%energy%hourglass + sum(shell%hourglass_energy(1:shell%element_count)) &
+                                 + step_correction*sum(shell%hourglass_power(1:shell%element_count))
       end associate
     end do
     do k = 1, size(state%efg)
@@ -119,6 +132,27 @@ contains
             next_velocity = velocity + average_step*state%acceleration(:, node)
             kinetic(block%part) = kinetic(block%part) + &
                                   0.5_wp*state%corner_mass(lane, corner, b)*dot_product(velocity, next_velocity)
+          end do
+        end do
+      end associate
+    end do
+    do b = 1, size(state%shells)
+      associate (shell => state%shells(b))
+        internal(shell%part) = internal(shell%part) + sum(shell%internal_energy(1:shell%element_count)) &
+                               + step_correction*sum(shell%force_power(1:shell%element_count))
+        hourglass(shell%part) = hourglass(shell%part) + sum(shell%hourglass_energy(1:shell%element_count)) &
+                                + step_correction*sum(shell%hourglass_power(1:shell%element_count))
+        do corner = 1, 4
+          do lane = 1, shell%element_count
+            node = shell%nodes(lane, corner)
+            velocity = state%velocity(:, node)
+            next_velocity = velocity + average_step*state%acceleration(:, node)
+            kinetic(shell%part) = kinetic(shell%part) + &
+                                  0.5_wp*state%shell_corner_mass(lane, corner, b)*dot_product(velocity, next_velocity)
+            velocity = state%angular_velocity(:, node)
+            next_velocity = velocity + average_step*state%angular_acceleration(:, node)
+            kinetic(shell%part) = kinetic(shell%part) + &
+                                  0.5_wp*state%shell_corner_inertia(lane, corner, b)*dot_product(velocity, next_velocity)
           end do
         end do
       end associate

@@ -3,15 +3,16 @@
 module explicit_setup
   use kinds, only: wp, block_size
   use error_handling, only: error_t, make_error
-  use gather_list, only: gather_list_t, build_gather_list
+  use block_colouring, only: colour_blocks_by_nodes
   use model, only: model_t, formulation_efg, boundary_full_transformation, integration_gauss_conventional
   use efg_part, only: efg_part_t
   use efg_setup, only: build_efg_part
   use efg_forces, only: set_up_efg_solver
   use solid_block, only: solid_block_t, build_solid_blocks, solid_block_corner_masses, &
                          solid_block_time_steps
+  use shell_block, only: build_shell_blocks, shell_block_masses, shell_block_time_steps
   use explicit_state, only: explicit_state_t
-  use boundary_conditions, only: fixed_dof_mask
+  use boundary_conditions, only: fixed_dof_mask, fixed_rotation_mask
   use planar_rigid_walls, only: initialise_wall_states
   use penalty_contact, only: set_up_contacts
   use rigid_bodies, only: set_up_rigid_bodies, add_node_masses
@@ -53,6 +54,21 @@ contains
     state%block_time_step = huge(1.0_wp)
     state%block_critical_element = 0
     state%block_inverted_element = 0
+    call build_shell_blocks(model, state%shells)
+    block_count = size(state%shells)
+    allocate (state%shell_corner_mass(block_size, 4, block_count), state%shell_corner_inertia(block_size, 4, block_count), &
+              state%shell_time_step(block_count), state%shell_critical_element(block_count), &
+              state%shell_degenerate_element(block_count))
+    state%shell_time_step = huge(1.0_wp)
+    state%shell_critical_element = 0
+    state%shell_degenerate_element = 0
+    allocate (state%angular_velocity(3, node_count), state%angular_acceleration(3, node_count), &
+              state%internal_moment(3, node_count), state%rotary_inertia(node_count), &
+              state%fixed_rotation(3, node_count))
+    state%angular_velocity = 0.0_wp
+    state%angular_acceleration = 0.0_wp
+    state%internal_moment = 0.0_wp
+    call fixed_rotation_mask(model, state%fixed_rotation)
 
     call scale_masses(model, state)
     call colour_blocks(state)
@@ -97,70 +113,46 @@ contains
         end do
       end associate
     end do
+    do b = 1, size(state%shells)
+      associate (shell => state%shells(b))
+        state%physical_mass = state%physical_mass + sum(shell%density(1:shell%element_count)* &
+                              shell%thickness(1:shell%element_count)*shell%reference_area(1:shell%element_count))
+        if (target_step <= 0.0_wp) cycle
+        call shell_block_time_steps(shell, model%materials(shell%material), state%coordinates, element_time_step)
+        do i = 1, shell%element_count
+          if (element_time_step(i) >= target_step) cycle
+          factor = (target_step/element_time_step(i))**2
+          state%added_mass = state%added_mass + (factor - 1.0_wp)*shell%density(i)*shell%thickness(i)* &
+                             shell%reference_area(i)
+          shell%density(i) = shell%density(i)*factor
+        end do
+      end associate
+    end do
   end subroutine scale_masses
 
-  !> Greedy colouring of the blocks: a block takes the lowest colour that no block sharing a
-  !> node with it has taken. Within a colour, blocks stay in index order.
+  !> Colour the solid blocks and the shell blocks (each kind among itself: the solver adds the
+  !> solids' forces first, then the shells').
   subroutine colour_blocks(state)
     type(explicit_state_t), intent(inout) :: state
-    type(gather_list_t) :: node_blocks
-    integer, allocatable :: slot_node(:), colour(:), taken_by(:), count_of(:), blocks(:)
-    integer :: block_count, b, corner, lane, node, k, other, chosen, colour_count
-
-    block_count = size(state%blocks)
-    ! node -> blocks touching it (a slot is one corner of one lane of one block)
-    allocate (slot_node(block_size*8*block_count))
-    slot_node = 0
-    do b = 1, block_count
-      do corner = 1, 8
-        do lane = 1, state%blocks(b)%element_count
-          slot_node(corner_slot(lane, corner, b)) = state%blocks(b)%nodes(lane, corner)
-        end do
-      end do
+    integer, allocatable :: nodes(:, :, :), counts(:)
+    integer :: b
+    allocate (nodes(block_size, 8, size(state%blocks)), counts(size(state%blocks)))
+    do b = 1, size(state%blocks)
+      nodes(:, :, b) = state%blocks(b)%nodes
+      counts(b) = state%blocks(b)%element_count
     end do
-    call build_gather_list(state%node_count, slot_node, node_blocks)
-
-    allocate (colour(block_count), taken_by(block_count + 1))
-    taken_by = 0
-    colour_count = 0
-    do b = 1, block_count
-      do corner = 1, 8
-        do lane = 1, state%blocks(b)%element_count
-          node = state%blocks(b)%nodes(lane, corner)
-          do k = node_blocks%offsets(node), node_blocks%offsets(node + 1) - 1
-            other = (node_blocks%corners(k) - 1)/(block_size*8) + 1
-            if (other < b) taken_by(colour(other)) = b
-          end do
-        end do
-      end do
-      chosen = 1
-      do while (taken_by(chosen) == b)
-        chosen = chosen + 1
-      end do
-      colour(b) = chosen
-      colour_count = max(colour_count, chosen)
+    call colour_blocks_by_nodes(state%node_count, nodes, counts, state%block_colors)
+    deallocate (nodes, counts)
+    allocate (nodes(block_size, 4, size(state%shells)), counts(size(state%shells)))
+    do b = 1, size(state%shells)
+      nodes(:, :, b) = state%shells(b)%nodes
+      counts(b) = state%shells(b)%element_count
     end do
-
-    ! colour -> blocks, as a CSR list
-    allocate (count_of(colour_count + 1), blocks(block_count))
-    count_of = 0
-    do b = 1, block_count
-      count_of(colour(b) + 1) = count_of(colour(b) + 1) + 1
-    end do
-    count_of(1) = 1
-    do k = 1, colour_count
-      count_of(k + 1) = count_of(k + 1) + count_of(k)
-    end do
-    state%block_colors%offsets = count_of
-    do b = 1, block_count
-      blocks(count_of(colour(b))) = b
-      count_of(colour(b)) = count_of(colour(b)) + 1
-    end do
-    call move_alloc(blocks, state%block_colors%corners)
+    call colour_blocks_by_nodes(state%node_count, nodes, counts, state%shell_colors)
   end subroutine colour_blocks
 
   !> Lumped nodal masses: each block adds its corner masses to its nodes (serially, in block,
-  !> corner and lane order).
+  !> corner and lane order), solids first, then shells with their rotary inertias.
   subroutine lump_nodal_masses(state)
     type(explicit_state_t), intent(inout) :: state
     integer :: b, corner, lane, node
@@ -172,6 +164,17 @@ contains
         do lane = 1, state%blocks(b)%element_count
           node = state%blocks(b)%nodes(lane, corner)
           state%mass(node) = state%mass(node) + state%corner_mass(lane, corner, b)
+        end do
+      end do
+    end do
+    state%rotary_inertia = 0.0_wp
+    do b = 1, size(state%shells)
+      call shell_block_masses(state%shells(b), state%shell_corner_mass(:, :, b), state%shell_corner_inertia(:, :, b))
+      do corner = 1, 4
+        do lane = 1, state%shells(b)%element_count
+          node = state%shells(b)%nodes(lane, corner)
+          state%mass(node) = state%mass(node) + state%shell_corner_mass(lane, corner, b)
+          state%rotary_inertia(node) = state%rotary_inertia(node) + state%shell_corner_inertia(lane, corner, b)
         end do
       end do
     end do
@@ -286,8 +289,4 @@ contains
     write (text, '(i0)') id
   end function id_text
 
-  pure integer function corner_slot(lane, corner, block)
-    integer, intent(in) :: lane, corner, block
-    corner_slot = lane + (corner - 1)*block_size + (block - 1)*block_size*8
-  end function corner_slot
 end module explicit_setup

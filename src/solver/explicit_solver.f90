@@ -6,13 +6,13 @@ module explicit_solver
   use error_handling, only: error_t, make_error
   use model, only: model_t
   use explicit_state, only: explicit_state_t
-  use element_forces, only: compute_element_forces, compute_meshfree_forces
+  use element_forces, only: compute_element_forces, compute_shell_forces, compute_meshfree_forces
   use boundary_conditions, only: assemble_nodal_loads, load_work, impose_kinematic_conditions, &
                                  hold_prescribed_accelerations
   use planar_rigid_walls, only: enforce_planar_walls
   use cylinder_walls, only: enforce_cylinder_walls
   use rigid_bodies, only: advance_rigid_bodies
-  use penalty_contact, only: compute_contact_forces
+  use penalty_contact, only: compute_contact_forces, report_initial_penetrations
   use energy_balance, only: update_energy_totals, total_energy
   use run_output, only: output_plan_t, plan_output, write_due_output
   use history_buffer, only: history_set_t
@@ -38,7 +38,7 @@ contains
     type(history_set_t) :: histories
     type(output_plan_t) :: plan
     type(progress_t) :: progress
-    type(phase_timer_t) :: element_timer, meshfree_timer, output_timer, contact_timer
+    type(phase_timer_t) :: element_timer, shell_timer, meshfree_timer, output_timer, contact_timer
     type(error_t), allocatable :: output_error
     real(wp) :: previous_step, step, work, cylinder_work
     logical :: finished, wrote_state
@@ -49,6 +49,9 @@ contains
     call start_phase(element_timer)
     call compute_element_forces(model, state, 0.0_wp)
     call stop_phase(element_timer)
+    call start_phase(shell_timer)
+    call compute_shell_forces(model, state, 0.0_wp)
+    call stop_phase(shell_timer)
     call start_phase(meshfree_timer)
     call compute_meshfree_forces(model, state, 0.0_wp)
     call stop_phase(meshfree_timer)
@@ -95,6 +98,7 @@ contains
         call advance_rigid_bodies(model, state%rigid, state%time, step, 0.5_wp*(previous_step + step), &
                                   state%coordinates, state%velocity, work)
         state%energy%external_work = state%energy%external_work + work
+        if (size(state%shells) > 0) call rotate_with_rigid_bodies(model, state)
       end if
       call update_positions(state, step)
       state%energy%external_work = state%energy%external_work + &
@@ -107,6 +111,9 @@ contains
       call start_phase(element_timer)
       call compute_element_forces(model, state, step)
       call stop_phase(element_timer)
+      call start_phase(shell_timer)
+      call compute_shell_forces(model, state, step)
+      call stop_phase(shell_timer)
       call start_phase(meshfree_timer)
       call compute_meshfree_forces(model, state, step)
       call stop_phase(meshfree_timer)
@@ -116,6 +123,7 @@ contains
                                     state%mass, state%contact_force, work)
         call stop_phase(contact_timer)
         state%energy%contact = state%energy%contact + work
+        call report_initial_penetrations(model, state%contacts, state%time)
       end if
       call assemble_nodal_loads(model, state%time, state%external_force)
       state%energy%external_work = state%energy%external_work + &
@@ -138,12 +146,14 @@ contains
     summary%end_time = state%time
     summary%cycles = state%cycle
     summary%fe_solid_s = element_timer%seconds
+    summary%fe_shell_s = shell_timer%seconds
     summary%efg_s = meshfree_timer%seconds
     summary%contact_s = contact_timer%seconds
     summary%output_s = output_timer%seconds
   end subroutine run_explicit
 
-  !> a = (f_ext - f_int) / m; constrained dofs do not accelerate.
+  !> a = (f_ext - f_int) / m, and for the rotations of shell nodes alpha = -m_int / I;
+  !> constrained dofs do not accelerate.
   subroutine compute_accelerations(state)
     type(explicit_state_t), intent(inout) :: state
     integer :: node
@@ -156,11 +166,32 @@ contains
         state%acceleration(:, node) = 0.0_wp
       end if
       where (state%fixed(:, node)) state%acceleration(:, node) = 0.0_wp
+      if (state%rotary_inertia(node) > 0.0_wp) then
+        state%angular_acceleration(:, node) = -state%internal_moment(:, node)/state%rotary_inertia(node)
+      else
+        state%angular_acceleration(:, node) = 0.0_wp
+      end if
+      where (state%fixed_rotation(:, node)) state%angular_acceleration(:, node) = 0.0_wp
     end do
     !$omp end parallel do
   end subroutine compute_accelerations
 
-  !> v^{n+1/2} = v^{n-1/2} + a^n (dt^{n-1/2} + dt^{n+1/2}) / 2.
+  !> Shell nodes that belong to a rigid body turn with it. (The moments that deformable shells
+  !> put on such nodes are not passed on to the body: a shell tied to a rigid part transmits
+  !> forces only.)
+  subroutine rotate_with_rigid_bodies(model, state)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(inout) :: state
+    integer :: b, k
+    do b = 1, size(state%rigid)
+      do k = 1, size(model%rigid_bodies(b)%nodes)
+        state%angular_velocity(:, model%rigid_bodies(b)%nodes(k)) = state%rigid(b)%angular_velocity
+      end do
+    end do
+  end subroutine rotate_with_rigid_bodies
+
+  !> v^{n+1/2} = v^{n-1/2} + a^n (dt^{n-1/2} + dt^{n+1/2}) / 2, and the same for the angular
+  !> velocities (their rotations need no update: the shells take their frame from the nodes).
   subroutine update_velocities(state, average_step)
     type(explicit_state_t), intent(inout) :: state
     real(wp), intent(in) :: average_step
@@ -168,6 +199,7 @@ contains
     !$omp parallel do schedule(static) default(shared) private(node)
     do node = 1, state%node_count
       state%velocity(:, node) = state%velocity(:, node) + average_step*state%acceleration(:, node)
+      state%angular_velocity(:, node) = state%angular_velocity(:, node) + average_step*state%angular_acceleration(:, node)
     end do
     !$omp end parallel do
   end subroutine update_velocities
@@ -201,6 +233,12 @@ contains
         critical = state%block_critical_element(b)
       end if
     end do
+    do b = 1, size(state%shells)
+      if (state%shell_time_step(b) < smallest) then
+        smallest = state%shell_time_step(b)
+        critical = -state%shell_critical_element(b)
+      end if
+    end do
     ! meshfree integration points follow the FE rule of their background cell
     do k = 1, size(state%efg)
       do b = 1, size(state%efg(k)%blocks)
@@ -220,7 +258,8 @@ contains
     if (is_first .and. model%initial_time_step > 0.0_wp) &
       state%next_time_step = min(state%next_time_step, model%initial_time_step)
     ! a step that no element set, or a NaN that the comparisons above skipped, is not a step
-    if (smallest >= huge(1.0_wp) .or. any(state%block_time_step /= state%block_time_step)) &
+    if (smallest >= huge(1.0_wp) .or. any(state%block_time_step /= state%block_time_step) .or. &
+        any(state%shell_time_step /= state%shell_time_step)) &
       state%next_time_step = -huge(1.0_wp)
   end subroutine select_time_step
 
@@ -240,6 +279,14 @@ contains
       call make_error(error, trim(text))
       return
     end do
+    do b = 1, size(state%shells)
+      element = state%shell_degenerate_element(b)
+      if (element == 0) cycle
+      write (text, '(a,i0,a,i0,a,es12.5,a,i0)') "shell element ", model%shell_ids(element), " (part ", &
+        model%parts(model%shell_part(element))%id, ") has lost its area at time ", state%time, ", cycle ", state%cycle
+      call make_error(error, trim(text))
+      return
+    end do
     do k = 1, size(state%efg)
       do b = 1, size(state%efg(k)%blocks)
         point = state%efg(k)%block_inverted_point(b)
@@ -254,7 +301,11 @@ contains
     end do
     if (.not. (state%next_time_step > 0.0_wp .and. state%next_time_step < huge(1.0_wp))) then
       element = state%controlling_element
-      if (element > 0) then
+      if (element < 0) then
+        write (text, '(a,i0,a,i0,a,es12.5,a,i0)') "no finite stable time step (the smallest is set by shell ", &
+          model%shell_ids(-element), ", part ", model%parts(model%shell_part(-element))%id, ") at time ", &
+          state%time, ", cycle ", state%cycle
+      else if (element > 0) then
         write (text, '(a,i0,a,i0,a,es12.5,a,i0)') "no finite stable time step (the smallest is set by element ", &
           model%solid_ids(element), ", part ", model%parts(model%solid_part(element))%id, ") at time ", &
           state%time, ", cycle ", state%cycle

@@ -10,6 +10,7 @@ module explicit_state
   use kinds, only: wp, block_size
   use gather_list, only: gather_list_t
   use solid_block, only: solid_block_t
+  use shell_block, only: shell_block_t
   use efg_forces, only: efg_solver_t
   use rigid_body_state, only: rigid_body_state_t
   use penalty_contact, only: contact_state_t
@@ -49,6 +50,7 @@ module explicit_state
     real(wp) :: time_step = 0.0_wp                       !< t^{n+1} - t^n of the last step
     real(wp) :: next_time_step = 0.0_wp                  !< stable step for the coming cycle
     integer :: controlling_element = 0                   !< solid index that set next_time_step
+                                                         !< (a shell: minus its shell index)
     ! nodal arrays (3, nodes) and (nodes)
     real(wp), allocatable :: reference(:, :)             !< X
     real(wp), allocatable :: coordinates(:, :)           !< x = X + u
@@ -68,6 +70,20 @@ module explicit_state
     integer, allocatable :: block_critical_element(:)
     integer, allocatable :: block_inverted_element(:)
     type(gather_list_t) :: block_colors                  !< colour -> blocks (same CSR form as a gather list)
+    ! shell blocks (coloured among themselves, added after the solids) and the rotational dofs,
+    ! which only shell nodes have (rotary_inertia 0 elsewhere)
+    type(shell_block_t), allocatable :: shells(:)
+    real(wp), allocatable :: shell_corner_mass(:, :, :)  !< (block_size, 4, shell blocks)
+    real(wp), allocatable :: shell_corner_inertia(:, :, :)
+    real(wp), allocatable :: shell_time_step(:)
+    integer, allocatable :: shell_critical_element(:)
+    integer, allocatable :: shell_degenerate_element(:)
+    type(gather_list_t) :: shell_colors
+    real(wp), allocatable :: angular_velocity(:, :)      !< (3, nodes), w^{n+1/2}
+    real(wp), allocatable :: angular_acceleration(:, :)
+    real(wp), allocatable :: internal_moment(:, :)
+    real(wp), allocatable :: rotary_inertia(:)
+    logical, allocatable :: fixed_rotation(:, :)         !< SPC per rotational dof
     ! meshfree parts: their interior particles carry generalized displacements
     type(efg_solver_t), allocatable :: efg(:)
     logical, allocatable :: is_particle(:)               !< interior particle of an EFG part

@@ -119,8 +119,10 @@ contains
     type(run_summary_t), intent(inout) :: summary
     character(len=200) :: line
     integer :: k
-    summary%fe_elements = sum(state%blocks%element_count)
-    summary%dofs_total = 3*size(model%node_ids)
+    summary%fe_solids = sum(state%blocks%element_count)
+    summary%fe_shells = sum(state%shells%element_count)
+    summary%fe_elements = summary%fe_solids + summary%fe_shells
+    summary%dofs_total = 3*size(model%node_ids) + 3*count(state%rotary_inertia > 0.0_wp)
     summary%efg_particles = 0
     summary%dofs_efg = 0
     do k = 1, size(state%efg)
@@ -128,8 +130,8 @@ contains
       summary%efg_particles = summary%efg_particles + size(state%efg(k)%geometry%particles)
       summary%dofs_efg = summary%dofs_efg + 3*size(state%efg(k)%geometry%mass_node)
     end do
-    write (line, '(a,i0,a,i0,a,i0,a)') "model: ", size(model%node_ids), " nodes, ", size(model%solid_ids), &
-      " solids in ", size(model%parts), " parts"
+    write (line, '(a,i0,a,i0,a,i0,a,i0,a)') "model: ", size(model%node_ids), " nodes, ", size(model%solid_ids), &
+      " solids, ", size(model%shell_ids), " shells in ", size(model%parts), " parts"
     write (*, '(a)') trim(line)
     write (line, '(a,es12.5)') "mass: ", state%physical_mass
     write (*, '(a)') trim(line)
@@ -159,13 +161,20 @@ contains
     write (line, '(a,i0,a,es12.5,a)') "  ", summary%cycles, " cycles to time ", summary%end_time, &
       ", wall time "//format_duration(summary%wall_s)
     write (*, '(a)') trim(line)
-    write (line, '(a,f9.3,a,f9.3,a,f9.3,a,f9.3,a,f9.3)') "  seconds: setup", summary%setup_s, "  solids", &
-      summary%fe_solid_s, "  meshfree", summary%efg_s, "  output", summary%output_s, "  other", &
-      max(0.0_wp, summary%wall_s - summary%setup_s - summary%fe_solid_s - summary%efg_s - summary%output_s)
+    write (line, '(a,f9.3,a,f9.3,a,f9.3,a,f9.3,a,f9.3,a,f9.3,a,f9.3)') "  seconds: setup", summary%setup_s, &
+      "  solids", summary%fe_solid_s, "  shells", summary%fe_shell_s, "  meshfree", summary%efg_s, "  contact", &
+      summary%contact_s, "  output", summary%output_s, "  other", &
+      max(0.0_wp, summary%wall_s - summary%setup_s - summary%fe_solid_s - summary%fe_shell_s - summary%efg_s - &
+          summary%contact_s - summary%output_s)
     write (*, '(a)') trim(line)
-    if (.not. static .and. summary%cycles > 0 .and. summary%fe_elements > 0) then
-      per_element = 1.0e9_wp*summary%fe_solid_s/(real(summary%cycles, wp)*real(summary%fe_elements, wp))
+    if (.not. static .and. summary%cycles > 0 .and. summary%fe_solids > 0) then
+      per_element = 1.0e9_wp*summary%fe_solid_s/(real(summary%cycles, wp)*real(summary%fe_solids, wp))
       write (line, '(a,f0.1,a)') "  solid elements: ", per_element, " ns per element per cycle"
+      write (*, '(a)') trim(line)
+    end if
+    if (.not. static .and. summary%cycles > 0 .and. summary%fe_shells > 0) then
+      per_element = 1.0e9_wp*summary%fe_shell_s/(real(summary%cycles, wp)*real(summary%fe_shells, wp))
+      write (line, '(a,f0.1,a)') "  shell elements: ", per_element, " ns per element per cycle"
       write (*, '(a)') trim(line)
     end if
     if (.not. static .and. summary%cycles > 0 .and. summary%efg_particles > 0) then

@@ -97,9 +97,11 @@ contains
     end do
   end subroutine set_up_rigid_bodies
 
-  !> Mass, first and second moments of the part's hexahedra by 2x2x2 Gauss points, the
-  !> centre of mass and (before the nodal masses) the inertia about it; corner masses
-  !> rho V / 8 for the nodes; the stable step of the elements from E, PR and RO.
+  !> Mass, first and second moments of the part's hexahedra by 2x2x2 Gauss points and of its
+  !> shells by 2x2 points on their mid-surface (thickness terms neglected), the centre of mass
+  !> and (before the nodal masses) the inertia about it; corner masses rho V / 8 for the
+  !> hexahedra's nodes and rho t A / 4 for the shells'; the stable step of the elements from E,
+  !> PR and RO.
   subroutine integrate_rigid_elements(model, part, reference, body, corner_mass)
     type(model_t), intent(in) :: model
     integer, intent(in) :: part
@@ -113,7 +115,7 @@ contains
     real(wp) :: element_volume, density, wave_modulus, nu, youngs, length
     real(wp) :: xs(block_size, 8), ys(block_size, 8), zs(block_size, 8), area(block_size)
     real(wp) :: first(3), second(3, 3), origin(3)
-    integer :: solid, a, i, j, k, material
+    integer :: solid, shell, a, i, j, k, material
     logical :: started
 
     body%mass = 0.0_wp
@@ -172,12 +174,70 @@ contains
         length = element_volume/max(area(1), tiny(1.0_wp))
         body%time_step = min(body%time_step, length/sqrt(wave_modulus/density))
       end do
+      if (allocated(model%shell_part)) then
+        do shell = 1, size(model%shell_part)
+          if (model%shell_part(shell) /= part) cycle
+          if (.not. started) then
+            origin = reference(:, model%shell_nodes(1, shell))
+            started = .true.
+          end if
+          call add_rigid_shell(reference(:, model%shell_nodes(:, shell)), &
+                               density*0.25_wp*sum(model%shell_thickness(:, shell)), origin, body%mass, first, second, &
+                               element_volume, length)
+          ! element_volume: the shell's area here; corner masses as the deformable shells lump them
+          do a = 1, 4
+            if (a == 4 .and. model%shell_nodes(3, shell) == model%shell_nodes(4, shell)) cycle
+            corner_mass(model%shell_nodes(a, shell)) = corner_mass(model%shell_nodes(a, shell)) + &
+              density*0.25_wp*sum(model%shell_thickness(:, shell))*element_volume* &
+              merge(1.0_wp/3.0_wp, 0.25_wp, model%shell_nodes(3, shell) == model%shell_nodes(4, shell))
+          end do
+          body%time_step = min(body%time_step, length/sqrt(youngs/(density*(1.0_wp - nu*nu))))
+        end do
+      end if
     end if
     ! kept as moments about `origin` until the nodal masses are added
     body%centre = origin
     body%angular_momentum = first
     body%inertia = second
   end subroutine integrate_rigid_elements
+
+  !> Mass, first and second moments (about `origin`) of one shell of mass per area
+  !> `areal_density` with corners x(3, 4), by 2x2 Gauss points on the bilinear surface; its
+  !> area and its time-step length (area / longest side).
+  pure subroutine add_rigid_shell(x, areal_density, origin, mass, first, second, area, length)
+    real(wp), intent(in) :: x(3, 4), areal_density, origin(3)
+    real(wp), intent(inout) :: mass, first(3), second(3, 3)
+    real(wp), intent(out) :: area, length
+    real(wp), parameter :: g = 1.0_wp/sqrt(3.0_wp)
+    real(wp), parameter :: corner_xi(2, 4) = reshape([-1, -1, 1, -1, 1, 1, -1, 1], [2, 4])
+    real(wp) :: natural(2), shape(4), tangent_xi(3), tangent_eta(3), normal(3), weight, point(3)
+    integer :: a, i, j
+    area = 0.0_wp
+    do j = 1, 2
+      do i = 1, 2
+        natural = g*[real(2*i - 3, wp), real(2*j - 3, wp)]
+        tangent_xi = 0.0_wp
+        tangent_eta = 0.0_wp
+        do a = 1, 4
+          shape(a) = 0.25_wp*(1.0_wp + natural(1)*corner_xi(1, a))*(1.0_wp + natural(2)*corner_xi(2, a))
+          tangent_xi = tangent_xi + 0.25_wp*corner_xi(1, a)*(1.0_wp + natural(2)*corner_xi(2, a))*x(:, a)
+          tangent_eta = tangent_eta + 0.25_wp*corner_xi(2, a)*(1.0_wp + natural(1)*corner_xi(1, a))*x(:, a)
+        end do
+        normal = cross(tangent_xi, tangent_eta)
+        weight = norm2(normal)
+        point = matmul(x, shape) - origin
+        area = area + weight
+        mass = mass + areal_density*weight
+        first = first + areal_density*weight*point
+        second = second + areal_density*weight*outer(point, point)
+      end do
+    end do
+    length = 0.0_wp
+    do a = 1, 4
+      length = max(length, norm2(x(:, modulo(a, 4) + 1) - x(:, a)))
+    end do
+    length = area/max(length, tiny(1.0_wp))
+  end subroutine add_rigid_shell
 
   !> Add the nodal masses as point masses, then turn the moments into the centre of mass and
   !> the inertia tensor about it: I = tr(S) 1 - S, S = sum m r r^T about the centre.

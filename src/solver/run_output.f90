@@ -12,6 +12,7 @@ module run_output
   use history_buffer, only: history_set_t, add_history_series, append_history_row
   use energy_balance, only: update_energy_totals, part_energies, total_energy, energy_ratio
   use solid_block, only: solid_block_element_results
+  use shell_block, only: shell_block_element_results
   use efg_forces, only: efg_point_results, transform_to_physical
   use results_file, only: results_file_t, write_state, write_histories
   use rigid_bodies, only: rigid_body_history_row
@@ -41,6 +42,8 @@ module run_output
     real(wp) :: last_rwforc_time = 0.0_wp
     ! work arrays for the element results of a state, allocated once
     real(wp), allocatable :: solid_stress(:, :), solid_plastic_strain(:)
+    real(wp), allocatable :: shell_stress(:, :), shell_stress_peak(:, :)      !< (6, shells)
+    real(wp), allocatable :: shell_plastic_strain(:), shell_plastic_strain_peak(:)
     real(wp), allocatable :: node_velocity(:, :)     !< physical integer-step velocities of a state
     real(wp), allocatable :: node_displacement(:, :) !< physical displacements of a state
     real(wp), allocatable :: generalized_velocity(:, :) !< integer-step solver velocities (work array)
@@ -138,6 +141,12 @@ contains
       end if
     end if
     allocate (plan%solid_stress(6, size(model%solid_ids)), plan%solid_plastic_strain(size(model%solid_ids)))
+    allocate (plan%shell_stress(6, size(model%shell_ids)), plan%shell_stress_peak(6, size(model%shell_ids)), &
+              plan%shell_plastic_strain(size(model%shell_ids)), plan%shell_plastic_strain_peak(size(model%shell_ids)))
+    plan%shell_stress = 0.0_wp
+    plan%shell_stress_peak = 0.0_wp
+    plan%shell_plastic_strain = 0.0_wp
+    plan%shell_plastic_strain_peak = 0.0_wp
     allocate (plan%node_velocity(3, size(model%node_ids)), plan%node_displacement(3, size(model%node_ids)), &
               plan%generalized_velocity(3, size(model%node_ids)), plan%node_acceleration(3, size(model%node_ids)))
     allocate (plan%part_kinetic(size(model%parts)), plan%part_internal(size(model%parts)), &
@@ -319,7 +328,18 @@ contains
       call efg_point_results(model%materials(state%efg(k)%geometry%material), state%efg(k), plan%solid_stress, &
                              plan%solid_plastic_strain)
     end do
-    call write_state(results, state%time, plan%node_displacement, plan%node_velocity, plan%solid_stress, &
-                     plan%solid_plastic_strain, error)
+    do b = 1, size(state%shells)
+      call shell_block_element_results(state%shells(b), model%materials(state%shells(b)%material), &
+                                       plan%shell_stress, plan%shell_stress_peak, plan%shell_plastic_strain, &
+                                       plan%shell_plastic_strain_peak)
+    end do
+    if (size(model%shell_ids) > 0) then
+      call write_state(results, state%time, plan%node_displacement, plan%node_velocity, plan%solid_stress, &
+                       plan%solid_plastic_strain, error, plan%shell_stress, plan%shell_plastic_strain, &
+                       plan%shell_stress_peak, plan%shell_plastic_strain_peak)
+    else
+      call write_state(results, state%time, plan%node_displacement, plan%node_velocity, plan%solid_stress, &
+                       plan%solid_plastic_strain, error)
+    end if
   end subroutine write_current_state
 end module run_output

@@ -52,6 +52,33 @@ def nodes_card(nodes, first_id=1):
     return "\n".join(lines)
 
 
+def plate_mesh(counts, lengths, perturbation=0.0, seed=1):
+    """Nodes (n,3) in the z = 0 plane and quadrilaterals (m,4, 0-based, counter-clockwise seen
+    from +z) of a rectangle split into counts = (nx, ny) cells; `perturbation` moves interior
+    nodes by up to that fraction of the cell size (an irregular mesh)."""
+    nx, ny = counts
+    x, y = np.meshgrid(np.linspace(0.0, lengths[0], nx + 1), np.linspace(0.0, lengths[1], ny + 1), indexing="ij")
+    nodes = np.stack([x, y, np.zeros_like(x)], axis=-1)
+    if perturbation > 0.0:
+        rng = np.random.default_rng(seed)
+        cell = np.array([lengths[0] / nx, lengths[1] / ny])
+        shift = rng.uniform(-perturbation, perturbation, (nx + 1, ny + 1, 2)) * cell
+        nodes[1:-1, 1:-1, :2] += shift[1:-1, 1:-1]
+    nodes = nodes.reshape(-1, 3)
+    index = lambda i, j: i * (ny + 1) + j
+    shells = [[index(i, j), index(i + 1, j), index(i + 1, j + 1), index(i, j + 1)]
+              for i in range(nx) for j in range(ny)]
+    return nodes, np.array(shells, dtype=int)
+
+
+def shells_card(shells, part_id=1, first_id=1, first_node_id=1):
+    lines = ["*ELEMENT_SHELL"]
+    for k, corners in enumerate(shells):
+        ids = "".join(f"{c + first_node_id:8d}" for c in corners)
+        lines.append(f"{k + first_id:8d}{part_id:8d}{ids}")
+    return "\n".join(lines)
+
+
 def solids_card(elements, part_id=1, first_id=1, first_node_id=1):
     lines = ["*ELEMENT_SOLID"]
     for k, corners in enumerate(elements):

@@ -49,6 +49,90 @@ CASES = [
 ]
 
 
+# Two shells (a plate strip) in a deck without solids. Line numbers: 9 *SECTION_SHELL, 10 its
+# card 1, 11 its card 2 (T1), 8 the *PART card, 22 and 23 the shells.
+SHELL_GOOD = """*KEYWORD
+*TITLE
+two shells
+*CONTROL_TERMINATION
+       1.0
+*PART
+plate
+         1         1         1
+*SECTION_SHELL
+         1         2
+       1.0
+*MAT_ELASTIC
+         1   7.85e-6     210.0       0.3
+*NODE
+       1             0.0             0.0             0.0
+       2             1.0             0.0             0.0
+       3             1.0             1.0             0.0
+       4             0.0             1.0             0.0
+       5             2.0             0.0             0.0
+       6             2.0             1.0             0.0
+*ELEMENT_SHELL
+       1       1       1       2       3       4
+       2       1       2       5       6       3
+*END
+"""
+
+HONEYCOMB = """*MAT_HONEYCOMB
+         1   6.0e-11    70000.       0.3      300.       0.2       0.0
+        11                            12                                      10
+     1000.      500.      500.      200.      200.      200.
+       0.0
+       0.0
+*DEFINE_CURVE
+        10
+0.0,1.0
+1.0,2.0
+*DEFINE_CURVE
+        11
+0.0,0.5
+1.0,0.7
+*DEFINE_CURVE
+        12
+0.0,0.0
+0.5,0.2
+"""
+
+SHELL_CASES = [
+    # (description, replace this, with that, expected fragments of the message)
+    ("unknown shell part", "       2       1       2       5", "       2       9       2       5",
+     ["deck.k:23:", "*ELEMENT_SHELL", "field PID", "part 9 of shell 2 is not defined"]),
+    ("shell on a solid section", "*SECTION_SHELL\n         1         2\n       1.0\n",
+     "*SECTION_SOLID\n         1         1\n$ (a solid section has one card)\n",
+     ["deck.k:22:", "*ELEMENT_SHELL", "field PID", "has solid section 1"]),
+    ("shell without thickness", "       1.0\n*MAT_ELASTIC", "       0.0\n*MAT_ELASTIC",
+     ["deck.k:22:", "*ELEMENT_SHELL", "field PID", "shell 1 has no thickness"]),
+    ("ELFORM 16", "         1         2\n       1.0", "         1        16\n       1.0",
+     ["deck.k:10:", "*SECTION_SHELL", "field ELFORM", "16", "ELFORM 2 (Belytschko-Tsay)"]),
+    ("NIP 11", "         1         2\n       1.0", "         1         2       0.0        11\n       1.0",
+     ["deck.k:10:", "*SECTION_SHELL", "field NIP", "1-10", "found 11"]),
+    ("NLOC 1", "       1.0\n*MAT_ELASTIC", "       1.0                                     1.0\n*MAT_ELASTIC",
+     ["deck.k:11:", "*SECTION_SHELL", "field NLOC", "found 1.0"]),
+    ("N5 given", "       1       1       1       2       3       4\n",
+     "       1       1       1       2       3       4       7\n",
+     ["deck.k:22:", "*ELEMENT_SHELL", "field N5", "8-node shells are not available"]),
+    ("honeycomb on a shell part", "*MAT_ELASTIC\n         1   7.85e-6     210.0       0.3\n", HONEYCOMB,
+     ["deck.k:8:", "*PART", "field MID", "shell"]),
+]
+
+
+@pytest.mark.parametrize("description, old, new, fragments", SHELL_CASES, ids=[c[0] for c in SHELL_CASES])
+def test_bad_shell_deck_is_rejected_with_a_clear_message(tmp_path, run_deck, description, old, new, fragments):
+    assert old in SHELL_GOOD
+    deck = tmp_path / "deck.k"
+    deck.write_text(SHELL_GOOD.replace(old, new, 1))
+    run = run_deck(deck)
+    assert run.status == 2, f"{description}: exit status {run.status}\n{run.stderr}"
+    for fragment in fragments:
+        assert fragment in run.stderr, f"{description}: '{fragment}' not in:\n{run.stderr}"
+    assert "At line" not in run.stderr, "a Fortran runtime error escaped"
+    assert not run.results.exists(), "no results for a rejected deck"
+
+
 @pytest.mark.parametrize("description, old, new, fragments", CASES, ids=[c[0] for c in CASES])
 def test_bad_deck_is_rejected_with_a_clear_message(tmp_path, run_deck, description, old, new, fragments):
     assert old in GOOD

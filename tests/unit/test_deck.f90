@@ -11,7 +11,8 @@ program test_deck
                    law_honeycomb, law_modified_honeycomb, law_low_density_foam, &
                    motion_displacement, motion_velocity, kernel_cubic_box, kernel_cubic_sphere, &
                    boundary_coupled, boundary_full_transformation, integration_local_boundary, &
-                   integration_gauss, integration_gauss_conventional
+                   integration_gauss, integration_gauss_conventional, formulation_rigid, &
+                   section_shell, section_solid
   use deck_reader, only: read_deck
   implicit none
 
@@ -50,6 +51,10 @@ program test_deck
   call test_segment_load_structure()
   call test_crushable_materials()
   call test_crushable_material_errors()
+  call test_shells()
+  call test_shell_rotations_on_solids()
+  call test_shell_errors()
+  call test_shell_section_errors()
   call execute_command_line("rm -rf "//directory)
   call finish_suite(suite)
 
@@ -733,7 +738,8 @@ contains
       "@: *CONTROL_TERMINATION: field ENDTIM: the deck has no *CONTROL_TERMINATION"])
     call read_bad("no_mesh.k", [lines(1:5), lines(17:)], [character(len=120) :: &
       "@: *NODE: field NID: the deck defines no nodes", &
-      "@: *ELEMENT_SOLID: field EID: the deck defines no solid elements"])
+      "@: *ELEMENT_SOLID: field EID: the deck defines no elements (no *ELEMENT_SOLID or "// &
+      "*ELEMENT_SHELL)"])
     call read_bad("inside_out.k", replaced(16, fixed(["1", "1", "1", "4", "3", "2", "5", "8", &
       "7", "6"], 8)), [character(len=120) :: "@:16: *ELEMENT_SOLID: field N1-N8: element 1 of "// &
       "part 1 is inside out: negative Jacobian at corner N"])
@@ -1279,4 +1285,311 @@ contains
       "@:37: *MAT_026: field D1: AOPT 2 needs a vector d (D1 D2 D3) not parallel to a", &
       "@:34: *MAT_026: field LCA: curve 8 of material 7 is not defined"], message_lines=12)
   end subroutine test_crushable_material_errors
+
+  ! ---------------------------------------------------------------- shells
+
+  !> A valid shell-only deck in fixed format. Line numbers:
+  !>  1 *KEYWORD  2 *CONTROL_TERMINATION  3 card  4 *NODE  5-10 nodes 1-6 (a 2 x 1 strip in
+  !>  z = 0)  11 *ELEMENT_SHELL  12 quad 1 (N1-N4 1 2 3 4)  13 triangle 2 (2 5 6, N4 blank)
+  !>  14 *PART  15 heading  16 card (PID 1 SECID 1 MID 1)  17 *SECTION_SHELL  18 card 1 (SECID 1)
+  !>  19 card 2 (T1 1.5)  20 *MAT_ELASTIC  21 card ... then `extra` lines from 22, then *END.
+  function plate_deck(extra) result(lines)
+    character(len=*), intent(in), optional :: extra(:)
+    character(len=line_length), allocatable :: lines(:)
+    character(len=line_length) :: base(21)
+    base(1) = "*KEYWORD"
+    base(2) = "*CONTROL_TERMINATION"
+    base(3) = fixed(["1.0"], 10)
+    base(4) = "*NODE"
+    base(5) = node_line(1, 0.0_wp, 0.0_wp, 0.0_wp)
+    base(6) = node_line(2, 1.0_wp, 0.0_wp, 0.0_wp)
+    base(7) = node_line(3, 1.0_wp, 1.0_wp, 0.0_wp)
+    base(8) = node_line(4, 0.0_wp, 1.0_wp, 0.0_wp)
+    base(9) = node_line(5, 2.0_wp, 0.0_wp, 0.0_wp)
+    base(10) = node_line(6, 2.0_wp, 1.0_wp, 0.0_wp)
+    base(11) = "*ELEMENT_SHELL"
+    base(12) = fixed(["1", "1", "1", "2", "3", "4"], 8)
+    base(13) = fixed(["2", "1", "2", "5", "6"], 8)
+    base(14) = "*PART"
+    base(15) = "the plate"
+    base(16) = fixed(["1", "1", "1"], 10)
+    base(17) = "*SECTION_SHELL"
+    base(18) = fixed(["1"], 10)
+    base(19) = fixed(["1.5"], 10)
+    base(20) = "*MAT_ELASTIC"
+    base(21) = fixed(["1     ", "7.8e-6", "210.0 ", "0.3   "], 10)
+    if (present(extra)) then
+      lines = [base, extra, text_line("*END")]
+    else
+      lines = [base, text_line("*END")]
+    end if
+  end function plate_deck
+
+  !> The plate deck with line `number` replaced.
+  function plate_replaced(number, text, extra) result(lines)
+    integer, intent(in) :: number
+    character(len=*), intent(in) :: text
+    character(len=*), intent(in), optional :: extra(:)
+    character(len=line_length), allocatable :: lines(:)
+    lines = plate_deck(extra)
+    lines(number) = text
+  end function plate_replaced
+
+  !> Shells of every form (fixed and comma cards, a triangle, *ELEMENT_SHELL_THICKNESS with a
+  !> THIC left 0), sections with defaults and with every field, a *MAT_RIGID shell part, the
+  !> rotations of *BOUNDARY_SPC_NODE/_SET and of *NODE RC, and a velocity generated on a
+  !> shell part. No solid: a deck of shells alone is accepted.
+  subroutine test_shells()
+    type(model_t) :: model
+    type(error_list_t) :: warnings
+    integer :: k
+    call read_good("shells.k", plate_replaced(9, trim(node_line(5, 2.0_wp, 0.0_wp, 0.0_wp))// &
+      "       0       4", [character(len=line_length) :: &
+      "*ELEMENT_SHELL_THICKNESS", &                                             ! 22
+      fixed(["3", "2", "2", "5", "6", "3"], 8), &                               ! 23
+      fixed(["0.5 ", "0.6 ", "0.0 ", "0.8 ", "30.0"], 16), &                    ! 24
+      "*PART", "thick plate", "2,2,2", &                                        ! 25-27
+      "*SECTION_SHELL_TITLE", "explicit", &                                     ! 28-29
+      "2,2,0.8333,5,1,0,0,1", "1.0,1.1,1.2,1.3,0", &                           ! 30-31
+      "*MAT_ELASTIC", "2,2.7e-6,70.0,0.33", &                                   ! 32-33
+      "*MAT_RIGID", "3,7.8e-6,210.0,0.3", &                                     ! 34-35
+      "*PART", "rigid", "3,1,3", &                                              ! 36-38
+      "*NODE", trim(node_line(7, 3.0_wp, 0.0_wp, 0.0_wp)), &                   ! 39-40
+      trim(node_line(8, 4.0_wp, 0.0_wp, 0.0_wp)), &
+      trim(node_line(9, 4.0_wp, 1.0_wp, 0.0_wp)), &
+      trim(node_line(10, 3.0_wp, 1.0_wp, 0.0_wp)), &                           ! 43
+      "*ELEMENT_SHELL", "4,3,7,8,9,10", &                                       ! 44-45
+      "*BOUNDARY_SPC_NODE", "1,0,1,1,1,1,1,1", "4,0,0,0,0,0,1,0", &            ! 46-48
+      "*BOUNDARY_SPC_SET", "1,0,0,0,0,0,0,1", &                                 ! 49-50
+      "*SET_NODE_LIST", "1", "6", &                                             ! 51-53
+      "*INITIAL_VELOCITY_GENERATION", "2,2,0.0,0.0,0.0,3.0", "0,0,0,0,0,1"]), &
+      model, warnings)
+    if (.not. allocated(model%shell_ids)) return
+    call check(suite, "shells: no solids", size(model%solid_ids) == 0 .and. &
+               all(shape(model%solid_nodes) == [8, 0]))
+    call check(suite, "shells: four shells", size(model%shell_ids) == 4 .and. &
+               all(shape(model%shell_nodes) == [4, 4]) .and. &
+               all(shape(model%shell_thickness) == [4, 4]))
+    if (size(model%shell_ids) /= 4) return
+    call check(suite, "shells: ids", all(model%shell_ids == [1, 2, 3, 4]))
+    call check(suite, "shells: part indices", all(model%shell_part == [1, 1, 2, 3]))
+    call check(suite, "shells: quad node indices", all(model%shell_nodes(:, 1) == [1, 2, 3, 4]))
+    call check(suite, "shells: triangle repeats N3", all(model%shell_nodes(:, 2) == [2, 5, 6, 6]))
+    call check(suite, "shells: _THICKNESS nodes", all(model%shell_nodes(:, 3) == [2, 5, 6, 3]))
+    call check(suite, "shells: rigid part nodes", all(model%shell_nodes(:, 4) == [7, 8, 9, 10]))
+    call check_close(suite, "shells: section T1 on all corners", model%shell_thickness(:, 1), &
+                     [1.5_wp, 1.5_wp, 1.5_wp, 1.5_wp], thr=0.0_wp)
+    call check_close(suite, "shells: triangle thickness", model%shell_thickness(:, 2), &
+                     [1.5_wp, 1.5_wp, 1.5_wp, 1.5_wp], thr=0.0_wp)
+    call check_close(suite, "shells: THIC, THIC3 0 takes the section's T3", &
+                     model%shell_thickness(:, 3), [0.5_wp, 0.6_wp, 1.2_wp, 0.8_wp], thr=0.0_wp)
+    call check(suite, "shells: two sections", size(model%sections) == 2)
+    associate (section => model%sections(1))
+      call check(suite, "section defaults: kind, ELFORM 2, NIP 2", section%kind == &
+                 section_shell .and. section%element_formulation == 2 .and. &
+                 section%integration_points == 2 .and. section%title == "")
+      call check_close(suite, "section defaults: SHRF 1, T2-T4 = T1, NLOC 0", &
+                       [section%shear_factor, section%thickness, section%reference_surface], &
+                       [1.0_wp, 1.5_wp, 1.5_wp, 1.5_wp, 1.5_wp, 0.0_wp], thr=0.0_wp)
+    end associate
+    associate (section => model%sections(2))
+      call check(suite, "section: title, kind, NIP 5", section%title == "explicit" .and. &
+                 section%kind == section_shell .and. section%integration_points == 5 .and. &
+                 section%id == 2)
+      call check_close(suite, "section: SHRF, T1-T4", [section%shear_factor, section%thickness], &
+                       [0.8333_wp, 1.0_wp, 1.1_wp, 1.2_wp, 1.3_wp], thr=0.0_wp)
+    end associate
+    call check(suite, "shells: parts", all([(model%parts(k)%section, k=1, 3)] == [1, 2, 1]) .and. &
+               all([(model%parts(k)%material, k=1, 3)] == [1, 2, 3]))
+    call check(suite, "shells: formulations", model%parts(1)%formulation == formulation_fe .and. &
+               model%parts(3)%formulation == formulation_rigid)
+    call check(suite, "shells: rigid shell part is a rigid body", size(model%rigid_bodies) == 1)
+    if (size(model%rigid_bodies) == 1) call check(suite, "shells: rigid body nodes", &
+      model%rigid_bodies(1)%part == 3 .and. all(model%rigid_bodies(1)%nodes == [7, 8, 9, 10]))
+    call check(suite, "shells: four constrained nodes", size(model%spcs) == 4)
+    if (size(model%spcs) == 4) then
+      call check(suite, "spc: nodes", all(model%spcs%node == [1, 4, 5, 6]))
+      call check(suite, "spc: node 1 all six", all(model%spcs(1)%fixed) .and. &
+                 all(model%spcs(1)%fixed_rotation))
+      call check(suite, "spc: node 4 DOFRY", .not. any(model%spcs(2)%fixed) .and. &
+                 all(model%spcs(2)%fixed_rotation .eqv. [.false., .true., .false.]))
+      call check(suite, "spc: node 5 RC 4 (x and y)", .not. any(model%spcs(3)%fixed) .and. &
+                 all(model%spcs(3)%fixed_rotation .eqv. [.true., .true., .false.]))
+      call check(suite, "spc: node set DOFRZ", .not. any(model%spcs(4)%fixed) .and. &
+                 all(model%spcs(4)%fixed_rotation .eqv. [.false., .false., .true.]))
+    end if
+    call check_close(suite, "shells: velocity generated on a shell part", &
+      reshape(model%initial_velocity(:, 1:6), [18]), [0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, &
+      3.0_wp, 0.0_wp, 0.0_wp, 3.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 3.0_wp, 0.0_wp, &
+      0.0_wp, 3.0_wp], thr=0.0_wp)
+    call check(suite, "shells: no warnings", warnings%count == 0, warnings%text)
+  end subroutine test_shells
+
+  !> Rotations fixed on nodes of no shell (the cube's) are dropped with one warning per card
+  !> (per *NODE block for RC), at the card that fixes them; shell nodes keep theirs. The solids
+  !> and shells of one deck keep their own sections.
+  subroutine test_shell_rotations_on_solids()
+    type(model_t) :: model
+    type(error_list_t) :: warnings
+    call read_good("solid_rotations.k", cube_deck([character(len=line_length) :: &
+      "*BOUNDARY_SPC_NODE", "1,0,1,0,0,0,1,0", &                                ! 24-25
+      "*NODE", trim(node_line(9, 2.0_wp, 0.0_wp, 0.0_wp))//"       0       7", & ! 26-27
+      trim(node_line(10, 2.0_wp, 1.0_wp, 0.0_wp))//"       0       1", &
+      trim(node_line(11, 3.0_wp, 0.0_wp, 0.0_wp))//"       0       7", &       ! 29
+      trim(node_line(12, 3.0_wp, 1.0_wp, 0.0_wp))//"       0       2", &
+      "*BOUNDARY_SPC_SET", "1,0,0,0,0,1", &                                     ! 31-32
+      "*SET_NODE_LIST", "1", "5,6", &
+      "*ELEMENT_SHELL", "5,2,2,9,10,3", &
+      "*PART", "plate", "2,2,1", &
+      "*SECTION_SHELL", "2", "0.1", &
+      "*BOUNDARY_SPC_NODE", "10,0,0,0,0,0,0,1"]), model, warnings)
+    if (.not. allocated(model%spcs)) return
+    call check(suite, "solid rotations: mixed mesh", size(model%solid_ids) == 1 .and. &
+               size(model%shell_ids) == 1 .and. model%sections(model%parts(1)%section)%kind == &
+               section_solid .and. model%sections(model%parts(2)%section)%kind == section_shell)
+    call check(suite, "solid rotations: three constrained nodes", size(model%spcs) == 3)
+    if (size(model%spcs) == 3) then
+      call check(suite, "solid rotations: node 1 x only", model%spcs(1)%node == 1 .and. &
+        all(model%spcs(1)%fixed .eqv. [.true., .false., .false.]) .and. &
+        .not. any(model%spcs(1)%fixed_rotation))
+      call check(suite, "solid rotations: shell node 9 keeps RC 7", &
+        model%node_ids(model%spcs(2)%node) == 9 .and. .not. any(model%spcs(2)%fixed) .and. &
+        all(model%spcs(2)%fixed_rotation))
+      call check(suite, "solid rotations: shell node 10 keeps RC 1 and DOFRZ", &
+        model%node_ids(model%spcs(3)%node) == 10 .and. &
+        all(model%spcs(3)%fixed_rotation .eqv. [.true., .false., .true.]))
+    end if
+    call check(suite, "solid rotations: three warnings", warnings%count == 3, warnings%text)
+    call check(suite, "solid rotations: DOFRY warned", index(warnings%text, &
+      "solid_rotations.k:25: *BOUNDARY_SPC_NODE: field DOFRY: ignored: node 1 belongs to no "// &
+      "shell (solid nodes have no rotations)") > 0, warnings%text)
+    call check(suite, "solid rotations: RC warned once", index(warnings%text, &
+      "solid_rotations.k:29: *NODE: field RC: ignored on node 11, which belongs to no shell "// &
+      "(solid nodes have no rotations); 1 more node alike") > 0, warnings%text)
+    call check(suite, "solid rotations: set warned", index(warnings%text, &
+      "solid_rotations.k:32: *BOUNDARY_SPC_SET: field DOFRX: ignored: no node of set 1 "// &
+      "belongs to a shell (solid nodes have no rotations)") > 0, warnings%text)
+  end subroutine test_shell_rotations_on_solids
+
+  !> Shell element cards and references: every problem at its card and field.
+  subroutine test_shell_errors()
+    character(len=8), parameter :: c = ""
+    call read_bad("shell_part.k", plate_replaced(13, fixed(["2", "9", "2", "5", "6"], 8)), &
+      [character(len=120) :: "@:13: *ELEMENT_SHELL: field PID: part 9 of shell 2 is not "// &
+      "defined (no *PART with this PID)"], message_lines=1)
+    call read_bad("shell_on_solid.k", plate_replaced(16, fixed(["1", "2", "1"], 10), &
+      [character(len=line_length) :: "*SECTION_SOLID", "2,1"]), [character(len=300) :: &
+      "@:12: *ELEMENT_SHELL: field PID: part 1 of shell 1 has solid section 2 "// &
+      "(*SECTION_SOLID); shells need a *SECTION_SHELL section; 1 more element of this part "// &
+      "is alike"], message_lines=1)
+    call read_bad("solid_on_shell.k", replaced(19, fixed(["1", "5", "1"], 10), &
+      [character(len=line_length) :: "*SECTION_SHELL", "5", "1.0"]), [character(len=300) :: &
+      "@:16: *ELEMENT_SOLID: field PID: part 1 of solid element 1 has shell section 5 "// &
+      "(*SECTION_SHELL); solid elements need a *SECTION_SOLID or *SECTION_SOLID_EFG section"], &
+      message_lines=1)
+    call read_bad("no_thickness.k", plate_replaced(19, fixed(["0.0"], 10)), &
+      [character(len=300) :: "@:12: *ELEMENT_SHELL: field PID: shell 1 has no thickness: T1 "// &
+      "of its section 1 is 0.0 and *ELEMENT_SHELL gives none (set T1 on card 2 of "// &
+      "*SECTION_SHELL, or use *ELEMENT_SHELL_THICKNESS); 1 more shell of this part has none"], &
+      message_lines=1)
+    call read_bad("no_thic.k", plate_deck([character(len=line_length) :: &
+      "*PART", "p2", "2,2,1", "*SECTION_SHELL", "2", "0.0", &                    ! 22-27
+      "*ELEMENT_SHELL_THICKNESS", fixed(["3", "2", "2", "5", "6", "3"], 8), &  ! 28-29
+      "0.5,0,0.5,0.5", &                                                        ! 30
+      fixed(["4", "2", "2", "5", "6", "3"], 8), "-0.5"]), [character(len=300) :: &
+      "@:30: *ELEMENT_SHELL_THICKNESS: field THIC2: shell 3 has no thickness at N2: THIC2 is "// &
+      "blank or 0 and T2 of section 2 is 0.0; 1 more shell of this part has none", &
+      "@:32: *ELEMENT_SHELL_THICKNESS: field THIC1: thickness must be >= 0 (0 or blank: the "// &
+      "section's T1), found -0.5"], message_lines=2)
+    call read_bad("thickness_card.k", plate_deck([character(len=line_length) :: &
+      "*ELEMENT_SHELL_THICKNESS", fixed(["3", "1", "2", "5", "6", "3"], 8)]), &
+      [character(len=300) :: "@:23: *ELEMENT_SHELL_THICKNESS: field THIC1: the thickness "// &
+      "card (THIC1 THIC2 THIC3 THIC4 BETA) of shell 3 is missing"], message_lines=1)
+    call read_bad("eight_nodes.k", plate_replaced(12, fixed(["1", "1", "1", "2", "3", "4", &
+      "7"], 8), [character(len=line_length) :: "*ELEMENT_SHELL_THICKNESS", &
+      fixed(["3", "1", "2", "5", "6", "3", "0", "0", "0", "8"], 8), "0.5", "0.5", &
+      fixed(["4", "1", "2", "5", "6", "3"], 8), "0.5"]), [character(len=300) :: &
+      "@:12: *ELEMENT_SHELL: field N5: 8-node shells are not available; 4-node shells and "// &
+      "triangles leave N5-N8 blank, found 7", &
+      "@:23: *ELEMENT_SHELL_THICKNESS: field N8: 8-node shells"], message_lines=2)
+    call read_bad("shell_nodes.k", plate_replaced(12, fixed(["1", "1", "1", "2", "2", "4"], &
+      8), [character(len=line_length) :: "*ELEMENT_SHELL", &
+      fixed(["3", "1", "0", "2", "3"], 8), fixed([character(len=2) :: "4", "1", "1", "2", "3", "44"], 8), &
+      fixed(["2", "1", "4", "3", "6"], 8)]), [character(len=300) :: &
+      "@:12: *ELEMENT_SHELL: field N3: the shell repeats node 2 (N2 and N3); only N4 may "// &
+      "repeat N3 (a triangle)", &
+      "@:23: *ELEMENT_SHELL: field N1: node id must be > 0, found 0", &
+      "@:24: *ELEMENT_SHELL: field N4: node 44 of shell 4 is not defined", &
+      "@:25: *ELEMENT_SHELL: field EID: shell id 2 is defined twice (first at @:13)"], &
+      message_lines=4)
+    call read_bad("no_area.k", plate_replaced(13, fixed(["2", "1", "1", "2", "5"], 8)), &
+      [character(len=300) :: "@:13: *ELEMENT_SHELL: field N1-N4: shell 2 of part 1 has no "// &
+      "area: its corners coincide or lie on one line"], message_lines=1)
+    call read_bad("shell_honeycomb.k", plate_replaced(16, fixed(["1", "1", "3"], 10), &
+      [character(len=line_length) :: &
+      "*MAT_026", fixed([character(len=8) :: "3", "6.0e-11", "70000.", "0.3", "300.", "0.2", &
+      "0.0"], 10), &
+      fixed([character(len=8) :: "11", c, c, "12", c, c, c, "10"], 10), &
+      fixed([character(len=8) :: "1000.", "500.", "500.", "200.", "200.", "200."], 10), &
+      fixed([character(len=8) :: "0.0"], 10), fixed([character(len=8) :: "0.0"], 10), &
+      "*DEFINE_CURVE", fixed([character(len=8) :: "10"], 10), "0.0,1.0", "1.0,2.0", &
+      "*DEFINE_CURVE", fixed([character(len=8) :: "11"], 10), "0.0,0.5", "1.0,0.7", &
+      "*DEFINE_CURVE", fixed([character(len=8) :: "12"], 10), "0.0,0.0", "0.5,0.2"]), &
+      [character(len=300) :: "@:16: *PART: field MID: part 1: material 3 has no shell "// &
+      "(plane-stress) formulation; shell sections take *MAT_ELASTIC, *MAT_PLASTIC_KINEMATIC, "// &
+      "*MAT_PIECEWISE_LINEAR_PLASTICITY, *MAT_NULL or *MAT_RIGID"], message_lines=1)
+    call read_bad("shell_static.k", plate_deck([character(len=line_length) :: &
+      "*CONTROL_IMPLICIT_GENERAL", "1"]), [character(len=300) :: "@:12: *ELEMENT_SHELL: field "// &
+      "EID: the linear static analysis (*CONTROL_IMPLICIT_GENERAL IMFLAG = 1) takes solid "// &
+      "elements only; this deck has 2 shells, which run in explicit analyses only"], &
+      message_lines=1)
+    call read_bad("shell_spc_flag.k", plate_deck([character(len=line_length) :: &
+      "*BOUNDARY_SPC_NODE", "1,0,0,0,0,1,2"]), [character(len=120) :: &
+      "@:23: *BOUNDARY_SPC_NODE: field DOFRY: must be 0 (free) or 1 (fixed), found 2"], &
+      message_lines=1)
+  end subroutine test_shell_errors
+
+  !> *SECTION_SHELL fields crashfree does not have, each named; cards after a rejected ICOMP 1
+  !> (its angle cards) and after a rejected value are still read in their place.
+  subroutine test_shell_section_errors()
+    type(model_t) :: model
+    type(error_list_t) :: warnings
+    call read_bad("shell_elform.k", plate_replaced(18, "1,16"), [character(len=300) :: &
+      "@:18: *SECTION_SHELL: field ELFORM: shell formulation 16 is not available; ELFORM 2 "// &
+      "(Belytschko-Tsay) is the one shell crashfree has"], message_lines=1)
+    call read_bad("shell_nip.k", plate_replaced(18, "1,2,0.8333,11"), [character(len=300) :: &
+      "@:18: *SECTION_SHELL: field NIP: integration points through the thickness must be "// &
+      "1-10 (0 or blank: 2), found 11"], message_lines=1)
+    call read_bad("shell_nloc.k", plate_replaced(19, "1.5,,,,1.0"), [character(len=300) :: &
+      "@:19: *SECTION_SHELL: field NLOC: reference surface offsets are not available: "// &
+      "shells lie on their mid surface (NLOC 0 or blank), found 1.0"], message_lines=1)
+    call read_bad("shell_marea.k", plate_replaced(19, "1.5,,,,,0.1"), [character(len=300) :: &
+      "@:19: *SECTION_SHELL: field MAREA: non-structural mass per area is not available"], &
+      message_lines=1)
+    call read_bad("shell_rule.k", plate_replaced(18, "1,2,,,,1,,"), [character(len=300) :: &
+      "@:18: *SECTION_SHELL: field QR/IRID: only Gauss integration through the thickness (0) "// &
+      "is available; trapezoidal (1) and *INTEGRATION_SHELL rules (< 0) are not, found 1"], &
+      message_lines=1)
+    call read_bad("shell_icomp.k", plate_replaced(19, "1.5", [character(len=line_length) :: &
+      "*SECTION_SHELL", "2,2,,3,,,1", "1.0", "0.0,45.0,90.0", "3,,,,", "2.0", &
+      "*SECTION_SHELL", "4,2,,-1", "-1.0,,,,,,2"]), [character(len=300) :: &
+      "@:23: *SECTION_SHELL: field ICOMP: composite layers with one material angle per "// &
+      "integration point (ICOMP 1) are not available; leave ICOMP blank or 0", &
+      "@:29: *SECTION_SHELL: field NIP: integration points through the thickness must be "// &
+      "1-10 (0 or blank: 2), found -1", &
+      "@:30: *SECTION_SHELL: field T1: thickness must be >= 0, found -1.0"], message_lines=3)
+    call read_bad("shell_sections.k", plate_replaced(18, "1,2,-1.0,,,,2", &
+      [character(len=line_length) :: "*SECTION_SHELL_TITLE", "last"]), [character(len=300) :: &
+      "@:18: *SECTION_SHELL: field SHRF: shear factor must be > 0 (0 or blank: 1.0; 5/6 is "// &
+      "usual), found -1.0", &
+      "@:18: *SECTION_SHELL: field ICOMP: must be 0 (or 1, composite angles, which are not "// &
+      "available), found 2", &
+      "@:23: *SECTION_SHELL_TITLE: field SECID: card 1 (SECID ELFORM SHRF NIP PROPT QR/IRID "// &
+      "ICOMP SETYP) is missing"], message_lines=3)
+    call read_good("shell_warnings.k", plate_replaced(19, "1.5,,,,0,0,1,7"), model, warnings)
+    call check(suite, "shell section: IDOF and EDGSET warned", warnings%count == 2 .and. &
+      index(warnings%text, "shell_warnings.k:19: *SECTION_SHELL: field IDOF: ignored") > 0 .and. &
+      index(warnings%text, "shell_warnings.k:19: *SECTION_SHELL: field EDGSET: ignored "// &
+      "(seatbelt shells are not available)") > 0, warnings%text)
+  end subroutine test_shell_section_errors
 end program test_deck

@@ -3,11 +3,14 @@
 !> reverse yield), Cowper-Symonds factors (VP = 0 and VP = 1), history rotation and layout;
 !> *MAT_HONEYCOMB / *MAT_MODIFIED_HONEYCOMB single-point crush along each material axis (yield
 !> curves, compaction, unloading modulus, uncoupled shear, rotating axes) and
-!> *MAT_LOW_DENSITY_FOAM loading / hysteretic unloading.
+!> *MAT_LOW_DENSITY_FOAM loading / hysteretic unloading; *MAT_PIECEWISE_LINEAR_PLASTICITY
+!> uniaxial-stress paths on an LCSS curve and bilinear, Cowper-Symonds / LCSR factors (VP = 0)
+!> and the viscoplastic consistency (VP = 1); *MAT_NULL carries no stress.
 program test_materials
   use kinds, only: wp, block_size
   use model, only: material_t, law_elastic, law_plastic_kinematic, law_honeycomb, law_modified_honeycomb, &
-                   law_low_density_foam
+                   law_low_density_foam, law_piecewise_linear, law_null, piecewise_hardening_curve, &
+                   piecewise_rate_curve
   use curves, only: curve_t, curve_value
   use material_dispatch, only: material_wave_modulus
   use material_honeycomb, only: honeycomb_log_volume_slot, honeycomb_compacted_slot, honeycomb_axes_first_slot
@@ -36,6 +39,11 @@ program test_materials
   call test_modified_honeycomb_strain_abscissa()
   call test_honeycomb_axes_rotate()
   call test_foam_loading_unloading()
+  call test_piecewise_uniaxial_curve()
+  call test_piecewise_uniaxial_bilinear()
+  call test_piecewise_rate_factors()
+  call test_piecewise_viscoplastic()
+  call test_null_no_stress()
   call finish_suite(suite)
 
 contains
@@ -596,4 +604,239 @@ contains
     write (buffer, '(es12.4)') value
     text = trim(adjustl(buffer))
   end function real_image
+
+  ! ---------------------------------------------------------------- *MAT_024, *MAT_NULL
+
+  !> *MAT_024 as the deck builds it: hardening curve slot (no points: bilinear SIGY, ETAN) and
+  !> rate curve slot (no points: C, P).
+  function piecewise_steel(etan) result(material)
+    real(wp), intent(in) :: etan
+    type(material_t) :: material
+    material%law = law_piecewise_linear
+    material%density = 7.85e-9_wp
+    material%youngs_modulus = youngs
+    material%poissons_ratio = poisson
+    material%yield_stress = yield
+    material%tangent_modulus = etan
+    allocate (material%curve_ids(2), material%curves(2))
+    material%curve_ids(:) = 0
+  end function piecewise_steel
+
+  !> Static yield Y(eps_p) of a *MAT_024 material.
+  function piecewise_yield(material, eps) result(value)
+    type(material_t), intent(in) :: material
+    real(wp), intent(in) :: eps
+    real(wp) :: value
+    if (allocated(material%curves(piecewise_hardening_curve)%abscissa)) then
+      value = curve_value(material%curves(piecewise_hardening_curve), eps)
+    else
+      value = yield + plastic_hardening_modulus(material)*eps
+    end if
+  end function piecewise_yield
+
+  !> Uniaxial stress at total strain `strain`: strain = Y(eps_p)/E + eps_p (bisection).
+  function piecewise_uniaxial_stress(material, strain) result(stress)
+    type(material_t), intent(in) :: material
+    real(wp), intent(in) :: strain
+    real(wp) :: stress, low, high, middle
+    integer :: iteration
+    if (youngs*strain <= piecewise_yield(material, 0.0_wp)) then
+      stress = youngs*strain
+      return
+    end if
+    low = 0.0_wp
+    high = strain
+    do iteration = 1, 200
+      middle = 0.5_wp*(low + high)
+      if (piecewise_yield(material, middle)/youngs + middle > strain) then
+        high = middle
+      else
+        low = middle
+      end if
+    end do
+    stress = piecewise_yield(material, 0.5_wp*(low + high))
+  end function piecewise_uniaxial_stress
+
+  !> Lateral stress sigma_yy after a trial increment (axial, lateral, lateral) of lane 1 from
+  !> the given state (which is not changed).
+  function piecewise_lateral_stress(material, axial, lateral, stress, history) result(value)
+    type(material_t), intent(in) :: material
+    real(wp), intent(in) :: axial, lateral, stress(block_size, 6), history(block_size, 1)
+    real(wp) :: value
+    real(wp) :: trial_stress(block_size, 6), trial_history(block_size, 1), strain(block_size, 6), wave(block_size)
+    trial_stress = stress
+    trial_history = history
+    strain = 0.0_wp
+    strain(1, 1:3) = [axial, lateral, lateral]
+    call update_material_block(material, 1, 1.0e-6_wp, strain, trial_stress, trial_history, wave)
+    value = trial_stress(1, 2)
+  end function piecewise_lateral_stress
+
+  !> Uniaxial stress path of a *MAT_024 solid point to `peak_strain`: the lateral increments
+  !> (equal) are found by a secant iteration so that sigma_yy = sigma_zz = 0. Compares
+  !> sigma_xx with the uniaxial curve at every step and the plastic strain at the end.
+  subroutine check_piecewise_uniaxial(material, label, peak_strain)
+    type(material_t), intent(in) :: material
+    character(len=*), intent(in) :: label
+    real(wp), intent(in) :: peak_strain
+    real(wp) :: stress(block_size, 6), history(block_size, 1), strain(block_size, 6), wave(block_size)
+    real(wp) :: actual(steps), expected(steps), total, axial, lateral(2), residual(2), next
+    integer :: step, iteration
+    call check(suite, label//": one history variable", material_history_count(material) == 1)
+    history = 1.0_wp
+    call initialize_material_history(material, block_size, history)
+    stress = 0.0_wp
+    total = 0.0_wp
+    axial = peak_strain/steps
+    do step = 1, steps
+      lateral = [-poisson*axial, -0.5_wp*axial]
+      residual = [piecewise_lateral_stress(material, axial, lateral(1), stress, history), &
+                  piecewise_lateral_stress(material, axial, lateral(2), stress, history)]
+      do iteration = 1, 60
+        if (abs(residual(2)) <= 1.0e-12_wp*yield .or. residual(2) == residual(1)) exit
+        next = lateral(2) - residual(2)*(lateral(2) - lateral(1))/(residual(2) - residual(1))
+        lateral = [lateral(2), next]
+        residual = [residual(2), piecewise_lateral_stress(material, axial, next, stress, history)]
+      end do
+      strain = 0.0_wp
+      strain(1, 1:3) = [axial, lateral(2), lateral(2)]
+      call update_material_block(material, 1, 1.0e-6_wp, strain, stress, history, wave)
+      total = total + axial
+      actual(step) = stress(1, 1)
+      expected(step) = piecewise_uniaxial_stress(material, total)
+    end do
+    call check_close(suite, label//": uniaxial sigma_xx on the hardening curve (1% of SIGY)", actual, expected, &
+                     thr=0.01_wp*yield)
+    call check_close(suite, label//": uniaxial sigma_xx on the hardening curve (1e-9 of SIGY)", actual, expected, &
+                     thr=1.0e-9_wp*yield)
+    call check_close(suite, label//": plastic strain eps - sigma/E", history(1, 1), total - stress(1, 1)/youngs, &
+                     rel=1e-9_wp)
+    call check_close(suite, label//": lateral stress zero", stress(1, 2:3), [0.0_wp, 0.0_wp], thr=1e-9_wp*yield)
+  end subroutine check_piecewise_uniaxial
+
+  !> LCSS curve (250 at 0, 300 at 0.02, 340 at 0.05, 400 at 0.1, extrapolated beyond) on the
+  !> uniaxial path to 12%; the plastic strain output reads the history.
+  subroutine test_piecewise_uniaxial_curve()
+    type(material_t) :: material
+    real(wp) :: history(block_size, 1), plastic_strain(block_size)
+    material = piecewise_steel(0.0_wp)
+    material%curves(piecewise_hardening_curve) = make_curve(7, [0.0_wp, 0.02_wp, 0.05_wp, 0.1_wp], &
+                                                            [250.0_wp, 300.0_wp, 340.0_wp, 400.0_wp])
+    call check_piecewise_uniaxial(material, "MAT_024 LCSS curve", 0.12_wp)
+    history = 0.0625_wp
+    call material_plastic_strain(law_piecewise_linear, 2, history, plastic_strain)
+    call check_close(suite, "MAT_024: plastic strain output from the history", plastic_strain(1:2), &
+                     [0.0625_wp, 0.0625_wp], thr=0.0_wp)
+  end subroutine test_piecewise_uniaxial_curve
+
+  !> SIGY, ETAN without a curve: the bilinear curve with slopes E and ETAN.
+  subroutine test_piecewise_uniaxial_bilinear()
+    call check_piecewise_uniaxial(piecewise_steel(tangent), "MAT_024 bilinear SIGY/ETAN", 10.0_wp*yield/youngs)
+    call check_piecewise_uniaxial(piecewise_steel(0.0_wp), "MAT_024 perfectly plastic", 10.0_wp*yield/youngs)
+  end subroutine test_piecewise_uniaxial_bilinear
+
+  !> Isochoric extension de = a dt diag(1, -1/2, -1/2): the effective strain rate is exactly a.
+  !> Once plastic, sbar = k Y(eps_p) with k = 1 + (a/C)^(1/P) (C, P) or LCSR(a) (LCSR given,
+  !> which overrides C and P). Three rates in three lanes of one block.
+  subroutine test_piecewise_rate_factors()
+    type(material_t) :: material
+    real(wp) :: stress(block_size, 6), history(block_size, 1), strain(block_size, 6), wave(block_size)
+    real(wp) :: rates(3), factor, effective, time_step
+    integer :: step, lane, rate_case
+    rates = [30.0_wp, 100.0_wp, 300.0_wp]
+    time_step = 1.0e-5_wp
+    do rate_case = 1, 2
+      material = piecewise_steel(tangent)
+      material%rate_c = 40.0_wp
+      material%rate_p = 5.0_wp
+      if (rate_case == 2) material%curves(piecewise_rate_curve) = make_curve(9, [0.0_wp, 100.0_wp, 1000.0_wp], &
+                                                                             [1.0_wp, 1.2_wp, 1.5_wp])
+      stress = 0.0_wp
+      history = 0.0_wp
+      strain = 0.0_wp
+      do lane = 1, 3
+        strain(lane, 1:3) = rates(lane)*time_step*[1.0_wp, -0.5_wp, -0.5_wp]
+      end do
+      do step = 1, 100
+        call update_material_block(material, 3, time_step, strain, stress, history, wave)
+      end do
+      do lane = 1, 3
+        if (rate_case == 1) then
+          factor = 1.0_wp + (rates(lane)/material%rate_c)**(1.0_wp/material%rate_p)
+        else
+          factor = curve_value(material%curves(piecewise_rate_curve), rates(lane))
+        end if
+        effective = von_mises(stress, lane)
+        call check(suite, "MAT_024 rate factor: path is plastic", history(lane, 1) > 1.0e-3_wp)
+        call check_close(suite, "MAT_024 "//trim(merge("1 + (rate/C)^(1/P) (VP=0)", "LCSR(rate) over C, P     ", &
+                         rate_case == 1))//": sbar / Y(eps_p)", effective/piecewise_yield(material, history(lane, 1)), &
+                         factor, rel=1e-6_wp)
+      end do
+    end do
+    call check_close(suite, "MAT_024: wave modulus K + 4G/3", wave(1), &
+                     youngs*(1.0_wp - poisson)/((1.0_wp + poisson)*(1.0_wp - 2.0_wp*poisson)), rel=1e-14_wp)
+  end subroutine test_piecewise_rate_factors
+
+  !> VP = 1: the step's plastic increment d satisfies sbar = [1 + (d/(dt C))^(1/P)] Y(eps_p) on
+  !> the LCSS curve, and sbar = LCSR(d/dt) Y(eps_p) with LCSR.
+  subroutine test_piecewise_viscoplastic()
+    type(material_t) :: material
+    real(wp) :: stress(block_size, 6), history(block_size, 1), strain(block_size, 6), wave(block_size)
+    real(wp) :: time_step, previous, increment, factor
+    integer :: step, rate_case
+    time_step = 1.0e-5_wp
+    do rate_case = 1, 2
+      material = piecewise_steel(0.0_wp)
+      material%curves(piecewise_hardening_curve) = make_curve(7, [0.0_wp, 0.02_wp, 0.05_wp, 0.1_wp], &
+                                                              [250.0_wp, 300.0_wp, 340.0_wp, 400.0_wp])
+      material%rate_formulation = 1.0_wp
+      material%rate_c = 40.0_wp
+      material%rate_p = 5.0_wp
+      if (rate_case == 2) material%curves(piecewise_rate_curve) = make_curve(9, [0.0_wp, 100.0_wp, 1000.0_wp], &
+                                                                             [1.0_wp, 1.2_wp, 1.5_wp])
+      stress = 0.0_wp
+      history = 0.0_wp
+      strain = 0.0_wp
+      strain(1, 1:3) = 300.0_wp*time_step*[1.0_wp, -0.5_wp, -0.5_wp]
+      strain(1, 4) = 100.0_wp*time_step
+      previous = 0.0_wp
+      do step = 1, 30
+        previous = history(1, 1)
+        call update_material_block(material, 1, time_step, strain, stress, history, wave)
+      end do
+      increment = history(1, 1) - previous
+      if (rate_case == 1) then
+        factor = 1.0_wp + (increment/(time_step*material%rate_c))**(1.0_wp/material%rate_p)
+      else
+        factor = curve_value(material%curves(piecewise_rate_curve), increment/time_step)
+      end if
+      call check(suite, "MAT_024 viscoplastic: path is plastic", increment > 0.0_wp)
+      call check_close(suite, "MAT_024 viscoplastic (VP=1): sbar = k(d eps_p/dt) Y(eps_p), "// &
+                       trim(merge("C, P", "LCSR", rate_case == 1)), von_mises(stress, 1), &
+                       factor*piecewise_yield(material, history(1, 1)), rel=1e-10_wp)
+    end do
+  end subroutine test_piecewise_viscoplastic
+
+  !> von Mises stress of lane `lane` of a block of stresses (xx, yy, zz, xy, yz, zx).
+  pure function von_mises(stress, lane) result(value)
+    real(wp), intent(in) :: stress(:, :)
+    integer, intent(in) :: lane
+    real(wp) :: value, deviator(3)
+    deviator = stress(lane, 1:3) - sum(stress(lane, 1:3))/3.0_wp
+    value = sqrt(1.5_wp*sum(deviator**2) + 3.0_wp*sum(stress(lane, 4:6)**2))
+  end function von_mises
+
+  !> *MAT_NULL through the solid dispatch: no stress, no history.
+  subroutine test_null_no_stress()
+    type(material_t) :: material
+    real(wp) :: stress(block_size, 6), strain(block_size, 6), wave(block_size), history(block_size, 0)
+    material%law = law_null
+    material%youngs_modulus = youngs
+    material%poissons_ratio = poisson
+    stress = 3.0_wp
+    strain = 1.0e-3_wp
+    call update_material_block(material, 2, 1.0e-6_wp, strain, stress, history, wave)
+    call check(suite, "MAT_NULL: no stress, no history", all(stress(1:2, :) == 0.0_wp) .and. &
+               material_history_count(material) == 0)
+  end subroutine test_null_no_stress
 end program test_materials
