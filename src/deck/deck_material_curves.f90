@@ -125,9 +125,11 @@ contains
               "stiffness), found "//real_text(material%youngs_modulus))
           end if
         else if (crushable(material)) then
-          if (formulation /= 1 .and. formulation /= 2) call located_problem(deck, log, part_lines(part), "SECID", &
-            part_name//" (honeycomb or low-density foam) needs a hexahedron section, ELFORM 1 or 2; section "// &
-            integer_text(model%parts(part)%section_id)//" has ELFORM "//integer_text(formulation))
+          ! meshfree (ELFORM 41) points take the material axes of their background hexahedron
+          if (formulation /= 1 .and. formulation /= 2 .and. formulation /= 41) &
+            call located_problem(deck, log, part_lines(part), "SECID", &
+            part_name//" (honeycomb or low-density foam) needs a hexahedron section, ELFORM 1, 2 or 41; "// &
+            "section "//integer_text(model%parts(part)%section_id)//" has ELFORM "//integer_text(formulation))
         else if (material%law == law_null) then
           call located_problem(deck, log, part_lines(part), "MID", part_name//" (*MAT_NULL) needs an equation "// &
             "of state on solid elements (*EOS is not read); crashfree takes *MAT_NULL on shell parts only")

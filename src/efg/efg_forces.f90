@@ -73,6 +73,7 @@ contains
     type(efg_solver_t), intent(out) :: solver
     integer :: point_count, block_count, b, history_count, k, g
     integer, allocatable :: local_index(:), pair_slot(:), pair_point(:)
+    real(wp) :: element_edges(block_size, 6)
     type(gather_list_t) :: node_pairs
 
     solver%geometry = geometry
@@ -89,7 +90,16 @@ contains
         solver%blocks(b)%point_count = min(block_size, point_count - (b - 1)*block_size)
         allocate (solver%blocks(b)%history(block_size, max(history_count, 1)))
         solver%blocks(b)%history = 0.0_wp
-        call initialize_material_history(material, solver%blocks(b)%point_count, solver%blocks(b)%history)
+        ! material axes of AOPT 0 (honeycombs) from the edges 1-2 and 1-4 of each point's cell
+        do k = 1, solver%blocks(b)%point_count
+          g = solver%blocks(b)%first_point + k - 1
+          associate (corners => model%solid_nodes(:, geometry%point_cell(g)))
+            element_edges(k, 1:3) = model%coordinates(:, corners(2)) - model%coordinates(:, corners(1))
+            element_edges(k, 4:6) = model%coordinates(:, corners(4)) - model%coordinates(:, corners(1))
+          end associate
+        end do
+        call initialize_material_history(material, solver%blocks(b)%point_count, solver%blocks(b)%history, &
+                                         element_edges)
       end do
     end associate
     allocate (solver%point_stress(9, point_count))

@@ -23,9 +23,11 @@
 !> gamma = h - (h . x) B1 - (h . y) B2 with h = (1, -1, 1, -1), orthogonal to every linear field
 !> (so the patch test is unaffected). Its stiffnesses follow the forms of Belytschko & Tsay
 !> (1983), scaled by the element's gradient norm so that they do not depend on the mesh size:
-!> membrane E t A |B|^2 / 8, out-of-plane SHRF G t^3 A |B|^4 / 12, bending E t^3 A |B|^2 / 192.
-!> IHQ 4 and 5 accumulate QM times these stiffnesses times the mode rates (stiffness form); IHQ
-!> 1-3 use viscous forces QM sqrt(k m) times the rates, m the node's mass or rotary inertia.
+!> membrane E t A |B|^2 / 8, out-of-plane SHRF G t^3 |B|^2 / 6, bending E t^3 A |B|^2 / 192
+!> (for a square A |B|^2 = 2; the out-of-plane form grows only with |B|^2 as an element is
+!> crushed flat). IHQ 4 and 5 accumulate QM times these stiffnesses times the mode rates, on
+!> Belytschko & Tsay's mode amplitudes (gamma / 4: a factor 1/16); IHQ 1-3 use viscous forces
+!> QM sqrt(k m) times the rates, m the node's mass or rotary inertia.
 !>
 !> Time centring and energies as in solid_block: strain rates on the mid-step configuration,
 !> forces on x(n+1); the internal and hourglass energies are the exact work of the element's
@@ -505,10 +507,13 @@ contains
       t = block%thickness(i)
       norm_squared = sum(b1(i, :)**2 + b2(i, :)**2)
       stiffness(1:2) = youngs*t*area(i)*norm_squared/8.0_wp
-      stiffness(3) = block%shear_factor*shear_modulus*t**3*area(i)*norm_squared**2/12.0_wp
+      stiffness(3) = block%shear_factor*shear_modulus*t**3*norm_squared/6.0_wp
       stiffness(4:5) = youngs*t**3*area(i)*norm_squared/192.0_wp
       if (block%hourglass_type >= 4) then
-        block%hourglass_force(i, :) = block%hourglass_force(i, :) + block%hourglass_coefficient*dt*stiffness*rate
+        ! the stiffness forms act on the mode amplitudes of Belytschko & Tsay's normalisation
+        ! gamma / 4 (so forces are gamma/4 times QM k (gamma/4 . v) dt: k / 16 here)
+        block%hourglass_force(i, :) = block%hourglass_force(i, :) &
+                                      + block%hourglass_coefficient*dt*stiffness*rate/16.0_wp
       else if (dt > 0.0_wp) then
         mass(1:3) = 0.25_wp*block%density(i)*t*block%reference_area(i)
         mass(4:5) = mass(1)*(t*t + block%reference_area(i))/12.0_wp

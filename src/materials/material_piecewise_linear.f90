@@ -27,7 +27,7 @@
 !> robust for softening segments and the infinite slope of (rate/C)^(1/P) at zero rate.
 module material_piecewise_linear
   use kinds, only: wp, block_size
-  use curves, only: curve_t, curve_value, curve_slope
+  use curves, only: curve_t, curve_value, curve_slope, curve_value_and_slope
   implicit none
   private
 
@@ -144,8 +144,7 @@ contains
     real(wp), intent(in) :: initial_yield, hardening_modulus, plastic_strain
     real(wp), intent(out) :: yield, slope
     if (allocated(hardening_curve%abscissa)) then
-      yield = curve_value(hardening_curve, plastic_strain)
-      slope = curve_slope(hardening_curve, plastic_strain)
+      call curve_value_and_slope(hardening_curve, plastic_strain, yield, slope)
     else
       yield = initial_yield + hardening_modulus*plastic_strain
       slope = hardening_modulus
@@ -161,8 +160,7 @@ contains
     real(wp), intent(out) :: factor, slope
     real(wp) :: ratio
     if (allocated(rate_curve%abscissa)) then
-      factor = curve_value(rate_curve, rate)
-      slope = curve_slope(rate_curve, rate)
+      call curve_value_and_slope(rate_curve, rate, factor, slope)
     else if (rate_c > 0.0_wp .and. rate_p > 0.0_wp) then
       ratio = max(rate, 0.0_wp)/rate_c
       factor = 1.0_wp
@@ -228,6 +226,12 @@ contains
       if (.not. singular .and. slope < 0.0_wp) then
         if (abs(residual) < abs(slope)*(upper - lower)) candidate = multiplier - residual/slope
         if (candidate <= lower .or. candidate >= upper) candidate = 0.5_wp*(lower + upper)
+      end if
+      ! a Newton step at round-off ends it: the residual cannot fall below the rounding of
+      ! sbar (and the bracket does not shrink when Newton approaches from one side)
+      if (abs(candidate - multiplier) <= 4.0_wp*epsilon(1.0_wp)*abs(multiplier)) then
+        multiplier = candidate
+        exit
       end if
       multiplier = candidate
     end do

@@ -4,7 +4,7 @@ module curves
   implicit none
   private
 
-  public :: curve_t, curve_value, curve_slope
+  public :: curve_t, curve_value, curve_slope, curve_value_and_slope
 
   !> One curve with its scale and offset factors already applied to the stored points:
   !> stored abscissa = SFA * (A + OFFA), stored ordinate = SFO * (O + OFFO) (LS-DYNA's rule:
@@ -32,6 +32,23 @@ contains
     segment = find_segment(curve%abscissa, x)
     value = curve%ordinate(segment) + curve_slope_on(curve, segment)*(x - curve%abscissa(segment))
   end function curve_value
+
+  !> Value and slope of the curve at `x` with one search for the segment (the plasticity
+  !> kernels need both at every iteration of their return).
+  pure subroutine curve_value_and_slope(curve, x, value, slope)
+    type(curve_t), intent(in) :: curve
+    real(wp), intent(in) :: x
+    real(wp), intent(out) :: value, slope
+    integer :: segment
+    if (size(curve%abscissa) == 1) then
+      value = curve%ordinate(1)
+      slope = 0.0_wp
+      return
+    end if
+    segment = find_segment(curve%abscissa, x)
+    slope = curve_slope_on(curve, segment)
+    value = curve%ordinate(segment) + slope*(x - curve%abscissa(segment))
+  end subroutine curve_value_and_slope
 
   !> Slope of the curve at `x` (of the segment containing `x`).
   pure function curve_slope(curve, x) result(slope)

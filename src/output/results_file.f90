@@ -208,7 +208,7 @@ contains
     results%state_times(results%state_count) = time
 
     call write_xdmf(results%xdmf_path, results%h5_name, results%node_count, results%solid_count, &
-                    results%state_times(1:results%state_count), error)
+                    results%shell_count, results%state_times(1:results%state_count), error)
   end subroutine write_state
 
   !> Write every history series as `/history/<group>/<column>`, replacing what an earlier call

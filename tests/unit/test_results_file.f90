@@ -17,7 +17,7 @@ program test_results_file
   use kinds, only: wp
   use error_handling, only: error_t
   use version, only: crashfree_version
-  use model, only: model_t, part_t, formulation_efg
+  use model, only: model_t, part_t, formulation_efg, formulation_fe
   use run_summary, only: run_summary_t, status_normal
   use history_buffer, only: history_set_t, add_history_series, append_history_row
   use results_file, only: results_file_t, open_results, write_state, write_histories, close_results
@@ -45,6 +45,7 @@ program test_results_file
   call test_write_and_read_back(suite, model, directory)
   call test_errors(suite, model, directory)
   call test_open_again(suite, model, directory)
+  call test_shells_in_xdmf(suite, model, directory)
 
   if (.not. keep_output) call remove_outputs(directory)
   call finish_suite(suite)
@@ -122,6 +123,10 @@ contains
     call delete_file(directory//"/job.xdmf")
     call delete_file(directory//"/again.h5")
     call delete_file(directory//"/again.xdmf")
+    call delete_file(directory//"/mixed.h5")
+    call delete_file(directory//"/mixed.xdmf")
+    call delete_file(directory//"/plates.h5")
+    call delete_file(directory//"/plates.xdmf")
     call execute_command_line("rmdir '"//directory//"'")
   end subroutine remove_outputs
 
@@ -479,6 +484,108 @@ contains
     call check_histories(suite, file_id, 2)
     call h5fclose_f(file_id, status)
   end subroutine test_open_again
+
+  !> Shells in the XDMF file: the two bricks with two shells on their top face (solids and
+  !> shells: a spatial collection of a hexahedron and a quadrilateral grid per state), and the
+  !> same shells alone (one quadrilateral grid per state, no hexahedra).
+  subroutine test_shells_in_xdmf(suite, bricks, directory)
+    type(test_suite_t), intent(inout) :: suite
+    type(model_t), intent(in) :: bricks
+    character(len=*), intent(in) :: directory
+    type(model_t) :: mixed, plates
+    type(results_file_t) :: results
+    type(error_t), allocatable :: error
+    type(run_summary_t) :: summary
+    character(len=:), allocatable :: xdmf_text
+    real(wp) :: shell_stress(6, 2), no_solid_stress(6, 0), no_solid_strain(0), plate_field(3, 6)
+    integer(hid_t) :: file_id
+    integer :: status
+
+    mixed = bricks
+    ! Top face (k = 1) of the 3 x 2 grid: node index 7 + i + 3 j.
+    allocate (mixed%shell_ids(2), mixed%shell_part(2), mixed%shell_nodes(4, 2))
+    mixed%shell_ids = [31, 32]
+    mixed%shell_part = [2, 2]
+    mixed%shell_nodes(:, 1) = [7, 8, 11, 10]
+    mixed%shell_nodes(:, 2) = [8, 9, 12, 11]
+    deallocate (mixed%parts)
+    allocate (mixed%parts(2))
+    mixed%parts(1) = bricks%parts(1)
+    mixed%parts(2)%id = 6
+    mixed%parts(2)%material_id = 3
+    mixed%parts(2)%material = 1
+    mixed%parts(2)%formulation = formulation_fe
+    shell_stress = stress_field(7.0_wp)
+
+    call open_results(results, directory, "mixed", mixed, 1, error)
+    call check(suite, "solids and shells: file opens", .not. allocated(error), message_of(error))
+    if (allocated(error)) return
+    call write_state(results, 0.0_wp, nodal_field(0.0_wp), nodal_field(1.0_wp), stress_field(0.0_wp), &
+                     [0.0_wp, 0.0_wp], error, shell_stress, [0.5_wp, 0.25_wp], shell_stress, &
+                     [0.5_wp, 0.25_wp])
+    call check(suite, "solids and shells: state written", .not. allocated(error), message_of(error))
+    summary%status = status_normal
+    summary%message = ""
+    call close_results(results, summary, error)
+    call h5fopen_f(directory//"/mixed.h5", H5F_ACC_RDONLY_F, file_id, status)
+    call check(suite, "solids and shells: file readable", status == 0)
+    if (status == 0) then
+      call check(suite, "shells/connectivity_index shape (2,4)", &
+                 same_dims(dims_of(file_id, "/mesh/shells/connectivity_index"), [4, 2]))
+      call check(suite, "shells/connectivity_index 0-based", &
+                 all(integers_of(file_id, "/mesh/shells/connectivity_index") == &
+                     reshape(mixed%shell_nodes - 1, [8])))
+      call check(suite, "shell_stress shape (2,6)", &
+                 same_dims(dims_of(file_id, "/states/000000/shell_stress"), [6, 2]))
+      call h5fclose_f(file_id, status)
+    end if
+    call read_text_file(directory//"/mixed.xdmf", xdmf_text)
+    call check(suite, "xdmf solids and shells: a spatial collection per state", &
+               index(xdmf_text, '<Grid Name="state_000000" GridType="Collection" '// &
+                     'CollectionType="Spatial">') > 0)
+    call check(suite, "xdmf solids and shells: hexahedron grid", &
+               index(xdmf_text, '<Grid Name="solids" GridType="Uniform">') > 0 .and. &
+               index(xdmf_text, 'TopologyType="Hexahedron" NumberOfElements="2"') > 0)
+    call check(suite, "xdmf solids and shells: quadrilateral grid", &
+               index(xdmf_text, '<Grid Name="shells" GridType="Uniform">') > 0 .and. &
+               index(xdmf_text, 'TopologyType="Quadrilateral" NumberOfElements="2" '// &
+                     'NodesPerElement="4"') > 0 .and. &
+               index(xdmf_text, '>mixed.h5:/mesh/shells/connectivity_index<') > 0)
+    call check(suite, "xdmf shell stress as Tensor6 on cells", &
+               index(xdmf_text, 'Name="shell_stress" AttributeType="Tensor6" Center="Cell"') > 0 &
+               .and. index(xdmf_text, '>mixed.h5:/states/000000/shell_stress<') > 0 .and. &
+               index(xdmf_text, '>mixed.h5:/states/000000/shell_plastic_strain<') > 0)
+    call check(suite, "xdmf shell ids and part ids", &
+               index(xdmf_text, '>mixed.h5:/mesh/shells/ids<') > 0 .and. &
+               index(xdmf_text, '>mixed.h5:/mesh/shells/part_ids<') > 0)
+
+    ! The shells alone: nodes 7-12 of the bricks, renumbered 1-6.
+    allocate (plates%node_ids(6), plates%coordinates(3, 6))
+    plates%node_ids = bricks%node_ids(7:12)
+    plates%coordinates = bricks%coordinates(:, 7:12)
+    allocate (plates%shell_ids(2), plates%shell_part(2), plates%shell_nodes(4, 2))
+    plates%shell_ids = [31, 32]
+    plates%shell_part = [1, 1]
+    plates%shell_nodes = mixed%shell_nodes - 6
+    allocate (plates%parts(1))
+    plates%parts(1) = mixed%parts(2)
+    call open_results(results, directory, "plates", plates, 1, error)
+    call check(suite, "shells only: file opens", .not. allocated(error), message_of(error))
+    if (allocated(error)) return
+    plate_field = 0.0_wp
+    call write_state(results, 0.0_wp, plate_field, plate_field, &
+                     no_solid_stress, no_solid_strain, error, shell_stress, [0.5_wp, 0.25_wp], &
+                     shell_stress, [0.5_wp, 0.25_wp])
+    call check(suite, "shells only: state written", .not. allocated(error), message_of(error))
+    call close_results(results, summary, error)
+    call read_text_file(directory//"/plates.xdmf", xdmf_text)
+    call check(suite, "xdmf shells only: one quadrilateral grid per state", &
+               index(xdmf_text, '<Grid Name="state_000000" GridType="Uniform">') > 0 .and. &
+               index(xdmf_text, 'TopologyType="Quadrilateral" NumberOfElements="2"') > 0)
+    call check(suite, "xdmf shells only: no hexahedra, no spatial collection", &
+               index(xdmf_text, "Hexahedron") == 0 .and. index(xdmf_text, "Spatial") == 0 .and. &
+               index(xdmf_text, "solid_stress") == 0)
+  end subroutine test_shells_in_xdmf
 
   ! ---------------------------------------------------------------------------------------------
   ! Readers
