@@ -5,7 +5,9 @@
 #     information, the two cores of this machine share their caches and load);
 #  2. the same block with 0%, about 7.6% and about 19% of its dofs meshfree (the paper's ODB and
 #     dummy ratios): CPU time per cycle relative to the all-FE block;
-#  3. an all-EFG block: nanoseconds per interior particle per cycle and set-up per particle.
+#  3. an all-EFG block: nanoseconds per interior particle per cycle and set-up per particle;
+#  4. Belytschko-Tsay shells: the square tube of inputs/tube_crush (6,400 shells, NIP 5, MAT_024,
+#     single-surface contact), its first 5 mm of crush: nanoseconds per shell per cycle.
 set -euo pipefail
 python=${PYTHON:-python3}
 directory=build/bench
@@ -17,9 +19,12 @@ make_deck "$directory/block_100k.k" --cells 50 50 40 --cycles 200
 make_deck "$directory/coupled_7.k" --cells 50 50 40 --cycles 200 --efg-cells 3
 make_deck "$directory/coupled_19.k" --cells 50 50 40 --cycles 200 --efg-cells 9
 make_deck "$directory/efg_block.k" --cells 20 20 20 --cycles 100 --efg-cells 20
+[ -f "$directory/tube.k" ] || "$python" inputs/tube_crush/generate_tube.py --element 2.5 --crush 5 \
+  --output "$directory/tube.k" > /dev/null
 for repetition in 1 2 3; do run "$directory/block_100k.k" "fe_ncpu1_run$repetition" 1; done
 run "$directory/block_100k.k" fe_ncpu2 2
 run "$directory/coupled_7.k" coupled_7 1
 run "$directory/coupled_19.k" coupled_19 1
 run "$directory/efg_block.k" efg_block 1
+run "$directory/tube.k" tube_shells 1
 "$python" tools/bench_report.py "$directory"

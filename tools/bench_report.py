@@ -48,6 +48,17 @@ def main():
     print("|---|---|---|")
     print(f"| {t['efg_particles']} | {1e9 * t['efg_s'] / (t['efg_particles'] * t['cycles']):.0f} "
           f"| {1e6 * t['efg_setup_s'] / t['efg_particles']:.0f} |")
+    print()
+    t = timing(directory / "tube_shells.h5")
+    print("Belytschko-Tsay shells: square tube 50 x 1.5 mm, 2.5 mm elements, NIP 5, MAT_024, "
+          "single-surface contact, first 5 mm of crush, ncpu=1")
+    print()
+    print("| shells | cycles | shell ns per element per cycle | contact ns per shell per cycle | "
+          "whole cycle ns per shell |")
+    print("|---|---|---|---|---|")
+    per_shell = 1e9 / (t["fe_shells"] * t["cycles"])
+    print(f"| {t['fe_shells']} | {t['cycles']} | {t['fe_shell_s'] * per_shell:.0f} | {t['contact_s'] * per_shell:.0f} "
+          f"| {t['loop_s'] * per_shell:.0f} |")
 
 
 if __name__ == "__main__":
