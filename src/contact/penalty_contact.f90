@@ -389,27 +389,38 @@ contains
     energy_increment = -0.5_wp*step*(work_before + work_after)
   end subroutine compute_contact_forces
 
-  !> One warning line per pass whose first evaluation found penetrating nodes (then never
-  !> again): how many, the deepest and where. Their initial penetration is ignored.
+  !> One warning line per contact whose first evaluation found penetrating nodes (then never
+  !> again): how many (over its passes), the deepest and where. Their initial penetration is
+  !> ignored.
   subroutine report_initial_penetrations(model, contacts, time)
     type(model_t), intent(in) :: model
     type(contact_state_t), intent(inout) :: contacts(:)
     real(wp), intent(in) :: time
     character(len=300) :: text
-    integer :: k, p
+    integer :: k, p, count, node
+    real(wp) :: deepest
     do k = 1, size(contacts)
+      if (contacts(k)%pass_count == 0) cycle
+      if (.not. all(contacts(k)%passes(1:contacts(k)%pass_count)%initial_checked) .or. &
+          all(contacts(k)%passes(1:contacts(k)%pass_count)%initial_reported)) cycle
+      count = 0
+      deepest = 0.0_wp
+      node = 0
       do p = 1, contacts(k)%pass_count
         associate (pass => contacts(k)%passes(p))
-          if (.not. pass%initial_checked .or. pass%initial_reported) cycle
           pass%initial_reported = .true.
-          if (pass%initial_count == 0) cycle
-          write (text, '(a,i0,a,i0,a,es10.3,a,i0,a,es10.3,a)') "warning: contact ", model%contacts(k)%id, ": ", &
-            pass%initial_count, " node(s) penetrate at the first contact check (t = ", time, &
-            "), the deepest node ", model%node_ids(pass%initial_node), " by ", pass%initial_deepest, &
-            "; these initial penetrations are ignored (as LS-DYNA's IGNORE = 1)"
-          write (*, '(a)') trim(text)
+          count = count + pass%initial_count
+          if (pass%initial_count > 0 .and. pass%initial_deepest > deepest) then
+            deepest = pass%initial_deepest
+            node = pass%initial_node
+          end if
         end associate
       end do
+      if (count == 0) cycle
+      write (text, '(a,i0,a,i0,a,es10.3,a,i0,a,es10.3,a)') "warning: contact ", model%contacts(k)%id, ": ", &
+        count, " node(s) penetrate at the first contact check (t = ", time, "), the deepest node ", &
+        model%node_ids(node), " by ", deepest, "; these initial penetrations are ignored (as LS-DYNA's IGNORE = 1)"
+      write (*, '(a)') trim(text)
     end do
   end subroutine report_initial_penetrations
 

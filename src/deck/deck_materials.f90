@@ -319,6 +319,7 @@ contains
     line = 0
     do while (next_definition(deck, block, keyword%title, line, standard_widths, card, title, &
                               log, "card 1 (MID RO E PR DA DB K)", "MID"))
+      call reserve_material(input)
       n = input%material_count + 1
       input%material_count = n
       input%material_lines(n) = line
@@ -345,6 +346,7 @@ contains
     line = 0
     do while (next_definition(deck, block, keyword%title, line, standard_widths, card, title, &
                               log, "card 1 (MID RO E PR SIGY ETAN BETA)", "MID"))
+      call reserve_material(input)
       n = input%material_count + 1
       input%material_count = n
       input%material_lines(n) = line
@@ -398,6 +400,7 @@ contains
     line = 0
     do while (next_definition(deck, block, keyword%title, line, standard_widths, card, title, &
                               log, "card 1 (MID RO E PR SIGY VF MU BULK)", "MID"))
+      call reserve_material(input)
       n = input%material_count + 1
       input%material_count = n
       input%material_lines(n) = line
@@ -546,6 +549,7 @@ contains
     line = 0
     do while (next_definition(deck, block, keyword%title, line, standard_widths, card, title, &
                               log, "card 1 (MID RO E LCID TC HU BETA DAMP)", "MID"))
+      call reserve_material(input)
       n = input%material_count + 1
       input%material_count = n
       input%material_lines(n) = line

@@ -20,6 +20,7 @@ module deck_rigid_bodies
                          card_problem, field_is_blank, warn_if_set, id_heading, located_problem
   use deck_id_index, only: id_index_t, build_id_index, find_id
   use deck_input, only: deck_input_t
+  use deck_materials, only: reserve_material
   use deck_rigid_input, only: rigid_material_input_t, rigid_motion_input_t, nodal_rigid_input_t, &
                               element_mass_input_t
   implicit none
@@ -551,22 +552,6 @@ contains
       end do
     end subroutine apply_element_masses
   end subroutine build_rigid_bodies
-
-  !> Room for one more material (the materials list is sized for the other material keywords).
-  subroutine reserve_material(input)
-    type(deck_input_t), intent(inout) :: input
-    type(material_t), allocatable :: materials(:)
-    integer, allocatable :: lines(:)
-    integer :: n
-    n = input%material_count
-    if (n < size(input%model%materials)) return
-    allocate (materials(n + 4), lines(n + 4))
-    materials(1:n) = input%model%materials(1:n)
-    lines(1:n) = input%material_lines(1:n)
-    lines(n + 1:) = 0
-    call move_alloc(materials, input%model%materials)
-    call move_alloc(lines, input%material_lines)
-  end subroutine reserve_material
 
   subroutine append_rigid_material(input, entry)
     type(deck_input_t), intent(inout) :: input
