@@ -621,11 +621,12 @@ contains
     real(wp) :: x(3), corners(3, 4), weights(4), normal(3), gap, best_depth, best_weights(4), best_normal(3)
     real(wp) :: relative(3), stiffness, node_mass, segment_mass, reduced_mass, normal_force, damping
     real(wp) :: tangential(3), sliding(3), friction, limit, size_t, penetration, side, best_side
+    real(wp) :: reach, low(3), high(3)
     logical :: inside
     !$omp parallel do schedule(static) default(shared) private(i, c, seg, best, j, x, corners, weights, &
     !$omp& normal, gap, best_depth, best_weights, best_normal, relative, stiffness, node_mass, segment_mass, &
     !$omp& reduced_mass, normal_force, damping, tangential, sliding, friction, limit, size_t, inside, penetration, &
-    !$omp& side, best_side)
+    !$omp& side, best_side, reach, low, high)
     do i = 1, pass%node_count
       x = coordinates(:, pass%nodes(i))
       best = 0
@@ -634,6 +635,14 @@ contains
       do c = pass%candidate_first(i), pass%candidate_first(i + 1) - 1
         seg = pass%candidates(c)
         corners = coordinates(:, pass%segments(:, seg))
+        ! the candidate lists hold every segment within the search margin; most are out of
+        ! reach this cycle, which the segment's current box (grown by the deepest contact and
+        ! the parametric tolerance) shows without projecting
+        reach = pass%node_offset(i) + max(pass%segment_offset(seg), pass%depth(seg))
+        low = minval(corners, dim=2)
+        high = maxval(corners, dim=2)
+        reach = reach + (parametric_limit - 1.0_wp)*maxval(high - low)
+        if (any(x < low - reach) .or. any(x > high + reach)) cycle
         call project_on_segment(x, corners, pass%segments(3, seg) == pass%segments(4, seg), weights, normal, &
                                 gap, inside)
         if (.not. inside) cycle
