@@ -205,11 +205,15 @@ contains
     if (viscoplastic) call rate_scale_factor(rate_curve, rate_c, rate_p, 0.0_wp, factor0, unused)
     ! sbar(dgamma) <= trial / (1 + min(a) dgamma): this dgamma brings sbar to k(0) Y(eps_p).
     upper = max(trial_effective/max(factor0*yield0, tiny(1.0_wp)) - 1.0_wp, 0.0_wp)/minval(mode_stiffness)
-    do iteration = 1, 200
-      call evaluate(upper, residual, slope, singular)
-      if (residual <= 0.0_wp) exit
-      upper = 2.0_wp*upper + tiny(1.0_wp)
-    end do
+    ! with a yield stress that never falls as the plastic strain grows, phi(upper) <= 0 by
+    ! construction; only a softening curve needs the bracket searched
+    if (softening(hardening_curve) .or. hardening_modulus < 0.0_wp) then
+      do iteration = 1, 200
+        call evaluate(upper, residual, slope, singular)
+        if (residual <= 0.0_wp) exit
+        upper = 2.0_wp*upper + tiny(1.0_wp)
+      end do
+    end if
 
     lower = 0.0_wp
     multiplier = 0.0_wp
@@ -238,6 +242,19 @@ contains
     plastic_increment = 2.0_wp/3.0_wp*multiplier*effective_stress(multiplier)
 
   contains
+
+    pure logical function softening(curve)
+      type(curve_t), intent(in) :: curve
+      integer :: k
+      softening = .false.
+      if (.not. allocated(curve%ordinate)) return
+      do k = 2, size(curve%ordinate)
+        if (curve%ordinate(k) < curve%ordinate(k - 1)) then
+          softening = .true.
+          return
+        end if
+      end do
+    end function softening
 
     pure function effective_stress(gamma) result(sbar)
       real(wp), intent(in) :: gamma
