@@ -7,7 +7,7 @@ module element_forces
   use kinds, only: wp, block_size
   use model, only: model_t
   use solid_block, only: compute_solid_block
-  use shell_block, only: compute_shell_block
+  use shell_block, only: shell_block_t, compute_shell_block
   use explicit_state, only: explicit_state_t
   use efg_forces, only: compute_efg_forces, add_efg_forces
   implicit none
@@ -59,6 +59,8 @@ contains
     !$omp parallel do schedule(static) default(shared) private(node)
     do node = 1, state%node_count
       state%internal_moment(:, node) = 0.0_wp
+      state%shell_normal_sum(:, node) = 0.0_wp
+      state%shell_area_sum(node) = 0.0_wp
     end do
     !$omp end parallel do
     do colour = 1, size(state%shell_colors%offsets) - 1
@@ -68,24 +70,31 @@ contains
         call compute_shell_block(state%shells(b), model%materials(state%shells(b)%material), state%coordinates, &
                                  state%velocity, state%angular_velocity, dt, shell_force, state%shell_time_step(b), &
                                  state%shell_critical_element(b), state%shell_degenerate_element(b))
-        call add_shell_forces(state%shells(b)%element_count, state%shells(b)%nodes, shell_force, &
-                              state%internal_force, state%internal_moment)
+        call add_shell_forces(state%shells(b), shell_force, state%internal_force, state%internal_moment, &
+                              state%shell_normal_sum, state%shell_area_sum)
       end do
       !$omp end parallel do
     end do
   end subroutine compute_shell_forces
 
   !> internal_force and internal_moment of the block's nodes += the shells' nodal forces and
-  !> moments, corner by corner, lane by lane.
-  subroutine add_shell_forces(element_count, nodes, shell_force, internal_force, internal_moment)
-    integer, intent(in) :: element_count
-    integer, intent(in) :: nodes(block_size, 4)
+  !> moments, corner by corner, lane by lane; and each node's sums of area x normal and area of
+  !> its shells (for the drilling projection, see explicit_solver).
+  subroutine add_shell_forces(block, shell_force, internal_force, internal_moment, normal_sum, area_sum)
+    type(shell_block_t), intent(in) :: block
     real(wp), intent(in) :: shell_force(block_size, 4, 6)
-    real(wp), intent(inout) :: internal_force(:, :), internal_moment(:, :)
+    real(wp), intent(inout) :: internal_force(:, :), internal_moment(:, :), normal_sum(:, :), area_sum(:)
     integer :: corner, lane, node
     do corner = 1, 4
-      do lane = 1, element_count
-        node = nodes(lane, corner)
+      do lane = 1, block%element_count
+        if (corner == 4 .and. block%nodes(lane, 4) == block%nodes(lane, 3)) then
+          node = 0
+        else
+          node = block%nodes(lane, corner)
+          normal_sum(:, node) = normal_sum(:, node) + block%area(lane)*block%frame(lane, 3, :)
+          area_sum(node) = area_sum(node) + block%area(lane)
+        end if
+        node = block%nodes(lane, corner)
         internal_force(:, node) = internal_force(:, node) + shell_force(lane, corner, 1:3)
         internal_moment(:, node) = internal_moment(:, node) + shell_force(lane, corner, 4:6)
       end do

@@ -69,6 +69,9 @@ contains
     state%angular_acceleration = 0.0_wp
     state%internal_moment = 0.0_wp
     call fixed_rotation_mask(model, state%fixed_rotation)
+    allocate (state%shell_normal_sum(3, node_count), state%shell_area_sum(node_count))
+    state%shell_normal_sum = 0.0_wp
+    state%shell_area_sum = 0.0_wp
 
     call scale_masses(model, state)
     call colour_blocks(state)

@@ -77,6 +77,10 @@ contains
       step = state%next_time_step
       ! velocities at the half step, then the supports and walls correct them
       call update_velocities(state, 0.5_wp*(previous_step + step))
+      if (size(state%shells) > 0) then
+        call remove_drilling_rates(state, work)
+        state%energy%external_work = state%energy%external_work + work
+      end if
       call impose_kinematic_conditions(model, state%fixed, state%time, step, 0.5_wp*(previous_step + step), &
                                        state%displacement, state%acceleration, state%free_acceleration, &
                                        state%mass, state%velocity, work)
@@ -190,12 +194,48 @@ contains
     end do
   end subroutine rotate_with_rigid_bodies
 
+  !> Shells have no stiffness about their normal, so the nodes' rotation about it (drilling)
+  !> means nothing; left free, it can be fed where a node's shells tilt as they bend (a node of
+  !> a single element keeps a free direction that turns with the element) and spin up. Where a
+  !> node's shells are nearly coplanar (their area-weighted normals agree within about 20
+  !> degrees: not at folds, corners or T-joints, where one shell's drilling is another's
+  !> bending) the half-step angular velocity loses its component along the mean normal. The
+  !> constraint's impulse J = -I (w . n) n does the work J . (w^{n-1/2} + w^{n+1/2}) / 2, booked
+  !> as external work like a support's. Rotations fixed by an SPC are left out of n (a node
+  !> whose drilling direction is mostly fixed keeps its rates).
+  subroutine remove_drilling_rates(state, work)
+    type(explicit_state_t), intent(inout) :: state
+    real(wp), intent(out) :: work
+    real(wp), parameter :: coplanar = 0.94_wp   ! cos 20 degrees
+    real(wp) :: normal(3), length, drilling, previous(3)
+    integer :: node
+    work = 0.0_wp
+    !$omp parallel do schedule(static) default(shared) private(node, normal, length, drilling, previous) &
+    !$omp& reduction(+:work)
+    do node = 1, state%node_count
+      if (state%rotary_inertia(node) <= 0.0_wp .or. state%shell_area_sum(node) <= 0.0_wp) cycle
+      length = norm2(state%shell_normal_sum(:, node))
+      if (length < coplanar*state%shell_area_sum(node)) cycle
+      ! within the rotations an SPC leaves free (fixed ones stay zero)
+      normal = merge(0.0_wp, state%shell_normal_sum(:, node)/length, state%fixed_rotation(:, node))
+      length = dot_product(normal, normal)
+      if (length < 0.25_wp) cycle
+      normal = normal/sqrt(length)
+      drilling = dot_product(state%angular_velocity(:, node), normal)
+      previous = state%angular_velocity(:, node) - state%last_average_step*state%angular_acceleration(:, node)
+      state%angular_velocity(:, node) = state%angular_velocity(:, node) - drilling*normal
+      work = work - 0.5_wp*state%rotary_inertia(node)*drilling*dot_product(previous, normal)
+    end do
+    !$omp end parallel do
+  end subroutine remove_drilling_rates
+
   !> v^{n+1/2} = v^{n-1/2} + a^n (dt^{n-1/2} + dt^{n+1/2}) / 2, and the same for the angular
   !> velocities (their rotations need no update: the shells take their frame from the nodes).
   subroutine update_velocities(state, average_step)
     type(explicit_state_t), intent(inout) :: state
     real(wp), intent(in) :: average_step
     integer :: node
+    state%last_average_step = average_step
     !$omp parallel do schedule(static) default(shared) private(node)
     do node = 1, state%node_count
       state%velocity(:, node) = state%velocity(:, node) + average_step*state%acceleration(:, node)

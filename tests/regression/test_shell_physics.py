@@ -208,7 +208,7 @@ def cantilever_deck(path, points, width_cells=1, hourglass=4):
     strain, whose collapse moment is up to 2/sqrt(3) = 1.155 times the beam's: 1.15 was
     measured with 2 elements across). The tip nodes are driven along z only (x and the
     rotations free: a vertical force, no moment) at a velocity rising as a half cosine over
-    5 ms, 5 mm in 30 ms. Stiffness hourglass control IHQ 4 (see the xfail test below for the
+    5 ms, 5 mm in 30 ms. Stiffness hourglass control IHQ 4 (see the two-element-wide test below for the
     default viscous one)."""
     nodes, shells = plate_mesh((BEAM_CELLS[0], width_cells), (BEAM_LENGTH, BEAM_WIDTH))
     nodes = round_to_node_card(nodes)
@@ -279,23 +279,23 @@ def test_cantilever_collapses_at_the_plastic_moment_of_its_integration_rule(tmp_
           f"{gauss_plastic_moment_factor(points):.5f} M_p); P L / M_p {tip_moment:.4f}; elastic stiffness / "
           f"beam theory {elastic:.4f}; kinetic / work at the end {energies['kinetic_energy'][-1] / work[-1]:.1e}")
     assert abs(elastic - 1.0) < 0.02
-    assert np.abs(ratios - 1.0).max() < 0.015
+    # 1.004-1.022 measured (NIP 5: 1.010, 1.020, 1.022): the strip is 5 thicknesses wide, so
+    # the hinge carries some plate action (a fully clamped root, plane strain, would give up to
+    # 2/sqrt(3) = 1.155); with free drilling rates the nodes had a spurious freedom that gave
+    # 0.998-1.003 and made the two-element-wide strip unstable (the test below)
+    assert np.abs(ratios - 1.0).max() < 0.03
     assert abs(tip_moment - 1.0) < 0.05
     assert energies["kinetic_energy"][deflection > 1.0].max() < 0.01 * work[-1]
     imbalance = energies["total_energy"] - energies["total_energy"][0] - energies["external_work"]
     assert np.abs(imbalance).max() < 0.01 * work.max()
 
 
-@pytest.mark.xfail(strict=True, reason="open issue: with the default viscous hourglass control "
-                   "(IHQ 1) the bent strip (2 elements across) develops a growing out-of-plane hourglass / "
-                   "twist mode fed by its strain energy")
 def test_cantilever_with_viscous_hourglass_control_stays_quasi_static(tmp_path, run_deck):
     """The collapse deck above with 2 elements across the width and IHQ 1 (viscous, QM 0.1):
-    the kinetic energy should stay a small fraction of the work, as with IHQ 4. Measured: it
-    reaches ~98% of the work by 30 ms (an out-of-plane hourglass pattern, then twist), with
-    the energy balance still closed to 1e-5, the same growth at TSSFAC 0.9 and 0.45 (so not
-    the time integration: the semi-discrete equations are unstable) and also when the
-    material stays elastic. Kept as a strict xfail so that a fix shows up here."""
+    the kinetic energy stays a small fraction of the work, as with IHQ 4. Before the solver
+    removed the shell nodes' drilling rates (rotation about the mean normal, which the element
+    does not resist), the root corner nodes' drilling spun up here until ~98% of the work was
+    kinetic energy, with any hourglass form and also for elastic material."""
     deck, tip_id = cantilever_deck(tmp_path / "cantilever.k", 5, width_cells=2, hourglass=1)
     run = run_deck(deck)
     assert run.status == 0, run.stdout + run.stderr
