@@ -12,13 +12,14 @@ module deck_contact
                    surface_part_set, surface_part, surface_node_set, surface_all_parts
   use deck_problems, only: problem_log_t
   use deck_numbers, only: integer_text, real_text
-  use deck_lexer, only: deck_t
+  use deck_lexer, only: deck_t, line_location
   use deck_keywords, only: keyword_t, keyword_unknown
   use deck_fields, only: card_t, open_card, next_line, require_card, get_integer, get_real, &
                          card_problem, warn_if_set, id_heading, line_problem, located_problem, &
                          located_warning
   use deck_input, only: deck_input_t
   use deck_contact_input, only: contact_entry_t
+  use contact_surfaces, only: find_segment_owners, find_shell_owners
   implicit none
   private
 
@@ -335,6 +336,9 @@ contains
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
     integer :: k, j, next_id
+    logical, allocatable :: owners_checked(:)
+    allocate (owners_checked(input%segment_set_count))
+    owners_checked = .false.
     associate (model => input%model)
       allocate (model%segment_sets(input%segment_set_count))
       do k = 1, input%segment_set_count
@@ -407,6 +411,7 @@ contains
             if (model%segment_sets(m)%id == side%id) found = m
           end do
           if (found > 0) side%segments = model%segment_sets(found)%nodes
+          if (found > 0) call check_segment_owners(found, line, field)
           if (found == 0) call located_problem(deck, log, line, field, "segment set "// &
             integer_text(side%id)//" is not defined (no *SET_SEGMENT with this SID)")
         case (surface_node_set)
@@ -419,5 +424,38 @@ contains
         end select
       end associate
     end subroutine resolve_side
+
+    !> A contact segment must be a face of a solid or a shell: the set-up takes its stiffness
+    !> and orientation from that element. One that is neither stopped the set-up with a message
+    !> naming no line (found by fuzzing), so it is reported here, at its *SET_SEGMENT line,
+    !> once per set, with the same search the set-up uses.
+    subroutine check_segment_owners(set, contact_line, field)
+      integer, intent(in) :: set, contact_line
+      character(len=*), intent(in) :: field
+      integer, allocatable :: segments(:, :), owners(:), kept(:)
+      integer :: s
+      if (owners_checked(set)) return
+      owners_checked(set) = .true.
+      associate (model => input%model, given => input%segment_sets(set))
+        if (.not. allocated(given%usable)) return         ! its header was missing (reported)
+        ! elements with an undefined node (index 0, reported before) cannot own a segment
+        if (any(model%solid_nodes <= 0) .or. any(model%shell_nodes <= 0)) return
+        kept = pack([(s, s=1, given%count)], given%usable(1:given%count))
+        segments = model%segment_sets(set)%nodes   ! a copy: the search turns segments outwards
+        allocate (owners(size(segments, 2)))
+        call find_segment_owners(model%solid_nodes, size(model%node_ids), model%coordinates, &
+                                 segments, owners)
+        call find_shell_owners(model%shell_nodes, size(model%node_ids), segments, owners)
+        do s = 1, size(owners)
+          if (owners(s) /= 0) cycle
+          call located_problem(deck, log, given%lines(kept(s)), "N1-N4", "the segment (nodes "// &
+            integer_text(model%node_ids(segments(1, s)))//" "//integer_text(model%node_ids(segments(2, s)))// &
+            " "//integer_text(model%node_ids(segments(3, s)))//" "// &
+            integer_text(model%node_ids(segments(4, s)))//") of segment set "//integer_text(given%id)// &
+            " is neither a face of a solid element nor a shell; a contact surface ("//field// &
+            " of the contact at "//line_location(deck, contact_line)//") needs segments on elements")
+        end do
+      end associate
+    end subroutine check_segment_owners
   end subroutine build_contacts
 end module deck_contact

@@ -367,9 +367,12 @@ contains
     character(len=*), intent(in) :: including, name
     character(len=:), allocatable :: path
     integer :: slash
-    if (name(1:1) == "/") then
-      path = name
-      return
+    ! `name` is empty for *INCLUDE '' (quotes removed): name(1:1) would read past its end
+    if (len(name) > 0) then
+      if (name(1:1) == "/") then
+        path = name
+        return
+      end if
     end if
     slash = index(including, "/", back=.true.)
     path = including(:slash)//name

@@ -474,7 +474,9 @@ contains
           if (aopt /= 0.0_wp .and. aopt /= 2.0_wp) call card_problem(deck, log, card, "AOPT", "material "// &
             "axes option "//real_text(aopt)//" is not available: use 0 (element nodes 1-2-4) or 2 "// &
             "(global vectors a and d)")
-          material%axes_option = nint(aopt)
+          ! clamped: nint of a huge AOPT (reported above) overflowed, a floating-point trap
+          ! (found by fuzzing)
+          material%axes_option = nint(max(min(aopt, 2.0e9_wp), -2.0e9_wp))
           if (macf /= 1 .and. macf /= 0) call card_problem(deck, log, card, "MACF", "axis swaps are not "// &
             "available: MACF must be 1 (none), found "//integer_text(macf))
         end if

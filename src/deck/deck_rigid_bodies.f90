@@ -149,7 +149,9 @@ contains
         call get_real(deck, card, 3, "CON2", rotations, log)
         call get_integer(deck, card, 4, "SPCNID", spc_node, log)
         if (.not. card%failed) then
-          entry%constraint_mode = nint(mode)
+          ! clamped: nint of a huge CMO overflowed, a floating-point trap, before the value
+          ! could be reported (found by fuzzing)
+          entry%constraint_mode = nint(max(min(mode, 2.0e9_wp), -2.0e9_wp))
           select case (entry%constraint_mode)
           case (0)
           case (1)
@@ -189,7 +191,7 @@ contains
     integer function check_code(value, name)
       real(wp), intent(in) :: value
       character(len=*), intent(in) :: name
-      check_code = nint(value)
+      check_code = nint(max(min(value, 2.0e9_wp), -2.0e9_wp))   ! a huge value overflowed nint
       if (check_code < 0 .or. check_code > 7 .or. real(check_code, wp) /= value) then
         call card_problem(deck, log, card, name, "must be a code 0-7 (0 none, 1 x, 2 y, 3 z, 4 xy, "// &
                           "5 yz, 6 zx, 7 xyz), found "//real_text(value))
@@ -510,6 +512,10 @@ contains
                                  " is not defined")
             cycle
           end if
+          ! A DOF other than 1-3, 5-7 was reported by the reader but the motion was still kept:
+          ! it must not index the body's dofs (found by fuzzing: DOF -1 stopped the cross-check
+          ! with an out-of-bounds index instead of listing the problem).
+          if (all(given%dof /= [1, 2, 3, 5, 6, 7])) cycle
           dof = merge(given%dof, given%dof - 1, given%dof <= 3)
           if (model%rigid_bodies(body)%fixed(dof)) then
             call located_problem(deck, log, given%line, "DOF", "rigid part "//integer_text(given%part_id)// &

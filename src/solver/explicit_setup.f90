@@ -210,17 +210,26 @@ contains
     type(error_t), allocatable, intent(out) :: error
     type(efg_part_t) :: geometry
     integer :: part, count, k
+    logical, allocatable :: used(:)
 
     allocate (state%is_particle(state%node_count))
     state%is_particle = .false.
+    ! A part no element uses has nothing to set up, as in the static analysis (found by
+    ! fuzzing: an unused *PART on an EFG section stopped the run with "EFG part N has no solid
+    ! elements", a message naming no deck line, where an unused FE part is accepted).
+    allocate (used(size(model%parts)))
+    used = .false.
+    do k = 1, size(model%solid_part)
+      used(model%solid_part(k)) = .true.
+    end do
     count = 0
     do part = 1, size(model%parts)
-      if (model%parts(part)%formulation == formulation_efg) count = count + 1
+      if (model%parts(part)%formulation == formulation_efg .and. used(part)) count = count + 1
     end do
     allocate (state%efg(count))
     count = 0
     do part = 1, size(model%parts)
-      if (model%parts(part)%formulation /= formulation_efg) cycle
+      if (model%parts(part)%formulation /= formulation_efg .or. .not. used(part)) cycle
       count = count + 1
       if (model%sections(model%parts(part)%section)%boundary_treatment == boundary_full_transformation) then
         call make_error(error, "part "//trim(id_text(model%parts(part)%id))//": IEBT = 1 (full transformation) is "// &

@@ -30,6 +30,51 @@ element
 *END
 """
 
+HONEYCOMB = """*MAT_HONEYCOMB
+         1   6.0e-11    70000.       0.3      300.       0.2       0.0
+        11                            12                                      10
+     1000.      500.      500.      200.      200.      200.
+       0.0
+       0.0
+*DEFINE_CURVE
+        10
+0.0,1.0
+1.0,2.0
+*DEFINE_CURVE
+        11
+0.0,0.5
+1.0,0.7
+*DEFINE_CURVE
+        12
+0.0,0.0
+0.5,0.2
+"""
+
+# Part 1 made rigid, with a prescribed motion whose DOF is filled in (line 14 is its card).
+RIGID_MOTION = """*MAT_RIGID
+         1   7.85e-6     210.0       0.3
+*BOUNDARY_PRESCRIBED_MOTION_RIGID
+         1{dof:>10}         0         1
+*DEFINE_CURVE
+         1
+0.0,1.0
+1.0,1.0
+"""
+
+# A contact whose SURFB is a segment set on four nodes no element uses (line 31 is the
+# segment, 33 the contact card).
+LOOSE_SEGMENT_CONTACT = """*NODE
+       9             0.0             0.0             2.0
+      10             1.0             0.0             2.0
+      11             1.0             1.0             2.0
+      12             0.0             1.0             2.0
+*SET_SEGMENT
+         7
+         9        10        11        12
+*CONTACT_AUTOMATIC_NODES_TO_SURFACE
+         1         7         3         0
+*END"""
+
 CASES = [
     # (description, replace this, with that, expected fragments of the message)
     ("misspelled keyword", "*MAT_ELASTIC", "*MAT_ELASTICK", ["deck.k:11:", "*MAT_ELASTICK"]),
@@ -46,6 +91,28 @@ CASES = [
     ("inside-out element", "       1       1       1       2       3       4       5       6       7       8",
      "       1       1       5       6       7       8       1       2       3       4",
      ["deck.k:23:", "*ELEMENT_SOLID", "inside out"]),
+    # found by fuzzing: a rigid motion's DOF outside 1-3, 5-7 was reported, then indexed the
+    # rigid body's dofs in the cross-check (a Fortran runtime error or worse)
+    ("rigid motion DOF -1", "*MAT_ELASTIC\n         1   7.85e-6     210.0       0.3\n", RIGID_MOTION.format(dof=-1),
+     ["deck.k:14:", "*BOUNDARY_PRESCRIBED_MOTION_RIGID", "field DOF", "found -1"]),
+    ("rigid motion DOF 8", "*MAT_ELASTIC\n         1   7.85e-6     210.0       0.3\n", RIGID_MOTION.format(dof=8),
+     ["deck.k:14:", "*BOUNDARY_PRESCRIBED_MOTION_RIGID", "field DOF", "8 (motion along or about a vector"]),
+    # found by fuzzing: a huge CMO / CON1 / AOPT overflowed the conversion to an integer (a
+    # floating-point trap) before it could be reported
+    ("rigid CMO 1e20", "*MAT_ELASTIC\n         1   7.85e-6     210.0       0.3\n",
+     "*MAT_RIGID\n         1   7.85e-6     210.0       0.3\n      1e20\n",
+     ["deck.k:13:", "*MAT_RIGID", "field CMO", "found 1.0e20"]),
+    ("rigid CON1 1e20", "*MAT_ELASTIC\n         1   7.85e-6     210.0       0.3\n",
+     "*MAT_RIGID\n         1   7.85e-6     210.0       0.3\n       1.0      1e20\n",
+     ["deck.k:13:", "*MAT_RIGID", "field CON1", "found 1.0e20"]),
+    ("honeycomb AOPT 1e20", "*MAT_ELASTIC\n         1   7.85e-6     210.0       0.3\n",
+     HONEYCOMB.replace("200.      200.      200.\n", "200.      200.      200.      1e20\n"),
+     ["deck.k:14:", "*MAT_HONEYCOMB", "field AOPT", "1.0e20"]),
+    # found by fuzzing: a contact segment on no element stopped the contact set-up with a
+    # message naming no file or line
+    ("contact segment on no element", "       7       8\n*END", "       7       8\n" + LOOSE_SEGMENT_CONTACT,
+     ["deck.k:31:", "*SET_SEGMENT", "field N1-N4", "nodes 9 10 11 12", "neither a face of a solid element nor a shell",
+      "deck.k:33"]),
 ]
 
 
@@ -77,25 +144,6 @@ plate
 *END
 """
 
-HONEYCOMB = """*MAT_HONEYCOMB
-         1   6.0e-11    70000.       0.3      300.       0.2       0.0
-        11                            12                                      10
-     1000.      500.      500.      200.      200.      200.
-       0.0
-       0.0
-*DEFINE_CURVE
-        10
-0.0,1.0
-1.0,2.0
-*DEFINE_CURVE
-        11
-0.0,0.5
-1.0,0.7
-*DEFINE_CURVE
-        12
-0.0,0.0
-0.5,0.2
-"""
 
 SHELL_CASES = [
     # (description, replace this, with that, expected fragments of the message)
@@ -152,6 +200,18 @@ def test_good_deck_runs(tmp_path, run_deck):
     deck.write_text(GOOD)
     run = run_deck(deck)
     assert run.status == 0, run.stderr
+
+
+def test_unused_meshfree_part_is_accepted(tmp_path, run_deck):
+    """Found by fuzzing: a *PART on an EFG section that no element uses stopped the explicit
+    set-up with "EFG part 2 has no solid elements" (status 2, no deck line). An unused part has
+    nothing to set up, as an unused FE part and the static analysis already treat it."""
+    deck = tmp_path / "deck.k"
+    deck.write_text(GOOD.replace("*END", "*PART\nunused meshfree part\n         2         2         1\n"
+                                         "*SECTION_SOLID_EFG\n         2        41\n      1.01      1.01      1.01\n*END"))
+    run = run_deck(deck)
+    assert run.status == 0, run.stderr
+    assert "has no solid elements" not in run.stderr
 
 
 def test_curve_and_set_references_are_all_listed_at_once(tmp_path, run_deck):
