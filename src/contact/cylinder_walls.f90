@@ -42,7 +42,7 @@ contains
   !> rigid-wall energy increment (energy dissipated) and the work the moving walls did on the
   !> nodes (external work).
   subroutine enforce_cylinder_walls(walls, curves, states, time, dt, average_dt, coordinates, acceleration, &
-                                    mass, is_particle, velocity, energy_removed, wall_work)
+                                    mass, velocity, energy_removed, wall_work)
     type(rigid_wall_t), intent(in) :: walls(:)
     type(curve_t), intent(in) :: curves(:)
     type(wall_state_t), intent(inout) :: states(:)
@@ -50,7 +50,6 @@ contains
     real(wp), intent(in) :: coordinates(:, :)   !< x^n
     real(wp), intent(in) :: acceleration(:, :)  !< a^n
     real(wp), intent(in) :: mass(:)
-    logical, intent(in) :: is_particle(:)       !< interior EFG particles: not on a surface
     real(wp), intent(inout) :: velocity(:, :)   !< v^{n+1/2}
     real(wp), intent(out) :: energy_removed     !< rigid-wall (dissipated) energy increment
     real(wp), intent(out) :: wall_work          !< work of the moving walls on the nodes
@@ -87,7 +86,6 @@ contains
       total_impulse = 0.0_wp
       do k = 1, size(walls(w)%nodes)
         node = walls(w)%nodes(k)
-        if (is_particle(node)) cycle
         call surface_correction(walls(w), tail_start, tail_end, coordinates(:, node), &
                                 coordinates(:, node) + velocity(:, node)*dt, normal, depth)
         if (depth <= 0.0_wp) cycle

@@ -37,14 +37,13 @@ contains
   !> `dt` starting at `time`. `velocity` holds v^{n+1/2} computed from `acceleration` a^n with
   !> the step `average_dt`. Returns the energy the walls took (wall energy increment).
   subroutine enforce_planar_walls(walls, states, time, dt, average_dt, coordinates, acceleration, mass, &
-                                  is_particle, velocity, energy_removed)
+                                  velocity, energy_removed)
     type(rigid_wall_t), intent(in) :: walls(:)
     type(wall_state_t), intent(inout) :: states(:)
     real(wp), intent(in) :: time, dt, average_dt
     real(wp), intent(in) :: coordinates(:, :)   !< x^n
     real(wp), intent(in) :: acceleration(:, :)  !< a^n
     real(wp), intent(in) :: mass(:)
-    logical, intent(in) :: is_particle(:)       !< interior EFG particles: generalized dofs, not on a surface
     real(wp), intent(inout) :: velocity(:, :)   !< v^{n+1/2}
     real(wp), intent(out) :: energy_removed
     integer :: w, k, node
@@ -64,7 +63,6 @@ contains
       total_impulse = 0.0_wp
       do k = 1, size(walls(w)%nodes)
         node = walls(w)%nodes(k)
-        if (is_particle(node)) cycle
         gap = dot_product(coordinates(:, node) + velocity(:, node)*dt - wall_point, normal)
         if (gap >= 0.0_wp) cycle
         ! A node already behind the wall at the start of the step (further than it could have

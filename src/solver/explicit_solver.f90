@@ -88,12 +88,12 @@ contains
       if (size(model%walls) > 0) then
         call start_phase(contact_timer)
         call enforce_planar_walls(model%walls, state%walls, state%time, step, 0.5_wp*(previous_step + step), &
-                                  state%coordinates, state%acceleration, state%mass, state%is_particle, &
+                                  state%coordinates, state%acceleration, state%mass, &
                                   state%velocity, work)
         state%energy%rigid_wall = state%energy%rigid_wall + work
         call enforce_cylinder_walls(model%walls, model%curves, state%walls, state%time, step, &
                                     0.5_wp*(previous_step + step), state%coordinates, state%acceleration, &
-                                    state%mass, state%is_particle, state%velocity, work, cylinder_work)
+                                    state%mass, state%velocity, work, cylinder_work)
         call stop_phase(contact_timer)
         state%energy%rigid_wall = state%energy%rigid_wall + work
         state%energy%external_work = state%energy%external_work + cylinder_work
@@ -338,6 +338,15 @@ contains
         call make_error(error, trim(text))
         return
       end do
+    end do
+    ! rigid bodies set no element step: their motion must be finite too
+    do b = 1, size(state%rigid)
+      if (all(abs(state%rigid(b)%velocity) < huge(1.0_wp)) .and. &
+          all(abs(state%rigid(b)%angular_velocity) < huge(1.0_wp))) cycle
+      write (text, '(a,i0,a,es12.5,a,i0)') "the motion of rigid body ", model%rigid_bodies(b)%id, &
+        " is no longer finite at time ", state%time, ", cycle ", state%cycle
+      call make_error(error, trim(text))
+      return
     end do
     if (.not. (state%next_time_step > 0.0_wp .and. state%next_time_step < huge(1.0_wp))) then
       element = state%controlling_element
