@@ -1,6 +1,8 @@
 # crashfree: build, run and test.
 #   make            release build: bin/crashfree and lib/libcrashfree.a (+ .mod files in lib/)
-#   make run        install what is missing, build, run the default deck, plot
+#   make run        install what is missing, build, run the default job (the ODB component test,
+#                   coupled FE/EFG, about 2 min on one core), plot and tabulate (ODB_FE=1: run fe.k too)
+#   make taylor     the same for the Taylor bar
 #   make test       install what is missing, build, unit tests (debug build) and regression tests
 #   make bench      performance figures (ns per element per cycle)
 #   make verify     verification studies (patch test, cantilever): docs/verification.md (NCPU=n)
@@ -36,7 +38,7 @@ ALL_SOURCES := $(LIBRARY_SOURCES) src/app/crashfree.f90 $(TEST_SUPPORT) $(TEST_S
 
 vpath %.f90 $(sort $(dir $(ALL_SOURCES)))
 
-.PHONY: all deps run test unit regression bench clean debug verify
+.PHONY: all deps run taylor test unit regression bench clean debug verify
 # The release build is also published as bin/crashfree and lib/ (library and .mod files).
 ifeq ($(MODE),release)
 all: bin/crashfree
@@ -88,6 +90,10 @@ regression: all
 run: deps
 	@$(MAKE) --no-print-directory all
 	@bash tools/run_default.sh
+
+taylor: deps
+	@$(MAKE) --no-print-directory all
+	@bash tools/run_taylor_bar.sh
 
 test: deps
 	@bash tools/run_all_tests.sh

@@ -3,16 +3,18 @@
 
 Writes, into the output directory (default: this script's directory):
 
-  mesh.k     nodes, hexahedra (main block, its upper-left corner, bumper), optionally the
-             aluminium cladding shells, and the node sets the decks use;
-  fe.k       every solid part one-point hexahedra (ELFORM 1) with stiffness hourglass control;
+  mesh.k     nodes, hexahedra (main block, its upper-left corner, bumper), the aluminium
+             cladding shells and the node sets the decks use;
+  fe.k       every solid part one-point hexahedra (ELFORM 1) with viscous hourglass control;
   coupled.k  the same, with the corner part of the main block meshfree (*SECTION_SOLID_EFG).
-  fe_standin.k, coupled_standin.k
-             the same two with the corner part of an elastic-plastic stand-in material
-             (*MAT_PLASTIC_KINEMATIC), because crashfree rejects *MAT_MODIFIED_HONEYCOMB in a
-             meshfree part today (coupled.k is refused with a deck error naming part 3).
 
 Both decks include mesh.k and differ only in the section of part 3 (the corner).
+
+Cladding (on by default, --no-cladding leaves it out): Belytschko-Tsay shells of aluminium
+(*MAT_PLASTIC_KINEMATIC) on the main block's top (y = 650), bottom (y = 0) and rear (z = 0)
+faces (part 11) and a facing sheet on the bumper's rear face (z = 450, part 12). The shells are
+bonded to the honeycomb by shared nodes: each shell's four nodes are the face nodes of the
+hexahedron beneath it (no tied contact).
 
 Units: mm, ms, kg, kN, GPa (stress in GPa = kN/mm^2, density in kg/mm^3).
 
@@ -61,8 +63,6 @@ HONEYCOMB_MU = 0.05
 
 # aluminium sheet (*MAT_PLASTIC_KINEMATIC): density, E, nu, yield, tangent modulus
 SHEET = dict(mid=3, ro=2.68e-6, e=70.0, pr=0.33, sigy=0.18, etan=0.55)
-# stand-in for the corner part where the solver rejects MAT_126 (meshfree parts)
-STANDIN = dict(mid=5, ro=28.6e-9, e=0.003, pr=0.0, sigy=0.342e-3, etan=0.0, beta=1.0)
 CLADDING_THICKNESS = 0.81     # main block top, bottom, rear (ECE R94 Annex 9: 0.81 +- 0.07 mm)
 FACING_THICKNESS = 0.81       # bumper rear facing sheet (same specification)
 
@@ -227,13 +227,30 @@ class Mesh:
                 used.update(corners)
         return sorted(used)
 
-    def corner_share(self) -> float:
-        """Share of the dofs on nodes of the corner part (the solver's dofs_efg / dofs_total)."""
-        corner = set()
+    def dof_counts(self) -> dict:
+        """Degrees of freedom as the solver counts them in /timing: 3 translations per node,
+        3 rotations more per shell node (dofs_total), 3 per node of the corner part (dofs_efg,
+        the meshfree particles and the interface nodes; their rotations, where the cladding
+        covers the corner, belong to the shells)."""
+        corner, shell_nodes = set(), set()
         for _, pid, corners in self.solids:
             if pid == PART_CORNER:
                 corner.update(corners)
-        return len(corner) / len(self.nodes)
+        for _, _, corners in self.shells:
+            shell_nodes.update(corners)
+        return dict(nodes=len(self.nodes), shell_nodes=len(shell_nodes), corner_nodes=len(corner),
+                    total=3 * len(self.nodes) + 3 * len(shell_nodes), efg=3 * len(corner),
+                    translational=3 * len(self.nodes))
+
+    def corner_share(self) -> float:
+        """dofs_efg / dofs_total as in the solver's /timing (rotations counted)."""
+        counts = self.dof_counts()
+        return counts["efg"] / counts["total"]
+
+    def corner_share_translational(self) -> float:
+        """dofs_efg over the translational dofs only (= corner nodes / all nodes)."""
+        counts = self.dof_counts()
+        return counts["efg"] / counts["translational"]
 
 
 def footprint_area(xc: float, yc: float, radius: float, x_range, y_range, samples: int = 2000) -> float:
@@ -319,7 +336,7 @@ def honeycomb_cards(name: str) -> str:
     return "\n".join(cards)
 
 
-def write_deck(mesh: Mesh, path: Path, args, coupled: bool, standin: bool = False):
+def write_deck(mesh: Mesh, path: Path, args, coupled: bool):
     end_time = args.crush / SPEED
     xc, yc, radius = args.cyl_x, args.cyl_y, args.radius
     # the cylinder starts args.gap in front of the foremost face under its footprint
@@ -329,15 +346,14 @@ def write_deck(mesh: Mesh, path: Path, args, coupled: bool, standin: bool = Fals
     area = footprint_area(xc, yc, radius, (0.0, WIDTH), (0.0, HEIGHT))
     rim = footprint_perimeter(xc, yc, radius, (0.0, WIDTH), (0.0, HEIGHT))
     title = "ODB component test, " + ("coupled FE / EFG corner" if coupled else "all FE")
-    if standin:
-        title += ", corner of the stand-in material (MAT_003)"
     out = ["*KEYWORD", "*TITLE", title,
            "$ Offset deformable barrier component test (Wang, Wu, Guo & Botkin 2009, section 4.3),",
            "$ written by inputs/odb_component/generate_mesh.py. Units mm, ms, kg, kN, GPa.",
            f"$ element size {args.size:g} mm; crush {args.crush:g} mm at {SPEED:g} mm/ms; cylinder radius {radius:g}",
            f"$ at x = {xc:g}, y = {yc:g}; its end cap covers {area:.0f} mm2 of the barrier face, its rim",
            f"$ runs {rim:.0f} mm inside the face. Corner part (3): x < {mesh.efg_x:g}, y > {mesh.efg_y:g},",
-           f"$ {100 * mesh.corner_share():.1f}% of the nodes.",
+           f"$ {100 * mesh.corner_share():.1f}% of the dofs (3 per node, 3 more per shell node), "
+           f"{100 * mesh.corner_share_translational():.1f}% of the translational dofs.",
            "*CONTROL_TERMINATION", card(end_time),
            "*CONTROL_TIMESTEP", "$   DTINIT    TSSFAC      ISDO    TSLIMT     DT2MS",
            card(0.0, args.tssfac, 0, 0.0, -args.dt2ms if args.dt2ms > 0 else 0.0),
@@ -352,7 +368,7 @@ def write_deck(mesh: Mesh, path: Path, args, coupled: bool, standin: bool = Fals
         out += ["*DATABASE_RCFORC", card(end_time / 400)]
     out += ["*PART", "main honeycomb block", card(PART_MAIN, 1, 1, 0, 1),
             "*PART", "main block, upper-left corner" + (" (meshfree)" if coupled else ""),
-            card(PART_CORNER, 2 if coupled else 1, STANDIN["mid"] if standin else 1, 0, 1),
+            card(PART_CORNER, 2 if coupled else 1, 1, 0, 1),
             "*PART", "bumper honeycomb", card(PART_BUMPER, 1, 2, 0, 1)]
     if args.backing == "rigid":
         out += ["*PART", "rigid backing", card(PART_BACKING, 1, 4)]
@@ -364,15 +380,6 @@ def write_deck(mesh: Mesh, path: Path, args, coupled: bool, standin: bool = Fals
                 card(args.dx, args.dx, args.dx, 0, 0, 3, 1, 0.0)]
     out += ["*HOURGLASS", "$     HGID       IHQ        QM", card(1, args.ihq, args.qh)]
     out += [honeycomb_cards("main"), honeycomb_cards("bumper")]
-    if standin:
-        out += ["$ crashfree does not accept honeycomb (MAT_126) in a meshfree part: the corner part is",
-                "$ given this elastic-plastic stand-in (MAT_003, nu = 0, yield = the crush strength) in",
-                "$ both stand-in decks, so that FE and EFG can be compared on the same material.",
-                "*MAT_PLASTIC_KINEMATIC_TITLE", "honeycomb stand-in for the corner",
-                "$      MID        RO         E        PR      SIGY      ETAN      BETA",
-                card(STANDIN["mid"], STANDIN["ro"], STANDIN["e"], STANDIN["pr"], STANDIN["sigy"], STANDIN["etan"],
-                     STANDIN["beta"]),
-                card(0.0, 0.0)]
     if args.cladding:
         out += ["*PART", "main block cladding (top, bottom, rear)", card(PART_CLADDING, 11, 3),
                 "*PART", "bumper rear facing sheet", card(PART_FACING, 12, 3),
@@ -416,7 +423,9 @@ def write_deck(mesh: Mesh, path: Path, args, coupled: bool, standin: bool = Fals
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0],
                                      formatter_class=argparse.ArgumentDefaultsHelpFormatter)
-    parser.add_argument("--size", type=float, default=40.0, help="element size (mm); 50 for the CI variant")
+    parser.add_argument("--size", type=float, default=42.0,
+                        help="element size (mm): 42 for the shipped decks (41.7 x 41.25-40 x 40.9 mm cells), "
+                             "50 for the test's reduced model")
     parser.add_argument("--crush", type=float, default=330.0, help="cylinder travel after contact (mm)")
     parser.add_argument("--radius", type=float, default=125.0, help="cylinder radius (mm)")
     parser.add_argument("--cyl-x", type=float, default=110.0, help="cylinder axis x (mm)")
@@ -434,8 +443,8 @@ def main(argv=None):
     parser.add_argument("--dt2ms", type=float, default=0.0,
                         help="mass scaling: the step held at this value (ms); 0 = none")
     parser.add_argument("--states", type=int, default=20, help="number of state intervals")
-    parser.add_argument("--cladding", action=argparse.BooleanOptionalAction, default=False,
-                        help="write the aluminium cladding shells (needs shell elements in the solver)")
+    parser.add_argument("--cladding", action=argparse.BooleanOptionalAction, default=True,
+                        help="the aluminium cladding shells (main block top, bottom, rear; bumper rear)")
     parser.add_argument("--backing", choices=("spc", "rigid"), default="spc",
                         help="rigid backing: SPC on the rear face nodes, or a fixed *MAT_RIGID plate")
     parser.add_argument("--backing-thickness", type=float, default=20.0)
@@ -451,12 +460,11 @@ def main(argv=None):
     write_mesh(mesh, args.output / "mesh.k", args)
     write_deck(mesh, args.output / "fe.k", args, coupled=False)
     write_deck(mesh, args.output / "coupled.k", args, coupled=True)
-    write_deck(mesh, args.output / "fe_standin.k", args, coupled=False, standin=True)
-    write_deck(mesh, args.output / "coupled_standin.k", args, coupled=True, standin=True)
     area = footprint_area(args.cyl_x, args.cyl_y, args.radius, (0.0, WIDTH), (0.0, HEIGHT))
     print(f"{args.output}: mesh.k ({len(mesh.nodes)} nodes, {mesh.solid_count} solids, {len(mesh.shells)} shells), "
-          f"fe.k, coupled.k, fe_standin.k, coupled_standin.k; corner part x < {mesh.efg_x:g}, y > {mesh.efg_y:g}: "
-          f"{100 * mesh.corner_share():.1f}% of the dofs; cylinder footprint {area:.0f} mm2")
+          f"fe.k, coupled.k; corner part x < {mesh.efg_x:g}, y > {mesh.efg_y:g}: "
+          f"{100 * mesh.corner_share():.1f}% of the dofs ({100 * mesh.corner_share_translational():.1f}% of the "
+          f"translational dofs); cylinder footprint {area:.0f} mm2")
 
 
 if __name__ == "__main__":
