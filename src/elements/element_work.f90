@@ -1,11 +1,12 @@
 !> Work of element forces integrated the way central differences integrate the kinetic energy
-!> (see the comment at the top of solid_block): shared by the solid and shell blocks.
+!> (see the comment at the top of solid_block), and the block's smallest stable step: shared by
+!> the solid and shell blocks.
 module element_work
   use kinds, only: wp, block_size
   implicit none
   private
 
-  public :: add_force_work
+  public :: add_force_work, smallest_time_step
 
 contains
 
@@ -27,4 +28,25 @@ contains
       last_power(i) = new_power(i)
     end do
   end subroutine add_force_work
+
+  !> The smallest of the lanes' stable steps (huge if none) and the element of that lane
+  !> (`elements(lane)`; 0 if none).
+  pure subroutine smallest_time_step(nel, element_time_step, elements, critical_time_step, critical_element)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: element_time_step(block_size)
+    integer, intent(in) :: elements(block_size)
+    real(wp), intent(out) :: critical_time_step
+    integer, intent(out) :: critical_element
+    integer :: i, lane
+    critical_time_step = huge(1.0_wp)
+    lane = 0
+    do i = 1, nel
+      if (element_time_step(i) < critical_time_step) then
+        critical_time_step = element_time_step(i)
+        lane = i
+      end if
+    end do
+    critical_element = 0
+    if (lane > 0) critical_element = elements(lane)
+  end subroutine smallest_time_step
 end module element_work

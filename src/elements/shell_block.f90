@@ -41,7 +41,7 @@ module shell_block
   use model, only: model_t, material_t, formulation_fe, law_null
   use plane_stress_dispatch, only: plane_stress_history_count, initialize_plane_stress_history, &
                                    update_plane_stress_block, plane_stress_plastic_strain
-  use element_work, only: add_force_work
+  use element_work, only: add_force_work, smallest_time_step
   use gauss_legendre, only: gauss_legendre_rule
   implicit none
   private
@@ -245,7 +245,7 @@ contains
     real(wp) :: hourglass_global(block_size, 4, 6), element_time_step(block_size)
     real(wp) :: old_power(block_size), new_power(block_size), old_hourglass(block_size), new_hourglass(block_size)
     real(wp) :: shear_modulus, height, spin_angle(block_size)
-    integer :: nel, i, point, lane
+    integer :: nel, i, point
 
     nel = block%element_count
     nodal_force = 0.0_wp
@@ -315,17 +315,8 @@ contains
 
     element_time_step = huge(1.0_wp)
     call stable_steps(block, material, x, area, element_time_step)
-    critical_time_step = huge(1.0_wp)
-    critical_element = 0
+    call smallest_time_step(nel, element_time_step, block%elements, critical_time_step, critical_element)
     degenerate_element = 0
-    lane = 0
-    do i = 1, nel
-      if (element_time_step(i) < critical_time_step) then
-        critical_time_step = element_time_step(i)
-        lane = i
-      end if
-    end do
-    if (lane > 0) critical_element = block%elements(lane)
     do i = 1, nel
       if (.not. area(i) > 0.0_wp) then
         degenerate_element = block%elements(i)

@@ -41,7 +41,7 @@ module solid_block
                             hourglass_power
   use hex8_full, only: point_velocity_gradient, add_deviatoric_point_forces, add_mean_stress_forces, &
                        add_point_stress_power, corner_force_power
-  use element_work, only: add_force_work
+  use element_work, only: add_force_work, smallest_time_step
   use element_time_step, only: bulk_viscosity_pressure, solid_element_time_steps
   implicit none
   private
@@ -267,7 +267,7 @@ contains
     integer, intent(out) :: critical_element
     integer, intent(out) :: inverted_element
     real(wp) :: element_time_step(block_size)
-    integer :: nel, i, lane, point
+    integer :: nel, i, point
 
     nel = block%element_count
     ! The kernels write lanes 1..nel only; the rest stay zero (huge for the time step).
@@ -282,17 +282,8 @@ contains
     end if
     block%previous_time_step = dt
 
-    critical_time_step = huge(1.0_wp)
-    critical_element = 0
+    call smallest_time_step(nel, element_time_step, block%elements, critical_time_step, critical_element)
     inverted_element = 0
-    lane = 0
-    do i = 1, nel
-      if (element_time_step(i) < critical_time_step) then
-        critical_time_step = element_time_step(i)
-        lane = i
-      end if
-    end do
-    if (lane > 0) critical_element = block%elements(lane)
     ! Inverted: element volume (ELFORM 1) or a Gauss point volume (ELFORM 2) <= 0.
     lanes: do i = 1, nel
       do point = 1, block%point_count
