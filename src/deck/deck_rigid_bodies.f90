@@ -152,6 +152,8 @@ contains
           ! clamped: nint of a huge CMO overflowed, a floating-point trap, before the value
           ! could be reported (found by fuzzing)
           entry%constraint_mode = nint(max(min(mode, 2.0e9_wp), -2.0e9_wp))
+          ! CMO is a code: 0.5 is not "1" (found by fuzzing)
+          if (mode /= real(entry%constraint_mode, wp)) entry%constraint_mode = huge(1)
           select case (entry%constraint_mode)
           case (0)
           case (1)
