@@ -188,7 +188,8 @@ contains
     corner_inertia = 0.0_wp
     do i = 1, block%element_count
       do corner = 1, 4
-        corner_mass(i, corner) = block%density(i)*block%thickness(i)*block%reference_area(i)*mass_share(block, i, corner)
+        corner_mass(i, corner) = block%density(i)*block%thickness(i)*block%reference_area(i)* &
+                                 mass_share(block, i, corner)
         corner_inertia(i, corner) = corner_mass(i, corner)*(block%thickness(i)**2 + block%reference_area(i))/12.0_wp
       end do
     end do

@@ -79,25 +79,25 @@ contains
     state%energy%hourglass = 0.0_wp
     do b = 1, size(state%blocks)
       associate (block => state%blocks(b))
-        state%energy%internal = state%energy%internal + sum(block%internal_energy(1:block%element_count)) &
-                                + step_correction*sum(block%force_power(1:block%element_count))
-        state%energy%hourglass = state%energy%hourglass + sum(block%hourglass_energy(1:block%element_count)) &
-                                 + step_correction*sum(block%hourglass_power(1:block%element_count))
+        state%energy%internal = state%energy%internal + booked_energy(block%internal_energy, block%force_power, &
+          block%element_count, step_correction)
+        state%energy%hourglass = state%energy%hourglass + booked_energy(block%hourglass_energy, block%hourglass_power, &
+          block%element_count, step_correction)
       end associate
     end do
     do b = 1, size(state%shells)
       associate (shell => state%shells(b))
-        state%energy%internal = state%energy%internal + sum(shell%internal_energy(1:shell%element_count)) &
-                                + step_correction*sum(shell%force_power(1:shell%element_count))
-        state%energy%hourglass = state%energy%hourglass + sum(shell%hourglass_energy(1:shell%element_count)) &
-                                 + step_correction*sum(shell%hourglass_power(1:shell%element_count))
+        state%energy%internal = state%energy%internal + booked_energy(shell%internal_energy, shell%force_power, &
+          shell%element_count, step_correction)
+        state%energy%hourglass = state%energy%hourglass + booked_energy(shell%hourglass_energy, shell%hourglass_power, &
+          shell%element_count, step_correction)
       end associate
     end do
     do k = 1, size(state%efg)
       do b = 1, size(state%efg(k)%blocks)
         associate (block => state%efg(k)%blocks(b))
-          state%energy%internal = state%energy%internal + sum(block%internal_energy(1:block%point_count)) &
-                                  + step_correction*sum(block%force_power(1:block%point_count))
+          state%energy%internal = state%energy%internal + booked_energy(block%internal_energy, block%force_power, &
+            block%point_count, step_correction)
         end associate
       end do
     end do
@@ -121,10 +121,10 @@ contains
     step_correction = 0.25_wp*(state%next_time_step - state%time_step)
     do b = 1, size(state%blocks)
       associate (block => state%blocks(b))
-        internal(block%part) = internal(block%part) + sum(block%internal_energy(1:block%element_count)) &
-                               + step_correction*sum(block%force_power(1:block%element_count))
-        hourglass(block%part) = hourglass(block%part) + sum(block%hourglass_energy(1:block%element_count)) &
-                                + step_correction*sum(block%hourglass_power(1:block%element_count))
+        internal(block%part) = internal(block%part) + booked_energy(block%internal_energy, block%force_power, &
+          block%element_count, step_correction)
+        hourglass(block%part) = hourglass(block%part) + booked_energy(block%hourglass_energy, block%hourglass_power, &
+          block%element_count, step_correction)
         do corner = 1, 8
           do lane = 1, block%element_count
             node = block%nodes(lane, corner)
@@ -138,10 +138,10 @@ contains
     end do
     do b = 1, size(state%shells)
       associate (shell => state%shells(b))
-        internal(shell%part) = internal(shell%part) + sum(shell%internal_energy(1:shell%element_count)) &
-                               + step_correction*sum(shell%force_power(1:shell%element_count))
-        hourglass(shell%part) = hourglass(shell%part) + sum(shell%hourglass_energy(1:shell%element_count)) &
-                                + step_correction*sum(shell%hourglass_power(1:shell%element_count))
+        internal(shell%part) = internal(shell%part) + booked_energy(shell%internal_energy, shell%force_power, &
+          shell%element_count, step_correction)
+        hourglass(shell%part) = hourglass(shell%part) + booked_energy(shell%hourglass_energy, shell%hourglass_power, &
+          shell%element_count, step_correction)
         do corner = 1, 4
           do lane = 1, shell%element_count
             node = shell%nodes(lane, corner)
@@ -151,8 +151,8 @@ contains
                                   0.5_wp*state%shell_corner_mass(lane, corner, b)*dot_product(velocity, next_velocity)
             velocity = state%angular_velocity(:, node)
             next_velocity = velocity + average_step*state%angular_acceleration(:, node)
-            kinetic(shell%part) = kinetic(shell%part) + &
-                                  0.5_wp*state%shell_corner_inertia(lane, corner, b)*dot_product(velocity, next_velocity)
+            kinetic(shell%part) = kinetic(shell%part) + 0.5_wp*state%shell_corner_inertia(lane, corner, b)* &
+                                  dot_product(velocity, next_velocity)
           end do
         end do
       end associate
@@ -168,8 +168,8 @@ contains
     do k = 1, size(state%efg)
       associate (efg => state%efg(k), part => state%efg(k)%geometry%part)
         do b = 1, size(efg%blocks)
-          internal(part) = internal(part) + sum(efg%blocks(b)%internal_energy(1:efg%blocks(b)%point_count)) &
-                           + step_correction*sum(efg%blocks(b)%force_power(1:efg%blocks(b)%point_count))
+          internal(part) = internal(part) + booked_energy(efg%blocks(b)%internal_energy, efg%blocks(b)%force_power, &
+            efg%blocks(b)%point_count, step_correction)
         end do
         do lane = 1, size(efg%geometry%mass_node)
           node = efg%geometry%mass_node(lane)
@@ -181,6 +181,14 @@ contains
       end associate
     end do
   end subroutine part_energies
+
+  !> Energy of the first `count` lanes of a block as the solver reports it: the work booked by
+  !> the elements plus the step correction of their newest forces' power (see solid_block).
+  pure real(wp) function booked_energy(energy, power, count, step_correction)
+    real(wp), intent(in) :: energy(:), power(:), step_correction
+    integer, intent(in) :: count
+    booked_energy = sum(energy(1:count)) + step_correction*sum(power(1:count))
+  end function booked_energy
 
   !> Total energy: kinetic + internal + hourglass + contact + rigid-wall (energy the walls took).
   pure real(wp) function total_energy(state)

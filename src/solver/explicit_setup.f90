@@ -56,7 +56,8 @@ contains
     state%block_inverted_element = 0
     call build_shell_blocks(model, state%shells)
     block_count = size(state%shells)
-    allocate (state%shell_corner_mass(block_size, 4, block_count), state%shell_corner_inertia(block_size, 4, block_count), &
+    allocate (state%shell_corner_mass(block_size, 4, block_count), &
+              state%shell_corner_inertia(block_size, 4, block_count), &
               state%shell_time_step(block_count), state%shell_critical_element(block_count), &
               state%shell_degenerate_element(block_count))
     state%shell_time_step = huge(1.0_wp)
@@ -96,42 +97,51 @@ contains
   subroutine scale_masses(model, state)
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(inout) :: state
-    real(wp) :: element_time_step(block_size), target_step, factor
-    integer :: b, i
+    real(wp) :: element_time_step(block_size), target_step, volume(block_size)
+    integer :: b, nel
 
     state%physical_mass = 0.0_wp
     state%added_mass = 0.0_wp
     target_step = abs(model%mass_scaled_time_step)
+    element_time_step = huge(1.0_wp)
     do b = 1, size(state%blocks)
       associate (block => state%blocks(b))
-        state%physical_mass = state%physical_mass + &
-                              sum(block%density(1:block%element_count)*block%reference_volume(1:block%element_count))
-        if (target_step <= 0.0_wp) cycle
-        call solid_block_time_steps(block, model%materials(block%material), state%coordinates, element_time_step)
-        do i = 1, block%element_count
-          if (element_time_step(i) >= target_step) cycle
-          factor = (target_step/element_time_step(i))**2
-          state%added_mass = state%added_mass + (factor - 1.0_wp)*block%density(i)*block%reference_volume(i)
-          block%density(i) = block%density(i)*factor
-        end do
+        if (target_step > 0.0_wp) &
+          call solid_block_time_steps(block, model%materials(block%material), state%coordinates, element_time_step)
+        call scale_block_density(block%element_count, block%reference_volume, target_step, element_time_step, &
+                                 block%density, state%physical_mass, state%added_mass)
       end associate
     end do
     do b = 1, size(state%shells)
       associate (shell => state%shells(b))
-        state%physical_mass = state%physical_mass + sum(shell%density(1:shell%element_count)* &
-                              shell%thickness(1:shell%element_count)*shell%reference_area(1:shell%element_count))
-        if (target_step <= 0.0_wp) cycle
-        call shell_block_time_steps(shell, model%materials(shell%material), state%coordinates, element_time_step)
-        do i = 1, shell%element_count
-          if (element_time_step(i) >= target_step) cycle
-          factor = (target_step/element_time_step(i))**2
-          state%added_mass = state%added_mass + (factor - 1.0_wp)*shell%density(i)*shell%thickness(i)* &
-                             shell%reference_area(i)
-          shell%density(i) = shell%density(i)*factor
-        end do
+        nel = shell%element_count
+        volume(1:nel) = shell%thickness(1:nel)*shell%reference_area(1:nel)
+        if (target_step > 0.0_wp) &
+          call shell_block_time_steps(shell, model%materials(shell%material), state%coordinates, element_time_step)
+        call scale_block_density(nel, volume, target_step, element_time_step, shell%density, state%physical_mass, &
+                                 state%added_mass)
       end associate
     end do
   end subroutine scale_masses
+
+  !> One block of mass scaling: its physical mass, then each lane whose step is below
+  !> `target_step` (> 0) gets the density that brings its step to it (the step scales with
+  !> 1/sqrt(rho)), and the mass added.
+  subroutine scale_block_density(nel, volume, target_step, element_time_step, density, physical_mass, added_mass)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: volume(block_size), target_step, element_time_step(block_size)
+    real(wp), intent(inout) :: density(block_size), physical_mass, added_mass
+    real(wp) :: factor
+    integer :: i
+    physical_mass = physical_mass + sum(density(1:nel)*volume(1:nel))
+    if (target_step <= 0.0_wp) return
+    do i = 1, nel
+      if (element_time_step(i) >= target_step) cycle
+      factor = (target_step/element_time_step(i))**2
+      added_mass = added_mass + (factor - 1.0_wp)*density(i)*volume(i)
+      density(i) = density(i)*factor
+    end do
+  end subroutine scale_block_density
 
   !> Colour the solid blocks and the shell blocks (each kind among itself: the solver adds the
   !> solids' forces first, then the shells').

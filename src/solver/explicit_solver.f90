@@ -78,7 +78,7 @@ contains
       ! velocities at the half step, then the supports and walls correct them
       call update_velocities(state, 0.5_wp*(previous_step + step))
       if (size(state%shells) > 0) then
-        call remove_drilling_rates(state, work)
+        call remove_drilling_rates(state, 0.5_wp*(previous_step + step), work)
         state%energy%external_work = state%energy%external_work + work
       end if
       call impose_kinematic_conditions(model, state%fixed, state%time, step, 0.5_wp*(previous_step + step), &
@@ -203,8 +203,9 @@ contains
   !> constraint's impulse J = -I (w . n) n does the work J . (w^{n-1/2} + w^{n+1/2}) / 2, booked
   !> as external work like a support's. Rotations fixed by an SPC are left out of n (a node
   !> whose drilling direction is mostly fixed keeps its rates).
-  subroutine remove_drilling_rates(state, work)
+  subroutine remove_drilling_rates(state, average_step, work)
     type(explicit_state_t), intent(inout) :: state
+    real(wp), intent(in) :: average_step        !< the step of the velocity update just done
     real(wp), intent(out) :: work
     real(wp), parameter :: coplanar = 0.94_wp   ! cos 20 degrees
     real(wp) :: normal(3), length, drilling, previous(3)
@@ -222,7 +223,7 @@ contains
       if (length < 0.25_wp) cycle
       normal = normal/sqrt(length)
       drilling = dot_product(state%angular_velocity(:, node), normal)
-      previous = state%angular_velocity(:, node) - state%last_average_step*state%angular_acceleration(:, node)
+      previous = state%angular_velocity(:, node) - average_step*state%angular_acceleration(:, node)
       state%angular_velocity(:, node) = state%angular_velocity(:, node) - drilling*normal
       work = work - 0.5_wp*state%rotary_inertia(node)*drilling*dot_product(previous, normal)
     end do
@@ -235,11 +236,11 @@ contains
     type(explicit_state_t), intent(inout) :: state
     real(wp), intent(in) :: average_step
     integer :: node
-    state%last_average_step = average_step
     !$omp parallel do schedule(static) default(shared) private(node)
     do node = 1, state%node_count
       state%velocity(:, node) = state%velocity(:, node) + average_step*state%acceleration(:, node)
-      state%angular_velocity(:, node) = state%angular_velocity(:, node) + average_step*state%angular_acceleration(:, node)
+      state%angular_velocity(:, node) = state%angular_velocity(:, node) + &
+                                        average_step*state%angular_acceleration(:, node)
     end do
     !$omp end parallel do
   end subroutine update_velocities

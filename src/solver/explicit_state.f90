@@ -86,7 +86,6 @@ module explicit_state
     logical, allocatable :: fixed_rotation(:, :)         !< SPC per rotational dof
     real(wp), allocatable :: shell_normal_sum(:, :)      !< (3, nodes): sum of area x normal of the node's shells
     real(wp), allocatable :: shell_area_sum(:)           !< sum of their areas
-    real(wp) :: last_average_step = 0.0_wp               !< the step of the last velocity update
     ! meshfree parts: their interior particles carry generalized displacements
     type(efg_solver_t), allocatable :: efg(:)
     logical, allocatable :: is_particle(:)               !< interior particle of an EFG part
