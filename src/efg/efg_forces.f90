@@ -246,9 +246,12 @@ contains
       current_density(i) = density/max(jacobian(i), tiny(1.0_wp))
       sound_speed(i) = sqrt(max(wave_modulus(i), 0.0_wp)/density)
       cell_volume(i) = point_cell_volume(g)*max(jacobian(i), 0.0_wp)
-      ! the cell's length shrinks with the smallest principal stretch of Fbar (a cell squeezed
-      ! flat keeps its volume but not its thickness)
-      length(i) = geometry%point_length(g)*smallest_stretch(deformation(:, :, i))
+    end do
+    ! the cell's length shrinks with the smallest principal stretch of Fbar (a cell squeezed
+    ! flat keeps its volume but not its thickness)
+    call smallest_stretches(nel, deformation, length)
+    do i = 1, nel
+      length(i) = geometry%point_length(block%first_point + i - 1)*length(i)
     end do
     call bulk_viscosity_pressure(nel, bulk_quadratic, bulk_linear, current_density, sound_speed, cell_volume, &
                                  volumetric_rate, bulk_viscosity)
@@ -383,32 +386,52 @@ contains
                    + point_stress(7)*rate(1, 3) + point_stress(8)*rate(2, 3) + point_stress(9)*rate(3, 3)
   end function stress_power
 
-  !> Smallest principal stretch of F: the square root of the smallest eigenvalue of C = F^T F,
-  !> from the trigonometric solution of the characteristic cubic of a symmetric 3x3 matrix
-  !> (Smith, Comm. ACM 4 (1961) 168).
-  pure real(wp) function smallest_stretch(deformation)
-    real(wp), intent(in) :: deformation(3, 3)
-    real(wp) :: c(3, 3), mean, off_diagonal, spread_squared, spread, half_det, angle, shifted(3, 3)
+  !> Smallest principal stretch of F of lanes 1..nel: the square root of the smallest
+  !> eigenvalue of C = F^T F, from the trigonometric solution of the characteristic cubic of a
+  !> symmetric 3x3 matrix (Smith, Comm. ACM 4 (1961) 168). The invariants are gathered first
+  !> and the trigonometry runs in a loop of its own, which the compiler vectorizes (acos and
+  !> cos cost more than the rest of the point's kinematics when called lane by lane).
+  pure subroutine smallest_stretches(nel, deformation, stretch)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: deformation(3, 3, block_size)
+    real(wp), intent(out) :: stretch(block_size)
+    real(wp) :: mean(block_size), spread(block_size), half_det(block_size)
+    real(wp) :: c11, c22, c33, c12, c13, c23, off_diagonal, spread_squared, angle, eigenvalue
     real(wp), parameter :: pi = 3.14159265358979323846_wp
     integer :: i
-    c = matmul(transpose(deformation), deformation)
-    mean = (c(1, 1) + c(2, 2) + c(3, 3))/3.0_wp
-    off_diagonal = c(1, 2)**2 + c(1, 3)**2 + c(2, 3)**2
-    spread_squared = ((c(1, 1) - mean)**2 + (c(2, 2) - mean)**2 + (c(3, 3) - mean)**2 + 2.0_wp*off_diagonal)/6.0_wp
-    if (spread_squared <= epsilon(1.0_wp)*mean**2) then
-      smallest_stretch = sqrt(max(mean, 0.0_wp))
-      return
-    end if
-    spread = sqrt(spread_squared)
-    shifted = c
-    do i = 1, 3
-      shifted(i, i) = shifted(i, i) - mean
+    do i = 1, nel
+      associate (f => deformation(:, :, i))
+        c11 = f(1, 1)**2 + f(2, 1)**2 + f(3, 1)**2
+        c22 = f(1, 2)**2 + f(2, 2)**2 + f(3, 2)**2
+        c33 = f(1, 3)**2 + f(2, 3)**2 + f(3, 3)**2
+        c12 = f(1, 1)*f(1, 2) + f(2, 1)*f(2, 2) + f(3, 1)*f(3, 2)
+        c13 = f(1, 1)*f(1, 3) + f(2, 1)*f(2, 3) + f(3, 1)*f(3, 3)
+        c23 = f(1, 2)*f(1, 3) + f(2, 2)*f(2, 3) + f(3, 2)*f(3, 3)
+      end associate
+      mean(i) = (c11 + c22 + c33)/3.0_wp
+      c11 = c11 - mean(i)
+      c22 = c22 - mean(i)
+      c33 = c33 - mean(i)
+      off_diagonal = c12**2 + c13**2 + c23**2
+      spread_squared = (c11**2 + c22**2 + c33**2 + 2.0_wp*off_diagonal)/6.0_wp
+      if (spread_squared <= epsilon(1.0_wp)*mean(i)**2) then
+        ! (nearly) isotropic: every eigenvalue is the mean
+        spread(i) = 0.0_wp
+        half_det(i) = 1.0_wp
+      else
+        spread(i) = sqrt(spread_squared)
+        ! det((C - mean I) / spread) / 2
+        half_det(i) = 0.5_wp*(c11*(c22*c33 - c23**2) - c12*(c12*c33 - c23*c13) + c13*(c12*c23 - c22*c13)) &
+                      /spread_squared/spread(i)
+      end if
     end do
-    half_det = 0.5_wp*determinant(shifted/spread)
-    angle = acos(max(-1.0_wp, min(1.0_wp, half_det)))/3.0_wp
-    ! the eigenvalues are mean + 2 spread cos(angle + 2 pi k / 3); k = 1 gives the smallest
-    smallest_stretch = sqrt(max(mean + 2.0_wp*spread*cos(angle + 2.0_wp*pi/3.0_wp), 0.0_wp))
-  end function smallest_stretch
+    do i = 1, nel
+      angle = acos(max(-1.0_wp, min(1.0_wp, half_det(i))))/3.0_wp
+      ! the eigenvalues are mean + 2 spread cos(angle + 2 pi k / 3); k = 1 gives the smallest
+      eigenvalue = mean(i) + 2.0_wp*spread(i)*cos(angle + 2.0_wp*pi/3.0_wp)
+      stretch(i) = sqrt(max(eigenvalue, 0.0_wp))
+    end do
+  end subroutine smallest_stretches
 
   pure real(wp) function determinant(a)
     real(wp), intent(in) :: a(3, 3)

@@ -101,9 +101,9 @@ contains
     real(wp), intent(inout) :: stress(block_size, 6)
     real(wp), intent(inout), contiguous :: history(:, :)
 
-    real(wp) :: axes(3, 3), local_stress(6), local_increment(6), modulus(6), trial(6), lane(6)
+    real(wp) :: axes(3, 3), local_stress(6), local_increment(6), modulus(6), trial(6), viscous(6)
     real(wp) :: bulk, shear, compacted_moduli(6), relative_volume, beta, abscissa, limit
-    real(wp) :: rate_factor, rate, mean, deviator(6), effective, scale
+    real(wp) :: rate_factor, rate, mean, deviator(6), effective, scale, volumetric_increment
     integer :: i, k
     integer, parameter :: axes_first = honeycomb_axes_first_slot, viscous_first = honeycomb_viscous_first_slot
     integer, parameter :: strain_first = honeycomb_strain_first_slot
@@ -113,38 +113,56 @@ contains
     compacted_moduli = [youngs_modulus, youngs_modulus, youngs_modulus, shear, shear, shear]
 
     do i = 1, nel
-      axes = transpose(reshape(history(i, axes_first:axes_first + 8), [3, 3]))
-      lane = stress(i, :)
-      local_stress = to_axes(axes, lane) - history(i, viscous_first:viscous_first + 5)
-      lane = strain_increment(i, :)
-      local_increment = to_axes(axes, lane)
-      history(i, honeycomb_log_volume_slot) = history(i, honeycomb_log_volume_slot) &
-        + strain_increment(i, 1) + strain_increment(i, 2) + strain_increment(i, 3)
-      history(i, strain_first:strain_first + 5) = history(i, strain_first:strain_first + 5) + local_increment
+      ! rows of `axes` are a, b, c (element by element: the history row is strided)
+      do k = 1, 3
+        axes(1, k) = history(i, axes_first + k - 1)
+        axes(2, k) = history(i, axes_first + 2 + k)
+        axes(3, k) = history(i, axes_first + 5 + k)
+      end do
+      call to_axes(axes, stress(i, 1), stress(i, 2), stress(i, 3), stress(i, 4), stress(i, 5), stress(i, 6), &
+                   local_stress)
+      do k = 1, 6
+        local_stress(k) = local_stress(k) - history(i, viscous_first + k - 1)
+      end do
+      call to_axes(axes, strain_increment(i, 1), strain_increment(i, 2), strain_increment(i, 3), &
+                   strain_increment(i, 4), strain_increment(i, 5), strain_increment(i, 6), local_increment)
+      volumetric_increment = strain_increment(i, 1) + strain_increment(i, 2) + strain_increment(i, 3)
+      history(i, honeycomb_log_volume_slot) = history(i, honeycomb_log_volume_slot) + volumetric_increment
+      do k = 1, 6
+        history(i, strain_first + k - 1) = history(i, strain_first + k - 1) + local_increment(k)
+      end do
       relative_volume = exp(history(i, honeycomb_log_volume_slot))
       if (relative_volume <= compaction_volume) history(i, honeycomb_compacted_slot) = 1.0_wp
 
       if (history(i, honeycomb_compacted_slot) > 0.5_wp) then
         ! Isotropic elastic-perfectly plastic (von Mises, SIGY); isotropy makes the axes irrelevant.
-        mean = sum(local_stress(1:3))/3.0_wp + bulk*sum(local_increment(1:3))
-        deviator(1:3) = local_stress(1:3) - sum(local_stress(1:3))/3.0_wp &
-                        + 2.0_wp*shear*(local_increment(1:3) - sum(local_increment(1:3))/3.0_wp)
-        deviator(4:6) = local_stress(4:6) + 2.0_wp*shear*local_increment(4:6)
-        effective = sqrt(1.5_wp*sum(deviator(1:3)**2) + 3.0_wp*sum(deviator(4:6)**2))
+        mean = (local_stress(1) + local_stress(2) + local_stress(3))/3.0_wp + bulk*volumetric_increment
+        do k = 1, 3
+          deviator(k) = local_stress(k) - (local_stress(1) + local_stress(2) + local_stress(3))/3.0_wp &
+                        + 2.0_wp*shear*(local_increment(k) - volumetric_increment/3.0_wp)
+          deviator(k + 3) = local_stress(k + 3) + 2.0_wp*shear*local_increment(k + 3)
+        end do
+        effective = sqrt(1.5_wp*(deviator(1)**2 + deviator(2)**2 + deviator(3)**2) &
+                         + 3.0_wp*(deviator(4)**2 + deviator(5)**2 + deviator(6)**2))
         scale = 1.0_wp
         if (effective > yield_stress) scale = yield_stress/effective
-        trial(1:3) = scale*deviator(1:3) + mean
-        trial(4:6) = scale*deviator(4:6)
-        modulus = [bulk + 4.0_wp*shear/3.0_wp, bulk + 4.0_wp*shear/3.0_wp, bulk + 4.0_wp*shear/3.0_wp, &
-                   2.0_wp*shear, 2.0_wp*shear, 2.0_wp*shear]
+        do k = 1, 3
+          trial(k) = scale*deviator(k) + mean
+          trial(k + 3) = scale*deviator(k + 3)
+          modulus(k) = bulk + 4.0_wp*shear/3.0_wp
+          modulus(k + 3) = 2.0_wp*shear
+        end do
       else
         beta = max(min((1.0_wp - relative_volume)/(1.0_wp - compaction_volume), 1.0_wp), 0.0_wp)
-        modulus = uncompacted_moduli + beta*(compacted_moduli - uncompacted_moduli)
+        do k = 1, 6
+          modulus(k) = uncompacted_moduli(k) + beta*(compacted_moduli(k) - uncompacted_moduli(k))
+        end do
         modulus(4:6) = 2.0_wp*modulus(4:6)          ! tensor shear increments
         rate_factor = 1.0_wp
         if (has_rate_curve .and. time_step > 0.0_wp) then
-          rate = sqrt(2.0_wp/3.0_wp*(sum(strain_increment(i, 1:3)**2) + 2.0_wp*sum(strain_increment(i, 4:6)**2))) &
-                 /time_step
+          rate = sqrt(2.0_wp/3.0_wp*(strain_increment(i, 1)**2 + strain_increment(i, 2)**2 + strain_increment(i, 3)**2 &
+                                     + 2.0_wp*(strain_increment(i, 4)**2 + strain_increment(i, 5)**2 &
+                                               + strain_increment(i, 6)**2)))/time_step
           rate_factor = curve_value(rate_curve, rate)
         end if
         do k = 1, 6
@@ -160,62 +178,55 @@ contains
         end do
       end if
 
-      history(i, viscous_first:viscous_first + 5) = viscosity*modulus*local_increment
-      stress(i, :) = from_axes(axes, trial + history(i, viscous_first:viscous_first + 5))
+      do k = 1, 6
+        viscous(k) = viscosity*modulus(k)*local_increment(k)
+        history(i, viscous_first + k - 1) = viscous(k)
+        trial(k) = trial(k) + viscous(k)
+      end do
+      call from_axes(axes, trial, stress(i, 1), stress(i, 2), stress(i, 3), stress(i, 4), stress(i, 5), stress(i, 6))
     end do
   end subroutine honeycomb_update
 
-  !> Components in the axes whose rows are a, b, c: S' = Q S Q^T (6-vector, tensor shear).
-  pure function to_axes(axes, tensor) result(local)
-    real(wp), intent(in) :: axes(3, 3), tensor(6)
-    real(wp) :: local(6)
-    local = packed(congruence(axes, unpacked(tensor)))
-  end function to_axes
+  !> Components in the axes whose rows q1, q2, q3 are a, b, c: S'_kl = q_k . S q_l (6-vector,
+  !> tensor shear; written out so that the kernel makes no array temporaries).
+  pure subroutine to_axes(axes, sxx, syy, szz, sxy, syz, szx, local)
+    real(wp), intent(in) :: axes(3, 3), sxx, syy, szz, sxy, syz, szx
+    real(wp), intent(out) :: local(6)
+    real(wp) :: product(3, 3)
+    integer :: k
+    ! product(:, k) = S q_k
+    do k = 1, 3
+      product(1, k) = sxx*axes(k, 1) + sxy*axes(k, 2) + szx*axes(k, 3)
+      product(2, k) = sxy*axes(k, 1) + syy*axes(k, 2) + syz*axes(k, 3)
+      product(3, k) = szx*axes(k, 1) + syz*axes(k, 2) + szz*axes(k, 3)
+    end do
+    local(1) = axes(1, 1)*product(1, 1) + axes(1, 2)*product(2, 1) + axes(1, 3)*product(3, 1)
+    local(2) = axes(2, 1)*product(1, 2) + axes(2, 2)*product(2, 2) + axes(2, 3)*product(3, 2)
+    local(3) = axes(3, 1)*product(1, 3) + axes(3, 2)*product(2, 3) + axes(3, 3)*product(3, 3)
+    local(4) = axes(1, 1)*product(1, 2) + axes(1, 2)*product(2, 2) + axes(1, 3)*product(3, 2)
+    local(5) = axes(2, 1)*product(1, 3) + axes(2, 2)*product(2, 3) + axes(2, 3)*product(3, 3)
+    local(6) = axes(3, 1)*product(1, 1) + axes(3, 2)*product(2, 1) + axes(3, 3)*product(3, 1)
+  end subroutine to_axes
 
-  !> Global components from the material ones: S = Q^T S' Q.
-  pure function from_axes(axes, local) result(tensor)
+  !> Global components from the material ones: S = sum_kl S'_kl q_k (x) q_l.
+  pure subroutine from_axes(axes, local, sxx, syy, szz, sxy, syz, szx)
     real(wp), intent(in) :: axes(3, 3), local(6)
-    real(wp) :: tensor(6), transposed(3, 3)
-    transposed = transpose(axes)
-    tensor = packed(congruence(transposed, unpacked(local)))
-  end function from_axes
-
-  !> Q S Q^T written out (explicit loops: no array temporaries in the kernel).
-  pure function congruence(q, s) result(r)
-    real(wp), intent(in) :: q(3, 3), s(3, 3)
-    real(wp) :: r(3, 3), t(3, 3)
-    integer :: i, j, k
+    real(wp), intent(out) :: sxx, syy, szz, sxy, syz, szx
+    real(wp) :: weighted(3, 3)
+    integer :: j
+    ! weighted(k, :) = sum_l S'_kl q_l
     do j = 1, 3
-      do i = 1, 3
-        t(i, j) = 0.0_wp
-        do k = 1, 3
-          t(i, j) = t(i, j) + q(i, k)*s(k, j)
-        end do
-      end do
+      weighted(1, j) = local(1)*axes(1, j) + local(4)*axes(2, j) + local(6)*axes(3, j)
+      weighted(2, j) = local(4)*axes(1, j) + local(2)*axes(2, j) + local(5)*axes(3, j)
+      weighted(3, j) = local(6)*axes(1, j) + local(5)*axes(2, j) + local(3)*axes(3, j)
     end do
-    do j = 1, 3
-      do i = 1, 3
-        r(i, j) = 0.0_wp
-        do k = 1, 3
-          r(i, j) = r(i, j) + t(i, k)*q(j, k)
-        end do
-      end do
-    end do
-  end function congruence
-
-  pure function unpacked(tensor) result(matrix)
-    real(wp), intent(in) :: tensor(6)
-    real(wp) :: matrix(3, 3)
-    matrix = reshape([tensor(1), tensor(4), tensor(6), tensor(4), tensor(2), tensor(5), &
-                      tensor(6), tensor(5), tensor(3)], [3, 3])
-  end function unpacked
-
-  pure function packed(matrix) result(tensor)
-    real(wp), intent(in) :: matrix(3, 3)
-    real(wp) :: tensor(6)
-    tensor = [matrix(1, 1), matrix(2, 2), matrix(3, 3), 0.5_wp*(matrix(1, 2) + matrix(2, 1)), &
-              0.5_wp*(matrix(2, 3) + matrix(3, 2)), 0.5_wp*(matrix(3, 1) + matrix(1, 3))]
-  end function packed
+    sxx = axes(1, 1)*weighted(1, 1) + axes(2, 1)*weighted(2, 1) + axes(3, 1)*weighted(3, 1)
+    syy = axes(1, 2)*weighted(1, 2) + axes(2, 2)*weighted(2, 2) + axes(3, 2)*weighted(3, 2)
+    szz = axes(1, 3)*weighted(1, 3) + axes(2, 3)*weighted(2, 3) + axes(3, 3)*weighted(3, 3)
+    sxy = axes(1, 1)*weighted(1, 2) + axes(2, 1)*weighted(2, 2) + axes(3, 1)*weighted(3, 2)
+    syz = axes(1, 2)*weighted(1, 3) + axes(2, 2)*weighted(2, 3) + axes(3, 2)*weighted(3, 3)
+    szx = axes(1, 3)*weighted(1, 1) + axes(2, 3)*weighted(2, 1) + axes(3, 3)*weighted(3, 1)
+  end subroutine from_axes
 
   pure function cross(u, v) result(w)
     real(wp), intent(in) :: u(3), v(3)
