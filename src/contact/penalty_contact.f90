@@ -40,6 +40,10 @@ module penalty_contact
   real(wp), parameter :: parametric_limit = 1.025_wp
   !> Largest pair stiffness as a fraction of m* / dt^2 (a lone pair spring is stable up to 4).
   real(wp), parameter :: stable_fraction = 0.25_wp
+  !> How much deeper than its last penetration plus this step's approach a pair may be found:
+  !> a factor, not an offset, because the soft-constraint spring (m*/dt^2) throws a node out of
+  !> any new depth d at about d/dt; a factor keeps that kick proportional to the approach.
+  real(wp), parameter :: reach_factor = 2.0_wp
 
   !> Secondary nodes against primary segments.
   type :: contact_pass_t
@@ -76,6 +80,7 @@ module penalty_contact
     ! pair results, one per secondary node
     integer, allocatable :: pair_segment(:)
     real(wp), allocatable :: pair_side(:)          !< shells: +1 / -1, the side of the segment the node is on
+    real(wp), allocatable :: pair_depth(:)         !< penetration of the node's pair in the last cycle (0: none)
     real(wp), allocatable :: pair_weights(:, :), pair_force(:, :), tangential(:, :)
     real(wp) :: side_sign = 1.0_wp                !< +1: secondary is SURFA; -1: the B -> A pass
   end type contact_pass_t
@@ -293,8 +298,9 @@ contains
       allocate (pass%pair_segment(pass%node_count), pass%pair_weights(4, pass%node_count), &
                 pass%pair_force(3, pass%node_count), pass%tangential(3, pass%node_count))
       pass%pair_segment = 0
-      allocate (pass%pair_side(pass%node_count))
+      allocate (pass%pair_side(pass%node_count), pass%pair_depth(pass%node_count))
       pass%pair_side = 1.0_wp
+      pass%pair_depth = 0.0_wp
       pass%pair_weights = 0.0_wp
       pass%pair_force = 0.0_wp
       pass%tangential = 0.0_wp
@@ -358,6 +364,7 @@ contains
           associate (pass => state%passes(p))
             if (.not. active) then
               pass%pair_segment = 0
+              pass%pair_depth = 0.0_wp
               pass%pair_force = 0.0_wp
               pass%tangential = 0.0_wp
               cycle
@@ -621,12 +628,12 @@ contains
     real(wp) :: x(3), corners(3, 4), weights(4), normal(3), gap, best_depth, best_weights(4), best_normal(3)
     real(wp) :: relative(3), stiffness, node_mass, segment_mass, reduced_mass, normal_force, damping
     real(wp) :: tangential(3), sliding(3), friction, limit, size_t, penetration, side, best_side
-    real(wp) :: reach, low(3), high(3)
+    real(wp) :: reach, low(3), high(3), reachable
     logical :: inside
     !$omp parallel do schedule(static) default(shared) private(i, c, seg, best, j, x, corners, weights, &
     !$omp& normal, gap, best_depth, best_weights, best_normal, relative, stiffness, node_mass, segment_mass, &
     !$omp& reduced_mass, normal_force, damping, tangential, sliding, friction, limit, size_t, inside, penetration, &
-    !$omp& side, best_side, reach, low, high)
+    !$omp& side, best_side, reach, low, high, reachable)
     do i = 1, pass%node_count
       x = coordinates(:, pass%nodes(i))
       best = 0
@@ -672,6 +679,20 @@ contains
         ! side face it is level with is not in contact with it)
         if (dot_product(pass%node_normal(:, i), normal) >= 0.0_wp .and. &
             any(pass%node_normal(:, i) /= 0.0_wp)) cycle
+        ! a penetration grows only as fast as node and segment approach: one deeper than twice
+        ! the node's last penetration plus this step's approach was not reached from outside
+        ! (the node came round an edge, or a folding surface swept over it) and is not a contact;
+        ! a spring that deep would throw the node out with more energy than the crush holds
+        ! (LS-DYNA likewise releases nodes beyond its penetration limit). The first evaluation
+        ! records the initial penetrations instead (IGNORE = 1).
+        if (pass%initial_checked) then
+          relative = velocity(:, pass%nodes(i))
+          do j = 1, merge(3, 4, pass%segments(3, seg) == pass%segments(4, seg))
+            relative = relative - weights(j)*velocity(:, pass%segments(j, seg))
+          end do
+          reachable = reach_factor*(pass%pair_depth(i) + step*max(0.0_wp, -dot_product(relative, normal)))
+          if (penetration > reachable) cycle
+        end if
         if (penetration < best_depth) then
           best = seg
           best_depth = penetration
@@ -689,6 +710,8 @@ contains
       else
         pass%initial_depth(i) = 0.0_wp
       end if
+      pass%pair_depth(i) = 0.0_wp
+      if (best > 0) pass%pair_depth(i) = best_depth
       if (best > 0) then
         best_depth = best_depth - pass%initial_depth(i)
         if (best_depth <= 0.0_wp) best = 0

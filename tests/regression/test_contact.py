@@ -210,3 +210,51 @@ def test_contact_deck_errors(tmp_path, run_deck):
         text = run.stdout + run.stderr
         assert message in text, text
         assert "*CONTACT_AUTOMATIC_SURFACE_TO_SURFACE_ID" in text
+
+
+def test_node_arriving_under_a_segment_from_its_edge_is_not_pushed_out(tmp_path, run_deck):
+    """A penetration only grows as fast as node and segment approach. The slider starts beside
+    the base with its bottom 2 mm below the base's top face and slides in level: its nodes
+    reach the underside of the top segments (the contact surface) from their edge, 2 mm deep
+    with no approach along the normal. That is not a contact; pushing them out (a 2 mm spring at
+    once) would throw the slider upward. Before the rule, the contact gave the 4.9 J slider
+    848 J and the run stopped with a negative volume."""
+    base_nodes, base_elements = block_mesh((6, 4, 1), (60.0, 20.0, 5.0), origin=(-10.0, -5.0, -5.0))
+    slider_nodes, slider_elements = block_mesh((2, 2, 2), (SIDE, SIDE, 5.0), origin=(-25.0, 0.0, -2.0))
+    count = len(base_nodes)
+    speed, end_time = 50.0, 0.4
+    deck = write_deck(
+        tmp_path / "edge_entry.k",
+        "*TITLE\nslider entering under the contact surface from its edge",
+        "*CONTROL_TERMINATION\n" + fields(end_time),
+        "*DATABASE_GLSTAT\n" + fields(end_time / 100),
+        "*DATABASE_BINARY_D3PLOT\n" + fields(end_time / 4),
+        "*PART\nbase\n" + fields(1, 1, 1),
+        "*PART\nslider\n" + fields(2, 1, 1),
+        "*SECTION_SOLID\n" + fields(1, 1),
+        "*MAT_ELASTIC\n" + fields(1, DENSITY, MODULUS, POISSON),
+        node_list_set(1, list(range(1, count + 1))),
+        node_list_set(2, list(range(count + 1, count + len(slider_nodes) + 1))),
+        "*BOUNDARY_SPC_SET\n" + fields(1, 0, 1, 1, 1),
+        "*INITIAL_VELOCITY\n" + fields(2) + "\n" + fields(speed, 0.0, 0.0),
+        base_top_segments(7) + "\n*CONTACT_AUTOMATIC_NODES_TO_SURFACE\n" + fields(2, 7, 4, 0) + "\n" +
+        fields(0.0) + "\n" + fields(1.0),
+        nodes_card(np.vstack([base_nodes, slider_nodes])),
+        solids_card(base_elements, part_id=1) + "\n" +
+        "\n".join(solids_card(slider_elements, part_id=2, first_id=len(base_elements) + 1,
+                              first_node_id=count + 1).splitlines()[1:]),
+    )
+    run = run_deck(deck)
+    assert run.status == 0, run.stderr
+    with run.open() as results:
+        final = results["states"][sorted(results["states"].keys())[-1]]
+        displacement = final["displacement"][count:]
+        velocity = final["velocity"][count:]
+        contact = results["history/glstat/contact_energy"][...]
+    travel = displacement[:, 0].mean()
+    print(f"edge entry: slider travelled {travel:.2f} mm, largest |v_z| {np.abs(velocity[:, 2]).max():.3e} mm/ms, "
+          f"contact energy {np.abs(contact).max():.3e}")
+    assert travel > 15.0, "the slider must have passed under the top face (x > -10 mm by 5 mm)"
+    assert np.abs(velocity[:, 2]).max() < 1e-9 * speed
+    assert np.allclose(velocity[:, 0], speed, rtol=1e-9)
+    assert np.abs(contact).max() == 0.0
