@@ -56,6 +56,7 @@ contains
     integer :: w, k, node
     real(wp) :: start_shift, end_shift, speed, wall_velocity(3), tail_start(3), tail_end(3)
     real(wp) :: old_velocity(3), impulse(3), total_impulse(3), normal(3), depth, work
+    real(wp) :: end_point(3), relative(3), height, outside_squared
 
     energy_removed = 0.0_wp
     wall_work = 0.0_wp
@@ -84,10 +85,17 @@ contains
       states(w)%speed = speed
       if (time < walls(w)%birth .or. time > walls(w)%death) cycle
       total_impulse = 0.0_wp
+      ! squared distance from the axis beyond which a node is surely outside (the margin keeps
+      ! nodes on the surface to within round-off for the exact test of surface_correction)
+      outside_squared = (1.0_wp + 1.0e-8_wp)*walls(w)%radius**2
       do k = 1, size(walls(w)%nodes)
         node = walls(w)%nodes(k)
-        call surface_correction(walls(w), tail_start, tail_end, coordinates(:, node), &
-                                coordinates(:, node) + velocity(:, node)*dt, normal, depth)
+        ! most tracked nodes are far from the cylinder: a test without square roots first
+        end_point = coordinates(:, node) + velocity(:, node)*dt
+        relative = end_point - tail_end
+        height = dot_product(relative, walls(w)%normal)
+        if (dot_product(relative, relative) - height**2 >= outside_squared) cycle
+        call surface_correction(walls(w), tail_start, tail_end, coordinates(:, node), end_point, normal, depth)
         if (depth <= 0.0_wp) cycle
         old_velocity = velocity(:, node)
         velocity(:, node) = old_velocity + (depth/dt)*normal

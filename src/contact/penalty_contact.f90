@@ -646,9 +646,11 @@ contains
         ! reach this cycle, which the segment's current box (grown by the deepest contact and
         ! the parametric tolerance) shows without projecting
         reach = pass%node_offset(i) + max(pass%segment_offset(seg), pass%depth(seg))
-        low = minval(corners, dim=2)
-        high = maxval(corners, dim=2)
-        reach = reach + (parametric_limit - 1.0_wp)*maxval(high - low)
+        do j = 1, 3
+          low(j) = min(corners(j, 1), corners(j, 2), corners(j, 3), corners(j, 4))
+          high(j) = max(corners(j, 1), corners(j, 2), corners(j, 3), corners(j, 4))
+        end do
+        reach = reach + (parametric_limit - 1.0_wp)*max(high(1) - low(1), high(2) - low(2), high(3) - low(3))
         if (any(x < low - reach) .or. any(x > high + reach)) cycle
         call project_on_segment(x, corners, pass%segments(3, seg) == pass%segments(4, seg), weights, normal, &
                                 gap, inside)

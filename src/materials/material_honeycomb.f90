@@ -34,7 +34,7 @@
 !> rotated with the element by the objective (Jaumann) rotation, like the stress.
 module material_honeycomb
   use kinds, only: wp, block_size
-  use curves, only: curve_t, curve_value
+  use curves, only: curve_t, curve_value, smallest_magnitude_from
   implicit none
   private
 
@@ -104,6 +104,7 @@ contains
     real(wp) :: axes(3, 3), local_stress(6), local_increment(6), modulus(6), trial(6), viscous(6)
     real(wp) :: bulk, shear, compacted_moduli(6), relative_volume, beta, abscissa, limit
     real(wp) :: rate_factor, rate, mean, deviator(6), effective, scale, volumetric_increment
+    real(wp) :: least_yield(6)
     integer :: i, k
     integer, parameter :: axes_first = honeycomb_axes_first_slot, viscous_first = honeycomb_viscous_first_slot
     integer, parameter :: strain_first = honeycomb_strain_first_slot
@@ -111,6 +112,12 @@ contains
     shear = youngs_modulus/(2.0_wp*(1.0_wp + poissons_ratio))
     bulk = youngs_modulus/(3.0_wp*(1.0_wp - 2.0_wp*poissons_ratio))
     compacted_moduli = [youngs_modulus, youngs_modulus, youngs_modulus, shear, shear, shear]
+    ! a trial stress below the least the yield curve reaches (the abscissae are >= 0) is inside
+    ! the yield surface whatever the strain: most points of a barrier, away from the crush
+    ! zone, then need no curve evaluation
+    do k = 1, 6
+      least_yield(k) = smallest_magnitude_from(yield_curves(k), 0.0_wp)
+    end do
 
     do i = 1, nel
       ! rows of `axes` are a, b, c (element by element: the history row is strided)
@@ -167,6 +174,7 @@ contains
         end if
         do k = 1, 6
           trial(k) = local_stress(k) + modulus(k)*local_increment(k)
+          if (abs(trial(k)) <= rate_factor*least_yield(k)) cycle
           if (modified) then
             abscissa = abs(history(i, strain_first + k - 1))
             if (k > 3) abscissa = 2.0_wp*abscissa

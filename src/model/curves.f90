@@ -4,7 +4,7 @@ module curves
   implicit none
   private
 
-  public :: curve_t, curve_value, curve_slope, curve_value_and_slope
+  public :: curve_t, curve_value, curve_slope, curve_value_and_slope, smallest_magnitude_from
 
   !> One curve with its scale and offset factors already applied to the stored points:
   !> stored abscissa = SFA * (A + OFFA), stored ordinate = SFO * (O + OFFO) (LS-DYNA's rule:
@@ -73,6 +73,34 @@ contains
       slope = 0.0_wp
     end if
   end function curve_slope_on
+
+  !> The smallest |value| the curve takes for x >= `start`, or 0 where it may reach zero (a
+  !> change of sign, or a fall toward zero beyond the last point). A caller that only needs the
+  !> value when some quantity exceeds it can skip the evaluation below this bound.
+  pure function smallest_magnitude_from(curve, start) result(bound)
+    type(curve_t), intent(in) :: curve
+    real(wp), intent(in) :: start
+    real(wp) :: bound, previous
+    integer :: k, n
+    n = size(curve%abscissa)
+    if (n == 1) then
+      bound = abs(curve%ordinate(1))
+      return
+    end if
+    previous = curve_value(curve, start)
+    bound = abs(previous)
+    do k = find_segment(curve%abscissa, start) + 1, n
+      if (curve%abscissa(k) < start) cycle
+      if (previous*curve%ordinate(k) <= 0.0_wp) then
+        bound = 0.0_wp
+        return
+      end if
+      bound = min(bound, abs(curve%ordinate(k)))
+      previous = curve%ordinate(k)
+    end do
+    ! linear extrapolation beyond the last point: toward zero means no bound
+    if (curve_slope_on(curve, n - 1)*curve%ordinate(n) < 0.0_wp) bound = 0.0_wp
+  end function smallest_magnitude_from
 
   !> Index i of the segment [a(i), a(i+1)] holding x (bisection; ends extend outward).
   pure function find_segment(abscissa, x) result(low)

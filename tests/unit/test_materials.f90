@@ -11,7 +11,7 @@ program test_materials
   use model, only: material_t, law_elastic, law_plastic_kinematic, law_honeycomb, law_modified_honeycomb, &
                    law_low_density_foam, law_piecewise_linear, law_null, piecewise_hardening_curve, &
                    piecewise_rate_curve
-  use curves, only: curve_t, curve_value
+  use curves, only: curve_t, curve_value, smallest_magnitude_from
   use material_dispatch, only: material_wave_modulus
   use material_honeycomb, only: honeycomb_log_volume_slot, honeycomb_compacted_slot, honeycomb_axes_first_slot
   use material_dispatch, only: material_history_count, initialize_material_history, update_material_block, &
@@ -44,6 +44,7 @@ program test_materials
   call test_piecewise_rate_factors()
   call test_piecewise_viscoplastic()
   call test_null_no_stress()
+  call test_curve_lower_bound()
   call finish_suite(suite)
 
 contains
@@ -839,4 +840,28 @@ contains
     call check(suite, "MAT_NULL: no stress, no history", all(stress(1:2, :) == 0.0_wp) .and. &
                material_history_count(material) == 0)
   end subroutine test_null_no_stress
+
+  !> The honeycomb skips yield-curve evaluations below the least |value| a curve can reach: that
+  !> bound must never exceed the curve anywhere from its start on.
+  subroutine test_curve_lower_bound()
+    type(curve_t) :: rising, falling_end, crossing
+    real(wp) :: x, lowest
+    integer :: k
+    rising = curve_t(id=1, abscissa=[0.0_wp, 1.0_wp, 2.0_wp, 3.0_wp], ordinate=[1.0_wp, 3.0_wp, 3.0_wp, 4.0_wp])
+    falling_end = curve_t(id=2, abscissa=[0.0_wp, 1.0_wp, 2.0_wp], ordinate=[1.0_wp, 3.0_wp, 2.0_wp])
+    crossing = curve_t(id=3, abscissa=[0.0_wp, 1.0_wp], ordinate=[-1.0_wp, 1.0_wp])
+    call check_close(suite, "curve bound: rising curve from 0", smallest_magnitude_from(rising, 0.0_wp), 1.0_wp, 0.0_wp)
+    call check_close(suite, "curve bound: rising curve from 1.5", smallest_magnitude_from(rising, 1.5_wp), 3.0_wp, &
+                     0.0_wp)
+    call check(suite, "curve bound: a curve falling beyond its last point has none", &
+               smallest_magnitude_from(falling_end, 0.0_wp) == 0.0_wp)
+    call check(suite, "curve bound: a curve through zero has none", smallest_magnitude_from(crossing, 0.0_wp) == 0.0_wp)
+    ! the bound holds at every point of the rising curve, past its end too
+    lowest = huge(1.0_wp)
+    do k = 0, 1000
+      x = 0.005_wp*k
+      lowest = min(lowest, abs(curve_value(rising, x)))
+    end do
+    call check(suite, "curve bound: below every value of the curve", smallest_magnitude_from(rising, 0.0_wp) <= lowest)
+  end subroutine test_curve_lower_bound
 end program test_materials
