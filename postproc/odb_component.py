@@ -243,7 +243,7 @@ def plot_force(runs, summaries, labels, output: Path):
     plt.close(fig)
 
 
-def plot_deformed(runs, labels, output: Path, section_x: float = 110.0):
+def plot_deformed(runs, labels, output: Path, section_x: float = 70.0):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -361,7 +361,7 @@ def main(argv=None):
     parser.add_argument("--export-reference", type=Path, help="write the (single) run as a shipped .npz and stop")
     parser.add_argument("--labels", nargs="+", help="a label per run (default: FE, coupled)")
     parser.add_argument("-o", "--output", type=Path, help="output directory")
-    parser.add_argument("--section-x", type=float, default=110.0,
+    parser.add_argument("--section-x", type=float, default=70.0,
                         help="x of the side-view slice (mm; default: the cylinder axis of the generator)")
     args = parser.parse_args(argv)
     if args.export_reference:

@@ -5,7 +5,7 @@
 #
 # The FE run is shipped (inputs/odb_component/fe_reference.npz: its force and energy histories,
 # summary numbers and deformed mesh, from `inputs/odb_component/run.sh`), which keeps `make run`
-# to one run of about 2 minutes. ODB_FE=1 runs fe.k too (about 1.5 minutes more), and the CPU
+# to one run of about 1.3 minutes. ODB_FE=1 runs fe.k too (about 1 minute more), and the CPU
 # ratio in the table is then measured on this machine. NCPU=n sets the threads (default 1).
 set -euo pipefail
 decks=inputs/odb_component

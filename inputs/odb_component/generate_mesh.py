@@ -427,14 +427,14 @@ def main(argv=None):
                         help="element size (mm): 42 for the shipped decks (41.7 x 41.25-40 x 40.9 mm cells), "
                              "50 for the test's reduced model")
     parser.add_argument("--crush", type=float, default=330.0, help="cylinder travel after contact (mm)")
-    parser.add_argument("--radius", type=float, default=125.0, help="cylinder radius (mm)")
-    parser.add_argument("--cyl-x", type=float, default=110.0, help="cylinder axis x (mm)")
-    parser.add_argument("--cyl-y", type=float, default=560.0, help="cylinder axis y (mm)")
+    parser.add_argument("--radius", type=float, default=100.0, help="cylinder radius (mm)")
+    parser.add_argument("--cyl-x", type=float, default=70.0, help="cylinder axis x (mm)")
+    parser.add_argument("--cyl-y", type=float, default=555.0, help="cylinder axis y (mm)")
     parser.add_argument("--length", type=float, default=600.0, help="cylinder length (mm)")
     parser.add_argument("--gap", type=float, default=1.0, help="initial gap to the barrier face (mm)")
     parser.add_argument("--friction", type=float, default=0.0, help="cylinder wall FRIC")
-    parser.add_argument("--efg-x", type=float, default=250.0, help="corner part: x < this (mm, snapped)")
-    parser.add_argument("--efg-y", type=float, default=450.0, help="corner part: y > this (mm, snapped)")
+    parser.add_argument("--efg-x", type=float, default=208.0, help="corner part: x < this (mm, snapped)")
+    parser.add_argument("--efg-y", type=float, default=410.0, help="corner part: y > this (mm, snapped)")
     parser.add_argument("--dx", type=float, default=1.2, help="EFG normalized support DX = DY = DZ")
     parser.add_argument("--bumper-cells", type=int, default=2, help="least cells through the bumper depth")
     parser.add_argument("--ihq", type=int, default=1, help="hourglass type of the solid parts (4: see the docs)")
@@ -448,7 +448,7 @@ def main(argv=None):
     parser.add_argument("--backing", choices=("spc", "rigid"), default="spc",
                         help="rigid backing: SPC on the rear face nodes, or a fixed *MAT_RIGID plate")
     parser.add_argument("--backing-thickness", type=float, default=20.0)
-    parser.add_argument("--self-contact", action=argparse.BooleanOptionalAction, default=False,
+    parser.add_argument("--self-contact", action=argparse.BooleanOptionalAction, default=True,
                         help="single-surface contact on the honeycomb parts")
     parser.add_argument("-o", "--output", type=Path, default=Path(__file__).resolve().parent,
                         help="directory for mesh.k, fe.k, coupled.k")
