@@ -23,5 +23,9 @@ module run_summary
     ! sizes
     integer :: fe_elements = 0, efg_particles = 0, dofs_total = 0, dofs_efg = 0
     integer :: fe_solids = 0, fe_shells = 0      !< fe_elements = fe_solids + fe_shells
+    ! FE solids folded inside out at a corner (checked at each state)
+    integer :: tangled_solids = 0                !< at the last state
+    real(wp) :: worst_corner_jacobian_ratio = 1.0_wp !< smallest corner Jacobian ratio of the run
+    integer :: worst_corner_jacobian_element = 0 !< its solid ID (0: no FE solid)
   end type run_summary_t
 end module run_summary

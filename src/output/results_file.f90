@@ -416,6 +416,10 @@ contains
     call write_real_attribute(group_id, "/run", "end_time", summary%end_time, error)
     call write_integer_attribute(group_id, "/run", "cycles", summary%cycles, error)
     call write_integer_attribute(group_id, "/run", "threads", summary%threads, error)
+    call write_integer_attribute(group_id, "/run", "tangled_solids", summary%tangled_solids, error)
+    call write_real_attribute(group_id, "/run", "worst_corner_jacobian_ratio", summary%worst_corner_jacobian_ratio, error)
+    call write_integer_attribute(group_id, "/run", "worst_corner_jacobian_element", &
+                                 summary%worst_corner_jacobian_element, error)
     call h5gclose_f(group_id, status)
   end subroutine write_run_end
 

@@ -154,6 +154,10 @@ contains
     summary%efg_s = meshfree_timer%seconds
     summary%contact_s = contact_timer%seconds
     summary%output_s = output_timer%seconds
+    summary%tangled_solids = plan%distortion%tangled
+    summary%worst_corner_jacobian_ratio = plan%distortion%worst_ratio
+    if (plan%distortion%worst_element > 0) &
+      summary%worst_corner_jacobian_element = model%solid_ids(plan%distortion%worst_element)
   end subroutine run_explicit
 
   !> a = (f_ext - f_int) / m, and for the rotations of shell nodes alpha = -m_int / I;

@@ -16,6 +16,7 @@ module run_output
   use efg_forces, only: efg_point_results, transform_to_physical
   use results_file, only: results_file_t, write_state, write_histories
   use rigid_bodies, only: rigid_body_history_row
+  use distortion_check, only: distortion_t, check_solid_distortion
   implicit none
   private
 
@@ -49,6 +50,7 @@ module run_output
     real(wp), allocatable :: generalized_velocity(:, :) !< integer-step solver velocities (work array)
     real(wp), allocatable :: node_acceleration(:, :) !< physical accelerations (nodout)
     real(wp), allocatable :: part_kinetic(:), part_internal(:), part_hourglass(:)
+    type(distortion_t) :: distortion             !< FE solids folded at a corner, checked at each state
   end type output_plan_t
 
   character(len=32), parameter :: glstat_columns(12) = [character(len=32) :: "time", "time_step", &
@@ -246,6 +248,7 @@ contains
     if (clock_due(plan%rcforc, state%time, last)) call record_contact_forces(state, plan, histories)
     if (clock_due(plan%rbdout, state%time, last)) call record_rigid_bodies(model, state, plan, histories)
     if (states_due) then
+      call check_solid_distortion(model, state%blocks, state%coordinates, state%time, plan%distortion)
       call write_current_state(model, state, plan, results, error)
       if (allocated(error)) return
       call write_histories(results, histories, error)
