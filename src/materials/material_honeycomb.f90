@@ -112,12 +112,16 @@ contains
     shear = youngs_modulus/(2.0_wp*(1.0_wp + poissons_ratio))
     bulk = youngs_modulus/(3.0_wp*(1.0_wp - 2.0_wp*poissons_ratio))
     compacted_moduli = [youngs_modulus, youngs_modulus, youngs_modulus, shear, shear, shear]
-    ! a trial stress below the least the yield curve reaches (the abscissae are >= 0) is inside
-    ! the yield surface whatever the strain: most points of a barrier, away from the crush
-    ! zone, then need no curve evaluation
-    do k = 1, 6
-      least_yield(k) = smallest_magnitude_from(yield_curves(k), 0.0_wp)
-    end do
+    ! a trial stress below the least the yield curve reaches is inside the yield surface
+    ! whatever the strain: most points of a barrier, away from the crush zone, then need no
+    ! curve evaluation. *MAT_126's abscissae (strain magnitudes) are >= 0; *MAT_026's volumetric
+    ! strain is negative in expansion, where the curve is extrapolated: no bound there.
+    least_yield = 0.0_wp
+    if (modified) then
+      do k = 1, 6
+        least_yield(k) = smallest_magnitude_from(yield_curves(k), 0.0_wp)
+      end do
+    end if
 
     do i = 1, nel
       ! rows of `axes` are a, b, c (element by element: the history row is strided)

@@ -4,7 +4,7 @@
 !> The check warns whenever the number of such elements has grown since its last warning, names
 !> the worst element, and keeps the worst ratio of the run for `/run` in results.h5.
 module distortion_check
-  use kinds, only: wp, block_size
+  use kinds, only: wp
   use model, only: model_t
   use solid_block, only: solid_block_t
   use hex8_quality, only: corner_jacobian_ratio

@@ -34,6 +34,7 @@ program test_materials
   call test_cowper_symonds_viscoplastic()
   call test_back_stress_rotation()
   call test_honeycomb_axes_crush()
+  call test_honeycomb_026_expansion()
   call test_honeycomb_compaction_and_unloading()
   call test_honeycomb_shear_uncoupled()
   call test_modified_honeycomb_strain_abscissa()
@@ -434,6 +435,27 @@ contains
 
   !> Unloading before compaction with E_aa(V); past VF the compacted moduli (uniaxial strain:
   !> K + 4G/3 on the crushed axis, lambda on the others).
+  !> *MAT_026 in expansion: the abscissa 1 - V/V0 is negative and the yield curve is extrapolated
+  !> below its first point, to values under the curve's least from 0 (the honeycomb's shortcut
+  !> for trial stresses below that least must not apply here).
+  subroutine test_honeycomb_026_expansion()
+    type(material_t) :: material
+    real(wp) :: stress(block_size, 6), history(block_size, 23), local(6), increment(6), expected
+    integer :: step
+    material = honeycomb(law_honeycomb)
+    stress = 0.0_wp
+    call initialize_material_history(material, 1, history)
+    increment = global_increment([1.0e-4_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp])
+    do step = 1, 2000       ! to V/V0 = exp(0.2): abscissa -0.22, curve 1 extrapolated to 0.927
+      call honeycomb_step(material, increment, stress, history)
+    end do
+    local = local_stress(stress(1, :))
+    expected = curve_value(material%curves(1), 1.0_wp - exp(history(1, honeycomb_log_volume_slot)))
+    call check(suite, "honeycomb 026: in expansion sigma_aa follows the extrapolated curve", &
+               abs(local(1) - expected) < 1.0e-12_wp .and. expected < 0.95_wp, &
+               "sigma_aa "//real_image(local(1))//", curve "//real_image(expected))
+  end subroutine test_honeycomb_026_expansion
+
   subroutine test_honeycomb_compaction_and_unloading()
     type(material_t) :: material
     real(wp) :: stress(block_size, 6), history(block_size, 23), increment(6), before(6), after(6)
