@@ -9,7 +9,7 @@ module element_forces
   use solid_block, only: compute_solid_block
   use shell_block, only: shell_block_t, compute_shell_block
   use explicit_state, only: explicit_state_t
-  use efg_forces, only: compute_efg_forces, add_efg_forces
+  use efg_forces, only: compute_efg_forces
   implicit none
   private
 
@@ -110,8 +110,7 @@ contains
     integer :: k
     do k = 1, size(state%efg)
       call compute_efg_forces(model%materials(state%efg(k)%geometry%material), state%efg(k), &
-                              state%displacement, state%velocity, dt)
-      call add_efg_forces(state%efg(k), state%internal_force)
+                              state%displacement, state%velocity, dt, state%internal_force)
     end do
   end subroutine compute_meshfree_forces
 
