@@ -165,7 +165,7 @@ contains
   subroutine compute_efg_forces(material, solver, displacement, velocity, dt, internal_force)
     type(material_t), intent(in) :: material
     type(efg_solver_t), intent(inout) :: solver
-    real(wp), intent(in) :: displacement(:, :), velocity(:, :)
+    real(wp), intent(in), contiguous :: displacement(:, :), velocity(:, :)
     real(wp), intent(in) :: dt
     real(wp), intent(inout), contiguous :: internal_force(:, :)
     integer :: colour, k, b
@@ -218,7 +218,7 @@ contains
     real(wp), intent(in) :: point_cell_volume(:)
     real(wp), intent(in) :: density, bulk_quadratic, bulk_linear
     type(efg_block_t), intent(inout) :: block
-    real(wp), intent(in) :: displacement(:, :), velocity(:, :)
+    real(wp), intent(in), contiguous :: displacement(:, :), velocity(:, :)
     real(wp), intent(in) :: dt
     real(wp), intent(inout), contiguous :: point_stress(:, :)
     real(wp), intent(out) :: critical_time_step
@@ -303,7 +303,8 @@ contains
                               mid_jacobian, gradient)
     type(efg_part_t), intent(in) :: geometry
     integer, intent(in) :: g
-    real(wp), intent(in) :: displacement(:, :), velocity(:, :), dt
+    real(wp), intent(in), contiguous :: displacement(:, :), velocity(:, :)
+    real(wp), intent(in) :: dt
     real(wp), intent(out) :: deformation(3, 3), rate(3, 3), jacobian, mid_jacobian, gradient(9)
     real(wp) :: middle(3, 3), inverse(3, 3), velocity_gradient(3, 3)
     real(wp) :: f11, f21, f31, f12, f22, f32, f13, f23, f33
