@@ -27,7 +27,7 @@
 module efg_forces
   use kinds, only: wp, block_size
   use gather_list, only: gather_list_t
-  use block_colouring, only: colour_blocks_by_nodes
+  use block_colouring, only: colour_blocks_by_node_lists
   use model, only: model_t, material_t
   use efg_part, only: efg_part_t
   use material_dispatch, only: material_history_count, initialize_material_history, update_material_block, &
@@ -112,30 +112,31 @@ contains
     call colour_efg_blocks(size(model%node_ids), solver)
   end subroutine set_up_efg_solver
 
-  !> Colours the blocks by the nodes of their points' pairs (the shared greedy colouring; a
-  !> point's node list is padded to the longest with its first node, which changes nothing).
+  !> Colours the blocks by the nodes of their points' pairs (each node listed once per block).
   subroutine colour_efg_blocks(node_count, solver)
     integer, intent(in) :: node_count
     type(efg_solver_t), intent(inout) :: solver
-    integer, allocatable :: block_nodes(:, :, :), point_count(:)
-    integer :: b, i, g, first, last, most_pairs
-    associate (offsets => solver%geometry%point_offsets, pair_node => solver%geometry%pair_node)
-      most_pairs = max(1, maxval(offsets(2:) - offsets(:size(offsets) - 1)))
-      allocate (block_nodes(block_size, most_pairs, size(solver%blocks)), point_count(size(solver%blocks)))
-      block_nodes = 1
+    integer, allocatable :: offsets(:), block_nodes(:), listed_by(:)
+    integer :: b, k, node, count
+    associate (geometry => solver%geometry)
+      allocate (offsets(size(solver%blocks) + 1), block_nodes(size(geometry%pair_node)), listed_by(node_count))
+      listed_by = 0
+      count = 0
       do b = 1, size(solver%blocks)
-        point_count(b) = solver%blocks(b)%point_count
-        do i = 1, point_count(b)
-          g = solver%blocks(b)%first_point + i - 1
-          first = offsets(g)
-          last = offsets(g + 1) - 1
-          if (last < first) cycle
-          block_nodes(i, :, b) = pair_node(first)
-          block_nodes(i, 1:last - first + 1, b) = pair_node(first:last)
-        end do
+        offsets(b) = count + 1
+        associate (first_point => solver%blocks(b)%first_point, point_count => solver%blocks(b)%point_count)
+          do k = geometry%point_offsets(first_point), geometry%point_offsets(first_point + point_count) - 1
+            node = geometry%pair_node(k)
+            if (listed_by(node) == b) cycle
+            listed_by(node) = b
+            count = count + 1
+            block_nodes(count) = node
+          end do
+        end associate
       end do
+      offsets(size(solver%blocks) + 1) = count + 1
     end associate
-    call colour_blocks_by_nodes(node_count, block_nodes, point_count, solver%block_colours)
+    call colour_blocks_by_node_lists(node_count, offsets, block_nodes(1:count), solver%block_colours)
   end subroutine colour_efg_blocks
 
   !> The reference volume of each point's background cell: the sum of the volumes of the

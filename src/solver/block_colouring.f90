@@ -6,7 +6,7 @@ module block_colouring
   implicit none
   private
 
-  public :: colour_blocks_by_nodes
+  public :: colour_blocks_by_nodes, colour_blocks_by_node_lists
 
 contains
 
@@ -20,7 +20,7 @@ contains
     integer, intent(in) :: element_count(:)
     type(gather_list_t), intent(out) :: colours
     type(gather_list_t) :: node_blocks
-    integer, allocatable :: slot_node(:), colour(:), taken_by(:), count_of(:), blocks(:)
+    integer, allocatable :: slot_node(:), colour(:), taken_by(:)
     integer :: block_count, corner_count, slots_per_block, b, corner, lane, node, k, other, chosen, colour_count
 
     block_count = size(block_nodes, 3)
@@ -59,6 +59,55 @@ contains
       colour_count = max(colour_count, chosen)
     end do
 
+    call list_blocks_by_colour(colour, colour_count, colours)
+  end subroutine colour_blocks_by_nodes
+
+  !> The same greedy colouring for blocks given as node lists: the nodes of block b are
+  !> block_nodes(offsets(b) : offsets(b+1)-1), each once. Meshfree blocks touch hundreds of
+  !> nodes through their points' pairs, and a node a few hundred pairs: listing each node once
+  !> per block keeps the colouring linear in the number of (block, node) incidences.
+  subroutine colour_blocks_by_node_lists(node_count, offsets, block_nodes, colours)
+    integer, intent(in) :: node_count
+    integer, intent(in) :: offsets(:), block_nodes(:)
+    type(gather_list_t), intent(out) :: colours
+    type(gather_list_t) :: node_blocks
+    integer, allocatable :: slot_block(:), colour(:), taken_by(:)
+    integer :: block_count, b, k, slot, other, chosen, colour_count
+
+    block_count = size(offsets) - 1
+    allocate (slot_block(size(block_nodes)))
+    do b = 1, block_count
+      slot_block(offsets(b):offsets(b + 1) - 1) = b
+    end do
+    call build_gather_list(node_count, block_nodes, node_blocks)
+
+    allocate (colour(block_count), taken_by(block_count + 1))
+    taken_by = 0
+    colour_count = 0
+    do b = 1, block_count
+      do slot = offsets(b), offsets(b + 1) - 1
+        do k = node_blocks%offsets(block_nodes(slot)), node_blocks%offsets(block_nodes(slot) + 1) - 1
+          other = slot_block(node_blocks%corners(k))
+          if (other < b) taken_by(colour(other)) = b
+        end do
+      end do
+      chosen = 1
+      do while (taken_by(chosen) == b)
+        chosen = chosen + 1
+      end do
+      colour(b) = chosen
+      colour_count = max(colour_count, chosen)
+    end do
+    call list_blocks_by_colour(colour, colour_count, colours)
+  end subroutine colour_blocks_by_node_lists
+
+  !> colour -> blocks as a CSR list, blocks in index order within a colour.
+  subroutine list_blocks_by_colour(colour, colour_count, colours)
+    integer, intent(in) :: colour(:), colour_count
+    type(gather_list_t), intent(out) :: colours
+    integer, allocatable :: count_of(:), blocks(:)
+    integer :: block_count, b, k
+    block_count = size(colour)
     allocate (count_of(colour_count + 1), blocks(block_count))
     count_of = 0
     do b = 1, block_count
@@ -74,5 +123,5 @@ contains
       count_of(colour(b)) = count_of(colour(b)) + 1
     end do
     call move_alloc(blocks, colours%corners)
-  end subroutine colour_blocks_by_nodes
+  end subroutine list_blocks_by_colour
 end module block_colouring

@@ -18,6 +18,7 @@ program test_efg
                    integration_gauss_conventional, law_elastic
   use efg_part, only: efg_part_t
   use efg_setup, only: build_efg_part
+  use efg_forces, only: efg_solver_t, set_up_efg_solver
   use efg_kernel, only: cubic_spline, kernel_weight, kernel_weight_gradient
   use efg_supports, only: part_supports_t, build_part_supports
   use efg_neighbour_search, only: particle_grid_t, build_particle_grid, find_covering_particles
@@ -376,6 +377,7 @@ contains
     call check(suite, "4x4x4 block: 512 points, 125 mass nodes, 27 transformation rows", &
                size(efg%point_volume) == 512 .and. size(efg%mass_node) == 125 .and. &
                size(efg%transform_offsets) == 28)
+    call check_block_colours(model, efg, "4x4x4 block")
 
     ! one cell thick: no particle, FE in disguise with sub-cell integration
     call build_block(block_of([4, 3, 1]), kernel_cubic_box, 1.5_wp, boundary_coupled, integration_local_boundary, model)
@@ -393,6 +395,44 @@ contains
     call check(suite, "IEBT 1: every node is a particle", .not. allocated(error) .and. size(efg%particles) == 64 &
                .and. size(efg%gamma_nodes) == 0)
   end subroutine test_node_classes
+
+  !> The force step's colouring of the point blocks: every block once, and the blocks of one
+  !> colour share no node of their points' pairs (they add into the nodal forces in parallel).
+  subroutine check_block_colours(model, efg, name)
+    type(model_t), intent(in) :: model
+    type(efg_part_t), intent(in) :: efg
+    character(len=*), intent(in) :: name
+    type(efg_solver_t) :: solver
+    integer, allocatable :: touched_by(:), times_listed(:)
+    integer :: colour, k, b, pair, node
+    logical :: disjoint
+    character(len=80) :: detail
+    call set_up_efg_solver(model, efg, solver)
+    allocate (touched_by(size(model%node_ids)), times_listed(size(solver%blocks)))
+    touched_by = 0
+    times_listed = 0
+    disjoint = .true.
+    associate (colours => solver%block_colours)
+      do colour = 1, size(colours%offsets) - 1
+        do k = colours%offsets(colour), colours%offsets(colour + 1) - 1
+          b = colours%corners(k)
+          times_listed(b) = times_listed(b) + 1
+          associate (first => solver%blocks(b)%first_point, count => solver%blocks(b)%point_count)
+            do pair = efg%point_offsets(first), efg%point_offsets(first + count) - 1
+              node = efg%pair_node(pair)
+              ! a node met in another block of this colour: 1000 colour + block marks it
+              if (touched_by(node) /= 0 .and. touched_by(node) /= 1000*colour + b .and. &
+                  touched_by(node)/1000 == colour) disjoint = .false.
+              touched_by(node) = 1000*colour + b
+            end do
+          end associate
+        end do
+      end do
+      write (detail, '(a,i0,a,i0)') "blocks ", size(solver%blocks), " colours ", size(colours%offsets) - 1
+    end associate
+    call check(suite, "point blocks coloured (each once, no node shared within a colour), "//name, &
+               disjoint .and. all(times_listed == 1) .and. size(solver%blocks) > 1, trim(detail))
+  end subroutine check_block_colours
 
   ! ----------------------------------------------------------------------------------------
   ! properties 1-3 of the shape functions
