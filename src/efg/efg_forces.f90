@@ -14,7 +14,10 @@
 !> blocks are coloured so that the blocks of one colour share no node (as the finite element
 !> blocks, see element_forces): the blocks of a colour run in parallel, colours one after
 !> another, so each node receives its contributions in a fixed order (colour, point, pair) and
-!> the sum is bit-identical for any number of threads. `d` is the solver's nodal displacement:
+!> the sum is bit-identical for any number of threads. A small part has colours of one or two
+!> blocks, which would leave threads idle: with several threads, the blocks of colours smaller
+!> than twice the thread count are computed first, all in parallel, and only add their forces
+!> in the colour loop (the order at each node is the same, so are the results). `d` is the solver's nodal displacement:
 !> physical at Gamma nodes, generalized at interior particles.
 !>
 !> Internal energy is the work of the point forces, integrated as central differences
@@ -35,6 +38,7 @@ module efg_forces
   use objective_rotation, only: incremental_rotation, rotate_symmetric_tensors
   use hex8_geometry, only: deformation_increments
   use element_time_step, only: bulk_viscosity_pressure, solid_element_time_steps
+  !$ use omp_lib, only: omp_get_max_threads
   implicit none
   private
 
@@ -169,21 +173,54 @@ contains
     real(wp), intent(in), contiguous :: displacement(:, :), velocity(:, :)
     real(wp), intent(in) :: dt
     real(wp), intent(inout), contiguous :: internal_force(:, :)
-    integer :: colour, k, b
-    do colour = 1, size(solver%block_colours%offsets) - 1
-      !$omp parallel do schedule(dynamic, 1) default(shared) private(k, b)
-      do k = solver%block_colours%offsets(colour), solver%block_colours%offsets(colour + 1) - 1
-        b = solver%block_colours%corners(k)
-        call compute_efg_block(material, solver%geometry, solver%point_cell_volume, solver%density, &
-                               solver%bulk_quadratic, solver%bulk_linear, solver%blocks(b), displacement, velocity, &
-                               dt, solver%point_stress, &
-                               solver%block_time_step(b), solver%block_critical_point(b), &
-                               solver%block_inverted_point(b))
-        call add_block_forces(solver%geometry, solver%blocks(b), solver%point_stress, internal_force)
+    integer :: colour, k, b, threads
+    logical :: fused
+    threads = 1
+    !$ threads = omp_get_max_threads()
+    associate (colours => solver%block_colours)
+      if (threads > 1) then
+        ! the blocks of the small colours, all together (a thread moves on to the next colour
+        ! without waiting)
+        !$omp parallel default(shared) private(colour, k, b)
+        do colour = 1, size(colours%offsets) - 1
+          if (runs_fused(colours%offsets, colour, threads)) cycle
+          !$omp do schedule(dynamic, 1)
+          do k = colours%offsets(colour), colours%offsets(colour + 1) - 1
+            b = colours%corners(k)
+            call compute_efg_block(material, solver%geometry, solver%point_cell_volume, solver%density, &
+                                   solver%bulk_quadratic, solver%bulk_linear, solver%blocks(b), displacement, &
+                                   velocity, dt, solver%point_stress, solver%block_time_step(b), &
+                                   solver%block_critical_point(b), solver%block_inverted_point(b))
+          end do
+          !$omp end do nowait
+        end do
+        !$omp end parallel
+      end if
+      do colour = 1, size(colours%offsets) - 1
+        fused = runs_fused(colours%offsets, colour, threads)
+        !$omp parallel do schedule(dynamic, 1) default(shared) private(k, b)
+        do k = colours%offsets(colour), colours%offsets(colour + 1) - 1
+          b = colours%corners(k)
+          if (fused) then
+            call compute_efg_block(material, solver%geometry, solver%point_cell_volume, solver%density, &
+                                   solver%bulk_quadratic, solver%bulk_linear, solver%blocks(b), displacement, &
+                                   velocity, dt, solver%point_stress, solver%block_time_step(b), &
+                                   solver%block_critical_point(b), solver%block_inverted_point(b))
+          end if
+          call add_block_forces(solver%geometry, solver%blocks(b), solver%point_stress, internal_force)
+        end do
+        !$omp end parallel do
       end do
-      !$omp end parallel do
-    end do
+    end associate
   end subroutine compute_efg_forces
+
+  !> Whether the blocks of a colour compute their stresses in the colour loop, just before
+  !> adding their forces: always with one thread, with more when the colour has at least two
+  !> blocks per thread.
+  pure logical function runs_fused(offsets, colour, threads)
+    integer, intent(in) :: offsets(:), colour, threads
+    runs_fused = threads == 1 .or. offsets(colour + 1) - offsets(colour) >= 2*threads
+  end function runs_fused
 
   !> internal_force(:, node) += (W P)_g bbar for every pair of the block's points, point by
   !> point, pair by pair (a node appears once among a point's pairs).
