@@ -17,8 +17,8 @@
 !> the sum is bit-identical for any number of threads. A small part has colours of one or two
 !> blocks, which would leave threads idle: with several threads, the blocks of colours smaller
 !> than twice the thread count are computed first, all in parallel, and only add their forces
-!> in the colour loop (the order at each node is the same, so are the results). `d` is the solver's nodal displacement:
-!> physical at Gamma nodes, generalized at interior particles.
+!> in the colour loop (the order at each node is the same, so are the results). `d` is the
+!> solver's nodal displacement: physical at Gamma nodes, generalized at interior particles.
 !>
 !> Internal energy is the work of the point forces, integrated as central differences
 !> integrate the kinetic energy 1/2 m v(n-1/2) . v(n+1/2) (the finite elements do the same, see
