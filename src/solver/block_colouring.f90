@@ -1,7 +1,6 @@
 !> Colouring of element blocks for the race-free force assembly: blocks of one colour share no
 !> node, so their elements can add into the nodal forces in parallel, colour after colour.
 module block_colouring
-  use kinds, only: block_size
   use gather_list, only: gather_list_t, build_gather_list
   implicit none
   private
@@ -19,53 +18,32 @@ contains
     integer, intent(in) :: block_nodes(:, :, :)
     integer, intent(in) :: element_count(:)
     type(gather_list_t), intent(out) :: colours
-    type(gather_list_t) :: node_blocks
-    integer, allocatable :: slot_node(:), colour(:), taken_by(:)
-    integer :: block_count, corner_count, slots_per_block, b, corner, lane, node, k, other, chosen, colour_count
+    integer, allocatable :: offsets(:), listed(:)
+    integer :: block_count, b, corner, lane, count
 
+    ! every block as the list of its lanes' corner nodes (a node shared by lanes is listed more
+    ! than once, which the colouring tolerates: a hexahedral node has at most 8 elements)
     block_count = size(block_nodes, 3)
-    corner_count = size(block_nodes, 2)
-    slots_per_block = block_size*corner_count
-    ! node -> blocks touching it (a slot is one corner of one lane of one block)
-    allocate (slot_node(slots_per_block*block_count))
-    slot_node = 0
+    allocate (offsets(block_count + 1), listed(size(block_nodes)))
+    count = 0
     do b = 1, block_count
-      do corner = 1, corner_count
+      offsets(b) = count + 1
+      do corner = 1, size(block_nodes, 2)
         do lane = 1, element_count(b)
-          slot_node(lane + (corner - 1)*block_size + (b - 1)*slots_per_block) = block_nodes(lane, corner, b)
+          count = count + 1
+          listed(count) = block_nodes(lane, corner, b)
         end do
       end do
     end do
-    call build_gather_list(node_count, slot_node, node_blocks)
-
-    allocate (colour(block_count), taken_by(block_count + 1))
-    taken_by = 0
-    colour_count = 0
-    do b = 1, block_count
-      do corner = 1, corner_count
-        do lane = 1, element_count(b)
-          node = block_nodes(lane, corner, b)
-          do k = node_blocks%offsets(node), node_blocks%offsets(node + 1) - 1
-            other = (node_blocks%corners(k) - 1)/slots_per_block + 1
-            if (other < b) taken_by(colour(other)) = b
-          end do
-        end do
-      end do
-      chosen = 1
-      do while (taken_by(chosen) == b)
-        chosen = chosen + 1
-      end do
-      colour(b) = chosen
-      colour_count = max(colour_count, chosen)
-    end do
-
-    call list_blocks_by_colour(colour, colour_count, colours)
+    offsets(block_count + 1) = count + 1
+    call colour_blocks_by_node_lists(node_count, offsets, listed(1:count), colours)
   end subroutine colour_blocks_by_nodes
 
-  !> The same greedy colouring for blocks given as node lists: the nodes of block b are
-  !> block_nodes(offsets(b) : offsets(b+1)-1), each once. Meshfree blocks touch hundreds of
-  !> nodes through their points' pairs, and a node a few hundred pairs: listing each node once
-  !> per block keeps the colouring linear in the number of (block, node) incidences.
+  !> The greedy colouring for blocks given as node lists: the nodes of block b are
+  !> block_nodes(offsets(b) : offsets(b+1)-1). A node listed twice in a block only costs time:
+  !> meshfree blocks touch hundreds of nodes through their points' pairs, and a node a few
+  !> hundred pairs, so they list each node once per block (linear in the (block, node)
+  !> incidences).
   subroutine colour_blocks_by_node_lists(node_count, offsets, block_nodes, colours)
     integer, intent(in) :: node_count
     integer, intent(in) :: offsets(:), block_nodes(:)

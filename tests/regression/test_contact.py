@@ -132,18 +132,19 @@ def base_top_segments(set_id):
     return "\n".join(lines)
 
 
-def sliding_deck(path, kind="surface_to_surface"):
+def base_and_slider_deck(path, title, slider, end_time, glstat, d3plot, speed, cards):
+    """The fixed 60 x 20 x 5 mm base (part 1, top face at z = 0) and a slider (part 2, the
+    (nodes, elements) of `slider`) moving at `speed` along x; `cards` (loads, contact) go
+    between the initial velocity and the mesh."""
     base_nodes, base_elements = block_mesh((6, 4, 1), (60.0, 20.0, 5.0), origin=(-10.0, -5.0, -5.0))
-    slider_nodes, slider_elements = block_mesh((3, 3, 2), (SIDE, SIDE, 5.0))
+    slider_nodes, slider_elements = slider
     count = len(base_nodes)
-    slider_mass = nodal_masses(slider_nodes, slider_elements).sum()
-    per_node = slider_mass * GRAVITY / len(slider_nodes)
     return write_deck(
         path,
-        "*TITLE\nblock sliding with friction",
-        "*CONTROL_TERMINATION\n" + fields(0.2),
-        "*DATABASE_GLSTAT\n" + fields(0.002),
-        "*DATABASE_BINARY_D3PLOT\n" + fields(0.01),
+        "*TITLE\n" + title,
+        "*CONTROL_TERMINATION\n" + fields(end_time),
+        "*DATABASE_GLSTAT\n" + fields(glstat),
+        "*DATABASE_BINARY_D3PLOT\n" + fields(d3plot),
         "*PART\nbase\n" + fields(1, 1, 1),
         "*PART\nslider\n" + fields(2, 1, 1),
         "*SECTION_SOLID\n" + fields(1, 1),
@@ -151,18 +152,28 @@ def sliding_deck(path, kind="surface_to_surface"):
         node_list_set(1, list(range(1, count + 1))),
         node_list_set(2, list(range(count + 1, count + len(slider_nodes) + 1))),
         "*BOUNDARY_SPC_SET\n" + fields(1, 0, 1, 1, 1),
-        "*INITIAL_VELOCITY\n" + fields(2) + "\n" + fields(SPEED, 0.0, 0.0),
-        "*DEFINE_CURVE\n" + fields(1) + "\n" + fields(0.0, 1.0, width=20) + "\n" + fields(10.0, 1.0, width=20),
-        "*LOAD_NODE_SET\n" + fields(2, 3, 1, -per_node),
-        {"surface_to_surface": "*CONTACT_AUTOMATIC_SURFACE_TO_SURFACE\n" + fields(2, 1, 3, 3),
-         "nodes_to_surface": base_top_segments(7) + "\n*CONTACT_AUTOMATIC_NODES_TO_SURFACE\n" + fields(2, 7, 4, 0),
-         "single_surface": "*CONTACT_AUTOMATIC_SINGLE_SURFACE\n" + fields(0, 0, 5)}[kind] + "\n" +
-        fields(FRICTION, FRICTION, 0.0, 0.0, 20.0) + "\n" + fields(1.0),
+        "*INITIAL_VELOCITY\n" + fields(2) + "\n" + fields(speed, 0.0, 0.0),
+        *cards,
         nodes_card(np.vstack([base_nodes, slider_nodes])),
         solids_card(base_elements, part_id=1) + "\n" +
         "\n".join(solids_card(slider_elements, part_id=2, first_id=len(base_elements) + 1,
                               first_node_id=count + 1).splitlines()[1:]),
-    ), count, nodal_masses(slider_nodes, slider_elements)
+    ), count
+
+
+def sliding_deck(path, kind="surface_to_surface"):
+    slider_nodes, slider_elements = block_mesh((3, 3, 2), (SIDE, SIDE, 5.0))
+    slider_mass = nodal_masses(slider_nodes, slider_elements).sum()
+    per_node = slider_mass * GRAVITY / len(slider_nodes)
+    deck, count = base_and_slider_deck(
+        path, "block sliding with friction", (slider_nodes, slider_elements), 0.2, 0.002, 0.01, SPEED,
+        ["*DEFINE_CURVE\n" + fields(1) + "\n" + fields(0.0, 1.0, width=20) + "\n" + fields(10.0, 1.0, width=20),
+         "*LOAD_NODE_SET\n" + fields(2, 3, 1, -per_node),
+         {"surface_to_surface": "*CONTACT_AUTOMATIC_SURFACE_TO_SURFACE\n" + fields(2, 1, 3, 3),
+          "nodes_to_surface": base_top_segments(7) + "\n*CONTACT_AUTOMATIC_NODES_TO_SURFACE\n" + fields(2, 7, 4, 0),
+          "single_surface": "*CONTACT_AUTOMATIC_SINGLE_SURFACE\n" + fields(0, 0, 5)}[kind] + "\n" +
+         fields(FRICTION, FRICTION, 0.0, 0.0, 20.0) + "\n" + fields(1.0)])
+    return deck, count, nodal_masses(slider_nodes, slider_elements)
 
 
 @pytest.mark.parametrize("kind", ["surface_to_surface", "nodes_to_surface", "single_surface"])
@@ -219,31 +230,13 @@ def test_node_arriving_under_a_segment_from_its_edge_is_not_pushed_out(tmp_path,
     with no approach along the normal. That is not a contact; pushing them out (a 2 mm spring at
     once) would throw the slider upward. Before the rule, the contact gave the 4.9 J slider
     848 J and the run stopped with a negative volume."""
-    base_nodes, base_elements = block_mesh((6, 4, 1), (60.0, 20.0, 5.0), origin=(-10.0, -5.0, -5.0))
-    slider_nodes, slider_elements = block_mesh((2, 2, 2), (SIDE, SIDE, 5.0), origin=(-25.0, 0.0, -2.0))
-    count = len(base_nodes)
     speed, end_time = 50.0, 0.4
-    deck = write_deck(
-        tmp_path / "edge_entry.k",
-        "*TITLE\nslider entering under the contact surface from its edge",
-        "*CONTROL_TERMINATION\n" + fields(end_time),
-        "*DATABASE_GLSTAT\n" + fields(end_time / 100),
-        "*DATABASE_BINARY_D3PLOT\n" + fields(end_time / 4),
-        "*PART\nbase\n" + fields(1, 1, 1),
-        "*PART\nslider\n" + fields(2, 1, 1),
-        "*SECTION_SOLID\n" + fields(1, 1),
-        "*MAT_ELASTIC\n" + fields(1, DENSITY, MODULUS, POISSON),
-        node_list_set(1, list(range(1, count + 1))),
-        node_list_set(2, list(range(count + 1, count + len(slider_nodes) + 1))),
-        "*BOUNDARY_SPC_SET\n" + fields(1, 0, 1, 1, 1),
-        "*INITIAL_VELOCITY\n" + fields(2) + "\n" + fields(speed, 0.0, 0.0),
-        base_top_segments(7) + "\n*CONTACT_AUTOMATIC_NODES_TO_SURFACE\n" + fields(2, 7, 4, 0) + "\n" +
-        fields(0.0) + "\n" + fields(1.0),
-        nodes_card(np.vstack([base_nodes, slider_nodes])),
-        solids_card(base_elements, part_id=1) + "\n" +
-        "\n".join(solids_card(slider_elements, part_id=2, first_id=len(base_elements) + 1,
-                              first_node_id=count + 1).splitlines()[1:]),
-    )
+    deck, count = base_and_slider_deck(
+        tmp_path / "edge_entry.k", "slider entering under the contact surface from its edge",
+        block_mesh((2, 2, 2), (SIDE, SIDE, 5.0), origin=(-25.0, 0.0, -2.0)), end_time, end_time / 100,
+        end_time / 4, speed,
+        [base_top_segments(7) + "\n*CONTACT_AUTOMATIC_NODES_TO_SURFACE\n" + fields(2, 7, 4, 0) + "\n" +
+         fields(0.0) + "\n" + fields(1.0)])
     run = run_deck(deck)
     assert run.status == 0, run.stderr
     with run.open() as results:
