@@ -1,6 +1,7 @@
 !> Energies of the whole model and of each part (glstat, matsum), summed in a fixed order.
 module energy_balance
   use kinds, only: wp, block_size
+  use fixed_order_sum, only: sum_chunk_size, chunk_count
   use model, only: model_t
   use explicit_state, only: explicit_state_t
   use rigid_bodies, only: rigid_body_energy
@@ -8,10 +9,6 @@ module energy_balance
   private
 
   public :: update_energy_totals, part_energies, total_energy, energy_ratio
-
-  !> Nodes per partial sum of the kinetic energy: partial sums over fixed chunks, added in
-  !> chunk order, keep the result independent of the thread count.
-  integer, parameter :: chunk_size = 4096
 
 contains
 
@@ -26,20 +23,19 @@ contains
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(inout) :: state
     real(wp) :: body_kinetic, body_momentum(3), body_angular_momentum(3), body_velocity(3)
-    integer :: chunk_count, chunk, first, last, node, b, k
-    real(wp) :: partial(4, max(1, (state%node_count + chunk_size - 1)/chunk_size)), velocity(3), next_velocity(3)
+    integer :: chunk, first, last, node, b, k
+    real(wp) :: partial(4, chunk_count(state%node_count)), velocity(3), next_velocity(3)
     real(wp) :: half_step, average_step, step_correction
 
-    chunk_count = (state%node_count + chunk_size - 1)/chunk_size
     half_step = 0.5_wp*state%time_step
     average_step = 0.5_wp*(state%time_step + state%next_time_step)
     ! the elements book the newest forces' work with the step just taken; the kinetic energy
     ! above uses the mean of that step and the next (see solid_block)
     step_correction = 0.25_wp*(state%next_time_step - state%time_step)
     !$omp parallel do schedule(static) default(shared) private(chunk, first, last, node, velocity, next_velocity)
-    do chunk = 1, chunk_count
-      first = (chunk - 1)*chunk_size + 1
-      last = min(chunk*chunk_size, state%node_count)
+    do chunk = 1, size(partial, 2)
+      first = (chunk - 1)*sum_chunk_size + 1
+      last = min(chunk*sum_chunk_size, state%node_count)
       partial(:, chunk) = 0.0_wp
       do node = first, last
         if (state%is_rigid_node(node)) cycle   ! moves with its body (below)
@@ -57,7 +53,7 @@ contains
     !$omp end parallel do
     state%energy%kinetic = 0.0_wp
     state%energy%momentum = 0.0_wp
-    do chunk = 1, chunk_count
+    do chunk = 1, size(partial, 2)
       state%energy%kinetic = state%energy%kinetic + 0.5_wp*partial(1, chunk)
       state%energy%momentum = state%energy%momentum + partial(2:4, chunk)
     end do

@@ -3,6 +3,7 @@
 !> external loads -> accelerations -> next time step -> output.
 module explicit_solver
   use kinds, only: wp
+  use fixed_order_sum, only: sum_chunk_size, chunk_count, sum_in_order
   use error_handling, only: error_t, make_error
   use model, only: model_t
   use explicit_state, only: explicit_state_t
@@ -213,25 +214,30 @@ contains
     real(wp), intent(out) :: work
     real(wp), parameter :: coplanar = 0.94_wp   ! cos 20 degrees
     real(wp) :: normal(3), length, drilling, previous(3)
-    integer :: node
-    work = 0.0_wp
-    !$omp parallel do schedule(static) default(shared) private(node, normal, length, drilling, previous) &
-    !$omp& reduction(+:work)
-    do node = 1, state%node_count
-      if (state%rotary_inertia(node) <= 0.0_wp .or. state%shell_area_sum(node) <= 0.0_wp) cycle
-      length = norm2(state%shell_normal_sum(:, node))
-      if (length < coplanar*state%shell_area_sum(node)) cycle
-      ! within the rotations an SPC leaves free (fixed ones stay zero)
-      normal = merge(0.0_wp, state%shell_normal_sum(:, node)/length, state%fixed_rotation(:, node))
-      length = dot_product(normal, normal)
-      if (length < 0.25_wp) cycle
-      normal = normal/sqrt(length)
-      drilling = dot_product(state%angular_velocity(:, node), normal)
-      previous = state%angular_velocity(:, node) - average_step*state%angular_acceleration(:, node)
-      state%angular_velocity(:, node) = state%angular_velocity(:, node) - drilling*normal
-      work = work - 0.5_wp*state%rotary_inertia(node)*drilling*dot_product(previous, normal)
+    real(wp) :: partial(chunk_count(state%node_count))
+    integer :: node, chunk
+    ! the work is summed over fixed chunks of nodes, then chunk by chunk: the same sum for any
+    ! thread count (an OpenMP reduction would add in an order that depends on it)
+    !$omp parallel do schedule(static) default(shared) private(chunk, node, normal, length, drilling, previous)
+    do chunk = 1, size(partial)
+      partial(chunk) = 0.0_wp
+      do node = (chunk - 1)*sum_chunk_size + 1, min(chunk*sum_chunk_size, state%node_count)
+        if (state%rotary_inertia(node) <= 0.0_wp .or. state%shell_area_sum(node) <= 0.0_wp) cycle
+        length = norm2(state%shell_normal_sum(:, node))
+        if (length < coplanar*state%shell_area_sum(node)) cycle
+        ! within the rotations an SPC leaves free (fixed ones stay zero)
+        normal = merge(0.0_wp, state%shell_normal_sum(:, node)/length, state%fixed_rotation(:, node))
+        length = dot_product(normal, normal)
+        if (length < 0.25_wp) cycle
+        normal = normal/sqrt(length)
+        drilling = dot_product(state%angular_velocity(:, node), normal)
+        previous = state%angular_velocity(:, node) - average_step*state%angular_acceleration(:, node)
+        state%angular_velocity(:, node) = state%angular_velocity(:, node) - drilling*normal
+        partial(chunk) = partial(chunk) - 0.5_wp*state%rotary_inertia(node)*drilling*dot_product(previous, normal)
+      end do
     end do
     !$omp end parallel do
+    work = sum_in_order(partial)
   end subroutine remove_drilling_rates
 
   !> v^{n+1/2} = v^{n-1/2} + a^n (dt^{n-1/2} + dt^{n+1/2}) / 2, and the same for the angular
