@@ -53,13 +53,18 @@ contains
     flush (6)
   end subroutine report_progress
 
-  !> "1h 02m", "3m 05s", "12.3s".
+  !> "1h 02m", "3m 05s", "12.3s"; "> 100000h" for longer (or not finite) estimates, which a
+  !> collapsing time step gives and a default integer would overflow on.
   function format_duration(seconds) result(text)
     real(wp), intent(in) :: seconds
     character(len=:), allocatable :: text
     character(len=32) :: buffer
     integer :: whole
-    whole = int(seconds)
+    if (.not. (seconds < 3.6e8_wp)) then
+      text = "> 100000h"
+      return
+    end if
+    whole = int(max(seconds, 0.0_wp))
     if (seconds >= 3600.0_wp) then
       write (buffer, '(i0,"h ",i2.2,"m")') whole/3600, mod(whole, 3600)/60
     else if (seconds >= 60.0_wp) then

@@ -7,7 +7,7 @@ module deck_controls
   use deck_numbers, only: integer_text, real_text
   use deck_lexer, only: deck_t
   use deck_fields, only: card_t, next_line, require_card, get_integer, get_real, &
-                         card_problem, warn_if_set, line_title
+                         card_problem, warn_if_set, line_title, located_warning
   use deck_input, only: deck_input_t
   implicit none
   private
@@ -48,10 +48,20 @@ contains
     call get_integer(deck, card, 2, "ENDCYC", input%model%end_cycle, log)
     if (input%model%end_cycle < 0) call card_problem(deck, log, card, "ENDCYC", "must be "// &
       ">= 0 (0: no cycle limit), found "//integer_text(input%model%end_cycle))
-    call warn_if_set(deck, card, 3, "DTMIN", "the run does not stop on a small time step", &
-                     warnings)
-    call warn_if_set(deck, card, 4, "ENDENG", "the run does not stop on an energy change", &
-                     warnings)
+    call get_real(deck, card, 3, "DTMIN", input%model%minimum_time_step_factor, log)
+    call get_real(deck, card, 4, "ENDENG", input%model%energy_ratio_change_limit, log)
+    call get_real(deck, card, 5, "ENDMAS", input%model%mass_change_limit, log)
+    if (card%failed) return
+    if (input%model%minimum_time_step_factor < 0.0_wp) call card_problem(deck, log, card, "DTMIN", &
+      "must be >= 0 (a factor on the first time step; 0: off), found "//real_text(input%model%minimum_time_step_factor))
+    if (input%model%minimum_time_step_factor >= 1.0_wp) call card_problem(deck, log, card, "DTMIN", &
+      "must be below 1 (a factor on the first time step), found "//real_text(input%model%minimum_time_step_factor))
+    if (input%model%energy_ratio_change_limit < 0.0_wp) call card_problem(deck, log, card, "ENDENG", &
+      "must be >= 0 (percent; 0: off), found "//real_text(input%model%energy_ratio_change_limit))
+    ! LS-DYNA's ENDMAS default 1e8 percent: blank or 0 keeps it; a curve (ENDMAS < 0) is not read
+    if (input%model%mass_change_limit == 0.0_wp) input%model%mass_change_limit = 1.0e8_wp
+    if (input%model%mass_change_limit < 0.0_wp) call card_problem(deck, log, card, "ENDMAS", &
+      "a curve of the mass change (ENDMAS < 0) is not available; give a percentage")
     call warn_if_set(deck, card, 6, "NOSOL", "the solution always runs", warnings)
   end subroutine read_termination
 
@@ -81,6 +91,9 @@ contains
         "a time-step scale curve (TSSFAC < 0) is not available; give a factor > 0")
       if (limit_curve /= 0) call card_problem(deck, log, card, "LCTM", "a curve limiting "// &
         "the time step is not available; leave LCTM blank")
+      if (model%time_step_scale > 1.0_wp) call located_warning(deck, warnings, card%line, "TSSFAC", &
+        "a factor of "//real_text(model%time_step_scale)//" takes steps beyond the stable step of the elements: "// &
+        "the run is unstable unless their highest modes stay quiet (0.9, LS-DYNA's default, is safe)")
     end associate
     call warn_if_set(deck, card, 3, "ISDO", "shells only", warnings)
     call warn_if_set(deck, card, 4, "TSLIMT", "shells only", warnings)

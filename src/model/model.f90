@@ -342,6 +342,10 @@ module model
     logical :: implicit_static = .false.             !< *CONTROL_IMPLICIT_GENERAL IMFLAG = 1: linear static
     real(wp) :: end_time = 0.0_wp                    !< ENDTIM
     integer :: end_cycle = 0                         !< ENDCYC (0 = no limit)
+    real(wp) :: minimum_time_step_factor = 0.0_wp    !< DTMIN: stop below this times the first step (0: off)
+    real(wp) :: energy_ratio_change_limit = 0.0_wp   !< ENDENG: stop when |energy ratio - 1| exceeds this
+                                                     !< many percent (0: off)
+    real(wp) :: mass_change_limit = 1.0e8_wp         !< ENDMAS: percent of mass that mass scaling may add
     real(wp) :: time_step_scale = 0.9_wp             !< TSSFAC
     real(wp) :: initial_time_step = 0.0_wp           !< DTINIT (0 = computed)
     real(wp) :: mass_scaled_time_step = 0.0_wp       !< DT2MS (0 = no mass scaling)

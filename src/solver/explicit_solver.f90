@@ -15,6 +15,9 @@ module explicit_solver
   use rigid_bodies, only: advance_rigid_bodies
   use penalty_contact, only: compute_contact_forces, report_initial_penetrations
   use energy_balance, only: update_energy_totals, total_energy
+  use run_checks, only: set_up_run_checks, check_runaway_motion, check_elements, check_time_step, check_energy, &
+                        energy_check_interval
+  use stop_signals, only: received_stop_signal, progress_line_requested, signal_name
   use run_output, only: output_plan_t, plan_output, write_due_output
   use history_buffer, only: history_set_t
   use results_file, only: results_file_t
@@ -26,10 +29,15 @@ module explicit_solver
 
   public :: run_explicit
 
+  !> The timed phases of the loop (the run summary's columns).
+  integer, parameter :: phase_solids = 1, phase_shells = 2, phase_meshfree = 3, phase_contact = 4, &
+                        phase_output = 5, phase_count = 5
+
 contains
 
   !> Run from t = 0 to the end time (or end cycle). On a run-time error (inverted element,
-  !> non-finite state) the last state is written and `error` says what, where and when.
+  !> runaway motion, exploding energy, collapsing time step, a stop signal) the last state is
+  !> written and `error` says what, where and when.
   subroutine run_explicit(model, state, results, summary, error)
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(inout) :: state
@@ -39,34 +47,30 @@ contains
     type(history_set_t) :: histories
     type(output_plan_t) :: plan
     type(progress_t) :: progress
-    type(phase_timer_t) :: element_timer, shell_timer, meshfree_timer, output_timer, contact_timer
+    type(phase_timer_t) :: timers(phase_count)
     type(error_t), allocatable :: output_error
-    real(wp) :: previous_step, step, work, cylinder_work
+    real(wp) :: previous_step, step
     logical :: finished, wrote_state
 
     call plan_output(model, histories, plan)
 
-    ! cycle 0: forces and accelerations of the initial state
-    call start_phase(element_timer)
-    call compute_element_forces(model, state, 0.0_wp)
-    call stop_phase(element_timer)
-    call start_phase(shell_timer)
-    call compute_shell_forces(model, state, 0.0_wp)
-    call stop_phase(shell_timer)
-    call start_phase(meshfree_timer)
-    call compute_meshfree_forces(model, state, 0.0_wp)
-    call stop_phase(meshfree_timer)
-    call assemble_nodal_loads(model, 0.0_wp, state%external_force)
-    call compute_accelerations(state)
-    call hold_prescribed_accelerations(model, 0.0_wp, state%acceleration, state%free_acceleration)
-    call select_time_step(model, state, is_first=.true.)
-    call update_energy_totals(model, state)
-    state%energy%initial_total = total_energy(state)
-    call check_state(model, state, error)
+    ! cycle 0: forces and accelerations of the initial state (unless its motion is already
+    ! beyond any physical run, or mass scaling added more than ENDMAS allows)
+    call set_up_run_checks(model, state, error)
+    if (.not. allocated(error)) call check_runaway_motion(model, state, 0.0_wp, error)
+    if (.not. allocated(error)) then
+      call compute_forces(model, state, 0.0_wp, timers)
+      call compute_accelerations(state)
+      call hold_prescribed_accelerations(model, 0.0_wp, state%acceleration, state%free_acceleration)
+      call select_time_step(model, state, is_first=.true.)
+      call update_energy_totals(model, state)
+      state%energy%initial_total = total_energy(state)
+      call check_cycle(model, state, .true., error)
+    end if
     finished = allocated(error) .or. model%end_time <= 0.0_wp .and. model%end_cycle <= 0
-    call start_phase(output_timer)
+    call start_phase(timers(phase_output))
     call write_due_output(model, state, plan, histories, results, finished, wrote_state, output_error)
-    call stop_phase(output_timer)
+    call stop_phase(timers(phase_output))
     if (allocated(output_error)) then
       finished = .true.
       if (.not. allocated(error)) call move_alloc(output_error, error)
@@ -76,90 +80,148 @@ contains
 
     do while (.not. finished)
       step = state%next_time_step
-      ! velocities at the half step, then the supports and walls correct them
-      call update_velocities(state, 0.5_wp*(previous_step + step))
-      if (size(state%shells) > 0) then
-        call remove_drilling_rates(state, 0.5_wp*(previous_step + step), work)
-        state%energy%external_work = state%energy%external_work + work
+      call check_runaway_motion(model, state, 0.5_wp*(previous_step + step), error)
+      if (.not. allocated(error)) then
+        call advance_one_cycle(model, state, previous_step, step, timers)
+        previous_step = step
+        finished = state%time >= model%end_time*(1.0_wp - 1.0e-12_wp) .or. &
+                   (model%end_cycle > 0 .and. state%cycle >= model%end_cycle)
+        call check_cycle(model, state, finished, error)
       end if
-      call impose_kinematic_conditions(model, state%fixed, state%time, step, 0.5_wp*(previous_step + step), &
-                                       state%displacement, state%acceleration, state%free_acceleration, &
-                                       state%mass, state%velocity, work)
-      state%energy%external_work = state%energy%external_work + work
-      if (size(model%walls) > 0) then
-        call start_phase(contact_timer)
-        call enforce_planar_walls(model%walls, state%walls, state%time, step, 0.5_wp*(previous_step + step), &
-                                  state%coordinates, state%acceleration, state%mass, &
-                                  state%velocity, work)
-        state%energy%rigid_wall = state%energy%rigid_wall + work
-        call enforce_cylinder_walls(model%walls, model%curves, state%walls, state%time, step, &
-                                    0.5_wp*(previous_step + step), state%coordinates, state%acceleration, &
-                                    state%mass, state%velocity, work, cylinder_work)
-        call stop_phase(contact_timer)
-        state%energy%rigid_wall = state%energy%rigid_wall + work
-        state%energy%external_work = state%energy%external_work + cylinder_work
-      end if
-      if (size(state%rigid) > 0) then
-        call advance_rigid_bodies(model, state%rigid, state%time, step, 0.5_wp*(previous_step + step), &
-                                  state%coordinates, state%velocity, work)
-        state%energy%external_work = state%energy%external_work + work
-        if (size(state%shells) > 0) call rotate_with_rigid_bodies(model, state)
-      end if
-      call update_positions(state, step)
-      state%energy%external_work = state%energy%external_work + &
-                                   0.5_wp*load_work(model, state%external_force, state%velocity, step)
-      state%time = state%time + step
-      state%time_step = step
-      state%cycle = state%cycle + 1
-      previous_step = step
-
-      call start_phase(element_timer)
-      call compute_element_forces(model, state, step)
-      call stop_phase(element_timer)
-      call start_phase(shell_timer)
-      call compute_shell_forces(model, state, step)
-      call stop_phase(shell_timer)
-      call start_phase(meshfree_timer)
-      call compute_meshfree_forces(model, state, step)
-      call stop_phase(meshfree_timer)
-      if (size(state%contacts) > 0) then
-        call start_phase(contact_timer)
-        call compute_contact_forces(model, state%contacts, state%time, step, state%coordinates, state%velocity, &
-                                    state%mass, state%contact_force, work)
-        call stop_phase(contact_timer)
-        state%energy%contact = state%energy%contact + work
-        call report_initial_penetrations(model, state%contacts, state%time)
-      end if
-      call assemble_nodal_loads(model, state%time, state%external_force)
-      state%energy%external_work = state%energy%external_work + &
-                                   0.5_wp*load_work(model, state%external_force, state%velocity, step)
-      call compute_accelerations(state)
-      call hold_prescribed_accelerations(model, state%time, state%acceleration, state%free_acceleration)
-      call select_time_step(model, state, is_first=.false.)
-      call check_state(model, state, error)
-
-      finished = allocated(error) .or. state%time >= model%end_time*(1.0_wp - 1.0e-12_wp) .or. &
-                 (model%end_cycle > 0 .and. state%cycle >= model%end_cycle)
-      call start_phase(output_timer)
+      if (.not. allocated(error)) call check_stop_signal(state, error)
+      finished = finished .or. allocated(error)
+      call start_phase(timers(phase_output))
       call write_due_output(model, state, plan, histories, results, finished, wrote_state, output_error)
-      call stop_phase(output_timer)
+      call stop_phase(timers(phase_output))
       if (allocated(output_error)) exit
-      call report_progress(progress, state%cycle, state%time, step, finished)
+      call report_progress(progress, state%cycle, state%time, state%time_step, &
+                           finished .or. progress_line_requested())
     end do
 
     if (allocated(output_error) .and. .not. allocated(error)) call move_alloc(output_error, error)
     summary%end_time = state%time
     summary%cycles = state%cycle
-    summary%fe_solid_s = element_timer%seconds
-    summary%fe_shell_s = shell_timer%seconds
-    summary%efg_s = meshfree_timer%seconds
-    summary%contact_s = contact_timer%seconds
-    summary%output_s = output_timer%seconds
+    summary%fe_solid_s = timers(phase_solids)%seconds
+    summary%fe_shell_s = timers(phase_shells)%seconds
+    summary%efg_s = timers(phase_meshfree)%seconds
+    summary%contact_s = timers(phase_contact)%seconds
+    summary%output_s = timers(phase_output)%seconds
     summary%tangled_solids = plan%distortion%tangled
     summary%worst_corner_jacobian_ratio = plan%distortion%worst_ratio
     if (plan%distortion%worst_element > 0) &
       summary%worst_corner_jacobian_element = model%solid_ids(plan%distortion%worst_element)
   end subroutine run_explicit
+
+  !> One central-difference cycle from t^n to t^{n+1} = t^n + step: velocities at the half step,
+  !> supports, walls and rigid bodies, positions, then the forces and accelerations at t^{n+1}
+  !> and the next stable step. `previous_step` is t^n - t^{n-1}.
+  subroutine advance_one_cycle(model, state, previous_step, step, timers)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(inout) :: state
+    real(wp), intent(in) :: previous_step, step
+    type(phase_timer_t), intent(inout) :: timers(phase_count)
+    real(wp) :: average_step, work, cylinder_work
+
+    average_step = 0.5_wp*(previous_step + step)
+    ! velocities at the half step, then the supports and walls correct them
+    call update_velocities(state, average_step)
+    if (size(state%shells) > 0) then
+      call remove_drilling_rates(state, average_step, work)
+      state%energy%external_work = state%energy%external_work + work
+    end if
+    call impose_kinematic_conditions(model, state%fixed, state%time, step, average_step, &
+                                     state%displacement, state%acceleration, state%free_acceleration, &
+                                     state%mass, state%velocity, work)
+    state%energy%external_work = state%energy%external_work + work
+    if (size(model%walls) > 0) then
+      call start_phase(timers(phase_contact))
+      call enforce_planar_walls(model%walls, state%walls, state%time, step, average_step, &
+                                state%coordinates, state%acceleration, state%mass, state%velocity, work)
+      state%energy%rigid_wall = state%energy%rigid_wall + work
+      call enforce_cylinder_walls(model%walls, model%curves, state%walls, state%time, step, average_step, &
+                                  state%coordinates, state%acceleration, state%mass, state%velocity, work, &
+                                  cylinder_work)
+      call stop_phase(timers(phase_contact))
+      state%energy%rigid_wall = state%energy%rigid_wall + work
+      state%energy%external_work = state%energy%external_work + cylinder_work
+    end if
+    if (size(state%rigid) > 0) then
+      call advance_rigid_bodies(model, state%rigid, state%time, step, average_step, &
+                                state%coordinates, state%velocity, work)
+      state%energy%external_work = state%energy%external_work + work
+      if (size(state%shells) > 0) call rotate_with_rigid_bodies(model, state)
+    end if
+    call update_positions(state, step)
+    state%energy%external_work = state%energy%external_work + &
+                                 0.5_wp*load_work(model, state%external_force, state%velocity, step)
+    state%time = state%time + step
+    ! the step that was cut at ENDTIM lands on it exactly
+    if (model%end_time > 0.0_wp .and. state%time > model%end_time) state%time = model%end_time
+    state%time_step = step
+    state%cycle = state%cycle + 1
+
+    call compute_forces(model, state, step, timers)
+    if (size(state%contacts) > 0) then
+      call start_phase(timers(phase_contact))
+      call compute_contact_forces(model, state%contacts, state%time, step, state%coordinates, state%velocity, &
+                                  state%mass, state%contact_force, work)
+      call stop_phase(timers(phase_contact))
+      state%energy%contact = state%energy%contact + work
+      call report_initial_penetrations(model, state%contacts, state%time)
+    end if
+    call assemble_nodal_loads(model, state%time, state%external_force)
+    state%energy%external_work = state%energy%external_work + &
+                                 0.5_wp*load_work(model, state%external_force, state%velocity, step)
+    call compute_accelerations(state)
+    call hold_prescribed_accelerations(model, state%time, state%acceleration, state%free_acceleration)
+    call select_time_step(model, state, is_first=.false.)
+  end subroutine advance_one_cycle
+
+  !> Internal forces of the solids, shells and meshfree parts at the current configuration
+  !> (`step` is the step just taken, 0 at the start); the solids clear the force array first.
+  subroutine compute_forces(model, state, step, timers)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(inout) :: state
+    real(wp), intent(in) :: step
+    type(phase_timer_t), intent(inout) :: timers(phase_count)
+    call start_phase(timers(phase_solids))
+    call compute_element_forces(model, state, step)
+    call stop_phase(timers(phase_solids))
+    call start_phase(timers(phase_shells))
+    call compute_shell_forces(model, state, step)
+    call stop_phase(timers(phase_shells))
+    call start_phase(timers(phase_meshfree))
+    call compute_meshfree_forces(model, state, step)
+    call stop_phase(timers(phase_meshfree))
+  end subroutine compute_forces
+
+  !> The checks after a cycle: elements, the time step, and every few cycles and at the last
+  !> one the energy.
+  subroutine check_cycle(model, state, last, error)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(inout) :: state
+    logical, intent(in) :: last
+    type(error_t), allocatable, intent(out) :: error
+    call check_elements(model, state, error)
+    if (allocated(error)) return
+    call check_time_step(model, state, state%stable_time_step, error)
+    if (allocated(error)) return
+    if (last .or. mod(state%cycle, energy_check_interval) == 0) call check_energy(model, state, error)
+  end subroutine check_cycle
+
+  !> A SIGINT or SIGTERM ends the run after the cycle: the state is written and the run ends
+  !> with error termination.
+  subroutine check_stop_signal(state, error)
+    type(explicit_state_t), intent(in) :: state
+    type(error_t), allocatable, intent(out) :: error
+    character(len=40) :: text
+    integer :: number
+    number = received_stop_signal()
+    if (number == 0) return
+    write (text, '(es12.5,a,i0)') state%time, ", cycle ", state%cycle
+    call make_error(error, "stopped by "//signal_name(number)//" at time "//trim(adjustl(text))// &
+                    ": the results hold the run up to this time")
+  end subroutine check_stop_signal
 
   !> a = (f_ext - f_int) / m, and for the rotations of shell nodes alpha = -m_int / I;
   !> constrained dofs do not accelerate.
@@ -268,7 +330,8 @@ contains
     !$omp end parallel do
   end subroutine update_positions
 
-  !> Next step: TSSFAC times the smallest stable element step (never below |DT2MS| times TSSFAC
+  !> Next step: TSSFAC times the smallest stable element step, cut so that the last step ends
+  !> at ENDTIM (never below |DT2MS| times TSSFAC
   !> while mass scaling holds it there); DTINIT caps the first step.
   subroutine select_time_step(model, state, is_first)
     type(model_t), intent(in) :: model
@@ -304,76 +367,25 @@ contains
       smallest = state%rigid_time_step
       critical = 0
     end if
+    state%stable_time_step = smallest
     state%next_time_step = model%time_step_scale*smallest
     state%controlling_element = critical
     if (is_first .and. model%initial_time_step > 0.0_wp) &
       state%next_time_step = min(state%next_time_step, model%initial_time_step)
     ! a step that no element set, or a NaN that the comparisons above skipped, is not a step
     if (smallest >= huge(1.0_wp) .or. any(state%block_time_step /= state%block_time_step) .or. &
-        any(state%shell_time_step /= state%shell_time_step)) &
+        any(state%shell_time_step /= state%shell_time_step)) then
       state%next_time_step = -huge(1.0_wp)
+      state%stable_time_step = -huge(1.0_wp)
+    end if
+    ! the last step ends at ENDTIM; at ENDTIM the energies of the last state take the step just
+    ! taken as the next one (the run does not go on; TSSFAC times the stable step may be
+    ! meaningless, as with a TSSFAC far above 1)
+    if (model%end_time > state%time) then
+      state%next_time_step = min(state%next_time_step, model%end_time - state%time)
+    else if (.not. is_first) then
+      state%next_time_step = min(state%next_time_step, state%time_step)
+    end if
   end subroutine select_time_step
 
-  !> Run-time failures, found after the parallel loops: an inverted element or a state that
-  !> is no longer finite.
-  subroutine check_state(model, state, error)
-    type(model_t), intent(in) :: model
-    type(explicit_state_t), intent(in) :: state
-    type(error_t), allocatable, intent(out) :: error
-    integer :: b, k, element, point
-    character(len=256) :: text
-    do b = 1, size(state%blocks)
-      element = state%block_inverted_element(b)
-      if (element == 0) cycle
-      write (text, '(a,i0,a,i0,a,es12.5,a,i0)') "negative volume in solid element ", model%solid_ids(element), &
-        " (part ", model%parts(model%solid_part(element))%id, ") at time ", state%time, ", cycle ", state%cycle
-      call make_error(error, trim(text))
-      return
-    end do
-    do b = 1, size(state%shells)
-      element = state%shell_degenerate_element(b)
-      if (element == 0) cycle
-      write (text, '(a,i0,a,i0,a,es12.5,a,i0)') "shell element ", model%shell_ids(element), " (part ", &
-        model%parts(model%shell_part(element))%id, ") has lost its area at time ", state%time, ", cycle ", state%cycle
-      call make_error(error, trim(text))
-      return
-    end do
-    do k = 1, size(state%efg)
-      do b = 1, size(state%efg(k)%blocks)
-        point = state%efg(k)%block_inverted_point(b)
-        if (point == 0) cycle
-        element = state%efg(k)%geometry%point_cell(point)
-        write (text, '(a,i0,a,i0,a,es12.5,a,i0)') "negative volume at an integration point of meshfree part ", &
-          model%parts(state%efg(k)%geometry%part)%id, " (background cell ", model%solid_ids(element), &
-          ") at time ", state%time, ", cycle ", state%cycle
-        call make_error(error, trim(text))
-        return
-      end do
-    end do
-    ! rigid bodies set no element step: their motion must be finite too
-    do b = 1, size(state%rigid)
-      if (all(abs(state%rigid(b)%velocity) < huge(1.0_wp)) .and. &
-          all(abs(state%rigid(b)%angular_velocity) < huge(1.0_wp))) cycle
-      write (text, '(a,i0,a,es12.5,a,i0)') "the motion of rigid body ", model%rigid_bodies(b)%id, &
-        " is no longer finite at time ", state%time, ", cycle ", state%cycle
-      call make_error(error, trim(text))
-      return
-    end do
-    if (.not. (state%next_time_step > 0.0_wp .and. state%next_time_step < huge(1.0_wp))) then
-      element = state%controlling_element
-      if (element < 0) then
-        write (text, '(a,i0,a,i0,a,es12.5,a,i0)') "no finite stable time step (the smallest is set by shell ", &
-          model%shell_ids(-element), ", part ", model%parts(model%shell_part(-element))%id, ") at time ", &
-          state%time, ", cycle ", state%cycle
-      else if (element > 0) then
-        write (text, '(a,i0,a,i0,a,es12.5,a,i0)') "no finite stable time step (the smallest is set by element ", &
-          model%solid_ids(element), ", part ", model%parts(model%solid_part(element))%id, ") at time ", &
-          state%time, ", cycle ", state%cycle
-      else
-        write (text, '(a,es12.5,a,i0,a)') "no finite stable time step at time ", state%time, ", cycle ", &
-          state%cycle, ": the state is no longer finite"
-      end if
-      call make_error(error, trim(text))
-    end if
-  end subroutine check_state
 end module explicit_solver

@@ -17,7 +17,7 @@ module explicit_state
   implicit none
   private
 
-  public :: explicit_state_t, wall_state_t, energy_totals_t
+  public :: explicit_state_t, wall_state_t, energy_totals_t, run_watch_t
 
   !> Running totals for the energy balance (glstat).
   type :: energy_totals_t
@@ -30,6 +30,17 @@ module explicit_state
     real(wp) :: initial_total = 0.0_wp
     real(wp) :: momentum(3) = 0.0_wp         !< linear momentum of all nodes
   end type energy_totals_t
+
+  !> What the run checks (run_checks) compare against and remember from cycle to cycle.
+  type :: run_watch_t
+    real(wp) :: largest_wave_speed = 0.0_wp       !< of the model's materials (0: none has one)
+    real(wp) :: velocity_limit = huge(1.0_wp)     !< a node faster than this stops the run
+    real(wp) :: angular_velocity_limit = huge(1.0_wp)
+    real(wp) :: first_time_step = 0.0_wp          !< the step of the first cycle
+    real(wp) :: last_stable_step = 0.0_wp         !< the stable step (before TSSFAC) of the last cycle
+    integer :: step_decades_reported = 0          !< the step has been reported below 10^-k of the first
+    real(wp) :: largest_energy_supplied = 0.0_wp  !< largest |initial energy|, |external work| so far
+  end type run_watch_t
 
   !> Motion and accumulated force of one rigid wall (planar, or cylinder: `displacement` and
   !> `speed` then along its motion direction, and `mass` stays 0 as the motion is prescribed).
@@ -48,7 +59,8 @@ module explicit_state
     integer :: cycle = 0
     real(wp) :: time = 0.0_wp
     real(wp) :: time_step = 0.0_wp                       !< t^{n+1} - t^n of the last step
-    real(wp) :: next_time_step = 0.0_wp                  !< stable step for the coming cycle
+    real(wp) :: next_time_step = 0.0_wp                  !< step for the coming cycle (TSSFAC, DTINIT applied)
+    real(wp) :: stable_time_step = 0.0_wp                !< the smallest stable element step it comes from
     integer :: controlling_element = 0                   !< solid index that set next_time_step
                                                          !< (a shell: minus its shell index)
     ! nodal arrays (3, nodes) and (nodes)
@@ -100,6 +112,7 @@ module explicit_state
     real(wp) :: rigid_time_step = huge(1.0_wp)           !< smallest stable step of the rigid elements
     ! bookkeeping
     type(energy_totals_t) :: energy
+    type(run_watch_t) :: watch
     real(wp) :: added_mass = 0.0_wp                      !< by mass scaling
     real(wp) :: physical_mass = 0.0_wp
   end type explicit_state_t

@@ -20,6 +20,7 @@ module job
   use file_system, only: make_directory
   use progress_report, only: format_duration
   use version, only: crashfree_version
+  use stop_signals, only: catch_stop_signals
   use, intrinsic :: iso_fortran_env, only: error_unit
   !$ use omp_lib, only: omp_set_num_threads, omp_get_max_threads
   implicit none
@@ -43,6 +44,8 @@ contains
 
     started = seconds_now()
     exit_status = 2
+    ! from here on SIGINT / SIGTERM end the run after a cycle, with the results written
+    call catch_stop_signals()
     if (allocated(options%restart_file)) then
       write (error_unit, '(a)') "crashfree: r=: restarts are not supported yet"
       return
@@ -142,8 +145,9 @@ contains
       write (*, '(a)') trim(line)
     end if
     if (state%added_mass > 0.0_wp) then
-      write (line, '(a,es12.5,a,f0.3,a)') "mass scaling: added mass ", state%added_mass, " (", &
-        100.0_wp*state%added_mass/state%physical_mass, "% of the physical mass)"
+      ! (es: the percentage of a huge DT2MS does not fit a fixed format)
+      write (line, '(a,es12.5,a,es10.3,a)') "mass scaling: added mass ", state%added_mass, " (", &
+        100.0_wp*state%added_mass/state%physical_mass, " % of the physical mass)"
       write (*, '(a)') trim(line)
     end if
   end subroutine describe_model

@@ -1,0 +1,86 @@
+!> SIGINT and SIGTERM end a run cleanly; SIGUSR2 asks for a progress line.
+!>
+!> A batch system's kill (SIGTERM) or a Ctrl-C (SIGINT) during a run sets a flag that the time
+!> loop reads once per cycle: it finishes the cycle, writes the state, closes the results and
+!> ends with error termination (exit 1), so the results are complete up to that time. A second
+!> SIGINT or SIGTERM, while the first is being handled, ends the process at once (the handler
+!> gives the signal back to the system's default action). `kill -USR2 <pid>` prints the
+!> progress line at the next cycle, as LS-DYNA's sense switches do.
+!>
+!> The flags are the one piece of process-wide state in crashfree: the operating system delivers
+!> a signal to the process, not to a caller that could pass state down.
+module stop_signals
+  use, intrinsic :: iso_c_binding, only: c_int, c_funptr, c_funloc, c_null_funptr
+  implicit none
+  private
+
+  public :: catch_stop_signals, received_stop_signal, progress_line_requested, signal_name
+
+  !> Linux signal numbers (x86-64, aarch64).
+  integer(c_int), parameter :: signal_interrupt = 2, signal_terminate = 15, signal_user2 = 12
+
+  !> Set by the handlers, read by the time loop.
+  integer(c_int), volatile :: stop_signal = 0
+  integer(c_int), volatile :: progress_signal = 0
+
+  interface
+    !> The C library's signal(): installs `handler` for `number` (BSD semantics on glibc: the
+    !> handler stays installed and interrupted system calls restart).
+    function c_signal(number, handler) bind(c, name="signal") result(previous)
+      import :: c_int, c_funptr
+      integer(c_int), value :: number
+      type(c_funptr), value :: handler
+      type(c_funptr) :: previous
+    end function c_signal
+  end interface
+
+contains
+
+  !> Install the handlers (once, before the run starts).
+  subroutine catch_stop_signals()
+    type(c_funptr) :: previous
+    previous = c_signal(signal_interrupt, c_funloc(on_stop_signal))
+    previous = c_signal(signal_terminate, c_funloc(on_stop_signal))
+    previous = c_signal(signal_user2, c_funloc(on_progress_signal))
+  end subroutine catch_stop_signals
+
+  !> The number of the SIGINT or SIGTERM received (0: none).
+  integer function received_stop_signal()
+    received_stop_signal = int(stop_signal)
+  end function received_stop_signal
+
+  !> Whether SIGUSR2 came since the last call (the request is then taken).
+  logical function progress_line_requested()
+    progress_line_requested = progress_signal /= 0
+    if (progress_line_requested) progress_signal = 0
+  end function progress_line_requested
+
+  !> "SIGINT", "SIGTERM", ... for messages.
+  function signal_name(number) result(name)
+    integer, intent(in) :: number
+    character(len=:), allocatable :: name
+    character(len=12) :: buffer
+    select case (number)
+    case (signal_interrupt)
+      name = "SIGINT"
+    case (signal_terminate)
+      name = "SIGTERM"
+    case default
+      write (buffer, '(a,i0)') "signal ", number
+      name = trim(buffer)
+    end select
+  end function signal_name
+
+  !> Only async-signal-safe work: store the number, hand the next one to the default action.
+  subroutine on_stop_signal(number) bind(c)
+    integer(c_int), value :: number
+    type(c_funptr) :: previous
+    stop_signal = number
+    previous = c_signal(number, c_null_funptr)
+  end subroutine on_stop_signal
+
+  subroutine on_progress_signal(number) bind(c)
+    integer(c_int), value :: number
+    progress_signal = number
+  end subroutine on_progress_signal
+end module stop_signals
