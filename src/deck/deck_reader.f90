@@ -13,9 +13,10 @@
 module deck_reader
   use error_handling, only: error_t, error_list_t, add_error
   use model, only: model_t
-  use deck_problems, only: problem_log_t, report_problem, has_problems, problems_to_error
+  use deck_problems, only: problem_log_t, report_problem, has_problems, problems_to_error, &
+                           printable
   use deck_numbers, only: integer_text
-  use deck_lexer, only: deck_t, load_deck, line_location
+  use deck_lexer, only: deck_t, load_deck, release_deck, line_location
   use deck_keywords, only: keyword_t, identify_keyword, closest_keyword, keyword_count, &
     keyword_unknown, keyword_title, keyword_node, keyword_element_solid, keyword_part, &
     keyword_section_solid, keyword_section_solid_efg, keyword_mat_elastic, &
@@ -95,6 +96,7 @@ contains
       call read_block(deck, block, keywords(block), input, log, warnings)
     end do
     if (.not. log%unreadable) call check_and_build(deck, input, model, log, warnings)
+    call release_deck(deck)
     if (has_problems(log)) then
       call problems_to_error(log, error)
       return
@@ -114,7 +116,7 @@ contains
     where = line_location(deck, deck%blocks(block)%keyword_line)//": *"//deck%blocks(block)%name
     data_lines = deck%blocks(block)%last_line - deck%blocks(block)%first_line + 1
     if (ignore_unknown) then
-      call add_error(warnings, where//": unknown keyword skipped ("//integer_text(data_lines)// &
+      call add_error(warnings, printable(where)//": unknown keyword skipped ("//integer_text(data_lines)// &
                      " data lines not read)")
       return
     end if
