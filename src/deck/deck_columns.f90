@@ -52,10 +52,17 @@ contains
     integer, intent(in) :: widths(:)
     integer, intent(in) :: format
     type(field_spans_t), intent(out) :: spans
-    integer :: k, column, comma, start
+    integer :: k, column, comma, start, commas, tabs
 
-    spans%has_tab = index(line, achar(9)) > 0
-    spans%free = index(line, ",") > 0
+    ! one counting loop for both (it vectorizes; two calls of `index` cost several times more)
+    commas = 0
+    tabs = 0
+    do k = 1, len(line)
+      if (line(k:k) == ",") commas = commas + 1
+      if (line(k:k) == achar(9)) tabs = tabs + 1
+    end do
+    spans%has_tab = tabs > 0
+    spans%free = commas > 0
     if (spans%free) then
       start = 1
       do k = 1, max_fields

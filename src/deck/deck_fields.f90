@@ -376,12 +376,16 @@ contains
     last = 0
     if (k > card%spans%count) return
     if (card%spans%last(k) < card%spans%first(k)) return
-    start = verify(card%text(card%spans%first(k):card%spans%last(k)), " "//achar(9))
-    if (start == 0) return
-    finish = verify(card%text(card%spans%first(k):card%spans%last(k)), " "//achar(9), &
-                    back=.true.)
-    first = card%spans%first(k) + start - 1
-    last = card%spans%first(k) + finish - 1
+    ! plain loops: `verify` with a set is a general search, and this runs for every field
+    do start = card%spans%first(k), card%spans%last(k)
+      if (card%text(start:start) /= " " .and. card%text(start:start) /= achar(9)) exit
+    end do
+    if (start > card%spans%last(k)) return
+    do finish = card%spans%last(k), start, -1
+      if (card%text(finish:finish) /= " " .and. card%text(finish:finish) /= achar(9)) exit
+    end do
+    first = start
+    last = finish
   end subroutine field_bounds
 
   pure logical function is_reference(text)

@@ -18,7 +18,7 @@ module deck_lexer
   use deck_numbers, only: to_upper, parse_integer, parse_real, number_ok, integer_text
   use deck_columns, only: field_spans_t, split_fields, format_standard, format_long, format_i10
   use deck_line_table, only: line_table_t, start_table, append_line, line_file, line_number, &
-                             line_start
+                             line_place
   use deck_file_io, only: file_handle_t, inspect_file, open_file, read_bytes, close_file, &
                           file_missing, file_regular, file_directory, file_fifo, file_device
   implicit none
@@ -57,13 +57,16 @@ module deck_lexer
   end type deck_parameter_t
 
   !> The bytes of one file held for reading cards back: bytes first .. first + length - 1
-  !> (0 = the file's first byte) of file `file` (0: none yet).
+  !> (0 = the file's first byte) of file `file` (0: none yet). The line found last is kept
+  !> too, since a reader usually asks for a line twice (is it blank? then its fields).
   type :: text_window_t
     integer :: file = 0
     type(file_handle_t) :: handle
     integer(int64) :: first = 0
     integer :: length = 0
     character(len=:), allocatable :: buffer
+    integer :: line = 0                        !< the line found last (0: none)
+    integer :: line_first = 1, line_last = 0   !< its text in the buffer
   end type text_window_t
 
   !> The whole deck: files, the line table and the keyword blocks in reading order.
@@ -184,7 +187,7 @@ contains
     character(len=:), allocatable :: buffer
     integer(int64) :: buffer_start
     integer :: filled, position, newline, remainder, count
-    logical :: end_of_file
+    logical :: end_of_file, unusual
 
     call open_source(deck, path, include_line, state%file, handle, log, warnings)
     if (state%file == 0) return
@@ -197,17 +200,17 @@ contains
                           log)
     if (include_line == 0) deck%main_file_read = .not. state%ended
     do while (.not. state%ended)
-      newline = index(buffer(position:filled), line_feed)
+      call find_line_end(buffer(position:filled), newline, unusual)
       if (newline > 0) then
         call take_line(deck, buffer(position:position + newline - 2), &
-                       buffer_start + position - 1, chain, state, log, warnings)
+                       buffer_start + position - 1, unusual, chain, state, log, warnings)
         position = position + newline
         cycle
       end if
       if (end_of_file) then
         if (position <= filled) call take_line(deck, buffer(position:filled), &
-                                               buffer_start + position - 1, chain, state, log, &
-                                               warnings)
+                                               buffer_start + position - 1, unusual, chain, &
+                                               state, log, warnings)
         exit
       end if
       remainder = filled - position + 1
@@ -371,7 +374,7 @@ contains
         " characters, the longest line read (is this a keyword deck?)", unreadable=.true.)
     end if
     do
-      newline = index(buffer(position:filled), line_feed)
+      newline = line_feed_position(buffer(position:filled))
       if (newline > 0) then
         position = position + newline
         return
@@ -402,12 +405,49 @@ contains
     state%number = state%number + 1
   end subroutine count_line
 
-  !> Classify one physical line (`text`, its line feed removed, starting at byte `start`):
-  !> comment, keyword line, or data line of the open block.
-  recursive subroutine take_line(deck, text, start, chain, state, log, warnings)
+  !> Position of the first line feed in `text` (0 if none), and whether a control character
+  !> other than a tab comes before it (`unusual`: a carriage return, or one to report). One
+  !> plain loop over the bytes, the only pass the scan makes over a file's text; the general
+  !> substring search behind `index` takes three times as long.
+  pure subroutine find_line_end(text, newline, unusual)
+    character(len=*), intent(in) :: text
+    integer, intent(out) :: newline
+    logical, intent(out) :: unusual
+    integer :: k, code
+    unusual = .false.
+    newline = 0
+    do k = 1, len(text)
+      code = iachar(text(k:k))
+      if (code >= 32 .and. code /= 127) cycle
+      if (code == 10) then
+        newline = k
+        return
+      end if
+      if (code /= 9) unusual = .true.
+    end do
+  end subroutine find_line_end
+
+  !> Position of the first line feed in `text` (0 if none).
+  pure integer function line_feed_position(text)
+    character(len=*), intent(in) :: text
+    integer :: k
+    line_feed_position = 0
+    do k = 1, len(text)
+      if (text(k:k) == line_feed) then
+        line_feed_position = k
+        return
+      end if
+    end do
+  end function line_feed_position
+
+  !> Classify one physical line (`text`, its line feed removed, starting at byte `start`;
+  !> `unusual` when it may hold control characters): comment, keyword line, or data line of
+  !> the open block.
+  recursive subroutine take_line(deck, text, start, unusual, chain, state, log, warnings)
     type(deck_t), intent(inout) :: deck
     character(len=*), intent(in) :: text
     integer(int64), intent(in) :: start
+    logical, intent(in) :: unusual
     integer, intent(in) :: chain(:)
     type(scan_state_t), intent(inout) :: state
     type(problem_log_t), intent(inout) :: log
@@ -434,7 +474,7 @@ contains
       call close_block(deck, state%file, state%file_format, chain, state%block, log, warnings)
       call add_line(deck, start, state, log)
       if (state%ended) return
-      call check_characters(deck, text(1:last), state, log)
+      if (unusual) call check_characters(deck, text(1:last), state, log)
       deck%keyword_lines = deck%keyword_lines + 1
       call open_keyword(deck, deck%lines%count, text(1:last), state%file_format, state%block, &
                         state%ended, log)
@@ -444,7 +484,7 @@ contains
     if (leading == 0 .and. state%block%kind == block_none) return
     call add_line(deck, start, state, log)
     if (state%ended) return
-    call check_characters(deck, text(1:last), state, log)
+    if (unusual) call check_characters(deck, text(1:last), state, log)
     if (lead == "*") then
       call report_problem(log, line_location(deck, deck%lines%count)// &
         ": a keyword must start in column 1 (found '*' in column "//integer_text(leading)//")", &
@@ -467,21 +507,14 @@ contains
     character(len=*), intent(in) :: text
     type(scan_state_t), intent(inout) :: state
     type(problem_log_t), intent(inout) :: log
-    integer :: k, code, found
-    ! counted without an early exit, so that the loop over every card of a large deck stays
-    ! a simple one
-    found = 0
-    do k = 1, len(text)
-      code = iachar(text(k:k))
-      if ((code < 32 .and. code /= 9) .or. code == 127) found = found + 1
-    end do
-    if (found == 0) return
-    state%control_lines = state%control_lines + 1
-    if (state%control_lines > 1) return
+    integer :: k, code
     do k = 1, len(text)
       code = iachar(text(k:k))
       if ((code < 32 .and. code /= 9) .or. code == 127) exit
     end do
+    if (k > len(text)) return
+    state%control_lines = state%control_lines + 1
+    if (state%control_lines > 1) return
     call report_problem(log, line_location(deck, deck%lines%count)//": column "// &
       integer_text(k)//" holds the control character "//control_character_name(code)//" (byte "// &
       integer_text(code)//"); a keyword "// &
@@ -960,18 +993,22 @@ contains
     integer :: file, newline
 
     window => deck%window
-    file = line_file(deck%lines, line)
-    start = line_start(deck%lines, line)
+    if (window%line == line) then
+      first = window%line_first
+      last = window%line_last
+      return
+    end if
+    call line_place(deck%lines, line, file, start)
     file_end = deck%files(file)%size
     if (window%file /= file .or. start < window%first .or. &
         start >= window%first + window%length) call fill_window(deck, window, file, start)
     first = int(start - window%first) + 1
-    newline = index(window%buffer(first:window%length), line_feed)
+    newline = line_feed_position(window%buffer(first:window%length))
     if (newline == 0 .and. first > 1 .and. window%first + window%length < file_end) then
       ! the line runs past the bytes held: read from its start
       call fill_window(deck, window, file, start)
       first = 1
-      newline = index(window%buffer(1:window%length), line_feed)
+      newline = line_feed_position(window%buffer(1:window%length))
     end if
     if (newline == 0 .and. window%first + window%length < file_end .and. &
         len(window%buffer) <= max_line_length) then
@@ -980,7 +1017,7 @@ contains
       call move_alloc(larger, window%buffer)
       call fill_window(deck, window, file, start)
       first = 1
-      newline = index(window%buffer(1:window%length), line_feed)
+      newline = line_feed_position(window%buffer(1:window%length))
     end if
     if (newline == 0) then
       last = window%length
@@ -991,6 +1028,9 @@ contains
       if (window%buffer(last:last) /= carriage_return) exit
       last = last - 1
     end do
+    window%line = line
+    window%line_first = first
+    window%line_last = last
   end subroutine locate_line
 
   !> Read the bytes of file `file` from byte `start` on into the window (none when the file
@@ -1007,6 +1047,7 @@ contains
       window%file = file
       if (.not. opened) window%file = 0
     end if
+    window%line = 0
     window%first = start
     window%length = 0
     if (window%file == file) call read_bytes(window%handle, start, window%buffer, window%length)

@@ -12,6 +12,7 @@ module deck_line_table
   private
 
   public :: line_table_t, append_line, line_file, line_number, line_start, start_table
+  public :: line_place
 
   !> The table: `count` lines, `run_count` runs.
   type :: line_table_t
@@ -93,6 +94,18 @@ contains
     integer, intent(in) :: line
     line_start = table%run_base(run_of_line(table, line)) + int(table%offset(line), int64)
   end function line_start
+
+  !> The file of line `line` and the byte offset at which it starts (one search for both).
+  pure subroutine line_place(table, line, file, start)
+    type(line_table_t), intent(in) :: table
+    integer, intent(in) :: line
+    integer, intent(out) :: file
+    integer(int64), intent(out) :: start
+    integer :: run
+    run = run_of_line(table, line)
+    file = table%run_file(run)
+    start = table%run_base(run) + int(table%offset(line), int64)
+  end subroutine line_place
 
   !> The run holding line `line` (runs are stored in line order).
   pure integer function run_of_line(table, line)
