@@ -47,8 +47,8 @@ contains
     call split_fields(card%text, widths, deck%blocks(block)%format, card%spans)
     if (card%spans%has_tab .and. .not. card%spans%free) then
       call report_problem(log, line_location(deck, line)//": *"//keyword_label(deck, block)// &
-        ": the card holds a tab character; fixed columns need blanks (or separate the "// &
-        "fields with commas)", unreadable=.true.)
+        ": the card holds a tab character (column "//integer_text(card%spans%tab_column)// &
+        "); fixed columns need blanks (or separate the fields with commas)", unreadable=.true.)
       card%failed = .true.
     end if
   end subroutine open_card

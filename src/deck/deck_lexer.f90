@@ -201,16 +201,23 @@ contains
     if (include_line == 0) deck%main_file_read = .not. state%ended
     do while (.not. state%ended)
       call find_line_end(buffer(position:filled), newline, unusual)
-      if (newline > 0) then
+      if (newline > max_line_length + 1) then
+        call note_long_line(deck, buffer(position:position + newline - 2), state, log)
+        position = position + newline
+        cycle
+      else if (newline > 0) then
         call take_line(deck, buffer(position:position + newline - 2), &
                        buffer_start + position - 1, unusual, chain, state, log, warnings)
         position = position + newline
         cycle
       end if
       if (end_of_file) then
-        if (position <= filled) call take_line(deck, buffer(position:filled), &
-                                               buffer_start + position - 1, unusual, chain, &
-                                               state, log, warnings)
+        if (filled - position + 1 > max_line_length) then
+          call note_long_line(deck, buffer(position:filled), state, log)
+        else if (position <= filled) then
+          call take_line(deck, buffer(position:filled), buffer_start + position - 1, unusual, &
+                         chain, state, log, warnings)
+        end if
         exit
       end if
       remainder = filled - position + 1
@@ -256,7 +263,7 @@ contains
                           "path cannot be read)", log)
       return
     case (file_directory)
-      call source_problem(deck, path, include_line, "is a directory, not a deck file", log)
+      call source_problem(deck, path, include_line, "is a directory", log)
       return
     case (file_fifo)
       call source_problem(deck, path, include_line, "is a FIFO (named pipe), not a regular "// &
@@ -358,21 +365,10 @@ contains
     logical, intent(inout) :: end_of_file
     type(scan_state_t), intent(inout) :: state
     type(problem_log_t), intent(inout) :: log
-    integer :: leading, newline
-    logical :: comment
+    integer :: newline
 
-    call count_line(deck, state, log)
+    call note_long_line(deck, buffer(position:filled), state, log)
     if (state%ended) return
-    leading = first_nonblank(buffer(position:filled))
-    comment = state%block%kind == block_comment
-    if (leading > 0) comment = comment .or. buffer(position + leading - 1:position + leading - 1) &
-                                            == "$"
-    if (.not. comment) then
-      state%long_lines = state%long_lines + 1
-      if (state%long_lines == 1) call report_problem(log, deck%files(state%file)%path//":"// &
-        integer_text(state%number)//": the line is longer than "//integer_text(max_line_length)// &
-        " characters, the longest line read (is this a keyword deck?)", unreadable=.true.)
-    end if
     do
       newline = line_feed_position(buffer(position:filled))
       if (newline > 0) then
@@ -389,6 +385,27 @@ contains
       end_of_file = filled < scan_chunk
     end do
   end subroutine skip_long_line
+
+  !> A line longer than max_line_length, which starts with `text`: reported (once per file,
+  !> then counted) unless it is a comment, and not read.
+  subroutine note_long_line(deck, text, state, log)
+    type(deck_t), intent(in) :: deck
+    character(len=*), intent(in) :: text
+    type(scan_state_t), intent(inout) :: state
+    type(problem_log_t), intent(inout) :: log
+    integer :: leading
+    logical :: comment
+    call count_line(deck, state, log)
+    if (state%ended) return
+    leading = first_nonblank(text)
+    comment = state%block%kind == block_comment
+    if (leading > 0) comment = comment .or. text(leading:leading) == "$"
+    if (comment) return
+    state%long_lines = state%long_lines + 1
+    if (state%long_lines == 1) call report_problem(log, deck%files(state%file)%path//":"// &
+      integer_text(state%number)//": the line is longer than "//integer_text(max_line_length)// &
+      " characters, the longest line read (is this a keyword deck?)", unreadable=.true.)
+  end subroutine note_long_line
 
   !> One more physical line of the file being scanned (a file of more lines than a default
   !> integer counts is reported and read no further).
