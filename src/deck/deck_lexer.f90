@@ -26,7 +26,7 @@ module deck_lexer
 
   public :: deck_t, keyword_block_t, deck_parameter_t, load_deck, release_deck
   public :: line_location, find_parameter, trim_blanks, is_blank_line, card_text, block_of_line
-  public :: load_line_text, line_count
+  public :: load_line_text
 
   !> Longest line read (a comment line may be longer: it is skipped unread).
   integer, parameter, public :: max_line_length = 1048576
@@ -128,8 +128,9 @@ contains
     type(deck_t), intent(out) :: deck
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
-    integer :: chain(0)
+    integer :: chain(0), problems_before
 
+    problems_before = log%total
     allocate (deck%files(4), deck%blocks(64), deck%parameters(8))
     call start_table(deck%lines, 1024)
     allocate (deck%window)
@@ -140,7 +141,8 @@ contains
       call report_problem(log, path//": the file holds no keyword line (a keyword deck starts "// &
         "with *KEYWORD in column 1 and holds keywords such as *NODE); is it a keyword deck?", &
         unreadable=.true.)
-    else if (.not. starts_with_keyword(deck)) then
+    else if (log%total == problems_before .and. .not. starts_with_keyword(deck)) then
+      ! (only for a deck read without problems: a damaged first line says more itself)
       call add_error(warnings, path//": the deck does not start with *KEYWORD, as an LS-DYNA "// &
         "keyword deck does (is it an include file?); it is read as a keyword deck")
     end if
@@ -524,6 +526,7 @@ contains
     character(len=*), intent(in) :: text
     type(scan_state_t), intent(inout) :: state
     type(problem_log_t), intent(inout) :: log
+    character(len=:), allocatable :: hint
     integer :: k, code
     do k = 1, len(text)
       code = iachar(text(k:k))
@@ -532,10 +535,16 @@ contains
     if (k > len(text)) return
     state%control_lines = state%control_lines + 1
     if (state%control_lines > 1) return
+    if (code == iachar(carriage_return)) then
+      hint = " (lines ended by CR alone, as in old Mac files, are not line ends: save the "// &
+             "file with LF or CRLF line ends)"
+    else
+      hint = ""
+    end if
     call report_problem(log, line_location(deck, deck%lines%count)//": column "// &
-      integer_text(k)//" holds the control character "//control_character_name(code)//" (byte "// &
-      integer_text(code)//"); a keyword "// &
-      "deck is plain text (blanks, tabs or commas between fields)", unreadable=.true.)
+      integer_text(k)//" holds the control character "//control_character_name(code)// &
+      " (byte "//integer_text(code)//"); a keyword deck is plain text (blanks, tabs or commas "// &
+      "between fields)"//hint, unreadable=.true.)
   end subroutine check_characters
 
   !> At the end of a file: how many more lines held control characters or were too long.
@@ -933,12 +942,6 @@ contains
     larger(1:deck%parameter_count) = deck%parameters(1:deck%parameter_count)
     call move_alloc(larger, deck%parameters)
   end subroutine grow_parameters
-
-  !> Number of lines in the line table.
-  pure integer function line_count(deck)
-    type(deck_t), intent(in) :: deck
-    line_count = deck%lines%count
-  end function line_count
 
   !> `file:line` of line `line` of the line table.
   function line_location(deck, line) result(location)
