@@ -122,8 +122,8 @@ contains
     where = line_location(deck, deck%blocks(block)%keyword_line)//": *"//deck%blocks(block)%name
     data_lines = deck%blocks(block)%last_line - deck%blocks(block)%first_line + 1
     if (ignore_unknown) then
-      call add_error(warnings, printable(where)//": unknown keyword skipped ("//integer_text(data_lines)// &
-                     " data lines not read)")
+      call add_error(warnings, printable(where)//": unknown keyword skipped ("// &
+                     integer_text(data_lines)//" data lines not read)")
       return
     end if
     name = deck%blocks(block)%name
