@@ -1,7 +1,8 @@
 !> crashfree: explicit crash solver with coupled meshfree (EFG) / finite element parts.
 !> The program only reads the command line; everything else lives in libcrashfree.
 program crashfree
-  use command_line, only: run_options_t, parse_command_line, usage_text
+  use command_line, only: run_options_t, command_argument_t, get_command_arguments, &
+                          parse_command_line, usage_text
   use error_handling, only: error_t
   use job, only: run_job
   use version, only: crashfree_version
@@ -17,18 +18,16 @@ program crashfree
   end interface
   type(run_options_t) :: options
   type(error_t), allocatable :: error
-  character(len=4096), allocatable :: arguments(:)
-  integer :: k, exit_status
+  type(command_argument_t), allocatable :: arguments(:)
+  integer :: exit_status
 
-  allocate (arguments(command_argument_count()))
-  do k = 1, size(arguments)
-    call get_command_argument(k, arguments(k))
-  end do
+  call get_command_arguments(arguments)
   call parse_command_line(arguments, options, error)
   if (allocated(error)) then
     write (error_unit, '(a)') "crashfree: "//error%message
     call c_exit(2_c_int)
   end if
+  if (options%notes%count > 0) call write_notes(options%notes%text)
   if (options%show_help) then
     write (*, '(a)') usage_text()
     stop
@@ -41,4 +40,23 @@ program crashfree
   flush (output_unit)
   flush (error_unit)
   call c_exit(int(exit_status, c_int))
+
+contains
+
+  !> Each line of `text` on standard error as `crashfree: line`.
+  subroutine write_notes(text)
+    character(len=*), intent(in) :: text
+    integer :: start, finish
+    start = 1
+    do while (start <= len(text))
+      finish = index(text(start:), new_line("a"))
+      if (finish == 0) then
+        finish = len(text) + 1
+      else
+        finish = start + finish - 1
+      end if
+      write (error_unit, '(a)') "crashfree: "//text(start:finish - 1)
+      start = finish + 1
+    end do
+  end subroutine write_notes
 end program crashfree

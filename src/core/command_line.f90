@@ -1,10 +1,20 @@
 !> The command line in the style LS-DYNA users know: `crashfree i=deck.k ncpu=2 ...`.
+!>
+!> LS-DYNA's own arguments that have no meaning here (memory=, d=nodump, o=, ...) are accepted
+!> and listed as notes, so that a command line copied from an LS-DYNA job runs; a bare deck
+!> name as the first argument (`crashfree deck.k`) is the deck, as LS-DYNA takes it.
 module command_line
-  use error_handling, only: error_t, make_error
+  use error_handling, only: error_t, error_list_t, make_error, add_error
   implicit none
   private
 
-  public :: run_options_t, parse_command_line, usage_text
+  public :: run_options_t, command_argument_t, parse_command_line, usage_text
+  public :: get_command_arguments
+
+  !> One argument as the shell passed it, whatever its length.
+  type :: command_argument_t
+    character(len=:), allocatable :: text
+  end type command_argument_t
 
   !> What the user asked for.
   type :: run_options_t
@@ -16,22 +26,38 @@ module command_line
     logical :: ignore_unknown = .false.            !< --ignore-unknown
     logical :: show_help = .false.
     logical :: show_version = .false.
+    !> LS-DYNA arguments accepted but not used, one note each (for standard error).
+    type(error_list_t) :: notes
   end type run_options_t
 
 contains
 
+  !> The arguments the program was started with, each at its full length.
+  subroutine get_command_arguments(arguments)
+    type(command_argument_t), allocatable, intent(out) :: arguments(:)
+    integer :: k, length
+    allocate (arguments(command_argument_count()))
+    do k = 1, size(arguments)
+      call get_command_argument(k, length=length)
+      allocate (character(len=length) :: arguments(k)%text)
+      if (length > 0) call get_command_argument(k, arguments(k)%text)
+    end do
+  end subroutine get_command_arguments
+
   !> Parse `arguments` (already split as the shell split them).
   subroutine parse_command_line(arguments, options, error)
-    character(len=*), intent(in) :: arguments(:)
+    type(command_argument_t), intent(in) :: arguments(:)
     type(run_options_t), intent(out) :: options
     type(error_t), allocatable, intent(out) :: error
-    integer :: k, equals, status
-    character(len=:), allocatable :: argument, key, value
+    integer :: k, equals
+    character(len=:), allocatable :: argument, key, value, note
+    logical :: bare_deck
 
     options%output_dir = "."
     options%job_id = "results"
+    bare_deck = .false.
     do k = 1, size(arguments)
-      argument = trim(arguments(k))
+      argument = arguments(k)%text
       select case (argument)
       case ("--help", "-h", "help")
         options%show_help = .true.
@@ -44,6 +70,14 @@ contains
         cycle
       end select
       equals = index(argument, "=")
+      if (k == 1 .and. equals == 0 .and. len(argument) > 0) then
+        ! LS-DYNA takes a first argument without "=" as the input deck
+        if (argument(1:1) /= "-") then
+          options%deck = argument
+          bare_deck = .true.
+          cycle
+        end if
+      end if
       if (equals <= 1 .or. equals == len(argument)) then
         call make_error(error, "command line: '"//argument//"' is not of the form key=value (see --help)")
         return
@@ -52,6 +86,11 @@ contains
       value = argument(equals + 1:)
       select case (key)
       case ("i")
+        if (bare_deck) then
+          call make_error(error, "command line: two decks given: '"//options%deck//"' and i="// &
+                          value)
+          return
+        end if
         options%deck = value
       case ("outdir")
         options%output_dir = value
@@ -60,14 +99,15 @@ contains
       case ("r")
         options%restart_file = value
       case ("ncpu")
-        read (value, *, iostat=status) options%threads
-        if (status /= 0 .or. options%threads < 1 .or. verify(value, "0123456789") /= 0) then
-          call make_error(error, "command line: ncpu='"//value//"' is not a positive whole number")
+        call read_thread_count(value, options, error)
+        if (allocated(error)) return
+      case default
+        note = ignored_argument_note(key)
+        if (len(note) == 0) then
+          call make_error(error, "command line: unknown option '"//key//"=' (see --help)")
           return
         end if
-      case default
-        call make_error(error, "command line: unknown option '"//key//"=' (see --help)")
-        return
+        call add_error(options%notes, argument//": ignored ("//note//")")
       end select
     end do
     if (.not. (options%show_help .or. options%show_version) .and. .not. allocated(options%deck)) then
@@ -75,19 +115,68 @@ contains
     end if
   end subroutine parse_command_line
 
+  !> ncpu=N: N threads. LS-DYNA's ncpu=-N (N threads, results independent of N) is read as N,
+  !> with a note: crashfree's results are the same for any N anyway.
+  subroutine read_thread_count(value, options, error)
+    character(len=*), intent(in) :: value
+    type(run_options_t), intent(inout) :: options
+    type(error_t), allocatable, intent(out) :: error
+    character(len=:), allocatable :: digits
+    integer :: status
+    digits = value
+    if (len(value) > 1) then
+      if (value(1:1) == "-") digits = value(2:)
+    end if
+    status = 1
+    if (verify(digits, "0123456789") == 0 .and. len(digits) <= 9) &
+      read (digits, *, iostat=status) options%threads
+    if (status /= 0 .or. options%threads < 1) then
+      call make_error(error, "command line: ncpu='"//value//"' is not a positive whole number")
+      return
+    end if
+    if (len(digits) < len(value)) call add_error(options%notes, "ncpu="//value//": read as "// &
+      "ncpu="//digits//" (results are the same for any number of threads, as LS-DYNA's "// &
+      "negative ncpu asks for)")
+  end subroutine read_thread_count
+
+  !> Why LS-DYNA's argument `key`= is not used here ("" for a key LS-DYNA does not have
+  !> either, which is an error).
+  pure function ignored_argument_note(key) result(note)
+    character(len=*), intent(in) :: key
+    character(len=:), allocatable :: note
+    select case (key)
+    case ("memory", "memory2")
+      note = "crashfree sizes its memory from the model"
+    case ("d")
+      note = "crashfree writes no restart dumps"
+    case ("o")
+      note = "crashfree prints its run output on standard output"
+    case ("g")
+      note = "results go to DIR/results.h5, see outdir= and jobid="
+    case ("pfile")
+      note = "no MPP partitioning; OpenMP threads are set with ncpu="
+    case ("ncycle")
+      note = "an LS-DYNA option crashfree does not use"
+    case default
+      note = ""
+    end select
+  end function ignored_argument_note
+
   !> The text of --help.
   function usage_text() result(text)
     character(len=:), allocatable :: text
     character(len=*), parameter :: nl = new_line('a')
     text = "usage: crashfree i=DECK.k [outdir=DIR] [ncpu=N] [jobid=NAME] [r=RESTARTFILE]"//nl// &
-           "                 [--ignore-unknown] [--help] [--version]"//nl//nl// &
-           "  i=DECK.k        LS-DYNA style keyword deck to run"//nl// &
+           "                 [--ignore-unknown] [--help] [--version]"//nl// &
+           "       crashfree DECK.k [...]"//nl//nl// &
+           "  i=DECK.k        LS-DYNA style keyword deck to run (or the deck name alone, first)"//nl// &
            "  outdir=DIR      directory for the results (default: the current directory)"//nl// &
-           "  ncpu=N          OpenMP threads (default: OMP_NUM_THREADS, else all cores);"//nl// &
-           "                  results are bit-identical for any N"//nl// &
+           "  ncpu=N          OpenMP threads (default: OMP_NUM_THREADS, else all cores; at most"//nl// &
+           "                  the processors available); results are bit-identical for any N"//nl// &
            "  jobid=NAME      name the results NAME.h5 and NAME.xdmf (default: results)"//nl// &
            "  r=FILE          restart file (not supported yet: rejected)"//nl// &
-           "  --ignore-unknown  warn about unknown keywords instead of stopping"//nl//nl// &
+           "  --ignore-unknown  warn about unknown keywords instead of stopping"//nl// &
+           "  memory= memory2= d=nodump o= g= ncycle= pfile=   LS-DYNA's: accepted, not used"//nl//nl// &
            "Results: DIR/results.h5 (HDF5, see README) and DIR/results.xdmf for ParaView."//nl// &
            "Exit status: 0 normal termination, 1 error termination, 2 bad command line or deck."
   end function usage_text

@@ -12,7 +12,7 @@ module deck_fields
                           number_out_of_range, integer_text, real_text
   use deck_columns, only: field_spans_t, split_fields
   use deck_lexer, only: deck_t, line_location, find_parameter, trim_blanks, is_blank_line, &
-                        block_of_line
+                        block_of_line, load_line_text, card_text
   implicit none
   private
 
@@ -25,27 +25,30 @@ module deck_fields
   type :: card_t
     integer :: line = 0
     integer :: block = 0
+    character(len=:), allocatable :: text   !< the line (field positions refer to it)
     type(field_spans_t) :: spans
     logical :: failed = .false.     !< a field could not be read
   end type card_t
 
 contains
 
-  !> Split line `line` of block `block` with the standard `widths` of its layout.
+  !> Split line `line` of block `block` with the standard `widths` of its layout. `card` is
+  !> inout so that a reader going through many cards reuses the memory of its text.
   subroutine open_card(deck, block, line, widths, card, log)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block, line
     integer, intent(in) :: widths(:)
-    type(card_t), intent(out) :: card
+    type(card_t), intent(inout) :: card
     type(problem_log_t), intent(inout) :: log
     card%line = line
     card%block = block
-    call split_fields(deck%files(deck%line_file(line))%text(deck%line_first(line): &
-                      deck%line_last(line)), widths, deck%blocks(block)%format, card%spans)
+    card%failed = .false.
+    call load_line_text(deck, line, card%text)
+    call split_fields(card%text, widths, deck%blocks(block)%format, card%spans)
     if (card%spans%has_tab .and. .not. card%spans%free) then
       call report_problem(log, line_location(deck, line)//": *"//keyword_label(deck, block)// &
-        ": the card holds a tab character; fixed columns need blanks (or separate the "// &
-        "fields with commas)", unreadable=.true.)
+        ": the card holds a tab character (column "//integer_text(card%spans%tab_column)// &
+        "); fixed columns need blanks (or separate the fields with commas)", unreadable=.true.)
       card%failed = .true.
     end if
   end subroutine open_card
@@ -142,14 +145,14 @@ contains
     integer, intent(out) :: value
     type(problem_log_t), intent(inout) :: log
     integer, intent(in), optional :: default
-    integer :: file, first, last, status, parameter
+    integer :: first, last, status, parameter
     real(wp) :: real_value
 
     value = 0
     if (present(default)) value = default
-    call field_bounds(deck, card, k, file, first, last)
+    call field_bounds(card, k, first, last)
     if (last < first) return
-    associate (text => deck%files(file)%text(first:last))
+    associate (text => card%text(first:last))
       if (is_reference(text)) then
         call resolve_reference(deck, card, name, text, parameter, log)
         if (parameter == 0) return
@@ -197,13 +200,13 @@ contains
     real(wp), intent(out) :: value
     type(problem_log_t), intent(inout) :: log
     real(wp), intent(in), optional :: default
-    integer :: file, first, last, status, parameter
+    integer :: first, last, status, parameter
 
     value = 0.0_wp
     if (present(default)) value = default
-    call field_bounds(deck, card, k, file, first, last)
+    call field_bounds(card, k, first, last)
     if (last < first) return
-    associate (text => deck%files(file)%text(first:last))
+    associate (text => card%text(first:last))
       if (is_reference(text)) then
         call resolve_reference(deck, card, name, text, parameter, log)
         if (parameter == 0) return
@@ -238,11 +241,11 @@ contains
     character(len=*), intent(in) :: name
     character(len=:), allocatable, intent(out) :: value
     type(problem_log_t), intent(inout) :: log
-    integer :: file, first, last, parameter
+    integer :: first, last, parameter
     value = ""
-    call field_bounds(deck, card, k, file, first, last)
+    call field_bounds(card, k, first, last)
     if (last < first) return
-    value = deck%files(file)%text(first:last)
+    value = card%text(first:last)
     if (value(1:1) == "&") then
       call resolve_reference(deck, card, name, value, parameter, log)
       if (parameter > 0) value = trim_blanks(deck%parameters(parameter)%text_value)
@@ -250,27 +253,25 @@ contains
   end subroutine get_text
 
   !> True when field `k` is blank (the field's default applies).
-  logical function field_is_blank(deck, card, k)
-    type(deck_t), intent(in) :: deck
+  pure logical function field_is_blank(card, k)
     type(card_t), intent(in) :: card
     integer, intent(in) :: k
-    integer :: file, first, last
-    call field_bounds(deck, card, k, file, first, last)
+    integer :: first, last
+    call field_bounds(card, k, first, last)
     field_is_blank = last < first
   end function field_is_blank
 
   !> True when every field of `card` is blank or a number equal to zero: a card that sets
   !> nothing (such as the unconditional user-element cards some writers add to a keyword).
-  logical function card_is_empty(deck, card)
-    type(deck_t), intent(in) :: deck
+  logical function card_is_empty(card)
     type(card_t), intent(in) :: card
-    integer :: k, file, first, last, status
+    integer :: k, first, last, status
     real(wp) :: value
     card_is_empty = .false.
     do k = 1, card%spans%count
-      call field_bounds(deck, card, k, file, first, last)
+      call field_bounds(card, k, first, last)
       if (last < first) cycle
-      call parse_real(deck%files(file)%text(first:last), value, status)
+      call parse_real(card%text(first:last), value, status)
       if (status /= number_ok .or. value /= 0.0_wp) return
     end do
     card_is_empty = .true.
@@ -284,11 +285,11 @@ contains
     integer, intent(in) :: k
     character(len=*), intent(in) :: name, reason
     type(error_list_t), intent(inout) :: warnings
-    integer :: file, first, last, status
+    integer :: first, last, status
     real(wp) :: value
-    call field_bounds(deck, card, k, file, first, last)
+    call field_bounds(card, k, first, last)
     if (last < first) return
-    call parse_real(deck%files(file)%text(first:last), value, status)
+    call parse_real(card%text(first:last), value, status)
     if (status == number_ok .and. value == 0.0_wp) return
     call add_error(warnings, line_location(deck, card%line)//": *"// &
       keyword_label(deck, card%block)//": field "//name//": ignored ("//reason//")")
@@ -348,8 +349,7 @@ contains
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: line
     character(len=:), allocatable :: title
-    title = trim_blanks(deck%files(deck%line_file(line))%text(deck%line_first(line): &
-                                                                 deck%line_last(line)))
+    title = trim_blanks(card_text(deck, line))
   end function line_title
 
   !> An `_ID` card: the id (I10) and the heading (the rest of the line).
@@ -366,26 +366,26 @@ contains
     call get_text(deck, card, 2, "HEADING", heading, log)
   end subroutine id_heading
 
-  !> File and text positions of field `k` of `card`, blanks trimmed (last < first: blank).
-  subroutine field_bounds(deck, card, k, file, first, last)
-    type(deck_t), intent(in) :: deck
+  !> Positions of field `k` in the text of `card`, blanks trimmed (last < first: blank).
+  pure subroutine field_bounds(card, k, first, last)
     type(card_t), intent(in) :: card
     integer, intent(in) :: k
-    integer, intent(out) :: file, first, last
-    integer :: offset, start, finish
-    file = deck%line_file(card%line)
+    integer, intent(out) :: first, last
+    integer :: start, finish
     first = 1
     last = 0
     if (k > card%spans%count) return
     if (card%spans%last(k) < card%spans%first(k)) return
-    offset = deck%line_first(card%line) - 1
-    start = verify(deck%files(file)%text(offset + card%spans%first(k): &
-                   offset + card%spans%last(k)), " "//achar(9))
-    if (start == 0) return
-    finish = verify(deck%files(file)%text(offset + card%spans%first(k): &
-                    offset + card%spans%last(k)), " "//achar(9), back=.true.)
-    first = offset + card%spans%first(k) + start - 1
-    last = offset + card%spans%first(k) + finish - 1
+    ! plain loops: `verify` with a set is a general search, and this runs for every field
+    do start = card%spans%first(k), card%spans%last(k)
+      if (card%text(start:start) /= " " .and. card%text(start:start) /= achar(9)) exit
+    end do
+    if (start > card%spans%last(k)) return
+    do finish = card%spans%last(k), start, -1
+      if (card%text(finish:finish) /= " " .and. card%text(finish:finish) /= achar(9)) exit
+    end do
+    first = start
+    last = finish
   end subroutine field_bounds
 
   pure logical function is_reference(text)

@@ -4,7 +4,7 @@ module deck_keywords
   implicit none
   private
 
-  public :: keyword_t, identify_keyword, closest_keyword
+  public :: keyword_t, identify_keyword, suggest_keyword, known_keyword_count, known_keyword
 
   !> Keyword codes (one per reader entry; aliases such as *MAT_001 share a code).
   integer, parameter, public :: keyword_unknown = 0, keyword_title = 1, keyword_node = 2, &
@@ -90,7 +90,43 @@ module deck_keywords
     "TITLE", "TITLE", "TITLE", "TITLE", "TITLE", "TITLE", &
     "MOTION ID", "", "", "TITLE", "", "", "", "", ""]
 
+  !> The keywords read by other modules (deck_rigid_bodies, deck_contact, deck_materials), with
+  !> their options: spelling suggestions are taken from these and the entries above, and the
+  !> unit tests check that every name listed here is read.
+  integer, parameter :: other_count = 14
+  character(len=*), parameter :: other_names(other_count) = [character(len=36) :: &
+    "MAT_RIGID", "MAT_020", "BOUNDARY_PRESCRIBED_MOTION_RIGID", "CONSTRAINED_NODAL_RIGID_BODY", &
+    "ELEMENT_MASS", "CONTACT_AUTOMATIC_NODES_TO_SURFACE", "CONTACT_AUTOMATIC_SURFACE_TO_SURFACE", &
+    "CONTACT_AUTOMATIC_SINGLE_SURFACE", "CONTROL_CONTACT", "DATABASE_RCFORC", &
+    "MAT_PIECEWISE_LINEAR_PLASTICITY", "MAT_024", "MAT_NULL", "MAT_009"]
+  character(len=*), parameter :: other_options(other_count) = [character(len=28) :: &
+    "TITLE", "TITLE", "ID", "TITLE", "", "ID TITLE", "ID TITLE", "ID TITLE", "", "", "TITLE", &
+    "TITLE", "TITLE", "TITLE"]
+  !> Number of names suggestions are taken from.
+  integer, parameter :: known_count = entry_count + other_count
+  !> Longest keyword name a suggestion is looked for (longer ones are no typing slip).
+  integer, parameter :: longest_suggested = 80
+
 contains
+
+  !> Number of keyword names crashfree knows (those it reads and those the lexer handles).
+  pure integer function known_keyword_count()
+    known_keyword_count = known_count
+  end function known_keyword_count
+
+  !> Known keyword name `k` (1 .. known_keyword_count()) and the options it accepts
+  !> (blank-separated).
+  pure subroutine known_keyword(k, name, options)
+    integer, intent(in) :: k
+    character(len=:), allocatable, intent(out) :: name, options
+    if (k <= entry_count) then
+      name = trim(base_names(k))
+      options = trim(base_options(k))
+    else
+      name = trim(other_names(k - entry_count))
+      options = trim(other_options(k - entry_count))
+    end if
+  end subroutine known_keyword
 
   !> Take keyword `name` (upper case, no `*`) apart; `code` stays `keyword_unknown` when it is
   !> not a keyword crashfree reads. The longest base name whose options all fit wins, so
@@ -168,39 +204,195 @@ contains
     fits = text(len(text):) /= "_"
   end subroutine read_options
 
-  !> The known keyword nearest to `name` in spelling ("" when none is close), for
-  !> "did you mean" hints: edit distance at most 2, or a fifth of the name for long names.
-  pure function closest_keyword(name) result(closest)
+  !> A "did you mean" hint for the unknown keyword `name` (upper case, no `*`): the known
+  !> keyword nearest in spelling, with the options of `name` spelt right (`suggestion`), and
+  !> the same without options (`base`); both "" when no known keyword is close. Spelling
+  !> distance counts insertions, deletions, substitutions and swaps of neighbours; the
+  !> nearest name wins, a name of the same family (*MAT_..., *DATABASE_...) on a tie. A
+  !> keyword crashfree reads, but not with the options given, gets `base` alone.
+  pure subroutine suggest_keyword(name, suggestion, base)
     character(len=*), intent(in) :: name
-    character(len=:), allocatable :: closest
-    integer :: k, distance, best
-    best = max(2, len(name)/5) + 1
-    closest = ""
-    do k = 1, entry_count
-      distance = edit_distance(name, trim(base_names(k)))
-      if (distance < best) then
-        best = distance
-        closest = trim(base_names(k))
-      end if
-    end do
-  end function closest_keyword
+    character(len=:), allocatable, intent(out) :: suggestion, base
+    character(len=:), allocatable :: candidate, options, corrected
+    integer :: k, split, distance, best_score, option_distance
+    logical :: fits
 
-  !> Levenshtein distance (insertions, deletions, substitutions).
-  pure integer function edit_distance(first, second)
+    suggestion = ""
+    base = ""
+    if (len(name) == 0 .or. len(name) > longest_suggested) return
+    best_score = huge(best_score)
+    do k = 1, known_count
+      call known_keyword(k, candidate, options)
+      ! the whole name as the base name
+      distance = spelling_distance(name, candidate)
+      if (distance > 0 .and. close_enough(name, candidate, distance)) &
+        call consider(2*distance + family_penalty(name, candidate), candidate, candidate, &
+                      best_score, suggestion, base)
+      ! the name as a base name and options: NAME = HEAD_OPTION[_OPTION...]
+      do split = len(name) - 1, 2, -1
+        if (name(split:split) /= "_") cycle
+        call match_options(name(split + 1:), options, corrected, option_distance, fits)
+        if (.not. fits) cycle
+        distance = spelling_distance(name(:split - 1), candidate)
+        if (distance == 0 .and. option_distance == 0) cycle
+        if (.not. close_enough(name(:split - 1), candidate, max(distance, 1))) cycle
+        call consider(2*(distance + option_distance) + family_penalty(name, candidate), &
+                      candidate//"_"//corrected, candidate, best_score, suggestion, base)
+      end do
+    end do
+    if (len(suggestion) > 0) return
+    ! a keyword read without these options: name it alone
+    do split = len(name) - 1, 2, -1
+      if (name(split:split) /= "_") cycle
+      do k = 1, known_count
+        call known_keyword(k, candidate, options)
+        if (name(:split - 1) /= candidate) cycle
+        suggestion = candidate
+        base = candidate
+        return
+      end do
+    end do
+  end subroutine suggest_keyword
+
+  !> Keep `full` (and `new_base`) when `new_score` beats `best_score`.
+  pure subroutine consider(new_score, full, new_base, best_score, suggestion, base)
+    integer, intent(in) :: new_score
+    character(len=*), intent(in) :: full, new_base
+    integer, intent(inout) :: best_score
+    character(len=:), allocatable, intent(inout) :: suggestion, base
+    if (new_score >= best_score) return
+    best_score = new_score
+    suggestion = full
+    base = new_base
+  end subroutine consider
+
+  !> Options `text` ("TITEL", "MOVING_FORCES") each matched to the nearest of `allowed`
+  !> (blank-separated), within one slip per three letters; `corrected` joins the matches.
+  pure subroutine match_options(text, allowed, corrected, distance, fits)
+    character(len=*), intent(in) :: text, allowed
+    character(len=:), allocatable, intent(out) :: corrected
+    integer, intent(out) :: distance
+    logical, intent(out) :: fits
+    character(len=:), allocatable :: token, option, best_option
+    integer :: start, finish, option_start, option_end, best, slip
+
+    corrected = ""
+    distance = 0
+    fits = .false.
+    if (len(allowed) == 0 .or. len(text) == 0) return
+    start = 1
+    do while (start <= len(text))
+      finish = index(text(start:), "_")
+      if (finish == 0) then
+        finish = len(text)
+      else
+        finish = start + finish - 2
+      end if
+      token = text(start:finish)
+      start = finish + 2
+      if (len(token) == 0) return
+      best = huge(best)
+      option_start = 1
+      do while (option_start <= len(allowed))
+        option_end = index(allowed(option_start:), " ")
+        if (option_end == 0) then
+          option_end = len(allowed)
+        else
+          option_end = option_start + option_end - 2
+        end if
+        option = allowed(option_start:option_end)
+        option_start = option_end + 2
+        slip = spelling_distance(token, option)
+        if (slip < best) then
+          best = slip
+          best_option = option
+        end if
+      end do
+      if (best > max(1, len(best_option)/3)) return
+      distance = distance + best
+      if (len(corrected) > 0) corrected = corrected//"_"
+      corrected = corrected//best_option
+    end do
+    fits = text(len(text):) /= "_"
+  end subroutine match_options
+
+  !> A distance small enough for a typing slip: at most one slip per five letters (one for
+  !> short names, three at most), and, when both names have the same number of `_`-separated
+  !> words, at most one slip per three letters in each word, so that *DATABASE_BINARY_D3THDT
+  !> is not taken for *DATABASE_BINARY_D3PLOT.
+  pure logical function close_enough(name, candidate, distance)
+    character(len=*), intent(in) :: name, candidate
+    integer, intent(in) :: distance
+    integer :: name_start, candidate_start, name_end, candidate_end
+    close_enough = distance <= min(3, max(1, len(name)/5))
+    if (.not. close_enough) return
+    if (count_words(name) /= count_words(candidate)) return
+    name_start = 1
+    candidate_start = 1
+    do while (name_start <= len(name) .and. candidate_start <= len(candidate))
+      name_end = word_end(name, name_start)
+      candidate_end = word_end(candidate, candidate_start)
+      if (spelling_distance(name(name_start:name_end), candidate(candidate_start:candidate_end)) &
+          > max(1, (candidate_end - candidate_start + 1)/3)) then
+        close_enough = .false.
+        return
+      end if
+      name_start = name_end + 2
+      candidate_start = candidate_end + 2
+    end do
+  end function close_enough
+
+  pure integer function count_words(text)
+    character(len=*), intent(in) :: text
+    integer :: k
+    count_words = 1
+    do k = 1, len(text)
+      if (text(k:k) == "_") count_words = count_words + 1
+    end do
+  end function count_words
+
+  !> Last position of the `_`-separated word that starts at `start`.
+  pure integer function word_end(text, start)
+    character(len=*), intent(in) :: text
+    integer, intent(in) :: start
+    word_end = index(text(start:), "_")
+    if (word_end == 0) then
+      word_end = len(text)
+    else
+      word_end = start + word_end - 2
+    end if
+  end function word_end
+
+  !> 1 when `name` and `candidate` are of different families (the word before the first
+  !> `_`: MAT, DATABASE, CONTROL ...), else 0.
+  pure integer function family_penalty(name, candidate)
+    character(len=*), intent(in) :: name, candidate
+    family_penalty = merge(0, 1, name(:word_end(name, 1)) == candidate(:word_end(candidate, 1)))
+  end function family_penalty
+
+  !> Edit distance with swaps of neighbouring letters (optimal string alignment): the number
+  !> of insertions, deletions, substitutions and swaps that turn `first` into `second`.
+  pure integer function spelling_distance(first, second)
     character(len=*), intent(in) :: first, second
-    integer :: previous(0:len(second)), current(0:len(second))
+    integer :: before(0:len(second)), previous(0:len(second)), current(0:len(second))
     integer :: i, j, cost
     do j = 0, len(second)
       previous(j) = j
     end do
+    before = 0
     do i = 1, len(first)
       current(0) = i
       do j = 1, len(second)
         cost = merge(0, 1, first(i:i) == second(j:j))
         current(j) = min(previous(j) + 1, current(j - 1) + 1, previous(j - 1) + cost)
+        if (i > 1 .and. j > 1) then
+          if (first(i:i) == second(j - 1:j - 1) .and. first(i - 1:i - 1) == second(j:j)) &
+            current(j) = min(current(j), before(j - 2) + 1)
+        end if
       end do
+      before = previous
       previous = current
     end do
-    edit_distance = previous(len(second))
-  end function edit_distance
+    spelling_distance = previous(len(second))
+  end function spelling_distance
 end module deck_keywords

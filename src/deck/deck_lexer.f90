@@ -1,28 +1,40 @@
-!> Reads a deck and everything it includes into memory and cuts it into keyword blocks.
+!> Reads a deck and everything it includes and cuts it into keyword blocks.
 !>
 !> Comment lines (`$`), `*COMMENT` blocks, `*KEYWORD`, `*INCLUDE`, `*PARAMETER` and `*END` are
 !> handled here, so the keyword readers see only keyword blocks whose data lines are cards.
-!> Every line kept has an entry in the line table (file, line number, place in the file's text),
-!> which is how every later message can say `file:line`.
+!> Every line kept has an entry in the line table (file, line number, byte offset), which is
+!> how every later message can say `file:line`.
 !>
-!> Files are read whole (stream access) and lines point into their text: a deck of a million
-!> nodes is one read and a scan for newlines, not a million formatted reads.
+!> Files of any size are read without holding them in memory: each file is scanned once in
+!> chunks of a megabyte to build the line table, and the keyword readers then get each card's
+!> text through a small window that re-reads the file at the card's 64-bit offset (sequential
+!> reading refills it every quarter megabyte). Memory is the line table (about 4 bytes per
+!> line) and the model, not the deck's text.
 module deck_lexer
   use kinds, only: wp
+  use, intrinsic :: iso_fortran_env, only: int64
   use error_handling, only: error_list_t, add_error
-  use deck_problems, only: problem_log_t, report_problem
+  use deck_problems, only: problem_log_t, report_problem, control_character_name
   use deck_numbers, only: to_upper, parse_integer, parse_real, number_ok, integer_text
   use deck_columns, only: field_spans_t, split_fields, format_standard, format_long, format_i10
+  use deck_line_table, only: line_table_t, start_table, append_line, line_file, line_number, &
+                             line_place
+  use deck_file_io, only: file_handle_t, inspect_file, open_file, read_bytes, close_file, &
+                          file_missing, file_regular, file_directory, file_fifo, file_device
   implicit none
   private
 
-  public :: deck_t, keyword_block_t, deck_parameter_t, load_deck
+  public :: deck_t, keyword_block_t, deck_parameter_t, load_deck, release_deck
   public :: line_location, find_parameter, trim_blanks, is_blank_line, card_text, block_of_line
+  public :: load_line_text
 
-  !> One file of the deck, read whole.
+  !> Longest line read (a comment line may be longer: it is skipped unread).
+  integer, parameter, public :: max_line_length = 1048576
+
+  !> One file of the deck.
   type :: source_file_t
     character(len=:), allocatable :: path      !< as opened (include paths resolved)
-    character(len=:), allocatable :: text
+    integer(int64) :: size = 0                 !< bytes
   end type source_file_t
 
   !> One keyword and its data lines (indices into the line table; none when last < first).
@@ -44,16 +56,33 @@ module deck_lexer
     integer :: line = 0
   end type deck_parameter_t
 
-  !> The whole deck as text: files, the line table and the keyword blocks in reading order.
+  !> The bytes of one file held for reading cards back: bytes first .. first + length - 1
+  !> (0 = the file's first byte) of file `file` (0: none yet). The line found last is kept
+  !> too, since a reader usually asks for a line twice (is it blank? then its fields).
+  type :: text_window_t
+    integer :: file = 0
+    type(file_handle_t) :: handle
+    integer(int64) :: first = 0
+    integer :: length = 0
+    character(len=:), allocatable :: buffer
+    integer :: line = 0                        !< the line found last (0: none)
+    integer :: line_first = 1, line_last = 0   !< its text in the buffer
+  end type text_window_t
+
+  !> The whole deck: files, the line table and the keyword blocks in reading order.
   type :: deck_t
     integer :: file_count = 0
     type(source_file_t), allocatable :: files(:)
-    integer :: line_count = 0
-    integer, allocatable :: line_file(:), line_number(:), line_first(:), line_last(:)
+    type(line_table_t) :: lines
     integer :: block_count = 0
     type(keyword_block_t), allocatable :: blocks(:)
     integer :: parameter_count = 0
     type(deck_parameter_t), allocatable :: parameters(:)
+    integer :: keyword_lines = 0               !< keyword lines read, in all files
+    logical :: main_file_read = .false.        !< the main deck's text was scanned
+    !> The text window. A pointer, so that the readers, which get the deck with intent(in),
+    !> can still move it: it only caches what the files hold, the deck itself does not change.
+    type(text_window_t), pointer :: window => null()
   end type deck_t
 
   !> What the keyword line being read starts: a block for the keyword readers, or one of the
@@ -70,27 +99,84 @@ module deck_lexer
     integer :: format = format_standard
   end type open_block_t
 
+  !> What the scan of one file has found so far.
+  type :: scan_state_t
+    integer :: file = 0
+    integer :: number = 0                       !< physical lines read
+    integer :: file_format = format_standard
+    logical :: ended = .false.                  !< *END read, or the file cannot be read on
+    logical :: outside_reported = .false.       !< data before the first keyword was reported
+    integer :: control_lines = 0                !< lines holding control characters
+    integer :: long_lines = 0                   !< lines longer than max_line_length
+    type(open_block_t) :: block
+  end type scan_state_t
+
   !> Deepest include nesting accepted (a deeper chain is almost surely a file including itself).
   integer, parameter :: max_include_depth = 30
+  !> Bytes read per step of the scan, and the window's first size.
+  integer, parameter :: scan_chunk = 1048576, window_chunk = 262144
+  !> How far into a file NUL bytes mark it as binary (as grep and git decide it).
+  integer, parameter :: binary_probe = 8000
+  character, parameter :: line_feed = achar(10), carriage_return = achar(13), tab = achar(9)
 
 contains
 
-  !> Read the deck `path` with its includes. Problems go to `log`; duplicate parameters to
-  !> `warnings`.
+  !> Read the deck `path` with its includes. Problems go to `log`; duplicate parameters and
+  !> notes on the deck's form to `warnings`. Call `release_deck` when done with `deck`.
   subroutine load_deck(path, deck, log, warnings)
     character(len=*), intent(in) :: path
     type(deck_t), intent(out) :: deck
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
-    integer :: chain(0)
+    integer :: chain(0), problems_before
+
+    problems_before = log%total
     allocate (deck%files(4), deck%blocks(64), deck%parameters(8))
-    allocate (deck%line_file(1024), deck%line_number(1024), deck%line_first(1024), &
-              deck%line_last(1024))
+    call start_table(deck%lines, 1024)
+    allocate (deck%window)
+    allocate (character(len=window_chunk) :: deck%window%buffer)
     call load_file(deck, path, format_standard, 0, chain, log, warnings)
+    if (.not. deck%main_file_read) return
+    if (deck%keyword_lines == 0) then
+      call report_problem(log, path//": the file holds no keyword line (a keyword deck starts "// &
+        "with *KEYWORD in column 1 and holds keywords such as *NODE); is it a keyword deck?", &
+        unreadable=.true.)
+    else if (log%total == problems_before .and. .not. starts_with_keyword(deck)) then
+      ! (only for a deck read without problems: a damaged first line says more itself)
+      call add_error(warnings, path//": the deck does not start with *KEYWORD, as an LS-DYNA "// &
+        "keyword deck does (is it an include file?); it is read as a keyword deck")
+    end if
   end subroutine load_deck
 
-  !> Read one file and scan it line by line; `include_line` is the *INCLUDE card that named it
-  !> (0 for the main deck), `chain` the files that include it.
+  !> Close the file the text window holds and free it; `deck` keeps its line table and blocks
+  !> (for messages) but its text can no longer be read.
+  subroutine release_deck(deck)
+    type(deck_t), intent(inout) :: deck
+    if (.not. associated(deck%window)) return
+    call close_file(deck%window%handle)
+    deallocate (deck%window)
+  end subroutine release_deck
+
+  !> True when the main deck's first keyword line is *KEYWORD.
+  logical function starts_with_keyword(deck)
+    type(deck_t), intent(in) :: deck
+    character(len=:), allocatable :: text
+    integer :: line
+    starts_with_keyword = .false.
+    do line = 1, deck%lines%count
+      if (line_file(deck%lines, line) /= 1) cycle
+      text = card_text(deck, line)
+      if (len(text) == 0) cycle
+      if (text(1:1) /= "*") cycle
+      text = to_upper(text)
+      if (len(text) >= 8) starts_with_keyword = text(1:8) == "*KEYWORD" .and. &
+        verify(text(9:min(len(text), 9)), " "//tab) == 0
+      return
+    end do
+  end function starts_with_keyword
+
+  !> Scan one file line by line; `include_line` is the *INCLUDE card that named it (0 for the
+  !> main deck), `chain` the files that include it.
   recursive subroutine load_file(deck, path, format, include_line, chain, log, warnings)
     type(deck_t), intent(inout) :: deck
     character(len=*), intent(in) :: path
@@ -98,99 +184,396 @@ contains
     integer, intent(in) :: chain(:)
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
-    type(open_block_t) :: block
-    integer :: file, position, newline, last, next, number, file_format, text_length
-    logical :: ended, outside_reported
+    type(scan_state_t) :: state
+    type(file_handle_t) :: handle
+    character(len=:), allocatable :: buffer
+    integer(int64) :: buffer_start
+    integer :: filled, position, newline, remainder, count
+    logical :: end_of_file, unusual
 
-    call read_whole_file(deck, path, include_line, file, log)
-    if (file == 0) return
-    file_format = format
-    text_length = len(deck%files(file)%text)
-    position = 1
-    number = 0
-    outside_reported = .false.
-    do while (position <= text_length)
-      newline = position_of_newline(deck%files(file)%text(position:))
-      if (newline == 0) then
-        last = text_length
-        next = text_length + 1
-      else
-        last = position + newline - 2
-        next = position + newline
+    call open_source(deck, path, include_line, state%file, handle, log, warnings)
+    if (state%file == 0) return
+    state%file_format = format
+    allocate (character(len=scan_chunk + max_line_length) :: buffer)
+    buffer_start = 0
+    call read_bytes(handle, buffer_start, buffer(1:scan_chunk), filled)
+    end_of_file = filled < scan_chunk
+    call check_file_start(deck, path, include_line, buffer(1:filled), position, state%ended, &
+                          log)
+    if (include_line == 0) deck%main_file_read = .not. state%ended
+    do while (.not. state%ended)
+      call find_line_end(buffer(position:filled), newline, unusual)
+      if (newline > max_line_length + 1) then
+        call note_long_line(deck, buffer(position:position + newline - 2), state, log)
+        position = position + newline
+        cycle
+      else if (newline > 0) then
+        call take_line(deck, buffer(position:position + newline - 2), &
+                       buffer_start + position - 1, unusual, chain, state, log, warnings)
+        position = position + newline
+        cycle
       end if
-      number = number + 1
-      if (last >= position) then
-        if (deck%files(file)%text(last:last) == achar(13)) last = last - 1
+      if (end_of_file) then
+        if (filled - position + 1 > max_line_length) then
+          call note_long_line(deck, buffer(position:filled), state, log)
+        else if (position <= filled) then
+          call take_line(deck, buffer(position:filled), buffer_start + position - 1, unusual, &
+                         chain, state, log, warnings)
+        end if
+        exit
       end if
-      call take_line(deck, file, number, position, last, file_format, chain, block, ended, &
-                     outside_reported, log, warnings)
-      if (ended) exit
-      position = next
+      remainder = filled - position + 1
+      if (remainder >= max_line_length) then
+        call skip_long_line(deck, handle, buffer, buffer_start, position, filled, &
+                            end_of_file, state, log)
+        cycle
+      end if
+      ! keep the start of the line, read on behind it
+      buffer(1:remainder) = buffer(position:filled)
+      buffer_start = buffer_start + (position - 1)
+      position = 1
+      call read_bytes(handle, buffer_start + remainder, buffer(remainder + 1:remainder + &
+                      scan_chunk), count)
+      filled = remainder + count
+      end_of_file = count < scan_chunk
     end do
-    call close_block(deck, file, file_format, chain, block, log, warnings)
+    call close_file(handle)
+    deallocate (buffer)
+    call close_block(deck, state%file, state%file_format, chain, state%block, log, warnings)
+    call report_file_totals(deck, state, log)
   end subroutine load_file
 
-  !> Classify one physical line: comment, keyword line, or data line of the open block.
-  recursive subroutine take_line(deck, file, number, first, last, file_format, chain, block, &
-                                 ended, outside_reported, log, warnings)
+  !> Check that `path` is a regular file that can be read and add it to the deck's files
+  !> (`file` = 0 when it cannot be read, after reporting why).
+  subroutine open_source(deck, path, include_line, file, handle, log, warnings)
     type(deck_t), intent(inout) :: deck
-    integer, intent(in) :: file, number, first, last
-    integer, intent(inout) :: file_format
-    integer, intent(in) :: chain(:)
-    type(open_block_t), intent(inout) :: block
-    logical, intent(out) :: ended
-    logical, intent(inout) :: outside_reported
+    character(len=*), intent(in) :: path
+    integer, intent(in) :: include_line
+    integer, intent(out) :: file
+    type(file_handle_t), intent(out) :: handle
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
+    integer :: kind
+    integer(int64) :: file_size
+    logical :: opened
+
+    file = 0
+    call inspect_file(path, kind, file_size)
+    select case (kind)
+    case (file_missing)
+      call source_problem(deck, path, include_line, "does not exist (or a directory on its "// &
+                          "path cannot be read)", log)
+      return
+    case (file_directory)
+      call source_problem(deck, path, include_line, "is a directory", log)
+      return
+    case (file_fifo)
+      call source_problem(deck, path, include_line, "is a FIFO (named pipe), not a regular "// &
+                          "file; decks are read from regular files", log)
+      return
+    case (file_device)
+      call source_problem(deck, path, include_line, "is a device (such as /dev/zero), not a "// &
+                          "regular file; decks are read from regular files", log)
+      return
+    case (file_regular)
+    case default
+      call source_problem(deck, path, include_line, "is not a regular file (a socket?); decks "// &
+                          "are read from regular files", log)
+      return
+    end select
+    call open_file(path, handle, opened)
+    if (.not. opened) then
+      call source_problem(deck, path, include_line, "cannot be opened for reading (check its "// &
+                          "permissions)", log)
+      return
+    end if
+    if (file_size == 0) then
+      call close_file(handle)
+      if (include_line == 0) then
+        call report_problem(log, path//": the deck file is empty", unreadable=.true.)
+      else
+        call add_error(warnings, line_location(deck, include_line)//": *INCLUDE: field "// &
+                       "FILENAME: """//path//""" is empty; nothing was read from it")
+      end if
+      return
+    end if
+    if (deck%file_count == size(deck%files)) call grow_files(deck)
+    deck%file_count = deck%file_count + 1
+    file = deck%file_count
+    deck%files(file)%path = path
+    deck%files(file)%size = file_size
+  end subroutine open_source
+
+  !> A file that cannot be read: `path: what` for the main deck, at the *INCLUDE card for an
+  !> included file.
+  subroutine source_problem(deck, path, include_line, what, log)
+    type(deck_t), intent(in) :: deck
+    character(len=*), intent(in) :: path, what
+    integer, intent(in) :: include_line
+    type(problem_log_t), intent(inout) :: log
+    if (include_line == 0) then
+      call report_problem(log, path//": the deck file "//what, unreadable=.true.)
+    else
+      call report_problem(log, line_location(deck, include_line)//": *INCLUDE: field "// &
+        "FILENAME: cannot open """//path//""": it "//what//" (a relative name is taken from "// &
+        "the directory of the including file)", unreadable=.true.)
+    end if
+  end subroutine source_problem
+
+  !> The first bytes of a file: a UTF-8 byte-order mark is skipped (`position` is where the
+  !> first line starts); UTF-16 text, compressed and binary files are reported (`stop`).
+  subroutine check_file_start(deck, path, include_line, bytes, position, stop, log)
+    type(deck_t), intent(in) :: deck
+    character(len=*), intent(in) :: path, bytes
+    integer, intent(in) :: include_line
+    integer, intent(out) :: position
+    logical, intent(out) :: stop
+    type(problem_log_t), intent(inout) :: log
+    position = 1
+    stop = .true.
+    if (starts_with(bytes, [255, 254]) .or. starts_with(bytes, [254, 255])) then
+      call source_problem(deck, path, include_line, "is UTF-16 text; save it as plain text "// &
+                          "(ASCII or UTF-8)", log)
+    else if (starts_with(bytes, [31, 139])) then
+      call source_problem(deck, path, include_line, "is compressed (gzip); unpack it first", log)
+    else
+      if (starts_with(bytes, [239, 187, 191])) position = 4
+      stop = index(bytes(1:min(len(bytes), binary_probe)), achar(0)) > 0
+      if (stop) call source_problem(deck, path, include_line, "holds NUL bytes near its "// &
+        "start: it is a binary file (a d3plot, an archive?), not a keyword deck", log)
+    end if
+  end subroutine check_file_start
+
+  pure logical function starts_with(bytes, codes)
+    character(len=*), intent(in) :: bytes
+    integer, intent(in) :: codes(:)
+    integer :: k
+    starts_with = len(bytes) >= size(codes)
+    if (.not. starts_with) return
+    do k = 1, size(codes)
+      starts_with = starts_with .and. iachar(bytes(k:k)) == codes(k)
+    end do
+  end function starts_with
+
+  !> The line at `position` of `buffer` runs on for max_line_length bytes or more: report it
+  !> (unless it is a comment, which is skipped unread) and read on past its end.
+  subroutine skip_long_line(deck, handle, buffer, buffer_start, position, filled, end_of_file, &
+                            state, log)
+    type(deck_t), intent(in) :: deck
+    type(file_handle_t), intent(in) :: handle
+    character(len=*), intent(inout) :: buffer
+    integer(int64), intent(inout) :: buffer_start
+    integer, intent(inout) :: position, filled
+    logical, intent(inout) :: end_of_file
+    type(scan_state_t), intent(inout) :: state
+    type(problem_log_t), intent(inout) :: log
+    integer :: newline
+
+    call note_long_line(deck, buffer(position:filled), state, log)
+    if (state%ended) return
+    do
+      newline = line_feed_position(buffer(position:filled))
+      if (newline > 0) then
+        position = position + newline
+        return
+      end if
+      if (end_of_file) then
+        position = filled + 1
+        return
+      end if
+      buffer_start = buffer_start + filled
+      call read_bytes(handle, buffer_start, buffer(1:scan_chunk), filled)
+      position = 1
+      end_of_file = filled < scan_chunk
+    end do
+  end subroutine skip_long_line
+
+  !> A line longer than max_line_length, which starts with `text`: reported (once per file,
+  !> then counted) unless it is a comment, and not read.
+  subroutine note_long_line(deck, text, state, log)
+    type(deck_t), intent(in) :: deck
+    character(len=*), intent(in) :: text
+    type(scan_state_t), intent(inout) :: state
+    type(problem_log_t), intent(inout) :: log
     integer :: leading
+    logical :: comment
+    call count_line(deck, state, log)
+    if (state%ended) return
+    leading = first_nonblank(text)
+    comment = state%block%kind == block_comment
+    if (leading > 0) comment = comment .or. text(leading:leading) == "$"
+    if (comment) return
+    state%long_lines = state%long_lines + 1
+    if (state%long_lines == 1) call report_problem(log, deck%files(state%file)%path//":"// &
+      integer_text(state%number)//": the line is longer than "//integer_text(max_line_length)// &
+      " characters, the longest line read (is this a keyword deck?)", unreadable=.true.)
+  end subroutine note_long_line
+
+  !> One more physical line of the file being scanned (a file of more lines than a default
+  !> integer counts is reported and read no further).
+  subroutine count_line(deck, state, log)
+    type(deck_t), intent(in) :: deck
+    type(scan_state_t), intent(inout) :: state
+    type(problem_log_t), intent(inout) :: log
+    if (state%number == huge(state%number)) then
+      call report_problem(log, deck%files(state%file)%path//": the file has more than "// &
+        integer_text(huge(state%number))//" lines; the rest is not read", unreadable=.true.)
+      state%ended = .true.
+      return
+    end if
+    state%number = state%number + 1
+  end subroutine count_line
+
+  !> Position of the first line feed in `text` (0 if none), and whether a control character
+  !> other than a tab comes before it (`unusual`: a carriage return, or one to report). One
+  !> plain loop over the bytes, the only pass the scan makes over a file's text; the general
+  !> substring search behind `index` takes three times as long.
+  pure subroutine find_line_end(text, newline, unusual)
+    character(len=*), intent(in) :: text
+    integer, intent(out) :: newline
+    logical, intent(out) :: unusual
+    integer :: k, code
+    unusual = .false.
+    newline = 0
+    do k = 1, len(text)
+      code = iachar(text(k:k))
+      if (code >= 32 .and. code /= 127) cycle
+      if (code == 10) then
+        newline = k
+        return
+      end if
+      if (code /= 9) unusual = .true.
+    end do
+  end subroutine find_line_end
+
+  !> Position of the first line feed in `text` (0 if none).
+  pure integer function line_feed_position(text)
+    character(len=*), intent(in) :: text
+    integer :: k
+    line_feed_position = 0
+    do k = 1, len(text)
+      if (text(k:k) == line_feed) then
+        line_feed_position = k
+        return
+      end if
+    end do
+  end function line_feed_position
+
+  !> Classify one physical line (`text`, its line feed removed, starting at byte `start`;
+  !> `unusual` when it may hold control characters): comment, keyword line, or data line of
+  !> the open block.
+  recursive subroutine take_line(deck, text, start, unusual, chain, state, log, warnings)
+    type(deck_t), intent(inout) :: deck
+    character(len=*), intent(in) :: text
+    integer(int64), intent(in) :: start
+    logical, intent(in) :: unusual
+    integer, intent(in) :: chain(:)
+    type(scan_state_t), intent(inout) :: state
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    integer :: leading, last
     character :: lead
 
-    ended = .false.
-    leading = first_nonblank(deck%files(file)%text(first:last))
+    call count_line(deck, state, log)
+    if (state%ended) return
+    ! CRLF line ends (decks written on Windows) read as LF ones
+    last = len(text)
+    do while (last > 0)
+      if (text(last:last) /= carriage_return) exit
+      last = last - 1
+    end do
+    leading = first_nonblank(text(1:last))
     if (leading > 0) then
-      lead = deck%files(file)%text(first + leading - 1:first + leading - 1)
+      lead = text(leading:leading)
     else
       lead = " "
     end if
     if (lead == "$") return
     if (leading == 1 .and. lead == "*") then
-      call close_block(deck, file, file_format, chain, block, log, warnings)
-      call add_line(deck, file, number, first, last)
-      call open_keyword(deck, deck%line_count, file_format, block, ended, log)
+      call close_block(deck, state%file, state%file_format, chain, state%block, log, warnings)
+      call add_line(deck, start, state, log)
+      if (state%ended) return
+      if (unusual) call check_characters(deck, text(1:last), state, log)
+      deck%keyword_lines = deck%keyword_lines + 1
+      call open_keyword(deck, deck%lines%count, text(1:last), state%file_format, state%block, &
+                        state%ended, log)
       return
     end if
-    if (block%kind == block_comment) return
-    if (leading == 0 .and. block%kind == block_none) return
-    call add_line(deck, file, number, first, last)
+    if (state%block%kind == block_comment) return
+    if (leading == 0 .and. state%block%kind == block_none) return
+    call add_line(deck, start, state, log)
+    if (state%ended) return
+    if (unusual) call check_characters(deck, text(1:last), state, log)
     if (lead == "*") then
-      call report_problem(log, line_location(deck, deck%line_count)// &
+      call report_problem(log, line_location(deck, deck%lines%count)// &
         ": a keyword must start in column 1 (found '*' in column "//integer_text(leading)//")", &
         unreadable=.true.)
       return
     end if
-    if (block%kind == block_none) then
-      if (.not. outside_reported) call report_problem(log, line_location(deck, deck%line_count)// &
-        ": data line before the first keyword of the file", unreadable=.true.)
-      outside_reported = .true.
+    if (state%block%kind == block_none) then
+      if (.not. state%outside_reported) call report_problem(log, line_location(deck, &
+        deck%lines%count)//": data line before the first keyword of the file", unreadable=.true.)
+      state%outside_reported = .true.
       return
     end if
-    block%last_line = deck%line_count
+    state%block%last_line = deck%lines%count
   end subroutine take_line
 
-  !> Start the block of the keyword on line `line`.
-  subroutine open_keyword(deck, line, file_format, block, ended, log)
+  !> Report the first line of a file that holds a control character other than a tab (the
+  !> others are counted and reported at the end of the file).
+  subroutine check_characters(deck, text, state, log)
+    type(deck_t), intent(in) :: deck
+    character(len=*), intent(in) :: text
+    type(scan_state_t), intent(inout) :: state
+    type(problem_log_t), intent(inout) :: log
+    character(len=:), allocatable :: hint
+    integer :: k, code
+    do k = 1, len(text)
+      code = iachar(text(k:k))
+      if ((code < 32 .and. code /= 9) .or. code == 127) exit
+    end do
+    if (k > len(text)) return
+    state%control_lines = state%control_lines + 1
+    if (state%control_lines > 1) return
+    if (code == iachar(carriage_return)) then
+      hint = " (lines ended by CR alone, as in old Mac files, are not line ends: save the "// &
+             "file with LF or CRLF line ends)"
+    else
+      hint = ""
+    end if
+    call report_problem(log, line_location(deck, deck%lines%count)//": column "// &
+      integer_text(k)//" holds the control character "//control_character_name(code)// &
+      " (byte "//integer_text(code)//"); a keyword deck is plain text (blanks, tabs or commas "// &
+      "between fields)"//hint, unreadable=.true.)
+  end subroutine check_characters
+
+  !> At the end of a file: how many more lines held control characters or were too long.
+  subroutine report_file_totals(deck, state, log)
+    type(deck_t), intent(in) :: deck
+    type(scan_state_t), intent(in) :: state
+    type(problem_log_t), intent(inout) :: log
+    if (state%control_lines > 1) call report_problem(log, deck%files(state%file)%path//": "// &
+      integer_text(state%control_lines - 1)//" more lines hold control characters", &
+      unreadable=.true.)
+    if (state%long_lines > 1) call report_problem(log, deck%files(state%file)%path//": "// &
+      integer_text(state%long_lines - 1)//" more lines are longer than "// &
+      integer_text(max_line_length)//" characters", unreadable=.true.)
+  end subroutine report_file_totals
+
+  !> Start the block of the keyword on line `line`, whose text is `text`.
+  subroutine open_keyword(deck, line, text, file_format, block, ended, log)
     type(deck_t), intent(inout) :: deck
     integer, intent(in) :: line
+    character(len=*), intent(in) :: text
     integer, intent(inout) :: file_format
     type(open_block_t), intent(out) :: block
     logical, intent(out) :: ended
     type(problem_log_t), intent(inout) :: log
-    character(len=:), allocatable :: text, name
+    character(len=:), allocatable :: name
     integer :: name_end, suffix_format
 
     ended = .false.
-    text = card_text(deck, line)
-    name_end = scan(text, " "//achar(9)) - 1
+    name_end = scan(text, " "//tab) - 1
     if (name_end < 0) name_end = len(text)
     name = to_upper(text(2:name_end))
     suffix_format = -1
@@ -500,63 +883,19 @@ contains
     end if
   end function span_text
 
-  !> Read `path` whole into a new entry of `deck%files` (`file` = 0 when it cannot be read).
-  subroutine read_whole_file(deck, path, include_line, file, log)
+  !> Add the line being scanned, which starts at byte `start`, to the line table.
+  subroutine add_line(deck, start, state, log)
     type(deck_t), intent(inout) :: deck
-    character(len=*), intent(in) :: path
-    integer, intent(in) :: include_line
-    integer, intent(out) :: file
+    integer(int64), intent(in) :: start
+    type(scan_state_t), intent(inout) :: state
     type(problem_log_t), intent(inout) :: log
-    integer :: unit, status, file_size
-    character(len=:), allocatable :: text
-
-    file = 0
-    open (newunit=unit, file=path, access="stream", form="unformatted", status="old", &
-          action="read", iostat=status)
-    if (status == 0) then
-      inquire (unit=unit, size=file_size)
-      if (file_size < 0) status = 1
-    end if
-    if (status == 0) then
-      allocate (character(len=file_size) :: text)
-      if (file_size > 0) read (unit, iostat=status) text
-      close (unit)
-    end if
-    if (status /= 0) then
-      if (include_line == 0) then
-        call report_problem(log, path//": cannot open the deck file (missing, unreadable or "// &
-                            "a directory)", unreadable=.true.)
-      else
-        call report_problem(log, line_location(deck, include_line)//": *INCLUDE: field "// &
-          "FILENAME: cannot open """//path//""" (missing, unreadable or a directory; a "// &
-          "relative name is taken from the directory of the including file)", unreadable=.true.)
-      end if
-      return
-    end if
-    if (deck%file_count == size(deck%files)) call grow_files(deck)
-    deck%file_count = deck%file_count + 1
-    file = deck%file_count
-    deck%files(file)%path = path
-    call move_alloc(text, deck%files(file)%text)
-  end subroutine read_whole_file
-
-  subroutine add_line(deck, file, number, first, last)
-    type(deck_t), intent(inout) :: deck
-    integer, intent(in) :: file, number, first, last
-    integer :: n
-    if (deck%line_count == size(deck%line_file)) then
-      n = 2*size(deck%line_file)
-      call grow_integers(deck%line_file, n)
-      call grow_integers(deck%line_number, n)
-      call grow_integers(deck%line_first, n)
-      call grow_integers(deck%line_last, n)
-    end if
-    n = deck%line_count + 1
-    deck%line_count = n
-    deck%line_file(n) = file
-    deck%line_number(n) = number
-    deck%line_first(n) = first
-    deck%line_last(n) = last
+    logical :: added
+    call append_line(deck%lines, state%file, state%number, start, added)
+    if (added) return
+    call report_problem(log, deck%files(state%file)%path//":"//integer_text(state%number)// &
+      ": the deck has more than "//integer_text(huge(state%number))//" lines; the rest is "// &
+      "not read", unreadable=.true.)
+    state%ended = .true.
   end subroutine add_line
 
   subroutine add_block(deck, name, block)
@@ -591,7 +930,7 @@ contains
     allocate (larger(2*size(deck%files)))
     do k = 1, deck%file_count
       call move_alloc(deck%files(k)%path, larger(k)%path)
-      call move_alloc(deck%files(k)%text, larger(k)%text)
+      larger(k)%size = deck%files(k)%size
     end do
     call move_alloc(larger, deck%files)
   end subroutine grow_files
@@ -604,21 +943,13 @@ contains
     call move_alloc(larger, deck%parameters)
   end subroutine grow_parameters
 
-  subroutine grow_integers(values, new_size)
-    integer, allocatable, intent(inout) :: values(:)
-    integer, intent(in) :: new_size
-    integer, allocatable :: larger(:)
-    allocate (larger(new_size))
-    larger(1:size(values)) = values
-    call move_alloc(larger, values)
-  end subroutine grow_integers
-
   !> `file:line` of line `line` of the line table.
   function line_location(deck, line) result(location)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: line
     character(len=:), allocatable :: location
-    location = deck%files(deck%line_file(line))%path//":"//integer_text(deck%line_number(line))
+    location = deck%files(line_file(deck%lines, line))%path//":"// &
+               integer_text(line_number(deck%lines, line))
   end function line_location
 
   !> The block whose keyword line or data holds line `line` (blocks are stored in line order).
@@ -640,40 +971,112 @@ contains
     end do
   end function block_of_line
 
-  !> The text of line `line` of the line table.
+  !> The text of line `line` of the line table (without its line end).
   function card_text(deck, line) result(text)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: line
     character(len=:), allocatable :: text
-    text = deck%files(deck%line_file(line))%text(deck%line_first(line):deck%line_last(line))
+    integer :: first, last
+    call locate_line(deck, line, first, last)
+    text = deck%window%buffer(first:last)
   end function card_text
+
+  !> Put the text of line `line` into `text`; its memory is reused when the length does not
+  !> change, as for the cards of a *NODE block.
+  subroutine load_line_text(deck, line, text)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: line
+    character(len=:), allocatable, intent(inout) :: text
+    integer :: first, last
+    call locate_line(deck, line, first, last)
+    text = deck%window%buffer(first:last)
+  end subroutine load_line_text
 
   !> True when line `line` holds only blanks and tabs.
   logical function is_blank_line(deck, line)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: line
-    is_blank_line = first_nonblank(deck%files(deck%line_file(line))% &
-                                   text(deck%line_first(line):deck%line_last(line))) == 0
+    integer :: first, last
+    call locate_line(deck, line, first, last)
+    is_blank_line = first_nonblank(deck%window%buffer(first:last)) == 0
   end function is_blank_line
 
-  !> Position of the first line feed in `text` (0 if none); a plain loop, which compilers
-  !> turn into a fast scan, unlike the general substring search behind `index`.
-  pure integer function position_of_newline(text)
-    character(len=*), intent(in) :: text
-    integer :: k
-    position_of_newline = 0
-    do k = 1, len(text)
-      if (text(k:k) == achar(10)) then
-        position_of_newline = k
-        return
-      end if
+  !> Make the text window hold line `line`; its text is then window%buffer(first:last) (line
+  !> end removed).
+  subroutine locate_line(deck, line, first, last)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: line
+    integer, intent(out) :: first, last
+    type(text_window_t), pointer :: window
+    character(len=:), allocatable :: larger
+    integer(int64) :: start, file_end
+    integer :: file, newline
+
+    window => deck%window
+    if (window%line == line) then
+      first = window%line_first
+      last = window%line_last
+      return
+    end if
+    call line_place(deck%lines, line, file, start)
+    file_end = deck%files(file)%size
+    if (window%file /= file .or. start < window%first .or. &
+        start >= window%first + window%length) call fill_window(deck, window, file, start)
+    first = int(start - window%first) + 1
+    newline = line_feed_position(window%buffer(first:window%length))
+    if (newline == 0 .and. first > 1 .and. window%first + window%length < file_end) then
+      ! the line runs past the bytes held: read from its start
+      call fill_window(deck, window, file, start)
+      first = 1
+      newline = line_feed_position(window%buffer(1:window%length))
+    end if
+    if (newline == 0 .and. window%first + window%length < file_end .and. &
+        len(window%buffer) <= max_line_length) then
+      ! a line longer than the window (up to max_line_length): widen the window once
+      allocate (character(len=max_line_length + 1) :: larger)
+      call move_alloc(larger, window%buffer)
+      call fill_window(deck, window, file, start)
+      first = 1
+      newline = line_feed_position(window%buffer(1:window%length))
+    end if
+    if (newline == 0) then
+      last = window%length
+    else
+      last = first + newline - 2
+    end if
+    do while (last >= first)
+      if (window%buffer(last:last) /= carriage_return) exit
+      last = last - 1
     end do
-  end function position_of_newline
+    window%line = line
+    window%line_first = first
+    window%line_last = last
+  end subroutine locate_line
+
+  !> Read the bytes of file `file` from byte `start` on into the window (none when the file
+  !> can no longer be opened or has become shorter).
+  subroutine fill_window(deck, window, file, start)
+    type(deck_t), intent(in) :: deck
+    type(text_window_t), intent(inout) :: window
+    integer, intent(in) :: file
+    integer(int64), intent(in) :: start
+    logical :: opened
+    if (window%file /= file) then
+      call close_file(window%handle)
+      call open_file(deck%files(file)%path, window%handle, opened)
+      window%file = file
+      if (.not. opened) window%file = 0
+    end if
+    window%line = 0
+    window%first = start
+    window%length = 0
+    if (window%file == file) call read_bytes(window%handle, start, window%buffer, window%length)
+  end subroutine fill_window
 
   !> Position of the first character that is neither blank nor tab (0 if none).
   pure integer function first_nonblank(text)
     character(len=*), intent(in) :: text
-    first_nonblank = verify(text, " "//achar(9))
+    first_nonblank = verify(text, " "//tab)
   end function first_nonblank
 
   !> `text` without leading and trailing blanks and tabs.
@@ -681,12 +1084,12 @@ contains
     character(len=*), intent(in) :: text
     character(len=:), allocatable :: trimmed
     integer :: first, last
-    first = verify(text, " "//achar(9))
+    first = verify(text, " "//tab)
     if (first == 0) then
       trimmed = ""
       return
     end if
-    last = verify(text, " "//achar(9), back=.true.)
+    last = verify(text, " "//tab, back=.true.)
     trimmed = text(first:last)
   end function trim_blanks
 end module deck_lexer

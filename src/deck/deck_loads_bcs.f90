@@ -207,7 +207,7 @@ contains
     if (.not. skip_id_card(deck, block, keyword, line, log)) return
     do while (next_line(deck, block, line, .true.))
       call open_card(deck, block, line, standard_widths, card, log)
-      if (card_is_empty(deck, card)) cycle
+      if (card_is_empty(card)) cycle
       do k = 1, 4
         call get_integer(deck, card, k + 3, "N"//achar(iachar("0") + k), nodes(k), log)
       end do
@@ -358,7 +358,7 @@ contains
     if (card%failed .or. .not. given%usable) return
     associate (values => given%load%nodal_values)
       if (given%load%nodes(4) == given%load%nodes(3)) then
-        if (field_is_blank(deck, card, 4)) then
+        if (field_is_blank(card, 4)) then
           values(4) = values(3)
         else if (values(4) /= values(3)) then
           call card_problem(deck, log, card, "P4", "the segment is a triangle (N4 = N3), "// &

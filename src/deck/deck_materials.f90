@@ -246,7 +246,7 @@ contains
     type(problem_log_t), intent(inout) :: log
     if (material%yield_stress <= 0.0_wp) call card_problem(deck, log, card, "SIGY", "yield stress must be "// &
       "> 0 when neither LCSS nor the EPS1-8 / ES1-8 table is given, found "// &
-      shown(deck, card, 5, material%yield_stress))
+      shown(card, 5, material%yield_stress))
     if (material%tangent_modulus < 0.0_wp) then
       call card_problem(deck, log, card, "ETAN", "tangent modulus must be >= 0, found "// &
                         real_text(material%tangent_modulus))
@@ -285,7 +285,7 @@ contains
           if (material%id <= 0) call card_problem(deck, log, card, "MID", "material id must be "// &
                                                   "> 0, found "//integer_text(material%id))
           if (material%density <= 0.0_wp) call card_problem(deck, log, card, "RO", "density must "// &
-            "be > 0, found "//shown(deck, card, 2, material%density))
+            "be > 0, found "//shown(card, 2, material%density))
           if (material%pressure_cutoff > 0.0_wp) call card_problem(deck, log, card, "PC", "pressure "// &
             "cut-off must be <= 0, found "//real_text(material%pressure_cutoff))
           if (material%viscosity < 0.0_wp) call card_problem(deck, log, card, "MU", "viscosity "// &
@@ -417,7 +417,7 @@ contains
             "compacted material must be >= 0, found "//real_text(material%yield_stress))
           if (material%compaction_volume <= 0.0_wp .or. material%compaction_volume > 1.0_wp) &
             call card_problem(deck, log, card, "VF", "relative volume at full compaction must lie in (0, 1], "// &
-                              "found "//shown(deck, card, 6, material%compaction_volume))
+                              "found "//shown(card, 6, material%compaction_volume))
           if (material%viscosity < 0.0_wp) call card_problem(deck, log, card, "MU", "viscosity coefficient "// &
             "must be >= 0, found "//real_text(material%viscosity))
           if (value /= 0.0_wp .and. value /= 1.0_wp) call card_problem(deck, log, card, "BULK", "must be 0 "// &
@@ -469,7 +469,7 @@ contains
           do k = 1, 6
             if (material%uncompacted_moduli(k) <= 0.0_wp) call card_problem(deck, log, card, &
               trim(modulus_names(k)), "uncompacted modulus must be > 0, found "// &
-              shown(deck, card, k, material%uncompacted_moduli(k)))
+              shown(card, k, material%uncompacted_moduli(k)))
           end do
           if (aopt /= 0.0_wp .and. aopt /= 2.0_wp) call card_problem(deck, log, card, "AOPT", "material "// &
             "axes option "//real_text(aopt)//" is not available: use 0 (element nodes 1-2-4) or 2 "// &
@@ -572,9 +572,9 @@ contains
           if (material%id <= 0) call card_problem(deck, log, card, "MID", "material id must be "// &
                                                   "> 0, found "//integer_text(material%id))
           if (material%density <= 0.0_wp) call card_problem(deck, log, card, "RO", "density must "// &
-            "be > 0, found "//shown(deck, card, 2, material%density))
+            "be > 0, found "//shown(card, 2, material%density))
           if (material%youngs_modulus <= 0.0_wp) call card_problem(deck, log, card, "E", "Young's "// &
-            "modulus (tension, unloading) must be > 0, found "//shown(deck, card, 3, material%youngs_modulus))
+            "modulus (tension, unloading) must be > 0, found "//shown(card, 3, material%youngs_modulus))
           if (curve <= 0) call card_problem(deck, log, card, "LCID", "a loading curve id > 0 is required, "// &
                                             "found "//integer_text(curve))
           if (material%tension_cutoff == 0.0_wp) material%tension_cutoff = 1.0e20_wp
@@ -639,17 +639,17 @@ contains
     if (material%id <= 0) call card_problem(deck, log, card, "MID", "material id must be "// &
                                             "> 0, found "//integer_text(material%id))
     if (material%density <= 0.0_wp) call card_problem(deck, log, card, "RO", "density must "// &
-      "be > 0, found "//shown(deck, card, 2, material%density))
+      "be > 0, found "//shown(card, 2, material%density))
     if (material%youngs_modulus < 0.0_wp) then
       call card_problem(deck, log, card, "E", "Young's modulus must be > 0, found "// &
-        shown(deck, card, 3, material%youngs_modulus)//" (E < 0, a curve of E, is not available)")
+        shown(card, 3, material%youngs_modulus)//" (E < 0, a curve of E, is not available)")
     else if (material%youngs_modulus == 0.0_wp) then
       call card_problem(deck, log, card, "E", "Young's modulus must be > 0, found "// &
-                        shown(deck, card, 3, material%youngs_modulus))
+                        shown(card, 3, material%youngs_modulus))
     end if
     if (material%poissons_ratio <= -1.0_wp .or. material%poissons_ratio >= 0.5_wp) &
       call card_problem(deck, log, card, "PR", "Poisson's ratio must lie in (-1, 0.5), "// &
-                        "found "//shown(deck, card, 4, material%poissons_ratio))
+                        "found "//shown(card, 4, material%poissons_ratio))
   end subroutine read_elastic_constants
 
   subroutine check_hardening(deck, card, material, log)
@@ -699,13 +699,12 @@ contains
   end subroutine check_rate
 
   !> A value for a message, saying when it came from a blank field.
-  function shown(deck, card, k, value) result(text)
-    type(deck_t), intent(in) :: deck
+  function shown(card, k, value) result(text)
     type(card_t), intent(in) :: card
     integer, intent(in) :: k
     real(wp), intent(in) :: value
     character(len=:), allocatable :: text
     text = real_text(value)
-    if (field_is_blank(deck, card, k)) text = text//" (the field is blank)"
+    if (field_is_blank(card, k)) text = text//" (the field is blank)"
   end function shown
 end module deck_materials

@@ -120,7 +120,7 @@ contains
       if (.not. card%failed) then
         if (id <= 0) call card_problem(deck, log, card, "SECID", "section id must be > 0, "// &
                                        "found "//integer_text(id))
-        call check_solid_formulation(deck, log, card, formulation, field_is_blank(deck, card, &
+        call check_solid_formulation(deck, log, card, formulation, field_is_blank(card, &
                                      2), meshfree_keyword)
       end if
       call warn_if_set(deck, card, 3, "AET", "ambient elements are not available", warnings)
@@ -284,7 +284,7 @@ contains
     call read_efg_options_card(deck, card, log)
     do while (next_line(deck, block, line, .false.))
       call open_card(deck, block, line, standard_widths, card, log)
-      if (card_is_empty(deck, card)) cycle
+      if (card_is_empty(card)) cycle
       call card_problem(deck, log, card, "SECID", "*SECTION_SOLID_EFG holds one section "// &
         "(card 1, the EFG card and the optional card 3); give the next section its own "// &
         "*SECTION_SOLID_EFG", unreadable=.true.)

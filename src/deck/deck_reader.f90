@@ -13,10 +13,11 @@
 module deck_reader
   use error_handling, only: error_t, error_list_t, add_error
   use model, only: model_t
-  use deck_problems, only: problem_log_t, report_problem, has_problems, problems_to_error
+  use deck_problems, only: problem_log_t, report_problem, has_problems, problems_to_error, &
+                           printable
   use deck_numbers, only: integer_text
-  use deck_lexer, only: deck_t, load_deck, line_location
-  use deck_keywords, only: keyword_t, identify_keyword, closest_keyword, keyword_count, &
+  use deck_lexer, only: deck_t, load_deck, release_deck, line_location
+  use deck_keywords, only: keyword_t, identify_keyword, suggest_keyword, keyword_count, &
     keyword_unknown, keyword_title, keyword_node, keyword_element_solid, keyword_part, &
     keyword_section_solid, keyword_section_solid_efg, keyword_mat_elastic, &
     keyword_mat_plastic_kinematic, keyword_hourglass, keyword_control_hourglass, &
@@ -57,7 +58,7 @@ module deck_reader
   implicit none
   private
 
-  public :: read_deck
+  public :: read_deck, identify_any_keyword
 
 contains
 
@@ -80,13 +81,7 @@ contains
     call load_deck(path, deck, log, warnings)
     allocate (keywords(deck%block_count))
     do block = 1, deck%block_count
-      keywords(block) = identify_keyword(deck%blocks(block)%name)
-      if (keywords(block)%code == keyword_unknown) keywords(block) = &
-        identify_rigid_keyword(deck%blocks(block)%name)
-      if (keywords(block)%code == keyword_unknown) keywords(block) = &
-        identify_contact_keyword(deck%blocks(block)%name)
-      if (keywords(block)%code == keyword_unknown) keywords(block) = &
-        identify_material_keyword(deck%blocks(block)%name)
+      keywords(block) = identify_any_keyword(deck%blocks(block)%name)
       if (keywords(block)%code == keyword_unknown) call report_unknown(deck, block, &
         ignore_unknown, log, warnings)
     end do
@@ -95,12 +90,24 @@ contains
       call read_block(deck, block, keywords(block), input, log, warnings)
     end do
     if (.not. log%unreadable) call check_and_build(deck, input, model, log, warnings)
+    call release_deck(deck)
     if (has_problems(log)) then
       call problems_to_error(log, error)
       return
     end if
     model%deck_path = path
   end subroutine read_deck
+
+  !> The keyword `name` (upper case, no `*`) with its options, whichever module reads it
+  !> (code `keyword_unknown` when none does).
+  pure function identify_any_keyword(name) result(keyword)
+    character(len=*), intent(in) :: name
+    type(keyword_t) :: keyword
+    keyword = identify_keyword(name)
+    if (keyword%code == keyword_unknown) keyword = identify_rigid_keyword(name)
+    if (keyword%code == keyword_unknown) keyword = identify_contact_keyword(name)
+    if (keyword%code == keyword_unknown) keyword = identify_material_keyword(name)
+  end function identify_any_keyword
 
   !> An unknown keyword: an error (with a spelling hint), or a warning with `ignore_unknown`.
   subroutine report_unknown(deck, block, ignore_unknown, log, warnings)
@@ -109,22 +116,44 @@ contains
     logical, intent(in) :: ignore_unknown
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
-    character(len=:), allocatable :: where, hint
+    character(len=:), allocatable :: where, hint, suggestion, base, name
+    type(keyword_t) :: suggested
     integer :: data_lines
     where = line_location(deck, deck%blocks(block)%keyword_line)//": *"//deck%blocks(block)%name
     data_lines = deck%blocks(block)%last_line - deck%blocks(block)%first_line + 1
     if (ignore_unknown) then
-      call add_error(warnings, where//": unknown keyword skipped ("//integer_text(data_lines)// &
-                     " data lines not read)")
+      call add_error(warnings, printable(where)//": unknown keyword skipped ("// &
+                     integer_text(data_lines)//" data lines not read)")
       return
     end if
-    hint = closest_keyword(deck%blocks(block)%name)
-    if (len(hint) > 0) then
-      hint = " (did you mean *"//hint//"?)"
+    name = deck%blocks(block)%name
+    call suggest_keyword(name, suggestion, base)
+    ! the options may not all go together (*CONTACT_..._ID_TITLE): then the name alone
+    if (len(suggestion) > 0) then
+      suggested = identify_any_keyword(suggestion)
+      if (suggested%code == keyword_unknown .and. .not. handled_by_lexer(suggestion)) &
+        suggestion = base
     end if
+    hint = ""
+    if (len(base) > 0 .and. len(name) > len(base) + 1) then
+      if (name(:len(base) + 1) == base//"_" .and. suggestion == base) hint = &
+        " (crashfree reads *"//base//", but not with "//name(len(base) + 1:)//")"
+    end if
+    if (len(hint) == 0 .and. len(suggestion) > 0) hint = " (did you mean *"//suggestion//"?)"
     call report_problem(log, where//": unknown keyword"//hint//"; crashfree reads the "// &
       "keywords listed in docs/keywords.md (--ignore-unknown skips the others)", unreadable=.true.)
   end subroutine report_unknown
+
+  !> The keywords the lexer handles itself.
+  pure logical function handled_by_lexer(name)
+    character(len=*), intent(in) :: name
+    select case (name)
+    case ("KEYWORD", "INCLUDE", "PARAMETER", "COMMENT", "END")
+      handled_by_lexer = .true.
+    case default
+      handled_by_lexer = .false.
+    end select
+  end function handled_by_lexer
 
   !> Size the input lists from the number of data lines of each keyword.
   subroutine prepare_input_for(deck, keywords, input)

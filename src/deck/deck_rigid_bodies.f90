@@ -136,9 +136,9 @@ contains
             call card_problem(deck, log, card, "PR", "must lie in [0, 0.5), found "// &
                               real_text(material%poissons_ratio))
         end if
-        if (.not. field_is_blank(deck, card, 5)) call no_coupling("N")
-        if (.not. field_is_blank(deck, card, 6)) call no_coupling("COUPLE")
-        if (.not. field_is_blank(deck, card, 7)) call no_coupling("M")
+        if (.not. field_is_blank(card, 5)) call no_coupling("N")
+        if (.not. field_is_blank(card, 6)) call no_coupling("COUPLE")
+        if (.not. field_is_blank(card, 7)) call no_coupling("M")
       end associate
       ! card 2 (optional at the end of the keyword)
       if (next_line(deck, block, line, .false.)) then

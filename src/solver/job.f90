@@ -108,11 +108,38 @@ contains
     if (allocated(error)) write (error_unit, '(a)') "crashfree: error termination: "//error%message
   end subroutine run_job
 
-  !> ncpu=, else OMP_NUM_THREADS (the OpenMP runtime reads it), else all cores.
+  !> ncpu=, else OMP_NUM_THREADS (the OpenMP runtime reads it), else all cores; at most the
+  !> processors this process may run on (a typing slip such as ncpu=1000 would otherwise run
+  !> many times slower), with a warning naming both numbers. CRASHFREE_OVERSUBSCRIBE=1 lifts
+  !> the limit, for tests that compare results on more threads than the machine has.
   integer function select_threads(requested)
+    !$ use omp_lib, only: omp_get_num_procs
     integer, intent(in) :: requested
+    character(len=32) :: setting
+    integer :: wanted, processors, length, status
     select_threads = 1
-    !$ if (requested > 0) call omp_set_num_threads(requested)
+    wanted = 1
+    processors = 1
+    !$ wanted = requested
+    !$ if (wanted <= 0) wanted = omp_get_max_threads()
+    !$ processors = omp_get_num_procs()
+    if (wanted > processors) then
+      call get_environment_variable("CRASHFREE_OVERSUBSCRIBE", setting, length, status)
+      if (status /= 0 .or. trim(setting) /= "1") then
+        if (requested > 0) then
+          write (error_unit, '(a)') "crashfree: warning: ncpu="//trim(count_text(requested))// &
+            " is more than the "//trim(count_text(processors))//" processors available; "// &
+            "running on "//trim(count_text(processors))//" threads"
+        else
+          call get_environment_variable("OMP_NUM_THREADS", setting, length, status)
+          write (error_unit, '(a)') "crashfree: warning: OMP_NUM_THREADS="//trim(setting)// &
+            " is more than the "//trim(count_text(processors))//" processors available; "// &
+            "running on "//trim(count_text(processors))//" threads"
+        end if
+        wanted = processors
+      end if
+    end if
+    !$ call omp_set_num_threads(wanted)
     !$ select_threads = omp_get_max_threads()
   end function select_threads
 

@@ -53,9 +53,10 @@ def test_shell_drilling_work_is_identical_for_one_two_and_three_threads(tmp_path
     for run in runs:
         assert run.status == 0, run.stdout + run.stderr
     found = []
-    for run in runs:
+    for threads, run in zip((1, 2, 3), runs):
         with run.open() as results:
             assert results["run"].attrs["cycles"] == 300
+            assert results["run"].attrs["threads"] == threads
             found.append(datasets(results))
     assert found[0]["history/glstat/external_work"][-1] != 0.0
     for threads, other in zip((2, 3), found[1:]):

@@ -13,7 +13,12 @@ program test_deck
                    boundary_coupled, boundary_full_transformation, integration_local_boundary, &
                    integration_gauss, integration_gauss_conventional, formulation_rigid, &
                    section_shell, section_solid
-  use deck_reader, only: read_deck
+  use deck_reader, only: read_deck, identify_any_keyword
+  use deck_keywords, only: keyword_t, keyword_unknown, suggest_keyword, known_keyword_count, &
+                           known_keyword
+  use deck_line_table, only: line_table_t, start_table, append_line, line_file, line_number, &
+                             line_start
+  use, intrinsic :: iso_fortran_env, only: int64
   implicit none
 
   integer, parameter :: line_length = 200
@@ -55,6 +60,9 @@ program test_deck
   call test_shell_rotations_on_solids()
   call test_shell_errors()
   call test_shell_section_errors()
+  call test_line_table_beyond_2_gib()
+  call test_keyword_suggestions()
+  call test_known_keywords_are_read()
   call execute_command_line("rm -rf "//directory)
   call finish_suite(suite)
 
@@ -1592,4 +1600,109 @@ contains
       index(warnings%text, "shell_warnings.k:19: *SECTION_SHELL: field EDGSET: ignored "// &
       "(seatbelt shells are not available)") > 0, warnings%text)
   end subroutine test_shell_section_errors
+
+  ! ---------------------------------------------------------------- line table, keyword names
+
+  !> Lines starting beyond byte 2**31 and 2**32 of a file keep their exact offsets, files and
+  !> line numbers: a run of lines ends where the offset from its base would not fit in 32 bits,
+  !> where a line is skipped (comments) and where the file changes.
+  subroutine test_line_table_beyond_2_gib()
+    type(line_table_t) :: table
+    integer(int64), parameter :: gib = 2_int64**30
+    integer(int64), parameter :: starts(9) = [0_int64, 81_int64, 2*gib - 10, 2*gib + 70, &
+      4*gib + 3, 5*gib + 1, 100_int64, 181_int64, 9*gib]
+    integer, parameter :: files(9) = [1, 1, 1, 1, 1, 1, 2, 2, 1]
+    integer, parameter :: numbers(9) = [1, 2, 3, 4, 5, 9, 1, 2, 2000000000]
+    logical :: added, exact
+    integer :: k
+    call start_table(table, 4)
+    do k = 1, size(starts)
+      call append_line(table, files(k), numbers(k), starts(k), added)
+      if (.not. added) call check(suite, "line table: line added", .false.)
+    end do
+    exact = table%count == size(starts)
+    do k = 1, size(starts)
+      exact = exact .and. line_start(table, k) == starts(k) .and. line_file(table, k) == files(k) &
+              .and. line_number(table, k) == numbers(k)
+    end do
+    call check(suite, "line table: offsets beyond 2 GiB, files and numbers exact", exact)
+    ! runs: lines 1-3 | 4-5 (line 4 is more than 2**31 - 1 bytes after line 1, line 5 less
+    ! after line 4) | 6 (line number 9 after 5) | 7-8 (file 2) | 9 (file 1 again)
+    call check(suite, "line table: five runs", table%run_count == 5, &
+               "found "//trim(count_text(table%run_count)))
+    call check(suite, "line table: 4 bytes per line", storage_size(table%offset)/8 == 4)
+  end subroutine test_line_table_beyond_2_gib
+
+  !> Typing slips get the keyword meant, options spelt right; real LS-DYNA keywords crashfree
+  !> does not read get no far-fetched hint.
+  subroutine test_keyword_suggestions()
+    character(len=48), parameter :: typos(2, 24) = reshape([character(len=48) :: &
+      "DATABASE_RCFORK", "DATABASE_RCFORC", &
+      "MAT_RIGIDD", "MAT_RIGID", &
+      "MAT_ELASTICK", "MAT_ELASTIC", &
+      "ELEMNET_SOLID", "ELEMENT_SOLID", &
+      "SECTION_SOILD", "SECTION_SOLID", &
+      "CONTROL_TERMINATON", "CONTROL_TERMINATION", &
+      "BOUNDARY_SPC_NODES", "BOUNDARY_SPC_NODE", &
+      "SET_NODE_LIST_GENERAT", "SET_NODE_LIST_GENERATE", &
+      "MAT_PIECEWISE_LINEAR_PLASTICTY", "MAT_PIECEWISE_LINEAR_PLASTICITY", &
+      "SECTION_SOLID_TITEL", "SECTION_SOLID_TITLE", &
+      "MAT_RIGIDD_TITLE", "MAT_RIGID_TITLE", &
+      "CONTACT_AUTOMATIC_SURFACE_TO_SURFACE_IDD", "CONTACT_AUTOMATIC_SURFACE_TO_SURFACE_ID", &
+      "RIGIDWALL_PLANAR_MOVNG_FORCES", "RIGIDWALL_PLANAR_MOVING_FORCES", &
+      "DATABASE_GLSTATS", "DATABASE_GLSTAT", &
+      "MAT_20", "MAT_020", &
+      "NODES", "NODE", &
+      "INCLDUE", "INCLUDE", &
+      "PRAT", "PART", &
+      "CONSTRAINED_NODAL_RIGID_BODDY", "CONSTRAINED_NODAL_RIGID_BODY", &
+      "NODE_TITLE", "NODE", &
+      "DATABASE_BINARY_D3THDT", "", &
+      "CONTROL_OUTPUT", "", &
+      "AIRBAG_SIMPLE_AIRBAG_MODEL", "", &
+      "SECTION_BEAM", ""], [2, 24])
+    character(len=:), allocatable :: suggestion, base
+    integer :: k
+    do k = 1, size(typos, 2)
+      call suggest_keyword(trim(typos(1, k)), suggestion, base)
+      call check(suite, "suggestion for *"//trim(typos(1, k)), suggestion == trim(typos(2, k)), &
+                 "found '"//suggestion//"'")
+    end do
+  end subroutine test_keyword_suggestions
+
+  !> Every name suggestions are taken from is read, with each of its options (the lexer's own
+  !> keywords aside), so that the list cannot drift from the readers.
+  subroutine test_known_keywords_are_read()
+    character(len=:), allocatable :: name, options, option
+    type(keyword_t) :: keyword
+    integer :: k, start, finish
+    logical :: all_read
+    character(len=:), allocatable :: missing
+    all_read = .true.
+    missing = ""
+    do k = 1, known_keyword_count()
+      call known_keyword(k, name, options)
+      select case (name)
+      case ("KEYWORD", "INCLUDE", "PARAMETER", "COMMENT", "END")
+        cycle
+      end select
+      keyword = identify_any_keyword(name)
+      if (keyword%code == keyword_unknown) missing = missing//" "//name
+      start = 1
+      do while (start <= len(options))
+        finish = index(options(start:), " ")
+        if (finish == 0) then
+          finish = len(options)
+        else
+          finish = start + finish - 2
+        end if
+        option = options(start:finish)
+        start = finish + 2
+        keyword = identify_any_keyword(name//"_"//option)
+        if (keyword%code == keyword_unknown) missing = missing//" "//name//"_"//option
+      end do
+    end do
+    all_read = len(missing) == 0
+    call check(suite, "every known keyword name is read", all_read, "not read:"//missing)
+  end subroutine test_known_keywords_are_read
 end program test_deck
