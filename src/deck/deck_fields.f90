@@ -222,8 +222,8 @@ contains
       call parse_real(text, value, status)
       if (status /= number_ok) then
         if (status == number_out_of_range) then
-          call field_problem(deck, card, k, name, """"//text//""" is out of range (magnitudes "// &
-                             "must stay below 1e100)", log)
+          call field_problem(deck, card, k, name, """"//text//""" is out of range (a real "// &
+                             "value is 0 or of a magnitude between 1e-30 and 1e30)", log)
         else
           call field_problem(deck, card, k, name, """"//text//""" is not a number", log)
         end if

@@ -3,8 +3,8 @@
 !> List-directed reads accept "1 2" as 1 and "1,2" as 1, so every field is checked character by
 !> character here instead. Reals take Fortran's forms, as LS-DYNA reads them: `1.5`, `-.5`,
 !> `2e3`, `2.0D+3`, and `1.0-3` (exponent without its letter). Most values are converted
-!> directly (exact and fast); long mantissas fall back to an internal read. Magnitudes of 1e100
-!> and more are out of range.
+!> directly (exact and fast); long mantissas fall back to an internal read. Non-zero magnitudes
+!> outside [1e-30, 1e30] are out of range.
 module deck_numbers
   use kinds, only: wp
   use, intrinsic :: iso_fortran_env, only: int64
@@ -145,16 +145,15 @@ contains
       status = number_ok
       return
     end if
-    ! Decimal magnitude of the value. Values of 1e100 and more are refused: no input quantity is
-    ! near that (LS-DYNA's "never" is 1e20 or 1e28), and products of a few inputs (scale times
-    ! offset, speed times distance) then stay far from overflow.
+    ! Decimal magnitude of the value: 10**(magnitude-1) <= |value| < 10**magnitude. Non-zero
+    ! values outside [1e-30, 1e30] are refused: no input quantity in any consistent unit system
+    ! is near them (LS-DYNA's "never" is 1e20 or 1e28; densities in t/mm^3 are 1e-9), and the
+    ! products and quotients of the ten or so inputs that meet in one formula (stiffness over
+    ! density over a length, a wall's mass times its speed squared) then stay far from overflow
+    ! and underflow, so a deck of extreme values gets a message here instead of a blow-up later.
     magnitude = exponent + significant
-    if (magnitude > 100) then
+    if (magnitude > 31 .or. magnitude < -29) then
       status = number_out_of_range
-      return
-    end if
-    if (magnitude < -300) then
-      status = number_ok     ! underflows to zero, as a formatted read would
       return
     end if
     if (mantissa <= 2_int64**53 .and. abs(exponent) <= 22) then
