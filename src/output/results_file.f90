@@ -124,7 +124,7 @@ module results_file
 
   !> Rows per chunk of the extendible history datasets: small enough for many short nodout
   !> series, large enough that a long glstat is not cut into thousands of pieces.
-  integer(hsize_t), parameter :: history_chunk_rows = 256
+  integer(hsize_t), parameter :: history_chunk_rows = 64
 
   !> Space kept free for HDF5's own bookkeeping of one commit (object headers, B-tree nodes,
   !> heaps), on top of twice the values written; and for the run status at the end.
