@@ -222,15 +222,18 @@ contains
   !> without changing its size (fallocate with FALLOC_FL_KEEP_SIZE). Later writes that extend
   !> the file into the reserved range cannot fail for lack of space; when the disk is already
   !> too full, this fails first, before anything of the next piece is written.
+  !> `reserved_end` is the end of what earlier calls reserved (0 for none): only the part
+  !> beyond it is asked for, so that reserving again before each piece costs what is new.
   !> `error` is set only when the disk is full or the quota is exceeded (its message is the
   !> system's reason in lower case, e.g. "no space left on device"); a file system without
   !> fallocate (some network file systems) just gets no reservation.
-  subroutine reserve_file_space(path, bytes, error)
+  subroutine reserve_file_space(path, bytes, reserved_end, error)
     character(len=*), intent(in) :: path
     integer(long_int), intent(in) :: bytes
+    integer(long_int), intent(inout) :: reserved_end
     type(error_t), allocatable, intent(out) :: error
     type(c_ptr) :: stream
-    integer(c_long) :: end_of_file
+    integer(c_long) :: end_of_file, start
     integer(c_int) :: status, ignored
     integer :: number
 
@@ -239,9 +242,13 @@ contains
     stream = c_fopen(path//c_null_char, "r+"//c_null_char)
     if (.not. c_associated(stream)) return
     end_of_file = c_lseek(c_fileno(stream), 0_c_long, seek_end)
-    if (end_of_file >= 0) then
-      status = c_fallocate(c_fileno(stream), fallocate_keep_size, end_of_file, int(bytes, c_long))
-      if (status /= 0) then
+    start = max(end_of_file, int(reserved_end, c_long))
+    if (end_of_file >= 0 .and. start < end_of_file + int(bytes, c_long)) then
+      status = c_fallocate(c_fileno(stream), fallocate_keep_size, start, &
+                           end_of_file + int(bytes, c_long) - start)
+      if (status == 0) then
+        reserved_end = int(end_of_file, long_int) + bytes
+      else
         number = system_error_number()
         if (number == error_no_space .or. number == error_quota_exceeded) &
           call make_error(error, lower_first(system_error_text(number)))

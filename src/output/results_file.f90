@@ -7,9 +7,11 @@
 !> file says how the run ended. `write_histories` writes the histories alone.
 !>
 !> What the output costs and what survives a failure:
-!> - Each state is one commit: its datasets and the new history rows, then one flush. The
-!>   histories are extendible, chunked datasets to which only the new rows are written, so the
-!>   cost of a state does not grow with the number of states before it.
+!> - Each state is one commit: its group (created anonymous) with its datasets and the new
+!>   history rows, flushed; then its link in /states, flushed. The histories are extendible,
+!>   chunked datasets to which only the new rows are written, and /states keeps its links in
+!>   HDF5's dense form, so the cost of a state does not grow with the number of states before
+!>   it. A kill can only break the link being written (see write_state).
 !> - The XDMF file is rewritten whole (and atomically, see xdmf_writer) at the states 1, 2, 4,
 !>   8, ... and, for a reader watching a long run, whenever its last rewrite is 2 s old and
 !>   took less than a twentieth of that time: linear in total, and complete at `close_results`.
@@ -101,6 +103,7 @@ module results_file
     integer :: xdmf_bytes = 0                     !< size of the last XDMF file built
     integer(long_int) :: output_bytes = 0         !< bytes of state and history values written
     integer(long_int) :: reserved_bytes = 0       !< largest reservation asked for beyond the end
+    integer(long_int) :: reserved_end = 0         !< end of the disk space reserved (0: none)
   end type results_file_t
 
   interface
@@ -178,6 +181,7 @@ contains
     results%xdmf_bytes = 0
     results%output_bytes = 0
     results%reserved_bytes = 0
+    results%reserved_end = 0
 
     ! The lock before anything else: a second run must not truncate the first one's file.
     call acquire_file_lock(results%lock, join_path(directory, job_id//".lock"), error, holder)
@@ -261,8 +265,8 @@ contains
   end subroutine open_results
 
   !> Write the next state `/states/NNNNNN` and, when `histories` is given, the history rows
-  !> recorded since the previous call, as one commit (one flush); then rewrite the XDMF file
-  !> when its schedule says so.
+  !> recorded since the previous call, as one commit; then rewrite the XDMF file when its
+  !> schedule says so.
   !> Shell results (global axes): `shell_stress` the mid-surface stress (mean over the
   !> through-thickness points), `shell_plastic_strain` its mean plastic strain, and, as crashfree
   !> extensions, `shell_stress_peak` / `shell_plastic_strain_peak` at the point with the largest
@@ -468,6 +472,7 @@ contains
         call make_error(problem, "cannot close "//results%h5_path//system_reason())
     end if
     call release_file_space(results%h5_path, results%reserved_bytes)
+    results%reserved_end = 0
     call release_file_lock(results%lock)
     results%is_open = .false.
     results%file_id = -1
@@ -490,7 +495,7 @@ contains
     type(results_file_t), intent(inout) :: results
     integer(long_int), intent(in) :: bytes
     type(error_t), allocatable, intent(out) :: error
-    call reserve_file_space(results%h5_path, bytes, error)
+    call reserve_file_space(results%h5_path, bytes, results%reserved_end, error)
     if (.not. allocated(error)) results%reserved_bytes = max(results%reserved_bytes, bytes)
   end subroutine reserve_space
 
@@ -565,6 +570,7 @@ contains
     real(wp) :: started
     started = seconds_now()
     call release_file_space(results%h5_path, results%reserved_bytes)
+    results%reserved_end = 0
     call clear_system_error()
     call write_xdmf(results%xdmf_path, results%h5_name, results%node_count, results%solid_count, &
                     results%shell_count, results%state_times(1:results%state_count), xdmf_error, &
