@@ -2,10 +2,29 @@
 !> and its XDMF companion `DIR/JOBID.xdmf`.
 !>
 !> The solver calls `open_results` before the first cycle (mesh, and `/run` with status
-!> "running"), `write_state` at each state time, `write_histories` at each state and at the
-!> end, and `close_results` with the run summary, also after an error, so that the file always
-!> says how the run ended. Every call ends with a flush: a run that dies leaves a readable file
-!> holding everything written so far.
+!> "running"), `write_state` at each state time (with the history rows recorded since the
+!> previous state), and `close_results` with the run summary, also after an error, so that the
+!> file says how the run ended. `write_histories` writes the histories alone.
+!>
+!> What the output costs and what survives a failure:
+!> - Each state is one commit: its group (created anonymous) with its datasets and the new
+!>   history rows, flushed; then its link in /states, flushed. The histories are extendible,
+!>   chunked datasets to which only the new rows are written, and /states keeps its links in
+!>   HDF5's dense form, so the cost of a state does not grow with the number of states before
+!>   it. A kill can only break the link being written (see write_state).
+!> - The XDMF file is rewritten whole (and atomically, see xdmf_writer) at the states 1, 2, 4,
+!>   8, ... and, for a reader watching a long run, whenever its last rewrite is 2 s old and
+!>   took less than a twentieth of that time: linear in total, and complete at `close_results`.
+!> - Before a commit the disk blocks it needs are reserved (file_system's reserve_file_space),
+!>   so on a full disk the reservation fails before anything of the state is written: the
+!>   file keeps every complete state and is closed cleanly.
+!> - When a write fails anyway (a file system without reservations, an I/O error), the HDF5
+!>   handle is abandoned rather than flushed or closed: the metadata HDF5 holds in memory would
+!>   only partly reach the disk and could break the states already there, while the file on
+!>   disk is complete as of the previous commit. HDF5's exit handler is switched off for the
+!>   same reason (it would flush the abandoned file at exit; on a full disk it crashed).
+!> - The output directory is locked for the job (file_lock on `DIR/JOBID.lock`), so a second
+!>   run into the same files is refused before it truncates them.
 !>
 !> Conventions of the file:
 !> - Fortran arrays `(3, n)` are stored with HDF5 dimensions `(n, 3)`, which is how h5py and
@@ -16,58 +35,114 @@
 !> - Strings (attributes and `/mesh/parts/formulation`) are variable-length ASCII: h5py
 !>   returns attributes as `str` (and the dataset as `str` through `.asstr()`).
 !> - Extensions of the contract layout: `/mesh/solids/connectivity_index` (m,8), the 0-based
-!>   node indices of each solid, which the XDMF topology needs; the `/run` attribute `title`.
+!>   node indices of each solid, which the XDMF topology needs; the `/run` attribute `title`;
+!>   the `/timing` attributes `output_bytes` (values handed to HDF5 for states and histories)
+!>   and `xdmf_writes` (times the XDMF file was written), which show what the output cost.
 !>
 !> HDF5's automatic error printing is switched off: every failure becomes an `error_t` naming
 !> the file and the operation. The file is opened without HDF5's file lock, so ParaView or a
 !> script can read the states written so far while the run goes on.
 module results_file
-  use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_null_ptr, c_char, c_null_char
-  use hdf5, only: hid_t, hsize_t, h5open_f, h5eset_auto_f, &
+  use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_null_ptr, c_char, c_null_char, c_bool, &
+                                         c_int, c_int64_t
+  use hdf5, only: hid_t, hsize_t, h5open_f, h5eset_auto_f, h5dont_atexit_f, &
                   h5fcreate_f, h5fclose_f, h5fflush_f, H5F_ACC_TRUNC_F, H5F_SCOPE_GLOBAL_F, &
                   h5pcreate_f, h5pclose_f, h5pset_file_locking_f, h5pset_chunk_f, &
-                  H5P_FILE_ACCESS_F, H5P_DATASET_CREATE_F, &
-                  h5gcreate_f, h5gopen_f, h5gclose_f, h5lexists_f, h5ldelete_f, &
-                  h5screate_f, h5screate_simple_f, h5sclose_f, h5sget_simple_extent_ndims_f, &
-                  h5sget_simple_extent_dims_f, H5S_SCALAR_F, H5S_UNLIMITED_F, &
+                  H5P_FILE_ACCESS_F, H5P_DATASET_CREATE_F, H5P_GROUP_CREATE_F, &
+                  h5pset_link_phase_change_f, h5pset_link_creation_order_f, H5P_CRT_ORDER_TRACKED_F, &
+                  h5gcreate_f, h5gcreate_anon_f, h5gopen_f, h5gclose_f, h5lexists_f, h5ldelete_f, &
+                  h5olink_f, &
+                  h5screate_f, h5screate_simple_f, h5sclose_f, h5sselect_hyperslab_f, &
+                  H5S_SCALAR_F, H5S_UNLIMITED_F, H5S_SELECT_SET_F, &
                   h5dcreate_f, h5dopen_f, h5dclose_f, h5dwrite_f, h5dset_extent_f, &
                   h5dget_space_f, h5acreate_f, h5aclose_f, h5awrite_f, h5aexists_f, &
                   h5adelete_f, h5tcopy_f, h5tclose_f, H5T_STRING, H5T_NATIVE_INTEGER, &
-                  H5T_STD_I32LE, H5T_STD_I64LE, H5T_IEEE_F64LE, h5kind_to_type, H5_REAL_KIND
-  use kinds, only: wp
+                  H5T_STD_I32LE, H5T_STD_I64LE, H5T_IEEE_F64LE, h5kind_to_type, H5_REAL_KIND, &
+                  H5_INTEGER_KIND, h5oclose_f
+  use kinds, only: wp, long_int
   use error_handling, only: error_t, make_error
   use version, only: crashfree_version
   use model, only: model_t, formulation_fe, formulation_efg, formulation_rigid
   use run_summary, only: run_summary_t, status_error
   use history_buffer, only: history_set_t
   use xdmf_writer, only: write_xdmf, state_group_name
+  use wall_clock, only: seconds_now
+  use file_system, only: reserve_file_space, release_file_space, remove_file, file_size, &
+                         clear_system_error, system_error_number, system_error_text, &
+                         error_no_space, error_quota_exceeded
+  use file_lock, only: file_lock_t, acquire_file_lock, release_file_lock
   implicit none
   private
 
   public :: results_file_t, open_results, write_state, write_histories, close_results
 
-  !> An open results file: the HDF5 handle, the paths, and what rewriting the XDMF needs.
+  !> An open results file: the HDF5 handle, the paths, the lock, and what the incremental
+  !> writing of the histories and the XDMF file needs.
   type :: results_file_t
     integer(hid_t) :: file_id = -1                !< HDF5 file handle while open
     logical :: is_open = .false.
+    !> A write failed: the HDF5 handle is abandoned (see the module comment) and the file on
+    !> disk holds what the last commit left, `state_count` states.
+    logical :: broken = .false.
+    !> A write failed (the .h5, or the XDMF file): `close_results` then says what the files hold.
+    logical :: failed = .false.
     character(len=:), allocatable :: h5_path      !< DIR/JOBID.h5
     character(len=:), allocatable :: xdmf_path    !< DIR/JOBID.xdmf
     character(len=:), allocatable :: h5_name      !< JOBID.h5, as the XDMF refers to it
+    type(file_lock_t) :: lock                     !< held on DIR/JOBID.lock while open
     integer :: node_count = 0                     !< n, rows of the nodal datasets
     integer :: solid_count = 0                    !< m, rows of the solid datasets
     integer :: shell_count = 0                    !< k, rows of the shell datasets
-    integer :: state_count = 0                    !< states written so far
+    integer :: state_count = 0                    !< complete states in the file
     real(wp), allocatable :: state_times(:)       !< time of each state written (with spare room)
+    integer, allocatable :: history_rows(:)       !< rows of each history series in the file
+    integer :: xdmf_state_count = 0               !< states listed by the XDMF file on disk
+    integer :: xdmf_writes = 0                    !< times the XDMF file was written
+    real(wp) :: xdmf_written_at = 0.0_wp          !< wall clock (s) of its last writing
+    real(wp) :: xdmf_seconds = 0.0_wp             !< how long that took
+    integer :: xdmf_bytes = 0                     !< size of the last XDMF file built
+    integer(long_int) :: output_bytes = 0         !< bytes of state and history values written
+    integer(long_int) :: reserved_bytes = 0       !< largest reservation asked for beyond the end
+    integer(long_int) :: reserved_end = 0         !< end of the disk space reserved (0: none)
   end type results_file_t
+
+  interface
+    !> H5Pset_evict_on_close (HDF5 1.10.1), which the Fortran API of HDF5 1.10 does not wrap.
+    function c_h5pset_evict_on_close(access_list, evict) bind(c, name="H5Pset_evict_on_close") &
+      result(status)
+      import :: c_int64_t, c_bool, c_int
+      integer(c_int64_t), value :: access_list
+      logical(c_bool), value :: evict
+      integer(c_int) :: status
+    end function c_h5pset_evict_on_close
+  end interface
+
+  !> The groups and datasets of one commit, kept open until it is flushed: HDF5 evicts an
+  !> object's metadata from its cache when the object is closed (see open_results), writing
+  !> it if it is dirty, so closing before the flush would put half a state on disk.
+  type :: open_objects_t
+    integer(hid_t), allocatable :: ids(:)
+    integer :: count = 0
+  end type open_objects_t
 
   !> Rows per chunk of the extendible history datasets: small enough for many short nodout
   !> series, large enough that a long glstat is not cut into thousands of pieces.
-  integer(hsize_t), parameter :: history_chunk_rows = 256
+  integer(hsize_t), parameter :: history_chunk_rows = 64
+
+  !> Space kept free for HDF5's own bookkeeping of one commit (object headers, B-tree nodes,
+  !> heaps), on top of twice the values written; and for the run status at the end.
+  integer(long_int), parameter :: metadata_reserve = 65536_long_int
+
+  !> The XDMF file is rewritten, besides at the states 1, 2, 4, 8, ..., when its last
+  !> rewrite is this old (s) and took less than 1/xdmf_cost_fraction of that.
+  real(wp), parameter :: xdmf_refresh_seconds = 2.0_wp
+  real(wp), parameter :: xdmf_cost_fraction = 20.0_wp
 
 contains
 
-  !> Create `directory/job_id.h5` (replacing an earlier file) and write `/mesh` and `/run`
-  !> (status "running"). The directory must exist.
+  !> Lock `directory/job_id.lock`, create `directory/job_id.h5` (replacing an earlier file)
+  !> and write `/mesh` and `/run` (status "running"). The directory must exist. On a failure
+  !> nothing stays open or locked, and a half-written file is removed.
   subroutine open_results(results, directory, job_id, model, threads, error)
     type(results_file_t), intent(inout) :: results
     character(len=*), intent(in) :: directory   !< output directory ("" for the current one)
@@ -75,6 +150,8 @@ contains
     type(model_t), intent(in) :: model
     integer, intent(in) :: threads              !< OpenMP threads of the run
     type(error_t), allocatable, intent(out) :: error
+    type(error_t), allocatable :: space_error
+    character(len=:), allocatable :: holder
     integer(hid_t) :: access_list
     integer :: status, ignored
 
@@ -92,54 +169,115 @@ contains
     results%shell_count = 0
     if (allocated(model%shell_ids)) results%shell_count = size(model%shell_ids)
     results%state_count = 0
+    results%broken = .false.
+    results%failed = .false.
     if (allocated(results%state_times)) deallocate (results%state_times)
     allocate (results%state_times(16))
+    if (allocated(results%history_rows)) deallocate (results%history_rows)
+    allocate (results%history_rows(0))
+    results%xdmf_state_count = 0
+    results%xdmf_writes = 0
+    results%xdmf_seconds = 0.0_wp
+    results%xdmf_bytes = 0
+    results%output_bytes = 0
+    results%reserved_bytes = 0
+    results%reserved_end = 0
 
+    ! The lock before anything else: a second run must not truncate the first one's file.
+    call acquire_file_lock(results%lock, join_path(directory, job_id//".lock"), error, holder)
+    if (allocated(error)) then
+      if (len(holder) > 0) then
+        error%message = "another run (process "//holder//") is writing job '"//job_id// &
+                        "' in the output directory '"//directory_text(directory)// &
+                        "' (lock file "//join_path(directory, job_id//".lock")// &
+                        "); wait for it to end, or give this run another outdir= or jobid="
+      else
+        error%message = "results file "//results%h5_path//": "//error%message
+      end if
+      return
+    end if
+
+    ! Before the library starts (a later call in the same process changes nothing): no exit
+    ! handler, see the module comment.
+    call h5dont_atexit_f(ignored)
     ! Initialising again is harmless. Without automatic printing HDF5 keeps its error stack
     ! to itself: failures reach the user once, through `error`.
     call h5open_f(status)
     if (status /= 0) then
       call make_error(error, "results file "//results%h5_path//": cannot initialise HDF5")
+      call release_file_lock(results%lock)
       return
     end if
     call h5eset_auto_f(0, status)
 
     ! No file lock, so that readers may open the file between two writes.
+    call clear_system_error()
     call h5pcreate_f(H5P_FILE_ACCESS_F, access_list, status)
     if (status == 0) call h5pset_file_locking_f(access_list, .false., .true., status)
+    ! A state's groups and datasets are not opened again: evicting their metadata when they are
+    ! closed keeps HDF5's cache small, and with it the cost of each flush, which otherwise
+    ! grows with the number of objects in the cache (the states written so far).
+    if (status == 0) status = int(c_h5pset_evict_on_close(int(access_list, c_int64_t), .true._c_bool))
     if (status == 0) call h5fcreate_f(results%h5_path, H5F_ACC_TRUNC_F, results%file_id, status, &
                                       access_prp=access_list)
     call h5pclose_f(access_list, ignored)
     if (status /= 0) then
-      call make_error(error, "results file "//results%h5_path// &
-                      ": cannot create the file (does the directory exist and is it writable?)")
+      if (disk_full()) then
+        call make_error(error, lower_reason()//" while creating "//results%h5_path)
+      else
+        call make_error(error, "results file "//results%h5_path//": cannot create the file"// &
+                        system_reason())
+      end if
+      ! An empty file left by the attempt (created, then its first write failed) is no result.
+      if (file_size(results%h5_path) == 0) call remove_file(results%h5_path)
       results%file_id = -1
+      call release_file_lock(results%lock)
       return
     end if
     results%is_open = .true.
 
-    call write_mesh(results%file_id, model, error)
-    call write_run_start(results%file_id, model, threads, error)
-    call create_group_path(results%file_id, "/states", error)
-    call create_group_path(results%file_id, "/history", error)
-    call flush_file(results%file_id, error)
+    call reserve_space(results, mesh_bytes(results) + metadata_reserve, space_error)
+    if (allocated(space_error)) then
+      call make_error(error, space_error%message//" while creating "//results%h5_path)
+    else
+      call write_mesh(results%file_id, model, error)
+      call write_run_start(results%file_id, model, threads, error)
+      call create_states_group(results%file_id, error)
+      call create_group_path(results%file_id, "/history", error)
+      call flush_file(results%file_id, error)
+      if (allocated(error)) then
+        if (disk_full()) then
+          error%message = lower_reason()//" while creating "//results%h5_path
+        else
+          error%message = "results file "//results%h5_path//": "//error%message//system_reason()
+        end if
+      end if
+    end if
     if (allocated(error)) then
-      error%message = "results file "//results%h5_path//": "//error%message
-      call h5fclose_f(results%file_id, ignored)
+      ! Abandoned, not closed (a close would flush into a file that cannot take it), and
+      ! removed: it holds no result.
+      results%broken = .true.
       results%is_open = .false.
       results%file_id = -1
+      call remove_file(results%h5_path)
+      call release_file_lock(results%lock)
     end if
   end subroutine open_results
 
-  !> Write the next state `/states/NNNNNN`, flush, and rewrite the XDMF file.
+  !> Write the next state `/states/NNNNNN` and, when `histories` is given, the history rows
+  !> recorded since the previous call, as one commit; then rewrite the XDMF file when its
+  !> schedule says so.
   !> Shell results (global axes): `shell_stress` the mid-surface stress (mean over the
   !> through-thickness points), `shell_plastic_strain` its mean plastic strain, and, as crashfree
   !> extensions, `shell_stress_peak` / `shell_plastic_strain_peak` at the point with the largest
   !> von Mises stress / plastic strain. Without shell arguments the shell datasets are empty
   !> (a model without shells).
+  !> On a failure the message says which state and time could not be written and why ("no
+  !> space left on device while writing state 12 at time ... to DIR/results.h5"); the file
+  !> keeps the states before it.
   subroutine write_state(results, time, displacement, velocity, solid_stress, &
                          solid_plastic_strain, error, shell_stress, shell_plastic_strain, shell_stress_peak, &
-                         shell_plastic_strain_peak)
+                         shell_plastic_strain_peak, histories)
     type(results_file_t), intent(inout) :: results
     real(wp), intent(in) :: time
     ! Contiguous: the solver's whole arrays go to HDF5 without a copy.
@@ -150,13 +288,17 @@ contains
     type(error_t), allocatable, intent(out) :: error
     real(wp), intent(in), contiguous, optional :: shell_stress(:, :), shell_stress_peak(:, :) !< (6, shells)
     real(wp), intent(in), contiguous, optional :: shell_plastic_strain(:), shell_plastic_strain_peak(:) !< (shells)
+    type(history_set_t), intent(in), target, optional :: histories !< rows not yet in the file are added
     real(wp) :: no_shell_stress(6, 0), no_shell_strain(0)
     real(wp), allocatable :: grown(:)
-    character(len=:), allocatable :: path
-    integer(hid_t) :: group_id
+    type(error_t), allocatable :: space_error
+    character(len=:), allocatable :: path, what
+    type(open_objects_t) :: objects
+    integer(hid_t) :: group_id, states_id
+    integer(long_int) :: state_bytes, history_bytes, history_space
     integer :: status
 
-    if (.not. results%is_open) then
+    if (.not. results%is_open .or. results%broken) then
       call make_error(error, "results file: write_state on a file that is not open")
       return
     end if
@@ -172,32 +314,74 @@ contains
       return
     end if
 
-    path = "/states/"//state_group_name(results%state_count + 1)
-    call h5gcreate_f(results%file_id, path, group_id, status)
-    if (status /= 0) then
-      call make_error(error, "results file "//results%h5_path//": cannot create group "//path)
+    what = "state "//integer_text(results%state_count)//" at time "//real_text(time)
+    state_bytes = 8_long_int*(6_long_int*results%node_count + 7_long_int*results%solid_count + &
+                              14_long_int*results%shell_count)
+    history_bytes = 0
+    history_space = 0
+    if (present(histories)) call new_history_bytes(results, histories, history_bytes, history_space)
+    ! Twice the values (HDF5 allocates in blocks), its bookkeeping, and the room the next XDMF
+    ! file takes (given back just before it is written, see write_xdmf_now).
+    call reserve_space(results, 2_long_int*(state_bytes + history_space) + metadata_reserve + &
+                       xdmf_estimate(results, results%state_count + 1), space_error)
+    if (allocated(space_error)) then
+      ! Nothing of this state was written: the file is complete and can still be closed.
+      call make_error(error, space_error%message//" while writing "//what//" to "// &
+                      results%h5_path//kept_states(results))
+      results%failed = .true.
       return
     end if
-    call write_real_attribute(group_id, path, "time", time, error)
-    call write_real_dataset_2d(group_id, path, "displacement", displacement, error)
-    call write_real_dataset_2d(group_id, path, "velocity", velocity, error)
-    call write_real_dataset_2d(group_id, path, "solid_stress", solid_stress, error)
-    call write_real_dataset_1d(group_id, path, "solid_plastic_strain", solid_plastic_strain, error)
-    if (present(shell_stress)) then
-      call write_real_dataset_2d(group_id, path, "shell_stress", shell_stress, error)
-      call write_real_dataset_1d(group_id, path, "shell_plastic_strain", shell_plastic_strain, error)
-      call write_real_dataset_2d(group_id, path, "shell_stress_peak", shell_stress_peak, error)
-      call write_real_dataset_1d(group_id, path, "shell_plastic_strain_peak", shell_plastic_strain_peak, error)
+
+    call clear_system_error()
+    path = "/states/"//state_group_name(results%state_count + 1)
+    ! Two steps. First the state as an anonymous group (not yet in /states) and the new history
+    ! rows, flushed: this writes new objects and extends the histories, and a run killed here
+    ! leaves /states as it was. Then the link /states/NNNNNN, flushed: the only change to
+    ! /states, a few small blocks, so the window in which a kill can leave it half-updated is
+    ! as short as it can be with HDF5 (SWMR, which orders these writes, cannot add groups).
+    call h5gcreate_anon_f(results%file_id, group_id, status)
+    if (status /= 0) then
+      call make_error(error, "cannot create group "//path)
     else
-      call write_real_dataset_2d(group_id, path, "shell_stress", no_shell_stress, error)
-      call write_real_dataset_1d(group_id, path, "shell_plastic_strain", no_shell_strain, error)
+      call keep_open(objects, group_id)
+      call write_real_attribute(group_id, path, "time", time, error)
+      call write_real_dataset_2d(group_id, path, "displacement", displacement, error, objects)
+      call write_real_dataset_2d(group_id, path, "velocity", velocity, error, objects)
+      call write_real_dataset_2d(group_id, path, "solid_stress", solid_stress, error, objects)
+      call write_real_dataset_1d(group_id, path, "solid_plastic_strain", solid_plastic_strain, error, &
+                                 objects)
+      if (present(shell_stress)) then
+        call write_real_dataset_2d(group_id, path, "shell_stress", shell_stress, error, objects)
+        call write_real_dataset_1d(group_id, path, "shell_plastic_strain", shell_plastic_strain, error, &
+                                   objects)
+        call write_real_dataset_2d(group_id, path, "shell_stress_peak", shell_stress_peak, error, objects)
+        call write_real_dataset_1d(group_id, path, "shell_plastic_strain_peak", &
+                                   shell_plastic_strain_peak, error, objects)
+      else
+        call write_real_dataset_2d(group_id, path, "shell_stress", no_shell_stress, error, objects)
+        call write_real_dataset_1d(group_id, path, "shell_plastic_strain", no_shell_strain, error, objects)
+      end if
     end if
-    call h5gclose_f(group_id, status)
+    if (present(histories)) call append_histories(results, histories, objects, error)
+    call flush_file(results%file_id, error)
+    ! /states through an explicit open and close, so that its B-tree and name heap leave the
+    ! cache with it instead of staying there for every later flush to visit.
+    if (.not. allocated(error)) then
+      call h5gopen_f(results%file_id, "/states", states_id, status)
+      if (status == 0) then
+        call keep_open(objects, states_id)
+        call h5olink_f(group_id, states_id, state_group_name(results%state_count + 1), status)
+      end if
+      if (status /= 0) call make_error(error, "cannot link group "//path)
+    end if
     call flush_file(results%file_id, error)
     if (allocated(error)) then
-      error%message = "results file "//results%h5_path//": "//error%message
+      ! The objects stay open: closing them could write into the file (see open_objects_t).
+      call abandon(results, error, what)
       return
     end if
+    call close_objects(objects)
+    results%output_bytes = results%output_bytes + state_bytes + history_bytes
 
     if (results%state_count == size(results%state_times)) then
       allocate (grown(2*size(results%state_times)))
@@ -207,72 +391,430 @@ contains
     results%state_count = results%state_count + 1
     results%state_times(results%state_count) = time
 
-    call write_xdmf(results%xdmf_path, results%h5_name, results%node_count, results%solid_count, &
-                    results%shell_count, results%state_times(1:results%state_count), error)
+    if (xdmf_due(results)) call write_xdmf_now(results, error)
   end subroutine write_state
 
-  !> Write every history series as `/history/<group>/<column>`, replacing what an earlier call
-  !> wrote, and flush. The datasets are extendible and rewritten in place, so calling this at
-  !> every state does not make the file grow beyond the histories' own size.
+  !> Add the history rows recorded since the previous call (each series as
+  !> `/history/<group>/<column>`), and flush. Rows already in the file are not written again;
+  !> a series holding fewer rows than the file cuts the file's rows to its count.
   subroutine write_histories(results, histories, error)
     type(results_file_t), intent(inout) :: results
-    type(history_set_t), intent(in) :: histories
+    type(history_set_t), intent(in), target :: histories
     type(error_t), allocatable, intent(out) :: error
-    real(wp), allocatable :: column_values(:, :)
-    character(len=:), allocatable :: path
-    integer(hid_t) :: group_id
-    integer :: series_index, column, first_row, last_row, status
+    type(error_t), allocatable :: space_error
+    type(open_objects_t) :: objects
+    integer(long_int) :: history_bytes, history_space
 
-    if (.not. results%is_open) then
+    if (.not. results%is_open .or. results%broken) then
       call make_error(error, "results file: write_histories on a file that is not open")
       return
     end if
-    do series_index = 1, histories%count
-      associate (series => histories%series(series_index))
-        path = "/history/"//series%group
-        call create_group_path(results%file_id, path, error)
-        if (allocated(error)) exit
-        call h5gopen_f(results%file_id, path, group_id, status)
-        if (status /= 0) then
-          call make_error(error, "cannot open group "//path)
-          exit
-        end if
-        first_row = 1
-        do column = 1, size(series%widths)
-          ! A column is a strided slice of the rows: copy it to the contiguous form HDF5 takes.
-          last_row = first_row + series%widths(column) - 1
-          column_values = series%rows(first_row:last_row, 1:series%count)
-          call write_history_column(group_id, path, trim(series%names(column)), column_values, &
-                                    error)
-          first_row = last_row + 1
-        end do
-        call h5gclose_f(group_id, status)
-        if (allocated(error)) exit
-      end associate
-    end do
+    call new_history_bytes(results, histories, history_bytes, history_space)
+    call reserve_space(results, 2_long_int*history_space + metadata_reserve, space_error)
+    if (allocated(space_error)) then
+      call make_error(error, space_error%message//" while writing the histories to "// &
+                      results%h5_path//kept_states(results))
+      results%failed = .true.
+      return
+    end if
+    call clear_system_error()
+    call append_histories(results, histories, objects, error)
     call flush_file(results%file_id, error)
-    if (allocated(error)) error%message = "results file "//results%h5_path//": "//error%message
+    if (allocated(error)) then
+      call abandon(results, error, "the histories")
+      return
+    end if
+    call close_objects(objects)
+    results%output_bytes = results%output_bytes + history_bytes
   end subroutine write_histories
 
-  !> Write how the run ended (`/run`) and its timing (`/timing`), and close the file.
-  !> Does nothing when the file is not open (e.g. after `open_results` failed, or twice).
+  !> Write the complete XDMF file, how the run ended (`/run`) and its timing (`/timing`), close
+  !> the file and release the lock. Does nothing when the file is not open (e.g. after
+  !> `open_results` failed, or twice). After a failed write (or on a disk too full for the
+  !> status) `error` says what the two files hold; `/run` keeps the status "running" when it
+  !> could not be written.
   subroutine close_results(results, summary, error)
     type(results_file_t), intent(inout) :: results
     type(run_summary_t), intent(in) :: summary
     type(error_t), allocatable, intent(out) :: error
+    type(error_t), allocatable :: problem
+    character(len=:), allocatable :: final_status
     integer :: status
 
     if (.not. results%is_open) return
-    call write_run_end(results%file_id, summary, error)
-    call write_timing(results%file_id, summary, error)
-    call flush_file(results%file_id, error)
-    ! Close even after a failure: what is in the file stays readable.
-    call h5fclose_f(results%file_id, status)
-    if (status /= 0 .and. .not. allocated(error)) call make_error(error, "cannot close the file")
+    ! The XDMF first, so that /timing counts it; it lists the complete states only.
+    if (results%xdmf_state_count /= results%state_count .or. results%xdmf_writes == 0) &
+      call write_xdmf_now(results, problem)
+    final_status = "running"
+    if (.not. results%broken) then
+      ! A full disk: the file keeps its states, and closing a flushed file writes nothing.
+      call reserve_space(results, metadata_reserve + 2_long_int*len(text_or_empty(summary%message)), &
+                         error)
+      if (allocated(error)) then
+        error%message = error%message//" while writing the run status to "//results%h5_path
+      else
+        call clear_system_error()
+        call write_run_end(results%file_id, summary, error)
+        call write_timing(results, summary, error)
+        call flush_file(results%file_id, error)
+        if (allocated(error)) then
+          call abandon(results, error, "the run status")
+        else
+          final_status = status_error
+          if (allocated(summary%status)) final_status = summary%status
+        end if
+      end if
+      if (allocated(error) .and. .not. allocated(problem)) call move_alloc(error, problem)
+    end if
+    if (.not. results%broken) then
+      call h5fclose_f(results%file_id, status)
+      if (status /= 0 .and. .not. allocated(problem)) &
+        call make_error(problem, "cannot close "//results%h5_path//system_reason())
+    end if
+    call release_file_space(results%h5_path, results%reserved_bytes)
+    results%reserved_end = 0
+    call release_file_lock(results%lock)
     results%is_open = .false.
     results%file_id = -1
-    if (allocated(error)) error%message = "results file "//results%h5_path//": "//error%message
+
+    ! After any failure, what the user has: the run's own error said what went wrong first.
+    if (allocated(problem) .or. results%failed) then
+      call make_error(error, "")
+      if (allocated(problem) .and. .not. results%failed) error%message = problem%message//"; "
+      error%message = error%message//results%h5_path//" keeps "//state_range(results%state_count)// &
+                      " with /run status """//final_status//""", "//results%xdmf_path//" lists "// &
+                      state_range(results%xdmf_state_count)
+    end if
   end subroutine close_results
+
+  ! ---------------------------------------------------------------------------------------------
+  ! Commits, failures and the XDMF schedule.
+
+  !> Reserve `bytes` beyond the end of the file (see file_system); `error` only on a full disk.
+  subroutine reserve_space(results, bytes, error)
+    type(results_file_t), intent(inout) :: results
+    integer(long_int), intent(in) :: bytes
+    type(error_t), allocatable, intent(out) :: error
+    call reserve_file_space(results%h5_path, bytes, results%reserved_end, error)
+    if (.not. allocated(error)) results%reserved_bytes = max(results%reserved_bytes, bytes)
+  end subroutine reserve_space
+
+  !> After a failed HDF5 call while writing `what`: give up the handle (see the module comment)
+  !> and turn `error` into the user's message, the reason first when the disk is full.
+  subroutine abandon(results, error, what)
+    type(results_file_t), intent(inout) :: results
+    type(error_t), intent(inout) :: error
+    character(len=*), intent(in) :: what
+    results%broken = .true.
+    results%failed = .true.
+    if (disk_full()) then
+      error%message = lower_reason()//" while writing "//what//" to "//results%h5_path// &
+                      kept_states(results)
+    else
+      error%message = "results file "//results%h5_path//": "//error%message//system_reason()// &
+                      " while writing "//what//kept_states(results)
+    end if
+  end subroutine abandon
+
+  !> Whether the last failed system call found the disk full (or the quota used up).
+  logical function disk_full()
+    disk_full = system_error_number() == error_no_space .or. &
+                system_error_number() == error_quota_exceeded
+  end function disk_full
+
+  !> The system's reason of the last failure, in lower case ("no space left on device").
+  function lower_reason() result(text)
+    character(len=:), allocatable :: text
+    text = system_error_text(system_error_number())
+    if (len(text) > 0) then
+      if (text(1:1) >= "A" .and. text(1:1) <= "Z") text(1:1) = achar(iachar(text(1:1)) + 32)
+    end if
+  end function lower_reason
+
+  !> " (No such file or directory)" after a failure that set errno, else "".
+  function system_reason() result(text)
+    character(len=:), allocatable :: text
+    text = ""
+    if (system_error_number() /= 0) text = " ("//system_error_text(system_error_number())//")"
+  end function system_reason
+
+  !> What the file holds, for messages after a failure: "; the file keeps states 0 to 11 (up to
+  !> time ...)".
+  function kept_states(results) result(text)
+    type(results_file_t), intent(in) :: results
+    character(len=:), allocatable :: text
+    text = "; the file keeps "//state_range(results%state_count, results)
+  end function kept_states
+
+  !> Whether the XDMF file is to be rewritten now: at the states 1, 2, 4, 8, ... (so the
+  !> rewrites cost at most twice the final file in total), or when the last rewrite is older
+  !> than `xdmf_refresh_seconds` and took less than 1/xdmf_cost_fraction of the time since (so
+  !> that a reader watching a long run sees new states, at a bounded share of the run time).
+  logical function xdmf_due(results)
+    type(results_file_t), intent(in) :: results
+    real(wp) :: since
+    xdmf_due = results%state_count >= 2*results%xdmf_state_count
+    if (xdmf_due) return
+    since = seconds_now() - results%xdmf_written_at
+    xdmf_due = since >= xdmf_refresh_seconds .and. since >= xdmf_cost_fraction*results%xdmf_seconds
+  end function xdmf_due
+
+  !> Write the XDMF file listing the complete states, and note when and how long it took.
+  !> The space reserved beyond the end of the .h5 is given back first: it includes room for
+  !> this file, so that on a disk that fills up the XDMF file can still list every complete
+  !> state (the next commit reserves again).
+  subroutine write_xdmf_now(results, error)
+    type(results_file_t), intent(inout) :: results
+    type(error_t), allocatable, intent(inout) :: error
+    type(error_t), allocatable :: xdmf_error
+    real(wp) :: started
+    started = seconds_now()
+    call release_file_space(results%h5_path, results%reserved_bytes)
+    results%reserved_end = 0
+    call clear_system_error()
+    call write_xdmf(results%xdmf_path, results%h5_name, results%node_count, results%solid_count, &
+                    results%shell_count, results%state_times(1:results%state_count), xdmf_error, &
+                    results%xdmf_bytes)
+    results%xdmf_written_at = seconds_now()
+    results%xdmf_seconds = results%xdmf_written_at - started
+    results%xdmf_writes = results%xdmf_writes + 1
+    if (allocated(xdmf_error)) then
+      ! The previous XDMF file is still there, complete; the .h5 is not affected.
+      results%failed = .true.
+      if (disk_full()) xdmf_error%message = lower_reason()//" while writing "//results%xdmf_path// &
+        " after state "//integer_text(results%state_count - 1)//" at time "// &
+        real_text(results%state_times(results%state_count))
+      if (.not. allocated(error)) call move_alloc(xdmf_error, error)
+      return
+    end if
+    results%xdmf_state_count = results%state_count
+  end subroutine write_xdmf_now
+
+  !> Bytes the XDMF file listing `count` states will take: measured on the last one written
+  !> (with a margin), about 4 kB per state before.
+  function xdmf_estimate(results, count) result(bytes)
+    type(results_file_t), intent(in) :: results
+    integer, intent(in) :: count
+    integer(long_int) :: bytes
+    if (results%xdmf_state_count > 0) then
+      bytes = 4096_long_int + (5_long_int*results%xdmf_bytes*count)/(4_long_int*results%xdmf_state_count)
+    else
+      bytes = 4096_long_int*(count + 1)
+    end if
+  end function xdmf_estimate
+
+  !> "states 0 to 11 (up to time 1.1E-02)", "state 0 (time 0)", or "no state".
+  function state_range(count, results) result(text)
+    integer, intent(in) :: count
+    type(results_file_t), intent(in), optional :: results
+    character(len=:), allocatable :: text
+    if (count == 0) then
+      text = "no state"
+    else if (count == 1) then
+      text = "state 0"
+    else
+      text = "states 0 to "//integer_text(count - 1)
+    end if
+    if (present(results) .and. count > 0) text = text//" (up to time "//real_text(results%state_times(count))//")"
+  end function state_range
+
+  !> Bytes of the mesh datasets, for the reservation before they are written.
+  function mesh_bytes(results) result(bytes)
+    type(results_file_t), intent(in) :: results
+    integer(long_int) :: bytes
+    bytes = 2_long_int*(28_long_int*results%node_count + 72_long_int*results%solid_count + &
+                        40_long_int*results%shell_count)
+  end function mesh_bytes
+
+  !> Bytes of the history rows not yet in the file (`values`), and what writing them may add to
+  !> the file (`allocated`: the values and one new chunk per column of each series that gets
+  !> rows, as HDF5 allocates whole chunks).
+  subroutine new_history_bytes(results, histories, values, allocated)
+    type(results_file_t), intent(in) :: results
+    type(history_set_t), intent(in) :: histories
+    integer(long_int), intent(out) :: values, allocated
+    integer :: series_index, in_file
+    values = 0
+    allocated = 0
+    do series_index = 1, histories%count
+      in_file = 0
+      if (series_index <= size(results%history_rows)) in_file = results%history_rows(series_index)
+      associate (series => histories%series(series_index))
+        if (series%count > in_file) then
+          values = values + 8_long_int*series%row_width*(series%count - in_file)
+          allocated = allocated + 8_long_int*series%row_width*(series%count - in_file + history_chunk_rows)
+        end if
+      end associate
+    end do
+  end subroutine new_history_bytes
+
+  !> Append to every history series the rows not yet in the file (see write_histories).
+  !> The groups and datasets it opens are added to `objects`, for closing after the flush.
+  subroutine append_histories(results, histories, objects, error)
+    type(results_file_t), intent(inout) :: results
+    type(history_set_t), intent(in), target :: histories
+    type(open_objects_t), intent(inout) :: objects
+    type(error_t), allocatable, intent(inout) :: error
+    integer, allocatable :: grown(:)
+    character(len=:), allocatable :: path
+    integer(hid_t) :: group_id
+    integer :: series_index, column, first_row, in_file, status
+
+    if (allocated(error)) return
+    if (size(results%history_rows) < histories%count) then
+      allocate (grown(histories%count))
+      grown = 0
+      grown(1:size(results%history_rows)) = results%history_rows
+      call move_alloc(grown, results%history_rows)
+    end if
+    do series_index = 1, histories%count
+      associate (series => histories%series(series_index))
+        in_file = results%history_rows(series_index)
+        if (series%count == in_file) cycle
+        path = "/history/"//series%group
+        if (in_file == 0) call create_group_path(results%file_id, path, error)
+        if (allocated(error)) return
+        call h5gopen_f(results%file_id, path, group_id, status)
+        if (status /= 0) then
+          call make_error(error, "cannot open group "//path)
+          return
+        end if
+        call keep_open(objects, group_id)
+        first_row = 1
+        do column = 1, size(series%widths)
+          call append_history_column(group_id, path, trim(series%names(column)), series%rows, &
+                                     first_row, series%widths(column), in_file, series%count, &
+                                     objects, error)
+          first_row = first_row + series%widths(column)
+        end do
+        if (allocated(error)) return
+        results%history_rows(series_index) = series%count
+      end associate
+    end do
+  end subroutine append_histories
+
+  !> One history column, the rows `first_row : first_row + width - 1` of `rows(:, 1:count)`,
+  !> stored as (count) for width 1 and (count, width) otherwise, in a chunked dataset
+  !> extendible in rows. Only the rows after `in_file` (those already in the file) are written,
+  !> straight from `rows` through a strided memory selection (no copy). A count below
+  !> `in_file` cuts the dataset.
+  subroutine append_history_column(group_id, group_path, name, rows, first_row, width, in_file, &
+                                   count, objects, error)
+    integer(hid_t), intent(in) :: group_id
+    character(len=*), intent(in) :: group_path, name
+    real(wp), intent(in), target, contiguous :: rows(:, :)   !< (row width, capacity)
+    integer, intent(in) :: first_row, width, in_file, count
+    type(open_objects_t), intent(inout) :: objects          !< the dataset is added to it
+    type(error_t), allocatable, intent(inout) :: error
+    integer(hsize_t), allocatable :: dims(:), maximum_dims(:), chunk(:), start(:), block(:)
+    integer(hid_t) :: dataset_id, file_space, memory_space, create_list
+    integer :: status, rank, ignored
+    logical :: exists
+
+    if (allocated(error)) return
+    if (width == 1) then
+      dims = [int(count, hsize_t)]
+      maximum_dims = [H5S_UNLIMITED_F]
+      chunk = [history_chunk_rows]
+      start = [int(in_file, hsize_t)]
+      block = [int(count - in_file, hsize_t)]
+    else
+      dims = [int(width, hsize_t), int(count, hsize_t)]
+      maximum_dims = [int(width, hsize_t), H5S_UNLIMITED_F]
+      chunk = [int(width, hsize_t), history_chunk_rows]
+      start = [0_hsize_t, int(in_file, hsize_t)]
+      block = [int(width, hsize_t), int(count - in_file, hsize_t)]
+    end if
+    rank = size(dims)
+
+    exists = .false.
+    if (in_file > 0) then
+      exists = .true.
+    else
+      ! A dataset left by an earlier writer of the same file (not the solver): start afresh.
+      call h5lexists_f(group_id, name, exists, status)
+      if (status /= 0) then
+        call make_error(error, "cannot look up dataset "//group_path//"/"//name)
+        return
+      end if
+      if (exists) call h5ldelete_f(group_id, name, status)
+      exists = .false.
+    end if
+
+    if (exists) then
+      call h5dopen_f(group_id, name, dataset_id, status)
+      if (status /= 0) then
+        call make_error(error, "cannot open dataset "//group_path//"/"//name)
+        return
+      end if
+      call keep_open(objects, dataset_id)
+      call h5dset_extent_f(dataset_id, dims, status)
+      if (status /= 0) then
+        call make_error(error, "cannot extend dataset "//group_path//"/"//name)
+        return
+      end if
+    else
+      call h5screate_simple_f(rank, dims, file_space, status, maximum_dims)
+      if (status /= 0) then
+        call make_error(error, "cannot create the dataspace of "//group_path//"/"//name)
+        return
+      end if
+      call h5pcreate_f(H5P_DATASET_CREATE_F, create_list, status)
+      if (status == 0) call h5pset_chunk_f(create_list, rank, chunk, status)
+      if (status == 0) call h5dcreate_f(group_id, name, H5T_IEEE_F64LE, file_space, dataset_id, &
+                                        status, dcpl_id=create_list)
+      call h5pclose_f(create_list, ignored)
+      call h5sclose_f(file_space, ignored)
+      if (status /= 0) then
+        call make_error(error, "cannot create dataset "//group_path//"/"//name)
+        return
+      end if
+      call keep_open(objects, dataset_id)
+    end if
+
+    if (count > in_file) then
+      call h5dget_space_f(dataset_id, file_space, status)
+      if (status == 0) call h5sselect_hyperslab_f(file_space, H5S_SELECT_SET_F, start, block, status)
+      if (status == 0) then
+        call h5screate_simple_f(2, int(shape(rows), hsize_t), memory_space, status)
+        if (status == 0) then
+          call h5sselect_hyperslab_f(memory_space, H5S_SELECT_SET_F, &
+                                     [int(first_row - 1, hsize_t), int(in_file, hsize_t)], &
+                                     [int(width, hsize_t), int(count - in_file, hsize_t)], status)
+          if (status == 0) call h5dwrite_f(dataset_id, h5kind_to_type(wp, H5_REAL_KIND), c_loc(rows), &
+                                           status, mem_space_id=memory_space, file_space_id=file_space)
+          call h5sclose_f(memory_space, ignored)
+        end if
+        call h5sclose_f(file_space, ignored)
+      end if
+      if (status /= 0) call make_error(error, "cannot write dataset "//group_path//"/"//name)
+    end if
+  end subroutine append_history_column
+
+  !> Add an open group or dataset to the objects of a commit.
+  subroutine keep_open(objects, object_id)
+    type(open_objects_t), intent(inout) :: objects
+    integer(hid_t), intent(in) :: object_id
+    integer(hid_t), allocatable :: grown(:)
+    if (.not. allocated(objects%ids)) allocate (objects%ids(16))
+    if (objects%count == size(objects%ids)) then
+      allocate (grown(2*size(objects%ids)))
+      grown(1:objects%count) = objects%ids(1:objects%count)
+      call move_alloc(grown, objects%ids)
+    end if
+    objects%count = objects%count + 1
+    objects%ids(objects%count) = object_id
+  end subroutine keep_open
+
+  !> Close the objects of a commit after its flush, the last opened first.
+  subroutine close_objects(objects)
+    type(open_objects_t), intent(inout) :: objects
+    integer :: entry, ignored
+    do entry = objects%count, 1, -1
+      call h5oclose_f(objects%ids(entry), ignored)
+    end do
+    objects%count = 0
+  end subroutine close_objects
 
   ! ---------------------------------------------------------------------------------------------
   ! The groups of the layout. Like every private writer below, each does nothing once `error`
@@ -365,6 +907,31 @@ contains
     end function shell_connectivity_index
   end subroutine write_mesh
 
+  !> `/states`, as a group whose links are kept in HDF5's "dense" form (a fractal heap and a
+  !> B-tree of names, HDF5 1.8 and later): adding the n-th state then changes a few small blocks
+  !> of it, where the classic form rewrites its whole name heap (of size n) at every flush,
+  !> and moves it whenever it grows.
+  subroutine create_states_group(file_id, error)
+    integer(hid_t), intent(in) :: file_id
+    type(error_t), allocatable, intent(inout) :: error
+    integer(hid_t) :: create_list, group_id
+    integer :: status, ignored
+
+    if (allocated(error)) return
+    call h5pcreate_f(H5P_GROUP_CREATE_F, create_list, status)
+    ! Tracking the creation order is what makes HDF5 use the new form (no index is kept on it);
+    ! no "compact" phase: dense from the first state.
+    if (status == 0) call h5pset_link_creation_order_f(create_list, H5P_CRT_ORDER_TRACKED_F, status)
+    if (status == 0) call h5pset_link_phase_change_f(create_list, 0, 0, status)
+    if (status == 0) call h5gcreate_f(file_id, "/states", group_id, status, gcpl_id=create_list)
+    call h5pclose_f(create_list, ignored)
+    if (status /= 0) then
+      call make_error(error, "cannot create group /states")
+      return
+    end if
+    call h5gclose_f(group_id, ignored)
+  end subroutine create_states_group
+
   !> `/run` at the start. Every attribute of the contract is there from the start; the status
   !> is "running" until `close_results`, so a file left by a killed process says so.
   subroutine write_run_start(file_id, model, threads, error)
@@ -423,9 +990,10 @@ contains
     call h5gclose_f(group_id, status)
   end subroutine write_run_end
 
-  !> `/timing`: seconds per phase, and the sizes that normalise them.
-  subroutine write_timing(file_id, summary, error)
-    integer(hid_t), intent(in) :: file_id
+  !> `/timing`: seconds per phase, the sizes that normalise them, and what the output wrote
+  !> (`output_bytes`, `xdmf_writes`: see the module comment).
+  subroutine write_timing(results, summary, error)
+    type(results_file_t), intent(in) :: results
     type(run_summary_t), intent(in) :: summary
     type(error_t), allocatable, intent(inout) :: error
     character(len=*), parameter :: second_names(8) = [character(len=11) :: "wall_s", &
@@ -436,9 +1004,9 @@ contains
     integer :: counts(8), entry, status
     integer(hid_t) :: group_id
 
-    call create_group_path(file_id, "/timing", error)
+    call create_group_path(results%file_id, "/timing", error)
     if (allocated(error)) return
-    call h5gopen_f(file_id, "/timing", group_id, status)
+    call h5gopen_f(results%file_id, "/timing", group_id, status)
     if (status /= 0) then
       call make_error(error, "cannot open group /timing")
       return
@@ -455,113 +1023,26 @@ contains
       call write_integer_attribute(group_id, "/timing", trim(count_names(entry)), counts(entry), &
                                    error)
     end do
+    call write_long_attribute(group_id, "/timing", "output_bytes", results%output_bytes, error)
+    call write_integer_attribute(group_id, "/timing", "xdmf_writes", results%xdmf_writes, error)
     call h5gclose_f(group_id, status)
   end subroutine write_timing
-
-  !> One history column `values(width, rows)`, stored as (rows) for width 1 and (rows, width)
-  !> otherwise, in a chunked dataset extendible in rows. An existing dataset of the same width
-  !> is resized and overwritten in place; one of another width is replaced.
-  subroutine write_history_column(group_id, group_path, name, values, error)
-    integer(hid_t), intent(in) :: group_id
-    character(len=*), intent(in) :: group_path, name
-    real(wp), intent(in), target, contiguous :: values(:, :)
-    type(error_t), allocatable, intent(inout) :: error
-    integer(hsize_t), allocatable :: dims(:), maximum_dims(:), chunk(:)
-    integer(hsize_t) :: old_dims(2), old_maximum(2)
-    integer(hid_t) :: dataset_id, space_id, create_list
-    integer :: status, rank, old_rank, ignored
-    logical :: exists, reusable
-    type(c_ptr) :: buffer
-
-    if (allocated(error)) return
-    if (size(values, 1) == 1) then
-      dims = [int(size(values, 2), hsize_t)]
-      maximum_dims = [H5S_UNLIMITED_F]
-      chunk = [history_chunk_rows]
-    else
-      dims = int(shape(values), hsize_t)
-      maximum_dims = [dims(1), H5S_UNLIMITED_F]
-      chunk = [dims(1), history_chunk_rows]
-    end if
-    rank = size(dims)
-
-    call h5lexists_f(group_id, name, exists, status)
-    if (status /= 0) then
-      call make_error(error, "cannot look up dataset "//group_path//"/"//name)
-      return
-    end if
-    reusable = .false.
-    if (exists) then
-      call h5dopen_f(group_id, name, dataset_id, status)
-      if (status /= 0) then
-        call make_error(error, "cannot open dataset "//group_path//"/"//name)
-        return
-      end if
-      call h5dget_space_f(dataset_id, space_id, status)
-      if (status == 0) call h5sget_simple_extent_ndims_f(space_id, old_rank, status)
-      if (status == 0 .and. old_rank == rank) then
-        ! On success this returns the rank in `status`.
-        call h5sget_simple_extent_dims_f(space_id, old_dims, old_maximum, status)
-        reusable = status == rank .and. old_maximum(rank) == H5S_UNLIMITED_F
-        if (rank == 2) reusable = reusable .and. old_dims(1) == dims(1)
-      end if
-      call h5sclose_f(space_id, ignored)
-      if (reusable) then
-        call h5dset_extent_f(dataset_id, dims, status)
-        if (status /= 0) then
-          call h5dclose_f(dataset_id, ignored)
-          call make_error(error, "cannot resize dataset "//group_path//"/"//name)
-          return
-        end if
-      else
-        call h5dclose_f(dataset_id, ignored)
-        call h5ldelete_f(group_id, name, status)
-        if (status /= 0) then
-          call make_error(error, "cannot replace dataset "//group_path//"/"//name)
-          return
-        end if
-      end if
-    end if
-
-    if (.not. reusable) then
-      call h5screate_simple_f(rank, dims, space_id, status, maximum_dims)
-      if (status /= 0) then
-        call make_error(error, "cannot create the dataspace of "//group_path//"/"//name)
-        return
-      end if
-      call h5pcreate_f(H5P_DATASET_CREATE_F, create_list, status)
-      if (status == 0) call h5pset_chunk_f(create_list, rank, chunk, status)
-      if (status == 0) call h5dcreate_f(group_id, name, H5T_IEEE_F64LE, space_id, dataset_id, &
-                                        status, dcpl_id=create_list)
-      call h5pclose_f(create_list, ignored)
-      call h5sclose_f(space_id, ignored)
-      if (status /= 0) then
-        call make_error(error, "cannot create dataset "//group_path//"/"//name)
-        return
-      end if
-    end if
-
-    if (size(values) > 0) then
-      buffer = c_loc(values)
-      call h5dwrite_f(dataset_id, h5kind_to_type(wp, H5_REAL_KIND), buffer, status)
-      if (status /= 0) call make_error(error, "cannot write dataset "//group_path//"/"//name)
-    end if
-    call h5dclose_f(dataset_id, ignored)
-  end subroutine write_history_column
 
   ! ---------------------------------------------------------------------------------------------
   ! Small writers. Each closes the handles it opens, so a failure leaves nothing open.
   ! `parent_path` and `name` make the message ("" as `parent_path` when `name` is a full path).
 
   !> Create a contiguous dataset of `dims` and write `buffer` into it (nothing for size 0).
+  !> With `objects` the dataset is left open and added to it (see open_objects_t).
   subroutine write_dataset(parent_id, parent_path, name, file_type, memory_type, dims, buffer, &
-                           error)
+                           error, objects)
     integer(hid_t), intent(in) :: parent_id
     character(len=*), intent(in) :: parent_path, name
     integer(hid_t), intent(in) :: file_type, memory_type
     integer(hsize_t), intent(in) :: dims(:)
     type(c_ptr), intent(in) :: buffer
     type(error_t), allocatable, intent(inout) :: error
+    type(open_objects_t), intent(inout), optional :: objects
     integer(hid_t) :: space_id, dataset_id
     integer :: status, ignored
 
@@ -582,34 +1063,41 @@ contains
       if (status /= 0) call make_error(error, "cannot write dataset "// &
                                        object_path(parent_path, name))
     end if
-    call h5dclose_f(dataset_id, ignored)
+    if (present(objects)) then
+      call keep_open(objects, dataset_id)
+    else
+      call h5dclose_f(dataset_id, ignored)
+    end if
   end subroutine write_dataset
 
   !> Reals `(rows)`.
-  subroutine write_real_dataset_1d(parent_id, parent_path, name, values, error)
+  subroutine write_real_dataset_1d(parent_id, parent_path, name, values, error, objects)
     integer(hid_t), intent(in) :: parent_id
     character(len=*), intent(in) :: parent_path, name
     real(wp), intent(in), target, contiguous :: values(:)
     type(error_t), allocatable, intent(inout) :: error
+    type(open_objects_t), intent(inout), optional :: objects
     type(c_ptr) :: buffer
     buffer = c_null_ptr
     if (size(values) > 0) buffer = c_loc(values)
     call write_dataset(parent_id, parent_path, name, H5T_IEEE_F64LE, &
                        h5kind_to_type(wp, H5_REAL_KIND), [int(size(values), hsize_t)], buffer, &
-                       error)
+                       error, objects)
   end subroutine write_real_dataset_1d
 
   !> Reals `(columns, rows)` in Fortran, stored as (rows, columns).
-  subroutine write_real_dataset_2d(parent_id, parent_path, name, values, error)
+  subroutine write_real_dataset_2d(parent_id, parent_path, name, values, error, objects)
     integer(hid_t), intent(in) :: parent_id
     character(len=*), intent(in) :: parent_path, name
     real(wp), intent(in), target, contiguous :: values(:, :)
     type(error_t), allocatable, intent(inout) :: error
+    type(open_objects_t), intent(inout), optional :: objects
     type(c_ptr) :: buffer
     buffer = c_null_ptr
     if (size(values) > 0) buffer = c_loc(values)
     call write_dataset(parent_id, parent_path, name, H5T_IEEE_F64LE, &
-                       h5kind_to_type(wp, H5_REAL_KIND), int(shape(values), hsize_t), buffer, error)
+                       h5kind_to_type(wp, H5_REAL_KIND), int(shape(values), hsize_t), buffer, error, &
+                       objects)
   end subroutine write_real_dataset_2d
 
   !> Integers `(rows)`, stored as 32-bit.
@@ -733,6 +1221,18 @@ contains
                          c_loc(stored), error)
   end subroutine write_integer_attribute
 
+  !> A 64-bit integer scalar attribute (byte counts).
+  subroutine write_long_attribute(object_id, object_path, name, value, error)
+    integer(hid_t), intent(in) :: object_id
+    character(len=*), intent(in) :: object_path, name
+    integer(long_int), intent(in) :: value
+    type(error_t), allocatable, intent(inout) :: error
+    integer(long_int), target :: stored
+    stored = value
+    call write_attribute(object_id, object_path, name, H5T_STD_I64LE, &
+                         h5kind_to_type(long_int, H5_INTEGER_KIND), c_loc(stored), error)
+  end subroutine write_long_attribute
+
   !> A string scalar attribute, variable-length ASCII.
   subroutine write_string_attribute(object_id, object_path, name, value, error)
     integer(hid_t), intent(in) :: object_id
@@ -830,6 +1330,14 @@ contains
       path = directory(1:length)//"/"//name
     end if
   end function join_path
+
+  !> The directory as the user gave it, "." for the current one, for messages.
+  pure function directory_text(directory) result(text)
+    character(len=*), intent(in) :: directory
+    character(len=:), allocatable :: text
+    text = trim(directory)
+    if (len(text) == 0) text = "."
+  end function directory_text
 
   !> Full path of an object, for messages.
   pure function object_path(parent_path, name) result(path)

@@ -1,9 +1,11 @@
 !> The XDMF 3 description of a results file, so that ParaView (or VisIt) can open it.
 !>
 !> The XDMF file holds no data: it says where the mesh and each state live in the HDF5 file,
-!> which it names by file name alone, so the pair can be moved together. It is rewritten after
-!> every state, so a run still going (or one that stopped on an error) opens with the states
-!> written so far.
+!> which it names by file name alone, so the pair can be moved together. It is written whole
+!> each time (the results file decides when: on a schedule that keeps the total cost linear in
+!> the number of states, and at the end), into `<name>.tmp` beside it and then renamed over it,
+!> so that a reader, or a run killed at any moment, always finds a complete XML file: the
+!> previous one or the new one.
 !>
 !> The mapping (docs/output.md):
 !> - one temporal collection with one entry per `/states/NNNNNN`, `Time` = its `time`. The
@@ -28,6 +30,7 @@
 module xdmf_writer
   use kinds, only: wp
   use error_handling, only: error_t, make_error
+  use file_system, only: write_text_file, rename_file, remove_file
   implicit none
   private
 
@@ -36,12 +39,10 @@ module xdmf_writer
   !> The cell kind of one uniform grid.
   integer, parameter :: grid_solids = 1, grid_shells = 2, grid_points = 3
 
-  !> The output file and the first failure met while writing it (the writers below do nothing
-  !> once `status` is non-zero, so a sequence of writes reads as a list).
+  !> The XML text being built; written to the file in one piece at the end (see write_xdmf).
   type :: xml_output_t
-    integer :: unit = -1
-    integer :: status = 0
-    character(len=256) :: message = ""
+    character(len=:), allocatable :: text
+    integer :: length = 0                 !< characters of `text` in use
   end type xml_output_t
 
 contains
@@ -55,22 +56,22 @@ contains
   end function state_group_name
 
   !> Write (replace) the XDMF file `xdmf_path` describing the states whose times are given.
+  !> The file is replaced in one step (written as `xdmf_path.tmp`, then renamed); on a failure
+  !> the previous file is left as it was and the temporary one is removed.
   subroutine write_xdmf(xdmf_path, h5_file_name, node_count, solid_count, shell_count, &
-                        state_times, error)
+                        state_times, error, bytes)
     character(len=*), intent(in) :: xdmf_path      !< file to write
     character(len=*), intent(in) :: h5_file_name   !< the HDF5 file, by name only (relative)
     integer, intent(in) :: node_count, solid_count, shell_count
     real(wp), intent(in) :: state_times(:)         !< time of each state written so far
     type(error_t), allocatable, intent(out) :: error
+    integer, intent(out), optional :: bytes        !< size of the file (written or not)
     type(xml_output_t) :: output
-    integer :: state_index, status
+    character(len=:), allocatable :: temporary_path
+    integer :: state_index
 
-    open (newunit=output%unit, file=xdmf_path, status="replace", action="write", &
-          form="formatted", iostat=output%status, iomsg=output%message)
-    if (output%status /= 0) then
-      call make_error(error, "cannot write the XDMF file "//xdmf_path//": "//trim(output%message))
-      return
-    end if
+    ! About 2 kB per state (3 kB with solids and shells), whatever the mesh.
+    allocate (character(len=4096 + 2048*size(state_times)) :: output%text)
     call write_line(output, '<?xml version="1.0" encoding="utf-8"?>')
     call write_line(output, '<Xdmf Version="3.0" xmlns:xi="http://www.w3.org/2001/XInclude">')
     call write_line(output, '  <Domain>')
@@ -83,14 +84,17 @@ contains
     call write_line(output, '    </Grid>')
     call write_line(output, '  </Domain>')
     call write_line(output, '</Xdmf>')
-    if (output%status /= 0) then
-      call make_error(error, "cannot write the XDMF file "//xdmf_path//": "//trim(output%message))
-      close (output%unit, iostat=status)
+
+    if (present(bytes)) bytes = output%length
+    temporary_path = xdmf_path//".tmp"
+    call write_text_file(temporary_path, output%text(1:output%length), error)
+    if (allocated(error)) then
+      error%message = "the XDMF file: "//error%message
+      call remove_file(temporary_path)
       return
     end if
-    close (output%unit, iostat=output%status, iomsg=output%message)
-    if (output%status /= 0) call make_error(error, "cannot close the XDMF file "//xdmf_path// &
-                                            ": "//trim(output%message))
+    call rename_file(temporary_path, xdmf_path, error)
+    if (allocated(error)) call remove_file(temporary_path)
   end subroutine write_xdmf
 
   !> The entry of the temporal collection for one state: a uniform grid of the one element kind
@@ -240,12 +244,19 @@ contains
                     reference//'</DataItem>')
   end subroutine write_data_item
 
-  !> One line, unless an earlier write failed.
+  !> Append one line (and its new-line character) to the text.
   subroutine write_line(output, line)
     type(xml_output_t), intent(inout) :: output
     character(len=*), intent(in) :: line
-    if (output%status /= 0) return
-    write (output%unit, '(a)', iostat=output%status, iomsg=output%message) line
+    character(len=:), allocatable :: grown
+    if (output%length + len(line) + 1 > len(output%text)) then
+      allocate (character(len=2*len(output%text) + len(line) + 1) :: grown)
+      grown(1:output%length) = output%text(1:output%length)
+      call move_alloc(grown, output%text)
+    end if
+    output%text(output%length + 1:output%length + len(line)) = line
+    output%text(output%length + len(line) + 1:output%length + len(line) + 1) = new_line("a")
+    output%length = output%length + len(line) + 1
   end subroutine write_line
 
   !> Decimal text of an integer, without blanks.

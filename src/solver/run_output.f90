@@ -14,7 +14,7 @@ module run_output
   use solid_block, only: solid_block_element_results
   use shell_block, only: shell_block_element_results
   use efg_forces, only: efg_point_results, transform_to_physical
-  use results_file, only: results_file_t, write_state, write_histories
+  use results_file, only: results_file_t, write_state
   use rigid_bodies, only: rigid_body_history_row
   use distortion_check, only: distortion_t, check_solid_distortion
   implicit none
@@ -249,10 +249,9 @@ contains
     if (clock_due(plan%rbdout, state%time, last)) call record_rigid_bodies(model, state, plan, histories)
     if (states_due) then
       call check_solid_distortion(model, state%blocks, state%coordinates, state%time, plan%distortion)
-      call write_current_state(model, state, plan, results, error)
-      if (allocated(error)) return
-      call write_histories(results, histories, error)
-      wrote_state = .true.
+      ! the state and the history rows recorded since the previous one, as one commit
+      call write_current_state(model, state, plan, histories, results, error)
+      wrote_state = .not. allocated(error)
     end if
   end subroutine write_due_output
 
@@ -326,10 +325,11 @@ contains
     end do
   end subroutine physical_node_fields
 
-  subroutine write_current_state(model, state, plan, results, error)
+  subroutine write_current_state(model, state, plan, histories, results, error)
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(in) :: state
     type(output_plan_t), intent(inout) :: plan
+    type(history_set_t), intent(in) :: histories
     type(results_file_t), intent(inout) :: results
     type(error_t), allocatable, intent(out) :: error
     integer :: b, k
@@ -348,10 +348,10 @@ contains
     if (size(model%shell_ids) > 0) then
       call write_state(results, state%time, plan%node_displacement, plan%node_velocity, plan%solid_stress, &
                        plan%solid_plastic_strain, error, plan%shell_stress, plan%shell_plastic_strain, &
-                       plan%shell_stress_peak, plan%shell_plastic_strain_peak)
+                       plan%shell_stress_peak, plan%shell_plastic_strain_peak, histories=histories)
     else
       call write_state(results, state%time, plan%node_displacement, plan%node_velocity, plan%solid_stress, &
-                       plan%solid_plastic_strain, error)
+                       plan%solid_plastic_strain, error, histories=histories)
     end if
   end subroutine write_current_state
 end module run_output

@@ -1,12 +1,13 @@
 !> Unit tests of results_file: write a tiny model (2 hexahedra, 12 nodes, 1 part), two states,
-!> histories (twice, to see that the second call replaces the first) and the run summary into a
+!> histories (twice, to see that the second call adds the new rows) and the run summary into a
 !> temporary directory, then read everything back with the HDF5 library and compare: shapes as
-!> the contract gives them (h5py's row-major view) and values bit for bit.
+!> the contract gives them (h5py's row-major view) and values bit for bit. Then the commits of
+!> states with their history rows, the XDMF schedule and the lock on the job's files.
 !>
 !> Set CRASHFREE_KEEP_TEST_OUTPUT=DIR to write into DIR (which must exist) and keep the files:
 !> tests/regression/test_postproc.py uses that to read a Fortran-written file with h5py.
 program test_results_file
-  use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_f_pointer, c_char, c_size_t, c_null_ptr
+  use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_f_pointer, c_char, c_size_t, c_null_ptr, c_int
   use hdf5, only: hid_t, hsize_t, size_t, h5fopen_f, h5fclose_f, H5F_ACC_RDONLY_F, &
                   h5dopen_f, h5dclose_f, h5dread_f, h5dget_space_f, h5dget_type_f, &
                   h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, h5sclose_f, &
@@ -31,6 +32,12 @@ program test_results_file
       type(c_ptr), value :: string
       integer(c_size_t) :: length
     end function c_string_length
+
+    !> POSIX getpid, for the lock's message.
+    function c_getpid() bind(c, name="getpid") result(pid)
+      import :: c_int
+      integer(c_int) :: pid
+    end function c_getpid
   end interface
 
   type(test_suite_t) :: suite
@@ -46,6 +53,7 @@ program test_results_file
   call test_errors(suite, model, directory)
   call test_open_again(suite, model, directory)
   call test_shells_in_xdmf(suite, model, directory)
+  call test_commits_schedule_and_lock(suite, model, directory)
 
   if (.not. keep_output) call remove_outputs(directory)
   call finish_suite(suite)
@@ -127,6 +135,13 @@ contains
     call delete_file(directory//"/mixed.xdmf")
     call delete_file(directory//"/plates.h5")
     call delete_file(directory//"/plates.xdmf")
+    call delete_file(directory//"/commits.h5")
+    call delete_file(directory//"/commits.xdmf")
+    call delete_file(directory//"/job.lock")
+    call delete_file(directory//"/again.lock")
+    call delete_file(directory//"/mixed.lock")
+    call delete_file(directory//"/plates.lock")
+    call delete_file(directory//"/commits.lock")
     call execute_command_line("rmdir '"//directory//"'")
   end subroutine remove_outputs
 
@@ -586,6 +601,78 @@ contains
                index(xdmf_text, "Hexahedron") == 0 .and. index(xdmf_text, "Spatial") == 0 .and. &
                index(xdmf_text, "solid_stress") == 0)
   end subroutine test_shells_in_xdmf
+
+  !> Ten states, each with the history rows recorded since the previous one (one commit each):
+  !> the histories grow row by row and hold every row once; the XDMF file is written at the
+  !> states 1, 2, 4, 8 and at the close, lists every state and leaves no temporary file; /timing
+  !> counts the values written and the XDMF writes. A second open of the same job while the
+  !> first is open is refused, naming this process; after the close it succeeds.
+  subroutine test_commits_schedule_and_lock(suite, model, directory)
+    type(test_suite_t), intent(inout) :: suite
+    type(model_t), intent(in) :: model
+    character(len=*), intent(in) :: directory
+    type(results_file_t) :: results, second
+    type(error_t), allocatable :: error
+    type(history_set_t) :: histories
+    type(run_summary_t) :: summary
+    character(len=:), allocatable :: xdmf_text
+    character(len=16) :: pid_text
+    integer(hid_t) :: file_id
+    integer :: state, status, writes
+    logical :: exists, all_written
+
+    call open_results(results, directory, "commits", model, 1, error)
+    call check(suite, "commits: file opens", .not. allocated(error), message_of(error))
+    if (allocated(error)) return
+
+    write (pid_text, '(i0)') c_getpid()
+    call open_results(second, directory, "commits", model, 1, error)
+    call check(suite, "lock: a second open of the job is refused", allocated(error))
+    if (allocated(error)) call check(suite, "lock: the message names the job, directory and process", &
+                                     index(error%message, "another run (process "//trim(pid_text)// &
+                                           ") is writing job 'commits' in the output directory '"// &
+                                           directory//"'") > 0, error%message)
+    call check(suite, "lock: the refused file is not open", .not. second%is_open)
+
+    all_written = .true.
+    do state = 1, 10
+      call make_histories(histories, 2*state)
+      call write_state(results, 0.25_wp*real(state, wp), nodal_field(real(state, wp)), nodal_field(0.0_wp), &
+                       stress_field(0.0_wp), [0.0_wp, 0.0_wp], error, histories=histories)
+      all_written = all_written .and. .not. allocated(error)
+      if (state == 3) call check(suite, "commits: XDMF written at states 1, 2 (not 3)", results%xdmf_writes == 2)
+    end do
+    call check(suite, "commits: ten states written", all_written .and. results%state_count == 10)
+    writes = results%xdmf_writes
+    call check(suite, "commits: XDMF written at states 1, 2, 4, 8", writes == 4)
+    summary%status = status_normal
+    summary%message = ""
+    call close_results(results, summary, error)
+    call check(suite, "commits: close", .not. allocated(error), message_of(error))
+
+    call h5fopen_f(directory//"/commits.h5", H5F_ACC_RDONLY_F, file_id, status)
+    call check(suite, "commits: file readable", status == 0)
+    if (status /= 0) return
+    call check_histories(suite, file_id, 20)
+    call check(suite, "commits: state 9 is the last", link_exists(file_id, "/states/000009") .and. &
+               .not. link_exists(file_id, "/states/000010"))
+    call check(suite, "commits: output_bytes counts states and rows", &
+               integer_attribute(file_id, "/timing", "output_bytes") == &
+               10*8*(2*3*12 + 7*2) + 20*8*(8 + 10))
+    call check(suite, "commits: xdmf_writes counts the close", &
+               integer_attribute(file_id, "/timing", "xdmf_writes") == writes + 1)
+    call h5fclose_f(file_id, status)
+    call read_text_file(directory//"/commits.xdmf", xdmf_text)
+    call check(suite, "commits: XDMF lists all ten states", &
+               index(xdmf_text, ">commits.h5:/states/000009/displacement<") > 0 .and. &
+               index(xdmf_text, "</Xdmf>") > 0)
+    inquire (file=directory//"/commits.xdmf.tmp", exist=exists)
+    call check(suite, "commits: no temporary XDMF file left", .not. exists)
+
+    call open_results(second, directory, "commits", model, 1, error)
+    call check(suite, "lock: released by the close", .not. allocated(error), message_of(error))
+    call close_results(second, summary, error)
+  end subroutine test_commits_schedule_and_lock
 
   ! ---------------------------------------------------------------------------------------------
   ! Readers
