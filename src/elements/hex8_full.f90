@@ -14,7 +14,7 @@ module hex8_full
   private
 
   public :: point_velocity_gradient, add_deviatoric_point_forces, add_mean_stress_forces
-  public :: add_point_stress_power, corner_force_power
+  public :: add_point_stress_power, corner_force_power, add_point_gram, deviatoric_mode_bound
 
 contains
 
@@ -156,4 +156,55 @@ contains
       power(i) = sum_of_products
     end do
   end subroutine corner_force_power
+
+  !> Accumulates the 8 x 8 Gram matrix sum_p detJ_p sum_k dN_I/dx_k(p) dN_J/dx_k(p) of the
+  !> points (upper triangle packed row by row, 36 entries; start from zero), for
+  !> deviatoric_mode_bound.
+  subroutine add_point_gram(nel, determinant, dndx, dndy, dndz, gram)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: determinant(block_size)
+    real(wp), intent(in) :: dndx(block_size, 8), dndy(block_size, 8), dndz(block_size, 8)
+    real(wp), intent(inout) :: gram(block_size, 36)
+    integer :: first, second, k, i
+    k = 0
+    do first = 1, 8
+      do second = first, 8
+        k = k + 1
+        do i = 1, nel
+          gram(i, k) = gram(i, k) + determinant(i)*(dndx(i, first)*dndx(i, second) + dndy(i, first)*dndy(i, second) &
+                                                    + dndz(i, first)*dndz(i, second))
+        end do
+      end do
+    end do
+  end subroutine add_point_gram
+
+  !> For the stable step (element_time_step): a bound on lambda_max of the element's extra
+  !> deviatoric stiffness over the one-point element. With B_p the point gradients and
+  !> b = sum_p detJ_p B_p, the deviatoric energy splits exactly into that of the mean strain and
+  !> 2 mu sum_p detJ_p |dev sym(sum_I u_I (x) (B_pI - b_I / V))|^2, at most 2 mu u_k^T L u_k
+  !> summed over the directions k, L = gram - b b^T / V (the cross terms vanish since
+  !> sum_p detJ_p (B_p - b / V) = 0). Returns the largest absolute row sum of L (>= lambda_max).
+  subroutine deviatoric_mode_bound(nel, gram, bx, by, bz, volume, bound)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: gram(block_size, 36)
+    real(wp), intent(in) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8), volume(block_size)
+    real(wp), intent(out) :: bound(block_size)
+    real(wp) :: row(8), entry, inverse_volume
+    integer :: first, second, k, i
+    do i = 1, nel
+      inverse_volume = 1.0_wp/sign(max(abs(volume(i)), tiny(1.0_wp)), volume(i))
+      row = 0.0_wp
+      k = 0
+      do first = 1, 8
+        do second = first, 8
+          k = k + 1
+          entry = abs(gram(i, k) - (bx(i, first)*bx(i, second) + by(i, first)*by(i, second) &
+                                    + bz(i, first)*bz(i, second))*inverse_volume)
+          row(first) = row(first) + entry
+          if (second /= first) row(second) = row(second) + entry
+        end do
+      end do
+      bound(i) = maxval(row)
+    end do
+  end subroutine deviatoric_mode_bound
 end module hex8_full
