@@ -15,6 +15,7 @@ module hex8_full
 
   public :: point_velocity_gradient, add_deviatoric_point_forces, add_mean_stress_forces
   public :: add_point_stress_power, corner_force_power, add_point_gram, deviatoric_mode_bound
+  public :: add_point_gradient_norm, deviatoric_mode_trace_bound
 
 contains
 
@@ -207,4 +208,37 @@ contains
       bound(i) = maxval(row)
     end do
   end subroutine deviatoric_mode_bound
+
+  !> Accumulates sum_p detJ_p sum_I |dN_I/dx(p)|^2 (start from zero), the trace of the Gram
+  !> matrix of add_point_gram, for deviatoric_mode_trace_bound.
+  subroutine add_point_gradient_norm(nel, determinant, dndx, dndy, dndz, total)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: determinant(block_size)
+    real(wp), intent(in) :: dndx(block_size, 8), dndy(block_size, 8), dndz(block_size, 8)
+    real(wp), intent(inout) :: total(block_size)
+    integer :: node, i
+    do node = 1, 8
+      do i = 1, nel
+        total(i) = total(i) + determinant(i)*(dndx(i, node)**2 + dndy(i, node)**2 + dndz(i, node)**2)
+      end do
+    end do
+  end subroutine add_point_gradient_norm
+
+  !> The cheaper bound of deviatoric_mode_bound: lambda_max(L) <= tr L = sum_p detJ_p |B_p|^2 -
+  !> |b|^2 / V (L is positive semi-definite; for a cube tr L is 3.5 times lambda_max).
+  subroutine deviatoric_mode_trace_bound(nel, total, bx, by, bz, volume, bound)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: total(block_size)
+    real(wp), intent(in) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8), volume(block_size)
+    real(wp), intent(out) :: bound(block_size)
+    real(wp) :: norm
+    integer :: node, i
+    do i = 1, nel
+      norm = 0.0_wp
+      do node = 1, 8
+        norm = norm + bx(i, node)**2 + by(i, node)**2 + bz(i, node)**2
+      end do
+      bound(i) = max(total(i) - norm/sign(max(abs(volume(i)), tiny(1.0_wp)), volume(i)), 0.0_wp)
+    end do
+  end subroutine deviatoric_mode_trace_bound
 end module hex8_full

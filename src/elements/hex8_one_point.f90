@@ -546,14 +546,20 @@ contains
     integer, parameter :: pair_other(10) = [1, 2, 3, 4, 2, 3, 4, 3, 4, 4]
     real(wp) :: gram(block_size, 10), stiffness
     integer :: i, node, pair
-    do pair = 1, 10
-      gram(1:nel, pair) = 0.0_wp
-      do node = 1, 8
-        do i = 1, nel
-          gram(i, pair) = gram(i, pair) + gamma(i, node, pair_mode(pair))*gamma(i, node, pair_other(pair))
+    if (hourglass_type == 1) then
+      ! the base vectors themselves: orthogonal, |h|^2 = 8
+      gram(1:nel, :) = 0.0_wp
+      gram(1:nel, [1, 5, 8, 10]) = 8.0_wp
+    else
+      do pair = 1, 10
+        gram(1:nel, pair) = 0.0_wp
+        do node = 1, 8
+          do i = 1, nel
+            gram(i, pair) = gram(i, pair) + gamma(i, node, pair_mode(pair))*gamma(i, node, pair_other(pair))
+          end do
         end do
       end do
-    end do
+    end if
     do i = 1, nel
       ! largest absolute row sum of [g1 g2 g3 g4; g2 g5 g6 g7; g3 g6 g8 g9; g4 g7 g9 g10]
       gram(i, 1) = max(abs(gram(i, 1)) + abs(gram(i, 2)) + abs(gram(i, 3)) + abs(gram(i, 4)), &
@@ -582,26 +588,19 @@ contains
 
   !> IHQ 1 takes gamma_alpha = h_alpha, which is orthogonal to the strain modes b only on
   !> parallelepipeds. An upper bound on cos^2 of the largest principal angle between span{b_x,
-  !> b_y, b_z} and span{h_alpha} (orthogonal, |h|^2 = 8): with B = b^T b (3 x 3) and
-  !> F = (h^T b)^T (h^T b) / 8, cos^2 = lambda_max(B^-1 F) <= tr(B^-1 F), capped at 1.
-  subroutine standard_hourglass_overlap(nel, bx, by, bz, overlap)
+  !> b_y, b_z} and span{h_alpha} (orthogonal, |h|^2 = 8): with G = b^T b / V^2 (3 x 3, packed
+  !> 11 22 33 12 23 13 as hex8_gradient_invariants returns it) and F = (h^T b)^T (h^T b) / (8 V^2),
+  !> cos^2 = lambda_max(G^-1 F) <= tr(G^-1 F), capped at 1.
+  subroutine standard_hourglass_overlap(nel, bx, by, bz, volume, g, overlap)
     integer, intent(in) :: nel
-    real(wp), intent(in) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8)
+    real(wp), intent(in) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8), volume(block_size)
+    real(wp), intent(in) :: g(block_size, 6)
     real(wp), intent(out) :: overlap(block_size)
-    real(wp) :: b11, b22, b33, b12, b23, b13, f11, f22, f33, f12, f23, f13, hx, hy, hz
-    real(wp) :: c11, c22, c33, c12, c23, c13, determinant, numerator
+    real(wp) :: f11, f22, f33, f12, f23, f13, hx, hy, hz
+    real(wp) :: c11, c22, c33, c12, c23, c13, determinant, numerator, scale
     integer :: i, node, mode
     do i = 1, nel
-      b11 = 0.0_wp; b22 = 0.0_wp; b33 = 0.0_wp; b12 = 0.0_wp; b23 = 0.0_wp; b13 = 0.0_wp
       f11 = 0.0_wp; f22 = 0.0_wp; f33 = 0.0_wp; f12 = 0.0_wp; f23 = 0.0_wp; f13 = 0.0_wp
-      do node = 1, 8
-        b11 = b11 + bx(i, node)**2
-        b22 = b22 + by(i, node)**2
-        b33 = b33 + bz(i, node)**2
-        b12 = b12 + bx(i, node)*by(i, node)
-        b23 = b23 + by(i, node)*bz(i, node)
-        b13 = b13 + bx(i, node)*bz(i, node)
-      end do
       do mode = 1, 4
         hx = 0.0_wp
         hy = 0.0_wp
@@ -618,16 +617,17 @@ contains
         f23 = f23 + hy*hz
         f13 = f13 + hx*hz
       end do
-      ! tr(B^-1 F) = tr(cof(B) F) / det B; the cofactor matrix of a symmetric B is symmetric
-      c11 = b22*b33 - b23**2
-      c22 = b11*b33 - b13**2
-      c33 = b11*b22 - b12**2
-      c12 = b13*b23 - b12*b33
-      c23 = b12*b13 - b11*b23
-      c13 = b12*b23 - b13*b22
-      determinant = b11*c11 + b12*c12 + b13*c13
-      numerator = max(0.125_wp*(c11*f11 + c22*f22 + c33*f33 + 2.0_wp*(c12*f12 + c23*f23 + c13*f13)), 0.0_wp)
-      ! a degenerate element (det B ~ 0) gets 1, without dividing by zero
+      ! tr(G^-1 F) = tr(cof(G) F) / det G; the cofactor matrix of a symmetric G is symmetric
+      c11 = g(i, 2)*g(i, 3) - g(i, 5)**2
+      c22 = g(i, 1)*g(i, 3) - g(i, 6)**2
+      c33 = g(i, 1)*g(i, 2) - g(i, 4)**2
+      c12 = g(i, 6)*g(i, 5) - g(i, 4)*g(i, 3)
+      c23 = g(i, 4)*g(i, 6) - g(i, 1)*g(i, 5)
+      c13 = g(i, 4)*g(i, 5) - g(i, 6)*g(i, 2)
+      determinant = g(i, 1)*c11 + g(i, 4)*c12 + g(i, 6)*c13
+      scale = 0.125_wp/max(volume(i)**2, tiny(1.0_wp))
+      numerator = max(scale*(c11*f11 + c22*f22 + c33*f33 + 2.0_wp*(c12*f12 + c23*f23 + c13*f13)), 0.0_wp)
+      ! a degenerate element (det G ~ 0) gets 1, without dividing by zero
       overlap(i) = min(1.0_wp, numerator/max(determinant, numerator, tiny(1.0_wp)))
     end do
   end subroutine standard_hourglass_overlap

@@ -42,7 +42,8 @@ module solid_block
                             hourglass_stiffness_forces, one_point_force_powers, previous_hourglass_velocities, &
                             hourglass_power, hourglass_mode_bounds, standard_hourglass_overlap
   use hex8_full, only: point_velocity_gradient, add_deviatoric_point_forces, add_mean_stress_forces, &
-                       add_point_stress_power, corner_force_power, add_point_gram, deviatoric_mode_bound
+                       add_point_stress_power, corner_force_power, add_point_gram, deviatoric_mode_bound, &
+                       add_point_gradient_norm, deviatoric_mode_trace_bound
   use element_work, only: add_force_work, smallest_time_step
   use element_time_step, only: bulk_viscosity_pressure, solid_element_time_steps, eigenvalue_time_steps
   implicit none
@@ -260,7 +261,11 @@ contains
       gram(1:nel, :) = 0.0_wp
       do point = 1, 8
         call hex8_point_derivatives(nel, natural(:, :, point), x, y, z, dndx, dndy, dndz, determinant)
-        call add_point_gram(nel, determinant, dndx, dndy, dndz, gram)
+        if (use_gram(material)) then
+          call add_point_gram(nel, determinant, dndx, dndy, dndz, gram)
+        else
+          call add_point_gradient_norm(nel, determinant, dndx, dndy, dndz, gram(:, 1))
+        end if
       end do
       call deviatoric_modes(block, material, nel, gram, bx, by, bz, volume, mode_frequency_squared, mode_damping)
     else
@@ -293,16 +298,18 @@ contains
     real(wp), intent(in) :: volumetric_rate(block_size)
     real(wp), intent(in) :: mode_frequency_squared(block_size), mode_damping(block_size)
     real(wp), intent(inout) :: element_time_step(block_size)
-    real(wp) :: area(block_size), trace_g(block_size), largest_g(block_size), overlap(block_size)
-    real(wp) :: lame_bound, shear_bound
+    real(wp) :: area(block_size), g(block_size, 6), trace_g(block_size), largest_g(block_size)
+    real(wp) :: overlap(block_size), lame_bound, shear_bound
+    logical :: standard
     call hex8_largest_face_area(nel, x, y, z, area)
     call solid_element_time_steps(nel, block%bulk_quadratic, block%bulk_linear, volume, area, wave_modulus, &
                                   block%density, volumetric_rate, element_time_step)
-    call hex8_gradient_invariants(nel, x, y, z, bx, by, bz, volume, trace_g, largest_g, overlap)
+    standard = block%formulation == formulation_one_point .and. block%hourglass_type == 1
+    call hex8_gradient_invariants(nel, x, y, z, bx, by, bz, volume, g, trace_g, largest_g, overlap, &
+                                  with_overlap=.not. standard)
     ! IHQ 1's hourglass vectors are the plain base vectors, orthogonal to the strain modes only
     ! on parallelepipeds
-    if (block%formulation == formulation_one_point .and. block%hourglass_type == 1) &
-      call standard_hourglass_overlap(nel, bx, by, bz, overlap)
+    if (standard) call standard_hourglass_overlap(nel, bx, by, bz, volume, g, overlap)
     call material_stiffness_bounds(material, lame_bound, shear_bound)
     call eigenvalue_time_steps(nel, block%bulk_quadratic, block%bulk_linear, lame_bound, shear_bound, &
                                block%reference_volume, volume, block%density, sound_speed, viscosity_length, &
@@ -311,7 +318,9 @@ contains
   end subroutine stable_time_steps
 
   !> ELFORM 2: frequency bound of the deviatoric modes beyond the one-point element's,
-  !> 2 mu lambda_max(L) / m (hex8_full, deviatoric_mode_bound); they have no damping.
+  !> 2 mu lambda_max(L) / m (hex8_full); they have no damping. `gram` holds the points' Gram
+  !> matrix (use_gram, deviatoric_mode_bound) or, in its first column, its trace
+  !> (deviatoric_mode_trace_bound).
   subroutine deviatoric_modes(block, material, nel, gram, bx, by, bz, volume, mode_frequency_squared, mode_damping)
     type(solid_block_t), intent(in) :: block
     type(material_t), intent(in) :: material
@@ -319,13 +328,36 @@ contains
     real(wp), intent(in) :: gram(block_size, 36)
     real(wp), intent(in) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8), volume(block_size)
     real(wp), intent(out) :: mode_frequency_squared(block_size), mode_damping(block_size)
-    real(wp) :: bound(block_size), corner_mass(block_size), lame_bound, shear_bound
-    call deviatoric_mode_bound(nel, gram, bx, by, bz, volume, bound)
-    call material_stiffness_bounds(material, lame_bound, shear_bound)
+    real(wp) :: bound(block_size), corner_mass(block_size)
+    if (use_gram(material)) then
+      call deviatoric_mode_bound(nel, gram, bx, by, bz, volume, bound)
+    else
+      call deviatoric_mode_trace_bound(nel, gram(:, 1), bx, by, bz, volume, bound)
+    end if
     corner_mass = corner_mass_of(block, nel)
-    mode_frequency_squared(1:nel) = 2.0_wp*shear_bound*bound(1:nel)/max(corner_mass(1:nel), tiny(1.0_wp))
+    mode_frequency_squared(1:nel) = 2.0_wp*shear_bound_of(material)*bound(1:nel) &
+                                    /max(corner_mass(1:nel), tiny(1.0_wp))
     mode_damping(1:nel) = 0.0_wp
   end subroutine deviatoric_modes
+
+  !> ELFORM 2 computes the Gram matrix of its points' gradients (36 entries, a quarter of the
+  !> element's cost) only where its extra deviatoric modes can set the step: when lambda < mu
+  !> (nu < 1/4 for an elastic material). Above, the volumetric modes outrun them (a cube:
+  !> omega^2 = 4 (3 lambda + 2 mu) / (rho L^2) against 8 mu / (rho L^2) exactly and 18.7 mu /
+  !> (rho L^2) by the trace), and the trace bound, cheap and safe, does.
+  logical function use_gram(material)
+    type(material_t), intent(in) :: material
+    real(wp) :: lame_bound, shear_bound
+    call material_stiffness_bounds(material, lame_bound, shear_bound)
+    use_gram = lame_bound < shear_bound
+  end function use_gram
+
+  !> mu of material_stiffness_bounds.
+  real(wp) function shear_bound_of(material)
+    type(material_t), intent(in) :: material
+    real(wp) :: lame_bound
+    call material_stiffness_bounds(material, lame_bound, shear_bound_of)
+  end function shear_bound_of
 
   !> Lumped corner mass rho V0 / 8 of lanes 1..nel (the rest zero).
   pure function corner_mass_of(block, nel) result(corner_mass)
@@ -520,6 +552,7 @@ contains
     real(wp) :: old_power(block_size), new_power(block_size), trace_integral(block_size)
     real(wp) :: gram(block_size, 36), mode_frequency_squared(block_size), mode_damping(block_size)
     real(wp) :: viscosity_length(block_size)
+    logical :: gram_wanted
     integer :: nel, i, point
 
     nel = block%element_count
@@ -569,7 +602,12 @@ contains
     by(1:nel, :) = 0.0_wp
     bz(1:nel, :) = 0.0_wp
     mean_stress(1:nel) = 0.0_wp
-    gram(1:nel, :) = 0.0_wp
+    gram_wanted = use_gram(material)
+    if (gram_wanted) then
+      gram(1:nel, :) = 0.0_wp
+    else
+      gram(1:nel, 1) = 0.0_wp
+    end if
     do point = 1, 8
       call deformation_increments(nel, dt, gradient(:, :, point), volumetric_rate, strain_increment, &
                                   spin_increment)
@@ -582,7 +620,11 @@ contains
                                   block%point_volume(:, point))
       call add_deviatoric_point_forces(nel, block%point_volume(:, point), dndx, dndy, dndz, &
                                        block%stress(:, :, point), corner_force, mean_stress, bx, by, bz)
-      call add_point_gram(nel, block%point_volume(:, point), dndx, dndy, dndz, gram)
+      if (gram_wanted) then
+        call add_point_gram(nel, block%point_volume(:, point), dndx, dndy, dndz, gram)
+      else
+        call add_point_gradient_norm(nel, block%point_volume(:, point), dndx, dndy, dndz, gram(:, 1))
+      end if
     end do
 
     volume(1:nel) = 0.0_wp

@@ -315,7 +315,7 @@ contains
     call check(suite, "unit cube: unused lanes get a huge step", all(time_step(2:) == huge(1.0_wp)))
   end subroutine test_unit_cube
 
-  !> Upper bounds within 3% on the largest eigenvalue of symmetric 3 x 3 matrices with known
+  !> Upper bounds within 0.5% on the largest eigenvalue of symmetric 3 x 3 matrices with known
   !> eigenvalues, turned by a fixed rotation: distinct, two largest equal, all equal, rank one.
   subroutine test_largest_eigenvalue_bounds()
     real(wp), parameter :: eigenvalues(3, 5) = reshape([3.0_wp, 2.0_wp, 1.0_wp, 2.0_wp, 2.0_wp, 0.5_wp, &
@@ -332,7 +332,7 @@ contains
     call largest_eigenvalue_bounds(5, packed, bound)
     do k = 1, 5
       call check(suite, "largest eigenvalue bound: at or above it", bound(k) >= maxval(eigenvalues(:, k)))
-      call check(suite, "largest eigenvalue bound: within 3%", bound(k) <= 1.03_wp*maxval(eigenvalues(:, k)))
+      call check(suite, "largest eigenvalue bound: within 0.5%", bound(k) <= 1.005_wp*maxval(eigenvalues(:, k)))
     end do
   end subroutine test_largest_eigenvalue_bounds
 
@@ -352,7 +352,7 @@ contains
   subroutine test_gradient_invariants()
     real(wp) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
     real(wp) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8), volume(block_size)
-    real(wp) :: trace_g(block_size), largest_g(block_size), overlap(block_size)
+    real(wp) :: g(block_size, 6), trace_g(block_size), largest_g(block_size), overlap(block_size)
     integer :: node
     x = 0.0_wp
     y = 0.0_wp
@@ -365,10 +365,11 @@ contains
     x(2, 7) = 1.3_wp
     y(2, 7) = 2.2_wp
     call hex8_volume_derivatives(2, x, y, z, bx, by, bz, volume)
-    call hex8_gradient_invariants(2, x, y, z, bx, by, bz, volume, trace_g, largest_g, overlap)
+    call hex8_gradient_invariants(2, x, y, z, bx, by, bz, volume, g, trace_g, largest_g, overlap, .true.)
     call check_close(suite, "gradient invariants: brick tr G", trace_g(1), 0.5_wp*(1.0_wp + 0.25_wp + 0.0625_wp), &
                      rel=1e-12_wp)
-    call check_close(suite, "gradient invariants: brick lambda_max(G)", largest_g(1), 0.5_wp, rel=1e-5_wp)
+    call check_close(suite, "gradient invariants: brick lambda_max(G)", largest_g(1), 0.5_wp, rel=5e-3_wp)
+    call check(suite, "gradient invariants: brick lambda_max(G) bound", largest_g(1) >= 0.5_wp)
     call check(suite, "gradient invariants: brick has no overlap", abs(overlap(1)) < 1e-12_wp)
     call check(suite, "gradient invariants: distorted element overlaps", overlap(2) > 1e-4_wp .and. overlap(2) < 1.0_wp)
   end subroutine test_gradient_invariants
