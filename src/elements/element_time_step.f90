@@ -83,7 +83,7 @@ contains
   !>   dilatation, q = eta tr D with eta = rho l (Q2 c + Q1^2 l |tr D|) in compression:
   !>   beta_U = 8 tr G l (Q2 c + Q1 l |tr D|) (the quadratic term with Q1 as LS-DYNA's rule
   !>   has it, not with the Q1^2 of the pressure: it acts in shocks only, and with Q1^2 the
-  !>   Taylor bar's step at impact fell a further 18% where LS-DYNA's rule ran stably);
+  !>   Taylor bar's step at impact was 6% lower still, where LS-DYNA's rule ran stably);
   !> - W, the other modes (hourglass modes of ELFORM 1, extra deviatoric modes of ELFORM 2):
   !>   omega_W^2 and beta_W from the caller.
   !> With cos^2 theta <= `overlap` (r = sqrt(overlap)) between U and W, the largest eigenvalue of

@@ -701,7 +701,9 @@ contains
     real(wp), intent(out) :: density(block_size), sound_speed(block_size)
     integer :: i
     do i = 1, nel
-      density(i) = block_density(i)*reference_volume(i)/max(volume(i), tiny(1.0_wp))
+      ! an inverted or flattened element (the solver stops) gets at most 1e12 times its density:
+      ! with tiny(1.0) here the bulk viscosity of the last cycle overflowed in the checked build
+      density(i) = block_density(i)*reference_volume(i)/max(volume(i), 1.0e-12_wp*reference_volume(i), tiny(1.0_wp))
       sound_speed(i) = sqrt(max(wave_modulus(i), 0.0_wp)/max(block_density(i), tiny(1.0_wp)))
     end do
   end subroutine current_density_and_speed
