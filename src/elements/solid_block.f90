@@ -278,24 +278,22 @@ contains
                                  viscosity_scale, hourglass_volume, gradient_norm_squared, gamma, &
                                  corner_mass_of(block, nel), mode_frequency_squared, mode_damping)
     end if
-    call stable_time_steps(block, material, nel, x, y, z, bx, by, bz, volume, wave_modulus, sound_speed, rest, &
-                           rest, mode_frequency_squared, mode_damping, element_time_step)
+    call stable_time_steps(block, material, nel, x, y, z, bx, by, bz, volume, wave_modulus, rest, &
+                           mode_frequency_squared, mode_damping, element_time_step)
   end subroutine solid_block_time_steps
 
   !> Stable step of each lane (no TSSFAC) on the configuration x: the smaller of LS-DYNA's rule
   !> and the element's eigenvalue bound (element_time_step), given the frequency and damping
   !> bounds of the formulation's other modes (hourglass modes of ELFORM 1, extra deviatoric
   !> modes of ELFORM 2). Lanes 1..nel of element_time_step are overwritten.
-  subroutine stable_time_steps(block, material, nel, x, y, z, bx, by, bz, volume, wave_modulus, sound_speed, &
-                               viscosity_length, volumetric_rate, mode_frequency_squared, mode_damping, &
-                               element_time_step)
+  subroutine stable_time_steps(block, material, nel, x, y, z, bx, by, bz, volume, wave_modulus, volumetric_rate, &
+                               mode_frequency_squared, mode_damping, element_time_step)
     type(solid_block_t), intent(in) :: block
     type(material_t), intent(in) :: material
     integer, intent(in) :: nel
     real(wp), intent(in) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
     real(wp), intent(in) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8), volume(block_size)
-    real(wp), intent(in) :: wave_modulus(block_size), sound_speed(block_size), viscosity_length(block_size)
-    real(wp), intent(in) :: volumetric_rate(block_size)
+    real(wp), intent(in) :: wave_modulus(block_size), volumetric_rate(block_size)
     real(wp), intent(in) :: mode_frequency_squared(block_size), mode_damping(block_size)
     real(wp), intent(inout) :: element_time_step(block_size)
     real(wp) :: area(block_size), g(block_size, 6), trace_g(block_size), largest_g(block_size)
@@ -312,9 +310,8 @@ contains
     if (standard) call standard_hourglass_overlap(nel, bx, by, bz, volume, g, overlap)
     call material_stiffness_bounds(material, lame_bound, shear_bound)
     call eigenvalue_time_steps(nel, block%bulk_quadratic, block%bulk_linear, lame_bound, shear_bound, &
-                               block%reference_volume, volume, block%density, sound_speed, viscosity_length, &
-                               volumetric_rate, trace_g, largest_g, overlap, mode_frequency_squared, mode_damping, &
-                               element_time_step)
+                               block%reference_volume, volume, block%density, volumetric_rate, trace_g, largest_g, &
+                               overlap, mode_frequency_squared, mode_damping, element_time_step)
   end subroutine stable_time_steps
 
   !> ELFORM 2: frequency bound of the deviatoric modes beyond the one-point element's,
@@ -377,8 +374,9 @@ contains
   !> bulk viscosity of the element's oscillation, on in compression and off in expansion, would
   !> alternate from cycle to cycle, and a step that alternates at the rate of the highest mode
   !> pumps energy into it: a single hexahedron at nu = 0 went unstable that way at TSSFAC 0.9
-  !> with a 17% alternation; over three cycles the smallest step holds still while the element
-  !> rings). inverted_element: 0, or the model solid index of the
+  !> when the bound counted the element's full bulk damping, a 17% alternation; over three
+  !> cycles the smallest step holds still while the element rings). inverted_element: 0, or the
+  !> model solid index of the
   !> first element whose volume (ELFORM 2: any Gauss point Jacobian) is <= 0; the state of the
   !> block is then not meaningful and the solver should stop. Allocates nothing.
   subroutine compute_solid_block(block, material, coordinates, velocities, dt, corner_force, &
@@ -455,7 +453,7 @@ contains
     real(wp) :: old_power(block_size), new_power(block_size)
     real(wp) :: old_hourglass_power(block_size), new_hourglass_power(block_size)
     real(wp) :: mode_frequency_squared(block_size), mode_damping(block_size)
-    real(wp) :: viscosity_length(block_size), viscosity_scale(block_size)
+    real(wp) :: viscosity_scale(block_size)
     integer :: nel, i
 
     nel = block%element_count
@@ -484,7 +482,7 @@ contains
     call current_density_and_speed(nel, block%density, block%reference_volume, volume, wave_modulus, &
                                    density, sound_speed)
     call bulk_viscosity_pressure(nel, block%bulk_quadratic, block%bulk_linear, density, sound_speed, volume, &
-                                 volumetric_rate, bulk_viscosity, viscosity_length)
+                                 volumetric_rate, bulk_viscosity)
     if (dt <= 0.0_wp) bulk_viscosity(1:nel) = 0.0_wp ! no step: no viscous forces (module comment)
 
     ! Power of the stress forces of the previous call and of this one (module comment).
@@ -521,8 +519,8 @@ contains
     call hourglass_mode_bounds(nel, block%hourglass_type, block%hourglass_coefficient, wave_modulus, &
                                viscosity_scale, hourglass_volume, gradient_norm_squared, gamma, &
                                corner_mass_of(block, nel), mode_frequency_squared, mode_damping)
-    call stable_time_steps(block, material, nel, x, y, z, bx, by, bz, volume, wave_modulus, sound_speed, &
-                           viscosity_length, volumetric_rate, mode_frequency_squared, mode_damping, element_time_step)
+    call stable_time_steps(block, material, nel, x, y, z, bx, by, bz, volume, wave_modulus, volumetric_rate, &
+                           mode_frequency_squared, mode_damping, element_time_step)
     block%volume(1:nel) = volume(1:nel)
     block%point_volume(1:nel, 1) = volume(1:nel)
     block%bulk_viscosity(1:nel) = bulk_viscosity(1:nel)
@@ -551,7 +549,6 @@ contains
     real(wp) :: bulk_viscosity(block_size), mean_stress(block_size)
     real(wp) :: old_power(block_size), new_power(block_size), trace_integral(block_size)
     real(wp) :: gram(block_size, 36), mode_frequency_squared(block_size), mode_damping(block_size)
-    real(wp) :: viscosity_length(block_size)
     logical :: gram_wanted
     integer :: nel, i, point
 
@@ -636,7 +633,7 @@ contains
     call current_density_and_speed(nel, block%density, block%reference_volume, volume, wave_modulus, &
                                    density, sound_speed)
     call bulk_viscosity_pressure(nel, block%bulk_quadratic, block%bulk_linear, density, sound_speed, volume, &
-                                 volumetric_rate, bulk_viscosity, viscosity_length)
+                                 volumetric_rate, bulk_viscosity)
     if (dt <= 0.0_wp) bulk_viscosity(1:nel) = 0.0_wp ! no step: no viscous forces (module comment)
     do i = 1, nel
       mean_stress(i) = mean_stress(i)/sign(max(abs(volume(i)), tiny(1.0_wp)), volume(i)) - bulk_viscosity(i)
@@ -649,8 +646,8 @@ contains
                         block%internal_energy)
 
     call deviatoric_modes(block, material, nel, gram, bx, by, bz, volume, mode_frequency_squared, mode_damping)
-    call stable_time_steps(block, material, nel, x, y, z, bx, by, bz, volume, wave_modulus, sound_speed, &
-                           viscosity_length, volumetric_rate, mode_frequency_squared, mode_damping, element_time_step)
+    call stable_time_steps(block, material, nel, x, y, z, bx, by, bz, volume, wave_modulus, volumetric_rate, &
+                           mode_frequency_squared, mode_damping, element_time_step)
     block%volume(1:nel) = volume(1:nel)
     block%bulk_viscosity(1:nel) = bulk_viscosity(1:nel)
   end subroutine compute_selective_reduced

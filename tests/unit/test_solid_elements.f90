@@ -768,15 +768,15 @@ contains
                  -expected_q*trace > 0.0_wp .and. expected_energy > 0.5_wp*dt*volume*sum(blocks(1)%stress(1, 1:3, 1)) &
                  *(-rate/(1.0_wp - 0.5_wp*rate*dt)))
       ! time step with the bulk viscosity: LS-DYNA's L / (Q + sqrt(Q^2 + c^2)), Q = Q2 c +
-      ! Q1 L |trD|, or the element's bound if smaller: on a cube (side L = l = V^(1/3)) the
-      ! volumetric mode has omega^2 = 4 (V / V0) (3 lambda + 2 mu) / (rho0 L^2) and the bulk
-      ! viscosity damps it at beta = 12 (Q2 c + Q1 L |trD|) / L: 4 / (beta + sqrt(beta^2 +
+      ! Q1 L |trD|, or the element's bound if smaller: on a cube (side L) the volumetric mode
+      ! has omega^2 = 4 (V / V0) (3 lambda + 2 mu) / (rho0 L^2), damped as LS-DYNA's rule
+      ! damps a row of elements, beta = 2 Q2 omega + 4 Q1 |trD|: 4 / (beta + sqrt(beta^2 +
       ! 4 omega^2)); the hourglass (IHQ 3) and extra deviatoric (ELFORM 2) modes are slower
       characteristic = volume/(volume**(2.0_wp/3.0_wp))
       viscous = q2*speed + q1*characteristic*abs(trace)
       frequency_squared = 4.0_wp*(volume/side**3)*(3.0_wp*lame_lambda() + 2.0_wp*lame_mu()) &
                           /(density*characteristic**2)
-      damping = 12.0_wp*viscous/characteristic
+      damping = 2.0_wp*q2*sqrt(frequency_squared) + 4.0_wp*q1*abs(trace)
       call check_close(suite, trim(label)//": time step with bulk viscosity", critical, &
                        min(characteristic/(viscous + sqrt(viscous**2 + speed**2)), &
                            4.0_wp/(damping + sqrt(damping**2 + 4.0_wp*frequency_squared))), rel=1e-6_wp)
