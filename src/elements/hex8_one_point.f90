@@ -314,7 +314,7 @@ contains
         do node = 1, 8
           norm = norm + bx(i, node)**2 + by(i, node)**2 + bz(i, node)**2
         end do
-        inverse_volume(i) = 1.0_wp/sign(max(abs(volume(i)), 1.0e-12_wp*norm**0.75_wp, tiny(1.0_wp)), volume(i))
+        inverse_volume(i) = 1.0_wp/sign(max(abs(volume(i)), 1.0e-12_wp*sqrt(norm*sqrt(norm)), tiny(1.0_wp)), volume(i))
       end do
       do mode = 1, 4
         do i = 1, nel
@@ -366,7 +366,7 @@ contains
     real(wp) :: inverse(block_size, 9)
     real(wp) :: j11, j12, j13, j21, j22, j23, j31, j32, j33
     real(wp) :: i11, i12, i13, i21, i22, i23, i31, i32, i33
-    real(wp) :: determinant, scale, px, py, pz, c1, c2, c3
+    real(wp) :: determinant, scale, px, py, pz, c1, c2, c3, size
     integer :: node, mode, i
 
     do i = 1, nel
@@ -401,10 +401,10 @@ contains
       gradient_norm_squared(i) = (i11**2 + i12**2 + i13**2 + i21**2 + i22**2 + i23**2 + i31**2 + i32**2 &
                                   + i33**2)/512.0_wp
       ! J^-1 / 8 = (8 J)^-1, kept finite for inverted elements (reported by the caller)
-      ! (a flattened element keeps finite shape vectors: det(8 J) ~ |8 J|^3, floored at 1e-12 of it)
-      scale = 1.0_wp/sign(max(abs(determinant), 1.0e-12_wp*(j11**2 + j12**2 + j13**2 + j21**2 + j22**2 + j23**2 &
-                                                              + j31**2 + j32**2 + j33**2)**1.5_wp, tiny(1.0_wp)), &
-                          determinant)
+      ! (a flattened element keeps finite shape vectors: det(8 J) ~ (largest |8 J_ka|)^3, floored
+      ! at 1e-12 of it)
+      size = max(abs(j11), abs(j12), abs(j13), abs(j21), abs(j22), abs(j23), abs(j31), abs(j32), abs(j33))
+      scale = 1.0_wp/sign(max(abs(determinant), 1.0e-12_wp*size**3, tiny(1.0_wp)), determinant)
       inverse(i, 1) = i11*scale
       inverse(i, 2) = i12*scale
       inverse(i, 3) = i13*scale
@@ -572,8 +572,8 @@ contains
       do i = 1, nel
         ! (a flattened element keeps a finite, huge stiffness: |V| is of order |b|^(3/2))
         stiffness = coefficient*wave_modulus(i)*gradient_norm_squared(i) &
-                    /(3.0_wp*max(abs(hourglass_volume(i)), 1.0e-12_wp*gradient_norm_squared(i)**0.75_wp, &
-                                 tiny(1.0_wp)))
+                    /(3.0_wp*max(abs(hourglass_volume(i)), &
+                                 1.0e-12_wp*sqrt(gradient_norm_squared(i)*sqrt(gradient_norm_squared(i))), tiny(1.0_wp)))
         ! (capped so that an inverted element, which stops the run, cannot overflow)
         frequency_squared(i) = min(stiffness, 1.0e150_wp)*min(gram(i, 1), 1.0e150_wp)
         damping(i) = 0.0_wp
