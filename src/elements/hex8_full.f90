@@ -14,7 +14,8 @@ module hex8_full
   private
 
   public :: point_velocity_gradient, add_deviatoric_point_forces, add_mean_stress_forces
-  public :: add_point_stress_power, corner_force_power
+  public :: add_point_stress_power, corner_force_power, add_point_gram, deviatoric_mode_bound
+  public :: add_point_gradient_norm, deviatoric_mode_trace_bound
 
 contains
 
@@ -156,4 +157,88 @@ contains
       power(i) = sum_of_products
     end do
   end subroutine corner_force_power
+
+  !> Accumulates the 8 x 8 Gram matrix sum_p detJ_p sum_k dN_I/dx_k(p) dN_J/dx_k(p) of the
+  !> points (upper triangle packed row by row, 36 entries; start from zero), for
+  !> deviatoric_mode_bound.
+  subroutine add_point_gram(nel, determinant, dndx, dndy, dndz, gram)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: determinant(block_size)
+    real(wp), intent(in) :: dndx(block_size, 8), dndy(block_size, 8), dndz(block_size, 8)
+    real(wp), intent(inout) :: gram(block_size, 36)
+    integer :: first, second, k, i
+    k = 0
+    do first = 1, 8
+      do second = first, 8
+        k = k + 1
+        do i = 1, nel
+          gram(i, k) = gram(i, k) + determinant(i)*(dndx(i, first)*dndx(i, second) + dndy(i, first)*dndy(i, second) &
+                                                    + dndz(i, first)*dndz(i, second))
+        end do
+      end do
+    end do
+  end subroutine add_point_gram
+
+  !> For the stable step (element_time_step): a bound on lambda_max of the element's extra
+  !> deviatoric stiffness over the one-point element. With B_p the point gradients and
+  !> b = sum_p detJ_p B_p, the deviatoric energy splits exactly into that of the mean strain and
+  !> 2 mu sum_p detJ_p |dev sym(sum_I u_I (x) (B_pI - b_I / V))|^2, at most 2 mu u_k^T L u_k
+  !> summed over the directions k, L = gram - b b^T / V (the cross terms vanish since
+  !> sum_p detJ_p (B_p - b / V) = 0). Returns the largest absolute row sum of L (>= lambda_max).
+  subroutine deviatoric_mode_bound(nel, gram, bx, by, bz, volume, bound)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: gram(block_size, 36)
+    real(wp), intent(in) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8), volume(block_size)
+    real(wp), intent(out) :: bound(block_size)
+    real(wp) :: row(8), entry, inverse_volume
+    integer :: first, second, k, i
+    do i = 1, nel
+      inverse_volume = 1.0_wp/sign(max(abs(volume(i)), tiny(1.0_wp)), volume(i))
+      row = 0.0_wp
+      k = 0
+      do first = 1, 8
+        do second = first, 8
+          k = k + 1
+          entry = abs(gram(i, k) - (bx(i, first)*bx(i, second) + by(i, first)*by(i, second) &
+                                    + bz(i, first)*bz(i, second))*inverse_volume)
+          row(first) = row(first) + entry
+          if (second /= first) row(second) = row(second) + entry
+        end do
+      end do
+      bound(i) = maxval(row)
+    end do
+  end subroutine deviatoric_mode_bound
+
+  !> Accumulates sum_p detJ_p sum_I |dN_I/dx(p)|^2 (start from zero), the trace of the Gram
+  !> matrix of add_point_gram, for deviatoric_mode_trace_bound.
+  subroutine add_point_gradient_norm(nel, determinant, dndx, dndy, dndz, total)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: determinant(block_size)
+    real(wp), intent(in) :: dndx(block_size, 8), dndy(block_size, 8), dndz(block_size, 8)
+    real(wp), intent(inout) :: total(block_size)
+    integer :: node, i
+    do node = 1, 8
+      do i = 1, nel
+        total(i) = total(i) + determinant(i)*(dndx(i, node)**2 + dndy(i, node)**2 + dndz(i, node)**2)
+      end do
+    end do
+  end subroutine add_point_gradient_norm
+
+  !> The cheaper bound of deviatoric_mode_bound: lambda_max(L) <= tr L = sum_p detJ_p |B_p|^2 -
+  !> |b|^2 / V (L is positive semi-definite; for a cube tr L is 3.5 times lambda_max).
+  subroutine deviatoric_mode_trace_bound(nel, total, bx, by, bz, volume, bound)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: total(block_size)
+    real(wp), intent(in) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8), volume(block_size)
+    real(wp), intent(out) :: bound(block_size)
+    real(wp) :: norm
+    integer :: node, i
+    do i = 1, nel
+      norm = 0.0_wp
+      do node = 1, 8
+        norm = norm + bx(i, node)**2 + by(i, node)**2 + bz(i, node)**2
+      end do
+      bound(i) = max(total(i) - norm/sign(max(abs(volume(i)), tiny(1.0_wp)), volume(i)), 0.0_wp)
+    end do
+  end subroutine deviatoric_mode_trace_bound
 end module hex8_full

@@ -17,6 +17,7 @@ module hex8_geometry
 
   public :: hex8_volume_derivatives, hex8_volume, hex8_velocity_gradient, hex8_largest_face_area
   public :: hex8_gauss_natural_derivatives, hex8_point_derivatives, deformation_increments
+  public :: hex8_gradient_invariants, largest_eigenvalue_bounds
 
   !> Natural coordinates of the eight nodes.
   real(wp), parameter, public :: node_xi(8) = [-1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp]
@@ -207,6 +208,119 @@ contains
     end do
   end subroutine hex8_largest_face_area
 
+  !> What the stable step of a hexahedron needs from its geometry (element_time_step): with the
+  !> mean gradients B_I = b_I / V (b the exact volume derivatives) and G = sum_I B_I B_I^T,
+  !> - g = G (packed 11 22 33 12 23 13), trace_g = tr G and largest_g >= lambda_max(G)
+  !>   (largest_eigenvalue_bounds);
+  !> - overlap = an upper bound on cos^2 of the largest principal angle between span{b_x, b_y,
+  !>   b_z} (the one-point element's strain modes, as vectors over the 8 nodes) and the space of
+  !>   nodal fields orthogonal to 1, x, y, z (where the hourglass modes of IHQ 2-5 and the
+  !>   extra deviatoric modes of ELFORM 2 lie): with S = sum_I x~_I x~_I^T (x~ about the
+  !>   centroid), sum_I x~_kI b_jI = V delta_jk gives cos^2 = 1 - 1 / lambda_max(S G), and
+  !>   since every eigenvalue of S G is >= 1, lambda_max(S G) <= tr(S G) - 2. It is 0 for a
+  !>   parallelepiped (G = S^-1), where the two kinds of modes are orthogonal. Only computed
+  !>   `with_overlap` (IHQ 1 has its own, standard_hourglass_overlap).
+  subroutine hex8_gradient_invariants(nel, x, y, z, bx, by, bz, volume, g, trace_g, largest_g, overlap, with_overlap)
+    integer, intent(in) :: nel
+    logical, intent(in) :: with_overlap
+    real(wp), intent(in) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
+    real(wp), intent(in) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8), volume(block_size)
+    real(wp), intent(out) :: g(block_size, 6), trace_g(block_size), largest_g(block_size), overlap(block_size)
+    real(wp) :: g11, g22, g33, g12, g23, g13, s11, s22, s33, s12, s23, s13
+    real(wp) :: xc, yc, zc, dx, dy, dz, scale, product_trace
+    integer :: node, i
+    do i = 1, nel
+      g11 = 0.0_wp; g22 = 0.0_wp; g33 = 0.0_wp; g12 = 0.0_wp; g23 = 0.0_wp; g13 = 0.0_wp
+      do node = 1, 8
+        g11 = g11 + bx(i, node)**2
+        g22 = g22 + by(i, node)**2
+        g33 = g33 + bz(i, node)**2
+        g12 = g12 + bx(i, node)*by(i, node)
+        g23 = g23 + by(i, node)*bz(i, node)
+        g13 = g13 + bx(i, node)*bz(i, node)
+      end do
+      ! b / V, kept finite for a flattened or inverted element (reported by the caller): V^2 is
+      ! of the order of |b|^3 for any element of reasonable shape
+      scale = 1.0_wp/max(volume(i)**2, 1.0e-12_wp*(g11 + g22 + g33)*sqrt(g11 + g22 + g33), tiny(1.0_wp))
+      g(i, 1) = g11*scale
+      g(i, 2) = g22*scale
+      g(i, 3) = g33*scale
+      g(i, 4) = g12*scale
+      g(i, 5) = g23*scale
+      g(i, 6) = g13*scale
+      trace_g(i) = g(i, 1) + g(i, 2) + g(i, 3)
+    end do
+    call largest_eigenvalue_bounds(nel, g, largest_g)
+    if (.not. with_overlap) return
+    do i = 1, nel
+      xc = 0.0_wp; yc = 0.0_wp; zc = 0.0_wp
+      do node = 1, 8
+        xc = xc + x(i, node)
+        yc = yc + y(i, node)
+        zc = zc + z(i, node)
+      end do
+      xc = 0.125_wp*xc
+      yc = 0.125_wp*yc
+      zc = 0.125_wp*zc
+      s11 = 0.0_wp; s22 = 0.0_wp; s33 = 0.0_wp; s12 = 0.0_wp; s23 = 0.0_wp; s13 = 0.0_wp
+      do node = 1, 8
+        dx = x(i, node) - xc
+        dy = y(i, node) - yc
+        dz = z(i, node) - zc
+        s11 = s11 + dx*dx
+        s22 = s22 + dy*dy
+        s33 = s33 + dz*dz
+        s12 = s12 + dx*dy
+        s23 = s23 + dy*dz
+        s13 = s13 + dx*dz
+      end do
+      product_trace = s11*g(i, 1) + s22*g(i, 2) + s33*g(i, 3) + 2.0_wp*(s12*g(i, 4) + s23*g(i, 5) + s13*g(i, 6))
+      overlap(i) = 1.0_wp - 1.0_wp/max(1.0_wp, product_trace - 2.0_wp)
+    end do
+  end subroutine hex8_gradient_invariants
+
+  !> Upper bounds on the largest eigenvalue of symmetric 3 x 3 matrices (a(i, :) = 11, 22, 33,
+  !> 12, 23, 13), at most 0.4% above it for positive semi-definite ones. The eigenvalues are
+  !> q + 2 p cos(theta_k) (q = tr / 3, p^2 = |A - q I|^2 / 6), the largest q + 2 p f(r) with
+  !> f(r) = cos(acos(r) / 3) and r = det(A - q I) / (2 p^3) in [-1, 1] (Smith, CACM 4 (1961)
+  !> 168). f is concave, so each of its tangents lies above it: the smallest of eight tangents
+  !> (and of f <= 1) bounds it within 0.006. Arithmetic only, in one loop over the lanes, so that
+  !> it vectorizes (acos and cos of the closed form, per lane, doubled the cost of a one-point
+  !> element; Newton steps on the characteristic polynomial cost four divisions).
+  subroutine largest_eigenvalue_bounds(nel, a, bound)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: a(block_size, 6)
+    real(wp), intent(out) :: bound(block_size)
+    ! tangent points r_k of f and f(r_k), f'(r_k) = sin(acos(r_k) / 3) / (3 sin(acos(r_k)))
+    real(wp), parameter :: point(8) = [0.6_wp, 0.0_wp, -0.5_wp, -0.8_wp, -0.93_wp, -0.98_wp, -0.995_wp, &
+                                       -0.9995_wp]
+    real(wp), parameter :: value(8) = [0.9526082218220564_wp, 0.8660254037844387_wp, 0.766044443118978_wp, &
+                                       0.6728829727813683_wp, 0.60443776901398_wp, 0.5566742948343846_wp, &
+                                       0.5285962191048232_wp, 0.5091011407914117_wp]
+    real(wp), parameter :: slope(8) = [0.12674995597537844_wp, 0.16666666666666666_wp, 0.2474090663228531_wp, &
+                                       0.41097163735488723_wp, 0.7224701663069244_wp, 1.3915265151213427_wp, &
+                                       2.8331215944236416_wp, 9.073779555306288_wp]
+    real(wp) :: q, p, d11, d22, d33, r, envelope
+    integer :: i, k
+    do i = 1, nel
+      q = (a(i, 1) + a(i, 2) + a(i, 3))/3.0_wp
+      d11 = a(i, 1) - q
+      d22 = a(i, 2) - q
+      d33 = a(i, 3) - q
+      p = sqrt((d11**2 + d22**2 + d33**2 + 2.0_wp*(a(i, 4)**2 + a(i, 5)**2 + a(i, 6)**2))/6.0_wp)
+      ! (p = 0, all eigenvalues equal: r = 0 and the bound q)
+      r = (d11*(d22*d33 - a(i, 5)**2) - a(i, 4)*(a(i, 4)*d33 - a(i, 5)*a(i, 6)) &
+           + a(i, 6)*(a(i, 4)*a(i, 5) - d22*a(i, 6)))/max(2.0_wp*p**3, tiny(1.0_wp))
+      r = min(1.0_wp, max(-1.0_wp, r))
+      envelope = 1.0_wp
+      do k = 1, 8
+        envelope = min(envelope, value(k) + slope(k)*(r - point(k)))
+      end do
+      ! round-off in r (of order epsilon q / p) moves the envelope by at most its steepest slope
+      bound(i) = q + 2.0_wp*p*envelope + 256.0_wp*epsilon(1.0_wp)*(abs(q) + 2.0_wp*p)
+    end do
+  end subroutine largest_eigenvalue_bounds
+
   !> Derivatives of the shape functions with respect to (xi, eta, zeta) at the eight Gauss
   !> points of the 2x2x2 rule (+-1/sqrt(3), weights 1; point p sits in the octant of node p):
   !> natural_derivatives(I, a, p) = dN_I/dxi_a at point p.
@@ -240,7 +354,7 @@ contains
     real(wp), intent(out) :: dndx(block_size, 8), dndy(block_size, 8), dndz(block_size, 8)
     real(wp), intent(out) :: determinant(block_size)
     real(wp) :: j11, j12, j13, j21, j22, j23, j31, j32, j33
-    real(wp) :: i11, i12, i13, i21, i22, i23, i31, i32, i33, inverse_determinant
+    real(wp) :: i11, i12, i13, i21, i22, i23, i31, i32, i33, inverse_determinant, size
     integer :: node, i
 
     do i = 1, nel
@@ -270,7 +384,9 @@ contains
       i32 = j12*j31 - j11*j32
       i33 = j11*j22 - j12*j21
       determinant(i) = j11*i11 + j12*i21 + j13*i31
-      inverse_determinant = 1.0_wp/sign(max(abs(determinant(i)), tiny(1.0_wp)), determinant(i))
+      ! a flattened point keeps finite derivatives: det J ~ (largest |J_ka|)^3, floored at 1e-15 of it
+      size = max(abs(j11), abs(j12), abs(j13), abs(j21), abs(j22), abs(j23), abs(j31), abs(j32), abs(j33))
+      inverse_determinant = 1.0_wp/sign(max(abs(determinant(i)), 1.0e-15_wp*size**3, tiny(1.0_wp)), determinant(i))
       ! dN_I/dx_k = sum_a dN_I/dxi_a (J^-1)_ak
       do node = 1, 8
         dndx(i, node) = (natural(node, 1)*i11 + natural(node, 2)*i21 + natural(node, 3)*i31)*inverse_determinant

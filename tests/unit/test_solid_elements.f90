@@ -8,7 +8,9 @@ program test_solid_elements
   use model, only: model_t, material_t, law_elastic, law_plastic_kinematic, formulation_fe, formulation_efg
   use material_dispatch, only: elastic_moduli
   use objective_rotation, only: incremental_rotation
-  use hex8_geometry, only: hex8_volume_derivatives, hex8_velocity_gradient, hex8_gauss_natural_derivatives
+  use hex8_geometry, only: hex8_volume_derivatives, hex8_velocity_gradient, hex8_gauss_natural_derivatives, &
+                           largest_eigenvalue_bounds, hex8_gradient_invariants, hex8_largest_face_area
+  use element_time_step, only: solid_element_time_steps
   use hex8_one_point, only: hourglass_base
   use solid_block, only: solid_block_t, build_solid_blocks, solid_block_corner_masses, solid_block_time_steps, &
                          compute_solid_block, solid_block_element_results
@@ -25,6 +27,8 @@ program test_solid_elements
 
   suite%name = "solid_elements"
   call test_unit_cube()
+  call test_largest_eigenvalue_bounds()
+  call test_gradient_invariants()
   call test_distorted_volumes()
   call test_incremental_rotation()
   call test_patch_single_elements()
@@ -68,6 +72,36 @@ contains
     material%tangent_modulus = 2100.0_wp
     material%hardening_beta = 0.5_wp
   end function plastic_steel
+
+  !> LS-DYNA's step L / c, L = V / largest face area, of one element at rest (elastic steel).
+  function lsdyna_step(coordinates) result(step)
+    real(wp), intent(in) :: coordinates(3, 8)
+    real(wp) :: step
+    real(wp) :: x(block_size, 8), y(block_size, 8), z(block_size, 8), steps(block_size)
+    real(wp) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8), volume(block_size), area(block_size)
+    real(wp) :: modulus(block_size), density_lanes(block_size), rates(block_size)
+    x = 0.0_wp
+    y = 0.0_wp
+    z = 0.0_wp
+    x(1, :) = coordinates(1, :)
+    y(1, :) = coordinates(2, :)
+    z(1, :) = coordinates(3, :)
+    call hex8_volume_derivatives(1, x, y, z, bx, by, bz, volume)
+    call hex8_largest_face_area(1, x, y, z, area)
+    modulus = density*wave_speed(elastic_steel())**2
+    density_lanes = density
+    rates = 0.0_wp
+    call solid_element_time_steps(1, 1.5_wp, 0.06_wp, volume, area, modulus, density_lanes, rates, steps)
+    step = steps(1)
+  end function lsdyna_step
+
+  pure real(wp) function lame_lambda()
+    lame_lambda = youngs*poisson/((1.0_wp + poisson)*(1.0_wp - 2.0_wp*poisson))
+  end function lame_lambda
+
+  pure real(wp) function lame_mu()
+    lame_mu = youngs/(2.0_wp*(1.0_wp + poisson))
+  end function lame_mu
 
   function wave_speed(material) result(speed)
     type(material_t), intent(in) :: material
@@ -274,10 +308,71 @@ contains
                      rel=1e-15_wp)
     call check(suite, "unit cube: unused lanes have no mass", all(corner_mass(2:, :) == 0.0_wp))
     call solid_block_time_steps(blocks(1), model%materials(1), model%coordinates, time_step)
-    call check_close(suite, "unit cube: time step L/c with L = V/A = 1", time_step(1), &
-                     1.0_wp/wave_speed(elastic_steel()), rel=1e-14_wp)
+    ! the volumetric mode (omega^2 = 4 (3 lambda + 2 mu) / (rho L^2)) sets it, below L / c = 1 / c
+    call check_close(suite, "unit cube: time step 2 / omega of the volumetric mode", time_step(1), &
+                     sqrt(density/(3.0_wp*lame_lambda() + 2.0_wp*lame_mu())), rel=1e-6_wp)
+    call check(suite, "unit cube: below LS-DYNA's L / c", time_step(1) < 0.74_wp/wave_speed(elastic_steel()))
     call check(suite, "unit cube: unused lanes get a huge step", all(time_step(2:) == huge(1.0_wp)))
   end subroutine test_unit_cube
+
+  !> Upper bounds within 0.5% on the largest eigenvalue of symmetric 3 x 3 matrices with known
+  !> eigenvalues, turned by a fixed rotation: distinct, two largest equal, all equal, rank one.
+  subroutine test_largest_eigenvalue_bounds()
+    real(wp), parameter :: eigenvalues(3, 5) = reshape([3.0_wp, 2.0_wp, 1.0_wp, 2.0_wp, 2.0_wp, 0.5_wp, &
+                                                        1.0_wp, 1.0_wp, 1.0_wp, 5.0_wp, 0.0_wp, 0.0_wp, &
+                                                        1.0e-6_wp, 1.0e-6_wp, 1.0e-6_wp*(1.0_wp - 1.0e-4_wp)], [3, 5])
+    real(wp) :: rotation(3, 3), matrix(3, 3), packed(block_size, 6), bound(block_size)
+    integer :: k
+    rotation = reshape([0.36_wp, 0.48_wp, -0.8_wp, -0.8_wp, 0.6_wp, 0.0_wp, 0.48_wp, 0.64_wp, 0.6_wp], [3, 3])
+    packed = 0.0_wp
+    do k = 1, 5
+      matrix = matmul(rotation, matmul(diagonal(eigenvalues(:, k)), transpose(rotation)))
+      packed(k, :) = [matrix(1, 1), matrix(2, 2), matrix(3, 3), matrix(1, 2), matrix(2, 3), matrix(1, 3)]
+    end do
+    call largest_eigenvalue_bounds(5, packed, bound)
+    do k = 1, 5
+      call check(suite, "largest eigenvalue bound: at or above it", bound(k) >= maxval(eigenvalues(:, k)))
+      call check(suite, "largest eigenvalue bound: within 0.5%", bound(k) <= 1.005_wp*maxval(eigenvalues(:, k)))
+    end do
+  end subroutine test_largest_eigenvalue_bounds
+
+  pure function diagonal(values) result(matrix)
+    real(wp), intent(in) :: values(3)
+    real(wp) :: matrix(3, 3)
+    integer :: i
+    matrix = 0.0_wp
+    do i = 1, 3
+      matrix(i, i) = values(i)
+    end do
+  end function diagonal
+
+  !> The geometry behind the element eigenvalue bound: a brick 1 x 2 x 4 has tr G = sum
+  !> 1 / (2 a^2), lambda_max(G) = 1/2 and no overlap between its strain and hourglass modes; a
+  !> distorted element has some.
+  subroutine test_gradient_invariants()
+    real(wp) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
+    real(wp) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8), volume(block_size)
+    real(wp) :: g(block_size, 6), trace_g(block_size), largest_g(block_size), overlap(block_size)
+    integer :: node
+    x = 0.0_wp
+    y = 0.0_wp
+    z = 0.0_wp
+    do node = 1, 8
+      x(1:2, node) = unit_cube(1, node)
+      y(1:2, node) = 2.0_wp*unit_cube(2, node)
+      z(1:2, node) = 4.0_wp*unit_cube(3, node)
+    end do
+    x(2, 7) = 1.3_wp
+    y(2, 7) = 2.2_wp
+    call hex8_volume_derivatives(2, x, y, z, bx, by, bz, volume)
+    call hex8_gradient_invariants(2, x, y, z, bx, by, bz, volume, g, trace_g, largest_g, overlap, .true.)
+    call check_close(suite, "gradient invariants: brick tr G", trace_g(1), 0.5_wp*(1.0_wp + 0.25_wp + 0.0625_wp), &
+                     rel=1e-12_wp)
+    call check_close(suite, "gradient invariants: brick lambda_max(G)", largest_g(1), 0.5_wp, rel=5e-3_wp)
+    call check(suite, "gradient invariants: brick lambda_max(G) bound", largest_g(1) >= 0.5_wp)
+    call check(suite, "gradient invariants: brick has no overlap", abs(overlap(1)) < 1e-12_wp)
+    call check(suite, "gradient invariants: distorted element overlaps", overlap(2) > 1e-4_wp .and. overlap(2) < 1.0_wp)
+  end subroutine test_gradient_invariants
 
   subroutine test_distorted_volumes()
     type(model_t) :: model
@@ -295,9 +390,12 @@ contains
     call make_model(model, prism, reshape([1, 2, 3, 4, 5, 6, 7, 8], [8, 1]), elastic_steel(), 1, 1)
     call build_solid_blocks(model, blocks)
     call check_close(suite, "trapezoidal prism: volume 3/2", blocks(1)%reference_volume(1), 1.5_wp, rel=1e-15_wp)
-    call solid_block_time_steps(blocks(1), model%materials(1), model%coordinates, time_step)
-    call check_close(suite, "trapezoidal prism: time step 0.75/c", time_step(1), &
+    call check_close(suite, "trapezoidal prism: LS-DYNA's step 0.75/c", lsdyna_step(prism), &
                      0.75_wp/wave_speed(elastic_steel()), rel=1e-14_wp)
+    ! the element's eigenvalue bound sets the step below it (nu = 0.3)
+    call solid_block_time_steps(blocks(1), model%materials(1), model%coordinates, time_step)
+    call check(suite, "trapezoidal prism: step below LS-DYNA's", time_step(1) < 0.75_wp/wave_speed(elastic_steel()) &
+               .and. time_step(1) > 0.6_wp*0.75_wp/wave_speed(elastic_steel()))
 
     ! An affine image of the unit cube: volume det(A), largest face area |A e_i x A e_j| max.
     map = reshape([1.3_wp, 0.2_wp, -0.1_wp, 0.4_wp, 0.9_wp, 0.3_wp, -0.2_wp, 0.1_wp, 1.1_wp], [3, 3])
@@ -306,10 +404,11 @@ contains
     call build_solid_blocks(model, blocks)
     call check_close(suite, "affine hexahedron: volume det(A)", blocks(1)%reference_volume(1), determinant3(map), &
                      rel=1e-14_wp)
-    call solid_block_time_steps(blocks(1), model%materials(1), model%coordinates, time_step)
-    call check_close(suite, "affine hexahedron: time step V/(A_max c)", time_step(1), determinant3(map) &
+    call check_close(suite, "affine hexahedron: LS-DYNA's step V/(A_max c)", lsdyna_step(mapped), determinant3(map) &
                      /max(norm2(cross(map(:, 1), map(:, 2))), norm2(cross(map(:, 2), map(:, 3))), &
                           norm2(cross(map(:, 3), map(:, 1))))/wave_speed(elastic_steel()), rel=1e-14_wp)
+    call solid_block_time_steps(blocks(1), model%materials(1), model%coordinates, time_step)
+    call check(suite, "affine hexahedron: step at most LS-DYNA's", time_step(1) <= lsdyna_step(mapped))
 
     ! General distorted hexahedra: exact volume against an independent Gauss rule, and the
     ! identities sum_I b_I = 0, sum_I x_I (x) b_I = V I of the exact volume derivatives.
@@ -624,7 +723,7 @@ contains
     real(wp) :: reference(3, 8), middle(3, 8), current(3, 8), velocities(3, 8), centre(3)
     real(wp) :: force(block_size, 8, 3), stress_force(block_size, 8, 3), critical
     real(wp) :: rate, volume, length, current_density, speed, expected_q, trace
-    real(wp) :: expected_energy, characteristic, viscous, q1, q2
+    real(wp) :: expected_energy, characteristic, viscous, q1, q2, frequency_squared, damping
     integer :: node, critical_element, inverted, formulation
     real(wp), parameter :: dt = 1.0e-6_wp, side = 2.0_wp
     character(len=32) :: label
@@ -668,11 +767,21 @@ contains
       call check(suite, trim(label)//": bulk viscosity work is positive in compression", &
                  -expected_q*trace > 0.0_wp .and. expected_energy > 0.5_wp*dt*volume*sum(blocks(1)%stress(1, 1:3, 1)) &
                  *(-rate/(1.0_wp - 0.5_wp*rate*dt)))
-      ! time step with the bulk viscosity: L / (Q + sqrt(Q^2 + c^2)), Q = Q2 c + Q1 L |trD|
+      ! time step with the bulk viscosity: LS-DYNA's L / (Q + sqrt(Q^2 + c^2)), Q = Q2 c +
+      ! Q1 L |trD|, or the element's bound if smaller: on a cube (side L) the volumetric mode
+      ! has omega^2 = 4 (V / V0) (3 lambda + 2 mu) / (rho0 L^2), damped as LS-DYNA's rule
+      ! damps a row of elements, beta = 2 Q2 omega + 4 Q1 |trD|: 4 / (beta + sqrt(beta^2 +
+      ! 4 omega^2)); the hourglass (IHQ 3) and extra deviatoric (ELFORM 2) modes are slower
       characteristic = volume/(volume**(2.0_wp/3.0_wp))
       viscous = q2*speed + q1*characteristic*abs(trace)
+      frequency_squared = 4.0_wp*(volume/side**3)*(3.0_wp*lame_lambda() + 2.0_wp*lame_mu()) &
+                          /(density*characteristic**2)
+      damping = 2.0_wp*q2*sqrt(frequency_squared) + 4.0_wp*q1*abs(trace)
       call check_close(suite, trim(label)//": time step with bulk viscosity", critical, &
-                       characteristic/(viscous + sqrt(viscous**2 + speed**2)), rel=1e-12_wp)
+                       min(characteristic/(viscous + sqrt(viscous**2 + speed**2)), &
+                           4.0_wp/(damping + sqrt(damping**2 + 4.0_wp*frequency_squared))), rel=1e-6_wp)
+      call check(suite, trim(label)//": the element's bound sets it", &
+                 critical < 0.8_wp*characteristic/(viscous + sqrt(viscous**2 + speed**2)))
       call check(suite, trim(label)//": critical element is the model solid", critical_element == 1)
     end do
     ! expansion: no bulk viscosity, plain time step
@@ -686,8 +795,9 @@ contains
                              critical_element, inverted)
     call check_close(suite, "bulk viscosity: none in expansion", blocks(1)%bulk_viscosity(1), 0.0_wp, thr=0.0_wp)
     volume = blocks(1)%volume(1)
-    call check_close(suite, "time step in expansion: L/c", critical, volume**(1.0_wp/3.0_wp)/wave_speed(elastic_steel()), &
-                     rel=1e-12_wp)
+    ! no damping: 2 / omega of the volumetric mode
+    call check_close(suite, "time step in expansion: 2 / omega", critical, volume**(1.0_wp/3.0_wp) &
+                     *sqrt(density*side**3/volume/(3.0_wp*lame_lambda() + 2.0_wp*lame_mu())), rel=1e-6_wp)
   end subroutine test_bulk_viscosity
 
   !> A pure hourglass velocity v_x = u h1 on a unit cube at x(n+1): q_x1 = 8u and, with the

@@ -1,0 +1,215 @@
+"""The stable time step of hexahedra against the eigenvalues of a single element.
+
+1. For one free element (a cube, bricks, a parallelepiped, distorted shapes; ELFORM 1 with the
+   viscous IHQ 1 and the stiffness IHQ 5, ELFORM 2; nu = 0, 0.3, 0.49), numpy builds the
+   element's stiffness (and for the viscous hourglass form its damping) against its lumped
+   masses as the solver does, and finds the largest step at which the central difference
+   scheme stays stable for it: 2 / omega_max without damping, else by bisection on the
+   spectral radius of the scheme's two-step matrix (the viscous forces use the velocity of the
+   last half step). The solver's first step with TSSFAC 1 must be at or below it, and not far
+   below (the bound is tight: 0.85 of it allowed).
+2. One and two hexahedra with a node kicked at 1 mm/ms run 3,000 cycles at the default
+   TSSFAC 0.9 and keep their energy. With LS-DYNA's rule L / c alone (L = V / largest face) a
+   single element at nu = 0.3 went to a negative volume at cycle 10: its volumetric mode
+   (every node out along its diagonal) has omega^2 = 4 (3 lambda + 2 mu) / (rho L^2), critical
+   at 0.73 L / c."""
+import numpy as np
+import pytest
+
+from deck_writer import block_mesh, fields, nodes_card, solids_card, write_deck
+
+YOUNGS, DENSITY = 210.0, 7.85e-6           # steel, GPa kg/mm^3 (mm, ms)
+HOURGLASS_COEFFICIENT = 0.1
+
+# natural coordinates of LS-DYNA's node order and the hourglass base vectors
+XI = np.array([-1, 1, 1, -1, -1, 1, 1, -1.0])
+ETA = np.array([-1, -1, 1, 1, -1, -1, 1, 1.0])
+ZETA = np.array([-1, -1, -1, -1, 1, 1, 1, 1.0])
+HOURGLASS_BASE = np.stack([ETA * ZETA, ZETA * XI, XI * ETA, XI * ETA * ZETA], axis=1)
+GAUSS = 1.0 / np.sqrt(3.0)
+
+
+def lame(poisson):
+    return YOUNGS * poisson / ((1 + poisson) * (1 - 2 * poisson)), YOUNGS / (2 * (1 + poisson))
+
+
+def elasticity(lam, mu):
+    """Voigt matrix with engineering shear strains."""
+    matrix = np.zeros((6, 6))
+    matrix[:3, :3] = lam
+    matrix[range(3), range(3)] += 2 * mu
+    matrix[range(3, 6), range(3, 6)] = mu
+    return matrix
+
+
+def strain_matrix(gradients):
+    """6 x 24 matrix of the strain (engineering shear) from nodal displacements."""
+    matrix = np.zeros((6, 24))
+    for node, (gx, gy, gz) in enumerate(gradients):
+        x, y, z = 3 * node, 3 * node + 1, 3 * node + 2
+        matrix[0, x], matrix[1, y], matrix[2, z] = gx, gy, gz
+        matrix[3, x], matrix[3, y] = gy, gx
+        matrix[4, y], matrix[4, z] = gz, gy
+        matrix[5, x], matrix[5, z] = gz, gx
+    return matrix
+
+
+def point_gradients(x, xi, eta, zeta):
+    natural = np.stack([XI * (1 + ETA * eta) * (1 + ZETA * zeta), ETA * (1 + XI * xi) * (1 + ZETA * zeta),
+                        ZETA * (1 + XI * xi) * (1 + ETA * eta)], axis=1) / 8
+    jacobian = x.T @ natural
+    return natural @ np.linalg.inv(jacobian), np.linalg.det(jacobian)
+
+
+def gauss_points():
+    return [(a, b, c) for a in (-GAUSS, GAUSS) for b in (-GAUSS, GAUSS) for c in (-GAUSS, GAUSS)]
+
+
+def volume_derivatives(x):
+    """Exact dV/dx_I (the 2x2x2 rule integrates the trilinear Jacobian exactly) and V."""
+    derivatives, volume = np.zeros((8, 3)), 0.0
+    for point in gauss_points():
+        gradients, determinant = point_gradients(x, *point)
+        derivatives += gradients * determinant
+        volume += determinant
+    return derivatives, volume
+
+
+def per_direction(matrix8):
+    """The 24 x 24 matrix acting alike on each direction."""
+    full = np.zeros((24, 24))
+    for direction in range(3):
+        index = np.arange(8) * 3 + direction
+        full[np.ix_(index, index)] = matrix8
+    return full
+
+
+def element_matrices(x, poisson, formulation, hourglass):
+    """Stiffness, damping and lumped masses of one element as the solver builds them:
+    ELFORM 1 (uniform strain with the exact volume derivatives) with IHQ 1 (viscous,
+    a_h = QM rho c V^(2/3) / 4 on the base vectors) or IHQ 5 (stiffness QM (lambda + 2 mu)
+    b.b / (3 V) on the Flanagan-Belytschko shape vectors); ELFORM 2 (deviatoric at the 2x2x2
+    points, volumetric from the element mean)."""
+    lam, mu = lame(poisson)
+    derivatives, volume = volume_derivatives(x)
+    damping = np.zeros((24, 24))
+    if formulation == 1:
+        strain = strain_matrix(derivatives / volume)
+        stiffness = volume * strain.T @ elasticity(lam, mu) @ strain
+        if hourglass == 5:
+            gamma = HOURGLASS_BASE - derivatives @ (x.T @ HOURGLASS_BASE) / volume
+            k = HOURGLASS_COEFFICIENT * (lam + 2 * mu) * np.sum(derivatives**2) / (3 * volume)
+            stiffness += per_direction(k * gamma @ gamma.T)
+        else:
+            speed = np.sqrt((lam + 2 * mu) / DENSITY)
+            viscosity = 0.25 * HOURGLASS_COEFFICIENT * DENSITY * speed * volume**(2 / 3)
+            damping = per_direction(viscosity * HOURGLASS_BASE @ HOURGLASS_BASE.T)
+    else:
+        deviatoric = elasticity(-2 * mu / 3, mu)
+        stiffness, mean = np.zeros((24, 24)), np.zeros(24)
+        for point in gauss_points():
+            gradients, determinant = point_gradients(x, *point)
+            strain = strain_matrix(gradients)
+            stiffness += determinant * strain.T @ deviatoric @ strain
+            mean += determinant * strain[:3].sum(axis=0)
+        stiffness += (lam + 2 * mu / 3) * np.outer(mean, mean) / volume
+    return stiffness, damping, np.full(24, DENSITY * volume / 8)
+
+
+def critical_step(stiffness, damping, masses):
+    """Largest dt for which u(n+1) = (2 - dt^2 M^-1 K - dt M^-1 C) u(n) - (1 - dt M^-1 C) u(n-1)
+    (damping on the velocity of the last half step) has no growing solution."""
+    inverse = 1.0 / masses
+    scaled = np.sqrt(inverse)[:, None] * stiffness * np.sqrt(inverse)[None, :]
+    undamped = 2.0 / np.sqrt(np.linalg.eigvalsh(scaled).max())
+    if not np.any(damping):
+        return undamped
+    a, c, n = inverse[:, None] * stiffness, inverse[:, None] * damping, len(masses)
+
+    def growth(step):
+        two_step = np.block([[2 * np.eye(n) - step**2 * a - step * c, -(np.eye(n) - step * c)],
+                             [np.eye(n), np.zeros((n, n))]])
+        return np.abs(np.linalg.eigvals(two_step)).max()
+
+    low, high = 0.0, undamped
+    for _ in range(50):
+        middle = 0.5 * (low + high)
+        # rigid and hourglass motions sit at |z| = 1 (double roots): round-off puts them at 1 +- 1e-8
+        low, high = (middle, high) if growth(middle) <= 1 + 1e-6 else (low, middle)
+    return low
+
+
+CUBE = np.stack([XI, ETA, ZETA], axis=1) * 0.5
+
+
+def shapes():
+    rng = np.random.default_rng(7)
+    yield "cube", CUBE
+    yield "brick 1 x 1 x 4", CUBE * [1.0, 1.0, 4.0]
+    yield "plate 1 x 1 x 0.25", CUBE * [1.0, 1.0, 0.25]
+    yield "sheared", CUBE @ np.array([[1.0, 0.4, 0.0], [0.0, 1.0, 0.3], [0.0, 0.0, 1.0]])
+    yield "distorted a", CUBE + rng.uniform(-0.15, 0.15, CUBE.shape)
+    yield "distorted b", CUBE * [2.0, 1.0, 1.0] + rng.uniform(-0.2, 0.2, CUBE.shape)
+
+
+def single_element_deck(path, x, poisson, formulation, hourglass, tssfac=1.0, cycles=1, kick=None):
+    blocks = ["*CONTROL_TERMINATION\n" + fields(1.0e3, cycles),
+              "*CONTROL_TIMESTEP\n" + fields(0.0, tssfac),
+              "*DATABASE_GLSTAT\n" + fields(1.0e-9),
+              "*PART\nelement\n" + fields(1, 1, 1, 0, 1),
+              "*SECTION_SOLID\n" + fields(1, formulation),
+              "*MAT_ELASTIC\n" + fields(1, DENSITY, YOUNGS, poisson),
+              "*HOURGLASS\n" + fields(1, hourglass, HOURGLASS_COEFFICIENT),
+              "*NODE\n" + "\n".join(f"{k + 1},{float(p[0])!r},{float(p[1])!r},{float(p[2])!r}" for k, p in enumerate(x)),
+              solids_card([list(range(8))])]
+    if kick is not None:
+        blocks.append("*INITIAL_VELOCITY_NODE\n" + fields(kick[0], *kick[1]))
+    return write_deck(path, *blocks)
+
+
+CASES = [(name, poisson, formulation, hourglass)
+         for name, _ in shapes() for poisson in (0.0, 0.3, 0.49) for formulation, hourglass in ((1, 1), (1, 5), (2, 1))]
+
+
+@pytest.mark.parametrize("name, poisson, formulation, hourglass", CASES)
+def test_single_element_step_is_below_its_critical_step(tmp_path, run_deck, name, poisson, formulation, hourglass):
+    x = dict(shapes())[name]
+    critical = critical_step(*element_matrices(x, poisson, formulation, hourglass))
+    run = run_deck(single_element_deck(tmp_path / "element.k", x, poisson, formulation, hourglass))
+    assert run.status == 0, run.stdout + run.stderr
+    with run.open() as results:
+        step = results["history/glstat/time_step"][0]
+    assert step <= critical * (1 + 1e-9), f"step {step:.6e} above the critical {critical:.6e}"
+    assert step >= 0.85 * critical, f"step {step:.6e} far below the critical {critical:.6e}"
+
+
+@pytest.mark.parametrize("elements", [1, 2])
+@pytest.mark.parametrize("formulation", [1, 2])
+@pytest.mark.parametrize("poisson", [0.0, 0.3, 0.49])
+def test_kicked_hexahedra_run_stably_at_the_default_tssfac(tmp_path, run_deck, elements, formulation, poisson):
+    """One or two unit cubes (default IHQ 1, bulk viscosity on), the far corner node kicked at
+    1 mm/ms, no *CONTROL_TIMESTEP (TSSFAC 0.9), 3,000 cycles: kinetic + internal + hourglass
+    energy (bulk viscosity and hourglass work included) stays equal to the initial kinetic
+    energy, and the elements really deform."""
+    nodes, solids = block_mesh((elements, 1, 1), (float(elements), 1.0, 1.0))
+    kicked = int(np.argmax(nodes.sum(axis=1))) + 1
+    deck = write_deck(
+        tmp_path / "kicked.k",
+        "*CONTROL_TERMINATION\n" + fields(1.0e3, 3000),
+        "*DATABASE_GLSTAT\n" + fields(1.0e-5),
+        "*PART\nblock\n" + fields(1, 1, 1),
+        "*SECTION_SOLID\n" + fields(1, formulation),
+        "*MAT_ELASTIC\n" + fields(1, DENSITY, YOUNGS, poisson),
+        nodes_card(nodes),
+        solids_card(solids),
+        "*INITIAL_VELOCITY_NODE\n" + fields(kicked, 1.0, 0.0, 0.0),
+    )
+    run = run_deck(deck)
+    assert run.status == 0, run.stdout + run.stderr
+    with run.open() as results:
+        assert results["run"].attrs["cycles"] == 3000
+        glstat = {name: results["history/glstat"][name][...] for name in results["history/glstat"]}
+    total = glstat["total_energy"]
+    assert np.isfinite(total).all()
+    assert np.abs(total - total[0]).max() < 1e-9 * total[0]
+    assert glstat["internal_energy"].max() > 0.05 * total[0]
