@@ -96,7 +96,9 @@ def test_clamped_strip_vibrates_at_the_beam_period_for_any_poisson_ratio(tmp_pat
     assert abs(ratio - 1.0) < PERIOD_TOLERANCE, f"period {period:.5f} ms, beam theory {beam_period():.5f} ms"
     # the rotations do not set the step: TSSFAC times the membrane rule L / c, L = 5 mm
     membrane_step = 0.9 * (LENGTH / CELLS[0]) / np.sqrt(YOUNGS / (DENSITY * (1.0 - poisson**2)))
-    assert glstat["time_step"][1:] == pytest.approx(membrane_step, rel=1e-6)
+    # (the last step is cut so that the run ends at ENDTIM)
+    assert glstat["time_step"][1:-1] == pytest.approx(membrane_step, rel=1e-6)
+    assert 0.0 < glstat["time_step"][-1] <= membrane_step * (1.0 + 1e-6)
     # nothing external works on the strip (clamped nodes do not move): the total is constant,
     # and the motion really turns into strain energy and back
     assert drift < 1e-9

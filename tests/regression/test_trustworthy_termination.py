@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from conftest import BINARY, last_state
+from test_contact import head_on_deck
 from deck_writer import block_mesh, fields, nodes_card, plate_mesh, shells_card, solids_card, write_deck
 
 STEEL = fields(1, 7.85e-6, 210.0, 0.3)
@@ -159,9 +160,20 @@ def test_without_dtmin_every_decade_of_the_falling_step_is_reported(tmp_path, ru
 
 
 def test_endeng_stops_a_run_whose_energy_ratio_drifts(tmp_path, run_deck):
-    """ENDENG 1e-9 percent: the round-off drift of the energy ratio of a kicked cube exceeds it."""
-    run = run_deck(one_hexahedron(tmp_path / "cube.k", energy_change=1e-9))
-    assert_error_termination(run, r"the energy ratio .* differs from 1 by more than ENDENG = 1\.0000E-09 percent")
+    """Two blocks meeting head on through penalty contact: the springs' work is integrated with an
+    error of about 1e-4 of the impact energy, so an ENDENG of 1e-6 percent stops the run once they
+    touch, and one of 10 percent lets it end normally."""
+    deck, *_ = head_on_deck(tmp_path / "head_on.k")
+    text = deck.read_text()
+    deck.write_text(text.replace("*CONTROL_TERMINATION\n" + fields(0.03),
+                                 "*CONTROL_TERMINATION\n" + fields(0.03, None, None, 1e-6)))
+    run = run_deck(deck)
+    found = assert_error_termination(run, r"the energy ratio .* differs from 1 by more than ENDENG = 1\.0000E-06 "
+                                          r"percent at time ([0-9.E+-]+)")
+    assert 0.0 < float(found.group(1)) < 0.03
+    deck.write_text(text.replace("*CONTROL_TERMINATION\n" + fields(0.03),
+                                 "*CONTROL_TERMINATION\n" + fields(0.03, None, None, 10.0)))
+    assert run_deck(deck, jobid="loose").status == 0
 
 
 def long_run_deck(path):
