@@ -33,7 +33,7 @@ fuzz_log=$(mktemp)
 fuzz_passed=0
 fuzz_failed=1
 if make --no-print-directory -s -j"$jobs" MODE=debug all; then
-  ${PYTHON:-python3} tests/fuzz/fuzz.py run --decks "${FUZZ_SHORT_DECKS:-400}" --seed "${FUZZ_SHORT_SEED:-3}" \
+  ${PYTHON:-python3} tests/fuzz/fuzz.py run --decks "${FUZZ_SHORT_DECKS:-400}" --seed "${FUZZ_SHORT_SEED:-1}" \
     --jobs "$jobs" --replay --quiet --findings "${TMPDIR:-/tmp}/crashfree-fuzz-findings/make-test" 2>&1 | tee "$fuzz_log"
   fuzz_line=$(grep -E '^fuzz: [0-9]+ passed, [0-9]+ failed' "$fuzz_log" | tail -n 1)
   if [ -n "$fuzz_line" ]; then

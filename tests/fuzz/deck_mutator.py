@@ -333,7 +333,7 @@ class DeckMutator:
             lines = deck[name].split("\n")
             description = family(lines, deck, name)
             if description:
-                deck[name] = "\n".join(lines) if isinstance(lines, list) else lines
+                deck[name] = "\n".join(lines)
                 done.append(f"{name}: {description}")
         return done
 

@@ -149,8 +149,9 @@ def downgrade(outcome: Outcome, end_time: str) -> Outcome:
     return outcome
 
 
-def run_many(cases, binaries, arguments, findings: Findings, scratch: Path, quiet=False):
-    """Run every (label, files, mutations) case with every build; returns {label: {build: outcome}}."""
+def run_many(cases, binaries, arguments, findings_for, scratch: Path, quiet=False):
+    """Run every (label, files, mutations) case with every build; `findings_for(label)` is the
+    Findings that keeps its failures. Returns {label: {build: outcome}}."""
     tasks = [(label, files, mutations, build) for label, files, mutations in cases for build in binaries]
     outcomes: dict[str, dict[str, Outcome]] = collections.defaultdict(dict)
     timeouts = {"release": arguments.timeout, "debug": arguments.timeout * arguments.debug_timeout_factor}
@@ -161,9 +162,11 @@ def run_many(cases, binaries, arguments, findings: Findings, scratch: Path, quie
     def work(task):
         label, files, mutations, build = task
         directory = scratch / f"{label}_{build}"
-        outcome = run_case(files, binaries[build], directory, timeouts[build])
+        # a stored reproducer may need its full time (one traps only at the 10 s progress line)
+        timeout = timeouts[build] * (2.0 if label.startswith("replay-") else 1.0)
+        outcome = run_case(files, binaries[build], directory, timeout)
         outcome = downgrade(outcome, arguments.end_time)
-        findings.add(label, build, files, mutations, outcome)
+        findings_for(label).add(label, build, files, mutations, outcome)
         shutil.rmtree(directory, ignore_errors=True)
         return label, build, outcome
 
@@ -208,6 +211,7 @@ def command_run(arguments) -> int:
     findings_directory = Path(arguments.findings or Path(tempfile.gettempdir()) / "crashfree-fuzz-findings" /
                               f"seed{arguments.seed}")
     findings = Findings(findings_directory, arguments.keep)
+    replay_findings = Findings(findings_directory / "replay", arguments.keep)
     cases = []
     for index in range(arguments.decks):
         name, files, mutations = make_mutant(seeds, arguments.seed, index)
@@ -221,8 +225,12 @@ def command_run(arguments) -> int:
           + f", builds {', '.join(binaries)}, {arguments.jobs} jobs; findings in {findings_directory}", flush=True)
     started = time.monotonic()
     with tempfile.TemporaryDirectory(prefix="crashfree-fuzz-") as scratch:
-        outcomes = run_many(cases + replayed, binaries, arguments, findings, Path(scratch), arguments.quiet)
+        outcomes = run_many(cases + replayed, binaries, arguments,
+                            lambda label: replay_findings if label.startswith("replay-") else findings,
+                            Path(scratch), arguments.quiet)
     findings.write_summary()
+    if replayed:
+        replay_findings.write_summary()
     mutants = {label: per_build for label, per_build in outcomes.items() if not label.startswith("replay-")}
     print_table(mutants, list(binaries), findings, f"outcomes of {len(mutants)} mutants by class and build "
                 f"({time.monotonic() - started:.0f} s)")
@@ -233,7 +241,14 @@ def command_run(arguments) -> int:
             text = ", ".join(f"{build} {outcome.kind}" + (f" ({outcome.signature})" if outcome.kind == "failure" else "")
                              for build, outcome in per_build.items())
             print(f"  {label[len('replay-'):]}: {text}")
-    failed = sum(1 for per_build in outcomes.values() if any(o.kind == "failure" for o in per_build.values()))
+    def failing(labels):
+        return sum(1 for label in labels if any(o.kind == "failure" for o in outcomes[label].values()))
+
+    failed = failing(outcomes)
+    if replayed:
+        replay_labels = [label for label, _, _ in replayed]
+        print(f"\nmutants: {len(mutants) - failing(mutants)} passed, {failing(mutants)} failed; stored reproducers: "
+              f"{len(replay_labels) - failing(replay_labels)} passed, {failing(replay_labels)} failed")
     print(f"\nfuzz: {len(outcomes) - failed} passed, {failed} failed")
     return 1 if failed else 0
 

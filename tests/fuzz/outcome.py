@@ -5,7 +5,8 @@ Classes (docs/fuzzing.md):
   normal       exit 0, a readable results file, status "normal termination", finite values,
                nothing past ENDTIM
   error        exit 1 with a message that names the time and an element, node, part or body
-  timeout      still running after the time limit (killed; not a failure)
+  timeout      still running after the time limit, or stopped by the file size limit (a
+               state written every cycle): killed, not a failure
   FAILURE      anything else: a signal (a floating-point trap of the debug build, a
                segmentation fault, an abort), a Fortran runtime error on any exit status, exit 0
                with non-finite values or with results past ENDTIM, a wrong status attribute, exit
@@ -31,7 +32,7 @@ import numpy as np
 
 RELATIVE_END_TIME_TOLERANCE = 1e-9
 MEMORY_LIMIT_BYTES = 3 * 1024 ** 3      # per run: a runaway allocation fails instead of swapping
-FILE_SIZE_LIMIT_BYTES = 512 * 1024 ** 2  # per file written by a run
+FILE_SIZE_LIMIT_BYTES = 256 * 1024 ** 2  # per file written by a run (a state every cycle of a long run)
 OUTPUT_KEEP_CHARACTERS = 200_000        # of stdout and stderr kept for classification and findings
 
 
@@ -289,6 +290,9 @@ def classify(status: int, stdout: str, stderr: str, results: Path, deck: Path, t
 
     if timed_out:
         return Outcome("timeout", "killed after the time limit", "", status, stdout=stdout, stderr=stderr, notes=notes)
+    if status == -signal.SIGXFSZ:
+        return Outcome("timeout", "stopped by the file size limit", "", status, stdout=stdout, stderr=stderr,
+                       notes=notes)
     problem = runtime_problem(everything)
     if problem:
         return failure(problem[1], problem[0])
@@ -313,7 +317,9 @@ def classify(status: int, stdout: str, stderr: str, results: Path, deck: Path, t
     if status == 1:
         if not message:
             return failure("exit 1 without a message", "exit 1 without a message")
-        if not (re.search(r"\btime\b", message, re.IGNORECASE) and LOCATION_WORDS.search(message)):
+        # the linear static analysis has no time: its messages name the node or element alone
+        timed = re.search(r"\btime\b", message, re.IGNORECASE) or message.startswith("static analysis")
+        if not (timed and LOCATION_WORDS.search(message)):
             return failure(f"run-time message without element/node and time: {message}",
                            f"message without location: {normalise(message)}")
     checked = check_results(results, status, deck)
