@@ -322,15 +322,17 @@ def classify(status: int, stdout: str, stderr: str, results: Path, deck: Path, t
         if not (timed and LOCATION_WORDS.search(message)):
             return failure(f"run-time message without element/node and time: {message}",
                            f"message without location: {normalise(message)}")
-    checked = check_results(results, status, deck)
+    checked = check_results(results, status, deck, notes)
     if checked:
         return failure(*checked)
     kind = "normal" if status == 0 else "error"
     return Outcome(kind, message, "", status, stdout=stdout, stderr=stderr, notes=notes)
 
 
-def check_results(results: Path, status: int, deck: Path):
-    """(reason, signature) of what is wrong with the results file of an exit 0 or 1, or None."""
+def check_results(results: Path, status: int, deck: Path, notes: list[str]):
+    """(reason, signature) of what is wrong with the results file of an exit 0 or 1, or None.
+    A negative kinetic energy after normal termination (a wrong result, not a crash) is added
+    to `notes`."""
     import h5py
     if not results.exists():
         return f"exit {status} but no results file", f"exit {status} without a results file"
@@ -353,6 +355,10 @@ def check_results(results: Path, status: int, deck: Path):
                             f"exit 0 with non-finite values ({', '.join(sorted({b.split('/')[0] for b in bad}))})")
             times = last_times(handle)
             glstat = handle.get("history/glstat")
+            if status == 0 and glstat is not None and "kinetic_energy" in glstat:
+                kinetic = glstat["kinetic_energy"][...]
+                if kinetic.size and np.nanmin(kinetic) < 0.0:
+                    notes.append("exit 0 with a negative kinetic energy in history/glstat")
             steps = glstat["time_step"][...] if glstat is not None and "time_step" in glstat else None
         except Exception as error:  # noqa: BLE001
             return f"exit {status} and results.h5 cannot be read: {error}", f"exit {status} with an unreadable results file"
