@@ -222,8 +222,8 @@ RUNTIME_LOCATION = re.compile(r"At line (\d+) of file (\S+)(?: \(unit = \d+.*\))
 LOCATION_WORDS = re.compile(r"\b(element|elements|shell|shells|node|nodes|part|parts|body|cell|wall|contact|segment|"
                             r"particle|point|curve)\s+\d+", re.IGNORECASE)
 DECK_LOCATION = re.compile(r"^\S[^\n:]*:\d+: ", re.MULTILINE)
-# a problem of the whole deck (no nodes, no elements) names the file and the keyword, no line
-DECK_FILE_ONLY = re.compile(r"^\S[^\n:]*\.\w+: \*[A-Za-z_]+: field ", re.MULTILINE)
+# a problem of the whole deck (no nodes, no elements, an empty or binary file) names the file, no line
+DECK_FILE_ONLY = re.compile(r"^\S[^\n:]*\.\w+: ", re.MULTILINE)
 SIGNAL_NAMES = {getattr(signal, name): name for name in dir(signal) if name.startswith("SIG") and "_" not in name}
 
 
