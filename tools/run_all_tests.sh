@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # make test: release build, Fortran unit tests in the checked (debug) build, then the pytest
 # regression tests on the release binary, then a short deck fuzzing run with both builds (each
-# mutant deck is one test). The last line adds them up: "N passed, N failed".
+# mutant deck and each stored reproducer of tests/fuzz/findings is one test). The last line adds
+# them up: "N passed, N failed".
 set -u
 jobs=$(nproc 2>/dev/null || echo 2)
 make --no-print-directory -s -j"$jobs" all || { echo "0 passed, 1 failed"; exit 1; }

@@ -210,6 +210,8 @@ def command_run(arguments) -> int:
     seeds = load_seeds(arguments.seeds)
     findings_directory = Path(arguments.findings or Path(tempfile.gettempdir()) / "crashfree-fuzz-findings" /
                               f"seed{arguments.seed}")
+    if (findings_directory / "summary.json").exists():
+        shutil.rmtree(findings_directory)      # the findings of an earlier run into the same folder
     findings = Findings(findings_directory, arguments.keep)
     replay_findings = Findings(findings_directory / "replay", arguments.keep)
     cases = []

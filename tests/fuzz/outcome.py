@@ -282,6 +282,7 @@ def error_message(stderr: str) -> str:
 
 
 def classify(status: int, stdout: str, stderr: str, results: Path, deck: Path, timed_out: bool) -> Outcome:
+    """The class of a finished run from its exit status, output and results file (module doc)."""
     everything = stdout + "\n" + stderr
     notes = notes_of(everything)
 
@@ -303,8 +304,9 @@ def classify(status: int, stdout: str, stderr: str, results: Path, deck: Path, t
         return failure(f"exit status {status}", f"exit status {status}")
     if status == 2:
         if not DECK_LOCATION.search(stderr) and DECK_FILE_ONLY.search(stderr):
-            line = DECK_FILE_ONLY.search(stderr).group(0)
-            notes.append(f"rejected with file but no line: {normalise(next(l for l in stderr.splitlines() if l.startswith(line)))}")
+            start = DECK_FILE_ONLY.search(stderr).group(0)
+            line = next(text for text in stderr.splitlines() if text.startswith(start))
+            notes.append(f"rejected with file but no line: {normalise(line)}")
         elif not DECK_LOCATION.search(stderr):
             lines = [l for l in stderr.splitlines() if l.strip() and "warning" not in l.lower()]
             message = lines[0] if lines else "(no message)"
