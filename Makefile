@@ -38,7 +38,7 @@ ALL_SOURCES := $(LIBRARY_SOURCES) src/app/crashfree.f90 $(TEST_SUPPORT) $(TEST_S
 
 vpath %.f90 $(sort $(dir $(ALL_SOURCES)))
 
-.PHONY: all deps run taylor test unit regression bench clean debug verify
+.PHONY: all deps run taylor test unit regression bench clean debug verify fuzz
 # The release build is also published as bin/crashfree and lib/ (library and .mod files).
 ifeq ($(MODE),release)
 all: bin/crashfree
@@ -115,6 +115,18 @@ verify: deps
 	  $(PYTHON) postproc/verification_report.py $(VERIFY_DIR) --doc docs/verification.md \
 	    --figures docs/verification || status=$$?; \
 	  exit $$status
+
+# Deck fuzzing (docs/fuzzing.md): FUZZ_DECKS mutants of the seed decks, each run with the release
+# and the checked debug build; a table of outcomes at the end; fails when any run fails
+# (findings in the temp folder, or FUZZ_FINDINGS=DIR).
+FUZZ_DECKS ?= 10000
+FUZZ_SEED ?= 1
+FUZZ_JOBS ?= 2
+fuzz: deps
+	@$(MAKE) --no-print-directory all
+	@$(MAKE) --no-print-directory MODE=debug all
+	@$(PYTHON) tests/fuzz/fuzz.py run --decks $(FUZZ_DECKS) --seed $(FUZZ_SEED) --jobs $(FUZZ_JOBS) \
+	    $(if $(FUZZ_FINDINGS),--findings $(FUZZ_FINDINGS))
 
 clean:
 	rm -rf build lib bin

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # make test: release build, Fortran unit tests in the checked (debug) build, then the pytest
-# regression tests on the release binary. The last line adds both up: "N passed, N failed".
+# regression tests on the release binary, then a short deck fuzzing run with both builds (each
+# mutant deck and each stored reproducer of tests/fuzz/findings is one test). The last line adds
+# them up: "N passed, N failed".
 set -u
 jobs=$(nproc 2>/dev/null || echo 2)
 make --no-print-directory -s -j"$jobs" all || { echo "0 passed, 1 failed"; exit 1; }
@@ -27,7 +29,22 @@ regression_failed=$(( $(count failed) + $(count errors?) ))
 if [ "$regression_passed" -eq 0 ]; then regression_failed=$((regression_failed + 1)); fi
 rm -f "$regression_log"
 
-passed=$((unit_passed + regression_passed))
-failed=$((unit_failed + regression_failed))
+echo "== deck fuzzing, short run (release and debug builds, fixed seed; docs/fuzzing.md) =="
+fuzz_log=$(mktemp)
+fuzz_passed=0
+fuzz_failed=1
+if make --no-print-directory -s -j"$jobs" MODE=debug all; then
+  ${PYTHON:-python3} tests/fuzz/fuzz.py run --decks "${FUZZ_SHORT_DECKS:-400}" --seed "${FUZZ_SHORT_SEED:-1}" \
+    --jobs "$jobs" --replay --quiet --findings "${TMPDIR:-/tmp}/crashfree-fuzz-findings/make-test" 2>&1 | tee "$fuzz_log"
+  fuzz_line=$(grep -E '^fuzz: [0-9]+ passed, [0-9]+ failed' "$fuzz_log" | tail -n 1)
+  if [ -n "$fuzz_line" ]; then
+    fuzz_passed=$(echo "$fuzz_line" | sed -E 's/^fuzz: ([0-9]+) passed.*/\1/')
+    fuzz_failed=$(echo "$fuzz_line" | sed -E 's/.* ([0-9]+) failed.*/\1/')
+  fi
+fi
+rm -f "$fuzz_log"
+
+passed=$((unit_passed + regression_passed + fuzz_passed))
+failed=$((unit_failed + regression_failed + fuzz_failed))
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
