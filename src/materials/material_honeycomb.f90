@@ -142,7 +142,9 @@ contains
       do k = 1, 6
         history(i, strain_first + k - 1) = history(i, strain_first + k - 1) + local_increment(k)
       end do
-      relative_volume = exp(history(i, honeycomb_log_volume_slot))
+      ! (an element folding through itself can pile up logarithmic strain beyond exp's range;
+      ! a relative volume of e^50 means the same to the law as any larger one)
+      relative_volume = exp(min(history(i, honeycomb_log_volume_slot), 50.0_wp))
       if (relative_volume <= compaction_volume) history(i, honeycomb_compacted_slot) = 1.0_wp
 
       if (history(i, honeycomb_compacted_slot) > 0.5_wp) then

@@ -23,7 +23,7 @@ module run_checks
   use error_handling, only: error_t, make_error
   use model, only: model_t, law_null
   use explicit_state, only: explicit_state_t
-  use energy_balance, only: update_energy_totals, total_energy, energy_ratio
+  use energy_balance, only: update_energy_totals, total_energy, energy_ratio, part_energies
   implicit none
   private
 
@@ -35,6 +35,10 @@ module run_checks
   !> Values beyond this are never physical in any unit system, and their squares still fit in a
   !> double: the bound when the model's materials give no wave speed.
   real(wp), parameter :: largest_meaningful_value = 1.0e100_wp
+  !> A step below this fraction of the first one stops the run even without DTMIN: the run could
+  !> not reach its end time (a collapsing element drove one to 1e-13 of its first step, and the
+  !> run stalled for good).
+  real(wp), parameter :: smallest_step_fraction = 1.0e-8_wp
   !> A stable step larger than this many times the last one is not physical.
   real(wp), parameter :: step_growth_limit = 100.0_wp
   !> Energy created by the run, in units of the largest energy put in so far, that stops it.
@@ -238,10 +242,17 @@ contains
         return
       end if
       watch%last_stable_step = stable_step
-      if (step < model%minimum_time_step_factor*watch%first_time_step) then
-        call make_error(error, "the time step "//real_text(step)//" fell below DTMIN ("// &
-                        real_text(model%minimum_time_step_factor)//") times the first step "// &
-                        real_text(watch%first_time_step)//" ("//step_setter(model, state)//")"//time_text(state))
+      if (step < max(model%minimum_time_step_factor, smallest_step_fraction)*watch%first_time_step) then
+        if (model%minimum_time_step_factor > smallest_step_fraction) then
+          call make_error(error, "the time step "//real_text(step)//" fell below DTMIN ("// &
+                          real_text(model%minimum_time_step_factor)//") times the first step "// &
+                          real_text(watch%first_time_step)//" ("//step_setter(model, state)//")"//time_text(state))
+        else
+          call make_error(error, "the time step "//real_text(step)//" fell below "// &
+                          real_text(smallest_step_fraction)//" times the first step "// &
+                          real_text(watch%first_time_step)//" ("//step_setter(model, state)//"): the run "// &
+                          "would need a hundred million times as many cycles as its first steps took"//time_text(state))
+        end if
         return
       end if
       fraction = step/watch%first_time_step
@@ -278,7 +289,8 @@ contains
       if (watch%largest_energy_supplied > 0.0_wp .and. &
           abs(total - supplied) > energy_excess_limit*watch%largest_energy_supplied) then
         call make_error(error, "the energy has exploded: the model holds "//real_text(total)//" but was given "// &
-                        real_text(supplied)//" ("//energy_text(state)//"): the run has become unstable"//time_text(state))
+                        real_text(supplied)//" ("//energy_text(state)//"; most of it in "// &
+                        part_with_most_energy(model, state)//"): the run has become unstable"//time_text(state))
         return
       end if
       if (model%energy_ratio_change_limit > 0.0_wp) then
@@ -290,6 +302,21 @@ contains
       end if
     end associate
   end subroutine check_energy
+
+  !> "part 3 (kinetic ..., internal ...)": the part whose energies are largest in magnitude.
+  function part_with_most_energy(model, state) result(text)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(in) :: state
+    character(len=:), allocatable :: text
+    real(wp) :: kinetic(size(model%parts)), internal(size(model%parts)), hourglass(size(model%parts))
+    integer :: k
+    text = "no part"
+    if (size(model%parts) == 0) return
+    call part_energies(model, state, size(model%parts), kinetic, internal, hourglass)
+    k = maxloc(abs(kinetic) + abs(internal) + abs(hourglass), dim=1)
+    text = "part "//integer_text(model%parts(k)%id)//" (kinetic "//real_text(kinetic(k))//", internal "// &
+           real_text(internal(k))//", hourglass "//real_text(hourglass(k))//")"
+  end function part_with_most_energy
 
   !> "kinetic ..., internal ..., ..." for messages.
   function energy_text(state) result(text)

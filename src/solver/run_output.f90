@@ -169,11 +169,11 @@ contains
     type(model_t), intent(in) :: model
     type(output_clock_t), intent(in) :: clock
     ! a first guess only (the series grow by doubling): at most 4096 rows, so that many parts
-    ! with a tiny interval do not reserve gigabytes; compared before dividing, as the end time
-    ! may be huge (ENDCYC only)
+    ! with a tiny interval do not reserve gigabytes; compared before dividing and without
+    ! multiplying the interval, as the end time and the default intervals may be huge (ENDCYC only)
     expected_rows = 16
     if (clock%interval > 0.0_wp) then
-      if (model%end_time < 4096.0_wp*clock%interval) then
+      if (model%end_time/4096.0_wp < clock%interval) then
         expected_rows = int(model%end_time/clock%interval) + 16
       else
         expected_rows = 4096 + 16
