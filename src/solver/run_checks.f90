@@ -74,9 +74,42 @@ contains
     if (state%physical_mass > 0.0_wp .and. 100.0_wp*state%added_mass > model%mass_change_limit*state%physical_mass) then
       call make_error(error, "mass scaling (DT2MS) adds "//real_text(state%added_mass)//" to the physical mass "// &
                       real_text(state%physical_mass)//", more than ENDMAS = "//real_text(model%mass_change_limit)// &
-                      " percent")
+                      " percent; the most scaled is "//most_scaled_element(model, state)//time_text(state))
     end if
   end subroutine set_up_run_checks
+
+  !> "solid element 12 (part 3), its density raised 1.2E+03 times": the element whose density
+  !> mass scaling raised most.
+  function most_scaled_element(model, state) result(text)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(in) :: state
+    character(len=:), allocatable :: text
+    real(wp) :: factor, largest
+    integer :: b, lane, element
+    largest = 0.0_wp
+    element = 0
+    do b = 1, size(state%blocks)
+      do lane = 1, state%blocks(b)%element_count
+        if (.not. model%materials(state%blocks(b)%material)%density > 0.0_wp) cycle
+        factor = state%blocks(b)%density(lane)/model%materials(state%blocks(b)%material)%density
+        if (factor > largest) then
+          largest = factor
+          element = state%blocks(b)%elements(lane)
+        end if
+      end do
+    end do
+    do b = 1, size(state%shells)
+      do lane = 1, state%shells(b)%element_count
+        if (.not. model%materials(state%shells(b)%material)%density > 0.0_wp) cycle
+        factor = state%shells(b)%density(lane)/model%materials(state%shells(b)%material)%density
+        if (factor > largest) then
+          largest = factor
+          element = -state%shells(b)%elements(lane)
+        end if
+      end do
+    end do
+    text = describe_element(model, element)//", its density raised "//real_text(largest)//" times"
+  end function most_scaled_element
 
   !> sqrt((K + 4G/3) / rho) of a material from its E, PR and RO (0 when it has none: *MAT_NULL
   !> shells, or constants that give no real speed).

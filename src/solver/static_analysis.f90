@@ -216,8 +216,9 @@ contains
     end if
     if (allocated(model%walls)) then
       if (size(model%walls) > 0) then
-        call make_error(error, "static analysis: rigid walls are contact, which a linear static analysis does "// &
-                        "not model; remove the *RIGIDWALL cards or prescribe the displacements they would impose")
+        call make_error(error, "static analysis: rigid wall "//integer_text(model%walls(1)%id)//" (and any "// &
+                        "other *RIGIDWALL) is contact, which a linear static analysis does not model; remove "// &
+                        "the *RIGIDWALL cards or prescribe the displacements they would impose")
         return
       end if
     end if
