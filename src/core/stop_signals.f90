@@ -2,15 +2,17 @@
 !>
 !> A batch system's kill (SIGTERM) or a Ctrl-C (SIGINT) during a run sets a flag that the time
 !> loop reads once per cycle: it finishes the cycle, writes the state, closes the results and
-!> ends with error termination (exit 1), so the results are complete up to that time. A second
-!> SIGINT or SIGTERM, while the first is being handled, ends the process at once (the handler
-!> gives the signal back to the system's default action). `kill -USR2 <pid>` prints the
-!> progress line at the next cycle, as LS-DYNA's sense switches do.
+!> ends with error termination (exit 1), so the results are complete up to that time. Further
+!> SIGINT or SIGTERM while that is done are the same request (a second Ctrl-C would otherwise
+!> kill the process halfway through its last writes); SIGQUIT (Ctrl-\) or SIGKILL end it at
+!> once. A signal that the parent had set to be ignored (a job started in the background by a
+!> non-interactive shell) stays ignored, as for any command-line tool. `kill -USR2 <pid>` prints
+!> the progress line at the next cycle, as LS-DYNA's sense switches do.
 !>
 !> The flags are the one piece of process-wide state in crashfree: the operating system delivers
 !> a signal to the process, not to a caller that could pass state down.
 module stop_signals
-  use, intrinsic :: iso_c_binding, only: c_int, c_funptr, c_funloc, c_null_funptr
+  use, intrinsic :: iso_c_binding, only: c_int, c_intptr_t, c_funptr, c_funloc
   implicit none
   private
 
@@ -38,11 +40,21 @@ contains
 
   !> Install the handlers (once, before the run starts).
   subroutine catch_stop_signals()
-    type(c_funptr) :: previous
-    previous = c_signal(signal_interrupt, c_funloc(on_stop_signal))
-    previous = c_signal(signal_terminate, c_funloc(on_stop_signal))
-    previous = c_signal(signal_user2, c_funloc(on_progress_signal))
+    call catch(signal_interrupt, c_funloc(on_stop_signal))
+    call catch(signal_terminate, c_funloc(on_stop_signal))
+    call catch(signal_user2, c_funloc(on_progress_signal))
   end subroutine catch_stop_signals
+
+  !> Install `handler` for `number` unless the signal is ignored (SIG_IGN, the address 1), which
+  !> is then put back.
+  subroutine catch(number, handler)
+    integer(c_int), intent(in) :: number
+    type(c_funptr), intent(in) :: handler
+    integer(c_intptr_t), parameter :: ignored = 1
+    type(c_funptr) :: previous
+    previous = c_signal(number, handler)
+    if (transfer(previous, 0_c_intptr_t) == ignored) previous = c_signal(number, previous)
+  end subroutine catch
 
   !> The number of the SIGINT or SIGTERM received (0: none).
   integer function received_stop_signal()
@@ -71,12 +83,10 @@ contains
     end select
   end function signal_name
 
-  !> Only async-signal-safe work: store the number, hand the next one to the default action.
+  !> Only async-signal-safe work: store the number.
   subroutine on_stop_signal(number) bind(c)
     integer(c_int), value :: number
-    type(c_funptr) :: previous
     stop_signal = number
-    previous = c_signal(number, c_null_funptr)
   end subroutine on_stop_signal
 
   subroutine on_progress_signal(number) bind(c)

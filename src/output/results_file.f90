@@ -1362,7 +1362,11 @@ contains
     real(wp), intent(in) :: value
     character(len=:), allocatable :: text
     character(len=32) :: buffer
-    write (buffer, '(es15.7e3)') value
+    if (abs(value) < 1.0e100_wp .and. (abs(value) >= 1.0e-99_wp .or. value == 0.0_wp)) then
+      write (buffer, '(es14.6)') value
+    else
+      write (buffer, '(es15.6e3)') value
+    end if
     text = trim(adjustl(buffer))
   end function real_text
 end module results_file

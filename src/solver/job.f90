@@ -100,12 +100,11 @@ contains
       exit_status = 0
     end if
     call close_results(results, summary, close_error)
-    if (allocated(close_error)) then
-      write (error_unit, '(a)') "crashfree: "//close_error%message
-      exit_status = 1
-    end if
+    if (allocated(close_error)) exit_status = 1
     call print_summary(summary, options, model%implicit_static)
     if (allocated(error)) write (error_unit, '(a)') "crashfree: error termination: "//error%message
+    ! last: what the results file holds after a failed write
+    if (allocated(close_error)) write (error_unit, '(a)') "crashfree: "//close_error%message
   end subroutine run_job
 
   !> ncpu=, else OMP_NUM_THREADS (the OpenMP runtime reads it), else all cores; at most the
