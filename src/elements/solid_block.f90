@@ -133,7 +133,7 @@ contains
     end do
     allocate (ordered_solids(first_of_part(part_count + 1) - 1))
     allocate (exposed(solid_count))
-    if (solid_count > 0) exposed = exposed_elements(size(model%coordinates, 2), model%solid_nodes)
+    if (solid_count > 0) exposed = exposed_elements(model%coordinates, model%solid_nodes)
     next_slot = first_of_part(1:part_count)
     do pass = 1, 2
       do solid = 1, solid_count
