@@ -547,7 +547,8 @@ contains
   !> out-of-plane hourglass stiffness against the lumped masses and rotary inertias; see
   !> out_of_plane_frequency_squared). With the rotary inertia of shell_block_masses the second
   !> stays above the first for SHRF <= 1 and any Poisson ratio; it guards larger SHRF and thick
-  !> or distorted elements. A null material without YM sets no step.
+  !> or distorted elements. The exposed lanes (a lone shell, a pair, a single row's ends) also
+  !> take membrane_time_step. A null material without YM sets no step.
   pure subroutine stable_steps(block, material, x, area, xl, yl, b1, b2, element_time_step)
     type(shell_block_t), intent(in) :: block
     type(material_t), intent(in) :: material
