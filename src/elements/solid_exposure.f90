@@ -26,7 +26,7 @@ module solid_exposure
   !> A node where the solids fill less than this solid angle exposes its elements: 7 pi / 4,
   !> the solid angle of an edge of 157.5 degrees (a cylinder meshed with fewer than 16
   !> elements around is exposed all along).
-  real(wp), parameter, public :: exposed_solid_angle = 1.75_wp*pi
+  real(wp), parameter :: exposed_solid_angle = 1.75_wp*pi
   !> The three corners joined to each corner by an edge of the hexahedron (LS-DYNA's order).
   integer, parameter :: edge_neighbours(3, 8) = reshape([2, 4, 5, 3, 1, 6, 4, 2, 7, 1, 3, 8, &
                                                          8, 6, 1, 5, 7, 2, 6, 8, 3, 7, 5, 4], [3, 8])
@@ -63,7 +63,8 @@ contains
         triple = abs(a(1)*(b(2)*c(3) - b(3)*c(2)) + a(2)*(b(3)*c(1) - b(1)*c(3)) + a(3)*(b(1)*c(2) - b(2)*c(1)))
         denominator = length_a*length_b*length_c + dot_product(a, b)*length_c + dot_product(a, c)*length_b &
                       + dot_product(b, c)*length_a
-        ! a degenerate corner (a zero edge) has triple = denominator = 0: atan2 gives 0
+        ! a degenerate corner (a zero edge) has triple = denominator = 0 and adds nothing
+        ! (atan2(0, 0) is not defined)
         if (triple > 0.0_wp .or. denominator /= 0.0_wp) &
           filled(node) = filled(node) + 2.0_wp*atan2(triple, denominator)
       end do
