@@ -67,6 +67,10 @@ module shell_block
     real(wp) :: point_weight(max_shell_points) = 0.0_wp !< their weights, summing to 1
     integer :: elements(block_size) = 0          !< model shell index of each lane
     integer :: nodes(block_size, 4) = 0          !< node indices (a triangle repeats node 3)
+    !> Lanes whose shell has two or more corners that no other shell shares (a lone shell, a
+    !> pair, the ends of a single row): only they get the membrane eigenvalue bound on their
+    !> step (stable_steps).
+    logical :: exposed(block_size) = .false.
     real(wp) :: centre_weight(block_size, 4) = 0.25_wp !< shape functions at the centre (1/3 on a triangle)
     real(wp) :: thickness(block_size) = 0.0_wp   !< mean of the corner thicknesses
     real(wp) :: density(block_size) = 0.0_wp     !< raised by mass scaling
@@ -98,11 +102,20 @@ contains
   subroutine build_shell_blocks(model, blocks)
     type(model_t), intent(in) :: model
     type(shell_block_t), allocatable, intent(out) :: blocks(:)
-    integer, allocatable :: per_part(:)
-    integer :: part, shell, block_count, lane, current, part_count, shell_count
+    integer, allocatable :: per_part(:), shells_around(:)
+    integer :: part, shell, block_count, lane, current, part_count, shell_count, corner
 
     shell_count = 0
     if (allocated(model%shell_part)) shell_count = size(model%shell_part)
+    ! shells around each node (a triangle's repeated node counted once), for `exposed`
+    allocate (shells_around(size(model%coordinates, 2)))
+    shells_around = 0
+    do shell = 1, shell_count
+      do corner = 1, 4
+        if (any(model%shell_nodes(1:corner - 1, shell) == model%shell_nodes(corner, shell))) cycle
+        shells_around(model%shell_nodes(corner, shell)) = shells_around(model%shell_nodes(corner, shell)) + 1
+      end do
+    end do
     part_count = size(model%parts)
     allocate (per_part(part_count))
     per_part = 0
@@ -128,6 +141,9 @@ contains
         blocks(current)%element_count = lane
         blocks(current)%elements(lane) = shell
         blocks(current)%nodes(lane, :) = model%shell_nodes(:, shell)
+        blocks(current)%exposed(lane) = count([(shells_around(model%shell_nodes(corner, shell)) == 1 .and. &
+                                                .not. any(model%shell_nodes(1:corner - 1, shell) == &
+                                                          model%shell_nodes(corner, shell)), corner=1, 4)]) >= 2
         blocks(current)%thickness(lane) = 0.25_wp*sum(model%shell_thickness(:, shell))
         if (model%shell_nodes(3, shell) == model%shell_nodes(4, shell)) then
           blocks(current)%thickness(lane) = sum(model%shell_thickness(1:3, shell))/3.0_wp
@@ -531,7 +547,8 @@ contains
   !> out-of-plane hourglass stiffness against the lumped masses and rotary inertias; see
   !> out_of_plane_frequency_squared). With the rotary inertia of shell_block_masses the second
   !> stays above the first for SHRF <= 1 and any Poisson ratio; it guards larger SHRF and thick
-  !> or distorted elements. A null material without YM sets no step.
+  !> or distorted elements. The exposed lanes (a lone shell, a pair, a single row's ends) also
+  !> take membrane_time_step. A null material without YM sets no step.
   pure subroutine stable_steps(block, material, x, area, xl, yl, b1, b2, element_time_step)
     type(shell_block_t), intent(in) :: block
     type(material_t), intent(in) :: material
@@ -551,8 +568,66 @@ contains
       out_of_plane = out_of_plane_frequency_squared(block, material, i, area(i), xl(i, :), yl(i, :), b1(i, :), &
                                                     b2(i, :))
       if (out_of_plane > 0.0_wp) element_time_step(i) = min(element_time_step(i), 2.0_wp/sqrt(out_of_plane))
+      if (block%exposed(i)) element_time_step(i) = min(element_time_step(i), &
+                                                       membrane_time_step(block, material, i, area(i), xl(i, :), &
+                                                                          yl(i, :), b1(i, :), b2(i, :)))
     end do
   end subroutine stable_steps
+
+  !> Stable step of lane i's in-plane motion alone (for the exposed lanes): the membrane rule
+  !> L / c is the critical step of a mesh, but a free shell's areal mode (u = x, v = y) has
+  !> omega^2 = (1 + nu) (2 c / L)^2 on a square, so a lone shell needs TSSFAC below
+  !> 1 / sqrt(1 + nu) (docs/shells.md). As for the solids and the bending part of
+  !> out_of_plane_frequency_squared, the one-point membrane stiffness t A B^T C B has against
+  !> the lumped masses omega^2 <= t A (lambda' tr S + 2 G lambda_max(S)), S_ab = sum B_a B_b / m
+  !> (exact for a square: the areal mode); the membrane hourglass modes add (QM k / 16) |gamma|^2
+  !> / m for IHQ 4, 5 (the largest eigenvalue of a sum is at most the sum of the largest), or a
+  !> damping QM sqrt(k m) |gamma|^2 / m for IHQ 1-3 (the viscous forces of hourglass_forces),
+  !> k = E t A sum B^2 / 8. Stable while dt^2 omega^2 + 2 dt beta <= 4:
+  !> dt = 4 / (beta + sqrt(beta^2 + 4 omega^2)).
+  pure real(wp) function membrane_time_step(block, material, i, area, xl, yl, b1, b2) result(step)
+    type(shell_block_t), intent(in) :: block
+    type(material_t), intent(in) :: material
+    integer, intent(in) :: i
+    real(wp), intent(in) :: area, xl(4), yl(4), b1(4), b2(4)
+    real(wp), parameter :: h(4) = [1.0_wp, -1.0_wp, 1.0_wp, -1.0_wp]
+    real(wp) :: g1(4), g2(4), gamma(4), mass(4), s11, s22, s12, t, youngs, nu, shear_modulus, plane_lambda
+    real(wp) :: stiffness, omega2, damping, gamma_mass
+    integer :: corners
+    t = block%thickness(i)
+    youngs = material%youngs_modulus
+    nu = material%poissons_ratio
+    shear_modulus = youngs/(2.0_wp*(1.0_wp + nu))
+    plane_lambda = youngs*nu/(1.0_wp - nu*nu)
+    gamma = h - dot_product(h, xl)*b1 - dot_product(h, yl)*b2
+    g1 = b1
+    g2 = b2
+    corners = 4
+    if (block%nodes(i, 3) == block%nodes(i, 4)) then
+      corners = 3
+      g1(3) = g1(3) + g1(4)
+      g2(3) = g2(3) + g2(4)
+      gamma(3) = gamma(3) + gamma(4)
+    end if
+    mass(1:corners) = block%density(i)*t*block%reference_area(i)/real(corners, wp)
+    s11 = sum(g1(1:corners)**2/mass(1:corners))
+    s22 = sum(g2(1:corners)**2/mass(1:corners))
+    s12 = sum(g1(1:corners)*g2(1:corners)/mass(1:corners))
+    omega2 = t*max(area, 0.0_wp)*(plane_lambda*(s11 + s22) &
+                                  + 2.0_wp*shear_modulus*(0.5_wp*(s11 + s22) + sqrt(0.25_wp*(s11 - s22)**2 + s12**2)))
+    ! the membrane hourglass stiffness of hourglass_forces
+    stiffness = youngs*t*max(area, 0.0_wp)*sum(b1**2 + b2**2)/8.0_wp
+    gamma_mass = sum(gamma(1:corners)**2/mass(1:corners))
+    damping = 0.0_wp
+    if (block%hourglass_type >= 4) then
+      omega2 = omega2 + block%hourglass_coefficient*stiffness/16.0_wp*gamma_mass
+    else
+      damping = block%hourglass_coefficient*sqrt(stiffness*0.25_wp*block%density(i)*t*block%reference_area(i)) &
+                *gamma_mass
+    end if
+    ! (a shell without stiffness gets huge, not an overflow)
+    step = 4.0_wp/max(damping + sqrt(damping**2 + 4.0_wp*omega2), 4.0_wp/huge(1.0_wp))
+  end function membrane_time_step
 
   !> Upper bound on omega^2 of lane i's out-of-plane motion (w, theta_x, theta_y) against its
   !> lumped masses m_I and rotary inertias I_I (element eigenvalues bound the mesh's). Three

@@ -45,6 +45,7 @@ module solid_block
                        add_point_stress_power, corner_force_power, add_point_gram, deviatoric_mode_bound, &
                        add_point_gradient_norm, deviatoric_mode_trace_bound
   use element_work, only: add_force_work, smallest_time_step
+  use solid_exposure, only: exposed_elements
   use element_time_step, only: bulk_viscosity_pressure, solid_element_time_steps, eigenvalue_time_steps
   implicit none
   private
@@ -67,6 +68,10 @@ module solid_block
     real(wp) :: bulk_quadratic = 1.5_wp          !< Q1
     real(wp) :: bulk_linear = 0.06_wp            !< Q2
     integer :: elements(block_size) = 0          !< model solid index of each lane
+    !> Lanes whose element sits at a corner or edge of the mesh (solid_exposure): only they get
+    !> the eigenvalue bound on their step; a block without them skips it.
+    logical :: exposed(block_size) = .false.
+    integer :: exposed_count = 0                 !< number of exposed lanes
     integer :: nodes(block_size, 8) = 0          !< node indices of each corner
     real(wp) :: density(block_size) = 0.0_wp     !< effective density (raised by mass scaling)
     real(wp) :: reference_volume(block_size) = 0.0_wp   !< exact initial volume
@@ -97,15 +102,18 @@ module solid_block
 
 contains
 
-  !> Group the model's solids into blocks: parts in model order, the solids of each part in
-  !> input order, at most block_size per block. Only parts discretised with finite elements
-  !> (formulation_fe) get blocks; EFG and rigid parts are handled elsewhere. Sets every field,
-  !> density = material density, exact reference volumes, zero stress, energies and history.
+  !> Group the model's solids into blocks: parts in model order; in each part first the solids
+  !> at a corner or edge of the mesh (solid_exposure), then the others, each group in input
+  !> order, at most block_size per block (so that the other blocks skip the eigenvalue bound).
+  !> Only parts discretised with finite elements (formulation_fe) get blocks; EFG and rigid
+  !> parts are handled elsewhere. Sets every field, density = material density, exact reference
+  !> volumes, zero stress, energies and history.
   subroutine build_solid_blocks(model, blocks)
     type(model_t), intent(in) :: model
     type(solid_block_t), allocatable, intent(out) :: blocks(:)
     integer, allocatable :: part_solid_count(:), first_of_part(:), ordered_solids(:), next_slot(:)
-    integer :: part, solid, block_count, solid_count, part_count, lane, current, slot
+    logical, allocatable :: exposed(:)
+    integer :: part, solid, block_count, solid_count, part_count, lane, current, slot, pass
 
     solid_count = 0
     if (allocated(model%solid_part)) solid_count = size(model%solid_part)
@@ -124,12 +132,17 @@ contains
       first_of_part(part + 1) = first_of_part(part) + part_solid_count(part)
     end do
     allocate (ordered_solids(first_of_part(part_count + 1) - 1))
+    allocate (exposed(solid_count))
+    if (solid_count > 0) exposed = exposed_elements(model%coordinates, model%solid_nodes)
     next_slot = first_of_part(1:part_count)
-    do solid = 1, solid_count
-      part = model%solid_part(solid)
-      if (model%parts(part)%formulation /= formulation_fe) cycle
-      ordered_solids(next_slot(part)) = solid
-      next_slot(part) = next_slot(part) + 1
+    do pass = 1, 2
+      do solid = 1, solid_count
+        part = model%solid_part(solid)
+        if (model%parts(part)%formulation /= formulation_fe) cycle
+        if (exposed(solid) .neqv. pass == 1) cycle
+        ordered_solids(next_slot(part)) = solid
+        next_slot(part) = next_slot(part) + 1
+      end do
     end do
 
     block_count = sum((part_solid_count + block_size - 1)/block_size)
@@ -148,6 +161,8 @@ contains
         blocks(current)%element_count = lane
         blocks(current)%elements(lane) = solid
         blocks(current)%nodes(lane, :) = model%solid_nodes(:, solid)
+        blocks(current)%exposed(lane) = exposed(solid)
+        if (exposed(solid)) blocks(current)%exposed_count = blocks(current)%exposed_count + 1
       end do
     end do
     do current = 1, block_count
@@ -256,7 +271,9 @@ contains
     call current_density_and_speed(nel, block%density, block%reference_volume, volume, wave_modulus, &
                                    density, sound_speed)
     rest(1:nel) = 0.0_wp
-    if (block%formulation == formulation_selective_reduced) then
+    if (block%exposed_count == 0) then
+      ! no exposed lane: LS-DYNA's rule alone (stable_time_steps reads no mode bounds)
+    else if (block%formulation == formulation_selective_reduced) then
       call hex8_gauss_natural_derivatives(natural)
       gram(1:nel, :) = 0.0_wp
       do point = 1, 8
@@ -282,10 +299,11 @@ contains
                            mode_frequency_squared, mode_damping, element_time_step)
   end subroutine solid_block_time_steps
 
-  !> Stable step of each lane (no TSSFAC) on the configuration x: the smaller of LS-DYNA's rule
-  !> and the element's eigenvalue bound (element_time_step), given the frequency and damping
-  !> bounds of the formulation's other modes (hourglass modes of ELFORM 1, extra deviatoric
-  !> modes of ELFORM 2). Lanes 1..nel of element_time_step are overwritten.
+  !> Stable step of each lane (no TSSFAC) on the configuration x: LS-DYNA's rule, and on the
+  !> exposed lanes the smaller of it and the element's eigenvalue bound (element_time_step),
+  !> given the frequency and damping bounds of the formulation's other modes (hourglass modes
+  !> of ELFORM 1, extra deviatoric modes of ELFORM 2; not read in a block without exposed
+  !> lanes). Lanes 1..nel of element_time_step are overwritten.
   subroutine stable_time_steps(block, material, nel, x, y, z, bx, by, bz, volume, wave_modulus, volumetric_rate, &
                                mode_frequency_squared, mode_damping, element_time_step)
     type(solid_block_t), intent(in) :: block
@@ -297,11 +315,13 @@ contains
     real(wp), intent(in) :: mode_frequency_squared(block_size), mode_damping(block_size)
     real(wp), intent(inout) :: element_time_step(block_size)
     real(wp) :: area(block_size), g(block_size, 6), trace_g(block_size), largest_g(block_size)
-    real(wp) :: overlap(block_size), lame_bound, shear_bound
+    real(wp) :: overlap(block_size), lame_bound, shear_bound, bound_time_step(block_size)
     logical :: standard
+    integer :: i
     call hex8_largest_face_area(nel, x, y, z, area)
     call solid_element_time_steps(nel, block%bulk_quadratic, block%bulk_linear, volume, area, wave_modulus, &
                                   block%density, volumetric_rate, element_time_step)
+    if (block%exposed_count == 0) return
     standard = block%formulation == formulation_one_point .and. block%hourglass_type == 1
     call hex8_gradient_invariants(nel, x, y, z, bx, by, bz, volume, g, trace_g, largest_g, overlap, &
                                   with_overlap=.not. standard)
@@ -309,9 +329,13 @@ contains
     ! on parallelepipeds
     if (standard) call standard_hourglass_overlap(nel, bx, by, bz, volume, g, overlap)
     call material_stiffness_bounds(material, lame_bound, shear_bound)
+    bound_time_step(1:nel) = element_time_step(1:nel)
     call eigenvalue_time_steps(nel, block%bulk_quadratic, block%bulk_linear, lame_bound, shear_bound, &
                                block%reference_volume, volume, block%density, volumetric_rate, trace_g, largest_g, &
-                               overlap, mode_frequency_squared, mode_damping, element_time_step)
+                               overlap, mode_frequency_squared, mode_damping, bound_time_step)
+    do i = 1, nel
+      element_time_step(i) = merge(bound_time_step(i), element_time_step(i), block%exposed(i))
+    end do
   end subroutine stable_time_steps
 
   !> ELFORM 2: frequency bound of the deviatoric modes beyond the one-point element's,
@@ -515,10 +539,12 @@ contains
     call add_force_work(nel, dt, block%previous_time_step, old_hourglass_power, new_hourglass_power, &
                         block%hourglass_power, block%hourglass_energy)
 
-    if (block%hourglass_type >= 4) viscosity_scale(1:nel) = 0.0_wp
-    call hourglass_mode_bounds(nel, block%hourglass_type, block%hourglass_coefficient, wave_modulus, &
-                               viscosity_scale, hourglass_volume, gradient_norm_squared, gamma, &
-                               corner_mass_of(block, nel), mode_frequency_squared, mode_damping)
+    if (block%exposed_count > 0) then
+      if (block%hourglass_type >= 4) viscosity_scale(1:nel) = 0.0_wp
+      call hourglass_mode_bounds(nel, block%hourglass_type, block%hourglass_coefficient, wave_modulus, &
+                                 viscosity_scale, hourglass_volume, gradient_norm_squared, gamma, &
+                                 corner_mass_of(block, nel), mode_frequency_squared, mode_damping)
+    end if
     call stable_time_steps(block, material, nel, x, y, z, bx, by, bz, volume, wave_modulus, volumetric_rate, &
                            mode_frequency_squared, mode_damping, element_time_step)
     block%volume(1:nel) = volume(1:nel)
@@ -549,7 +575,7 @@ contains
     real(wp) :: bulk_viscosity(block_size), mean_stress(block_size)
     real(wp) :: old_power(block_size), new_power(block_size), trace_integral(block_size)
     real(wp) :: gram(block_size, 36), mode_frequency_squared(block_size), mode_damping(block_size)
-    logical :: gram_wanted
+    logical :: gram_wanted, bound_wanted
     integer :: nel, i, point
 
     nel = block%element_count
@@ -599,10 +625,12 @@ contains
     by(1:nel, :) = 0.0_wp
     bz(1:nel, :) = 0.0_wp
     mean_stress(1:nel) = 0.0_wp
-    gram_wanted = use_gram(material)
+    ! the extra modes' bound, for the exposed lanes only
+    bound_wanted = block%exposed_count > 0
+    gram_wanted = bound_wanted .and. use_gram(material)
     if (gram_wanted) then
       gram(1:nel, :) = 0.0_wp
-    else
+    else if (bound_wanted) then
       gram(1:nel, 1) = 0.0_wp
     end if
     do point = 1, 8
@@ -619,7 +647,7 @@ contains
                                        block%stress(:, :, point), corner_force, mean_stress, bx, by, bz)
       if (gram_wanted) then
         call add_point_gram(nel, block%point_volume(:, point), dndx, dndy, dndz, gram)
-      else
+      else if (bound_wanted) then
         call add_point_gradient_norm(nel, block%point_volume(:, point), dndx, dndy, dndz, gram(:, 1))
       end if
     end do
@@ -645,7 +673,8 @@ contains
     call add_force_work(nel, dt, block%previous_time_step, old_power, new_power, block%force_power, &
                         block%internal_energy)
 
-    call deviatoric_modes(block, material, nel, gram, bx, by, bz, volume, mode_frequency_squared, mode_damping)
+    if (bound_wanted) &
+      call deviatoric_modes(block, material, nel, gram, bx, by, bz, volume, mode_frequency_squared, mode_damping)
     call stable_time_steps(block, material, nel, x, y, z, bx, by, bz, volume, wave_modulus, volumetric_rate, &
                            mode_frequency_squared, mode_damping, element_time_step)
     block%volume(1:nel) = volume(1:nel)

@@ -12,7 +12,17 @@
    TSSFAC 0.9 and keep their energy. With LS-DYNA's rule L / c alone (L = V / largest face) a
    single element at nu = 0.3 went to a negative volume at cycle 10: its volumetric mode
    (every node out along its diagonal) has omega^2 = 4 (3 lambda + 2 mu) / (rho L^2), critical
-   at 0.73 L / c."""
+   at 0.73 L / c.
+3. Free meshes (cubes of 2^3, 4^3 and 8^3 elements, a distorted 4^3 with every node moved;
+   nu = 0, 0.3, 0.49): numpy assembles the whole mesh's stiffness and lumped masses and takes
+   2 / omega_max of it (dense eigvalsh); the solver's first step with TSSFAC 1 must be at or
+   below it. Only the elements at the mesh's corners and edges get the eigenvalue bound, the
+   others LS-DYNA's rule, which alone is up to 1.23 times the critical step of these meshes
+   (their fastest modes sit at the corners). Kicked meshes (random nodal velocities) run
+   3,000 cycles at TSSFAC 0.9 with the energy balanced (with the rule alone, those at
+   nu = 0.49 invert an element within 27-33 cycles), and a mesh whose smallest step is inside
+   keeps LS-DYNA's rule there (the bound on every element made it 0.99 of that for ELFORM 1,
+   0.92 for ELFORM 2)."""
 import numpy as np
 import pytest
 
@@ -213,3 +223,116 @@ def test_kicked_hexahedra_run_stably_at_the_default_tssfac(tmp_path, run_deck, e
     assert np.isfinite(total).all()
     assert np.abs(total - total[0]).max() < 1e-9 * total[0]
     assert glstat["internal_energy"].max() > 0.05 * total[0]
+
+
+def mesh_matrices(nodes, elements, poisson, formulation, hourglass):
+    """Assembled stiffness and lumped masses of a mesh (no damping: the stiffness forms only)."""
+    stiffness, masses = np.zeros((3 * len(nodes), 3 * len(nodes))), np.zeros(3 * len(nodes))
+    for corners in elements:
+        element_stiffness, _, element_masses = element_matrices(nodes[corners], poisson, formulation, hourglass)
+        index = (3 * corners[:, None] + np.arange(3)).ravel()
+        stiffness[np.ix_(index, index)] += element_stiffness
+        masses[index] += element_masses
+    return stiffness, masses
+
+
+def mesh_critical_step(nodes, elements, poisson, formulation, hourglass):
+    """2 / omega_max of the free mesh's lumped-mass eigenproblem."""
+    stiffness, masses = mesh_matrices(nodes, elements, poisson, formulation, hourglass)
+    scale = 1.0 / np.sqrt(masses)
+    return 2.0 / np.sqrt(np.linalg.eigvalsh(scale[:, None] * stiffness * scale[None, :])[-1])
+
+
+def lsdyna_rule_steps(nodes, elements, poisson):
+    """L / c of every element: L = V / largest face area (half the cross product of the face's
+    diagonals), c = sqrt((lambda + 2 mu) / rho)."""
+    lam, mu = lame(poisson)
+    speed = np.sqrt((lam + 2 * mu) / DENSITY)
+    faces = [[0, 1, 2, 3], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]]
+    steps = []
+    for corners in elements:
+        x = nodes[corners]
+        area = max(0.5 * np.linalg.norm(np.cross(x[f[2]] - x[f[0]], x[f[3]] - x[f[1]])) for f in faces)
+        steps.append(volume_derivatives(x)[1] / area / speed)
+    return np.array(steps)
+
+
+def free_mesh(name):
+    count = {"cube 2^3": 2, "cube 4^3": 4, "cube 8^3": 8, "distorted 4^3": 4}[name]
+    nodes, elements = block_mesh((count,) * 3, (float(count),) * 3)
+    if name.startswith("distorted"):
+        nodes = nodes + np.random.default_rng(5).uniform(-0.15, 0.15, nodes.shape)
+    return nodes, elements
+
+
+def mesh_deck(path, nodes, elements, poisson, formulation, hourglass, tssfac, cycles, velocities=None):
+    blocks = ["*CONTROL_TERMINATION\n" + fields(1.0e3, cycles),
+              "*DATABASE_GLSTAT\n" + fields(1.0e-5),
+              "*PART\nmesh\n" + fields(1, 1, 1, 0, 1),
+              "*SECTION_SOLID\n" + fields(1, formulation),
+              "*MAT_ELASTIC\n" + fields(1, DENSITY, YOUNGS, poisson),
+              "*HOURGLASS\n" + fields(1, hourglass, HOURGLASS_COEFFICIENT),
+              "*NODE\n" + "\n".join(f"{k + 1},{float(p[0])!r},{float(p[1])!r},{float(p[2])!r}"
+                                    for k, p in enumerate(nodes)),
+              solids_card(elements)]
+    if tssfac is not None:
+        blocks.append("*CONTROL_TIMESTEP\n" + fields(0.0, tssfac))
+    if velocities is not None:
+        blocks.append("*INITIAL_VELOCITY_NODE\n" + "\n".join(
+            f"{k + 1},{float(v[0])!r},{float(v[1])!r},{float(v[2])!r}" for k, v in enumerate(velocities)))
+    return write_deck(path, *blocks)
+
+
+MESH_CASES = [(name, poisson, formulation, hourglass)
+              for name in ("cube 2^3", "cube 4^3", "cube 8^3", "distorted 4^3") for poisson in (0.0, 0.3, 0.49)
+              for formulation, hourglass in ((1, 5), (2, 1)) if not (name == "cube 8^3" and formulation == 2)]
+
+
+@pytest.mark.parametrize("name, poisson, formulation, hourglass", MESH_CASES)
+def test_free_mesh_step_is_below_its_critical_step(tmp_path, run_deck, name, poisson, formulation, hourglass):
+    """ELFORM 1 with the stiffness IHQ 5 (no damping: 2 / omega_max is the critical step) and
+    ELFORM 2. LS-DYNA's rule alone gives 1.07-1.24 times the critical step of the cubes at
+    nu = 0.3 and 0.49."""
+    nodes, elements = free_mesh(name)
+    critical = mesh_critical_step(nodes, elements, poisson, formulation, hourglass)
+    run = run_deck(mesh_deck(tmp_path / "mesh.k", nodes, elements, poisson, formulation, hourglass, 1.0, 1))
+    assert run.status == 0, run.stdout + run.stderr
+    with run.open() as results:
+        step = results["history/glstat/time_step"][0]
+    assert step <= critical * (1 + 1e-9), f"step {step:.6e} above the mesh's critical {critical:.6e}"
+    assert step >= 0.6 * critical, f"step {step:.6e} far below the mesh's critical {critical:.6e}"
+
+
+@pytest.mark.parametrize("formulation, hourglass", [(1, 1), (1, 5), (2, 1)])
+@pytest.mark.parametrize("poisson", [0.0, 0.3, 0.49])
+def test_kicked_mesh_runs_stably_at_the_default_tssfac(tmp_path, run_deck, poisson, formulation, hourglass):
+    """A free 4^3 mesh with random nodal velocities (up to 1 mm/ms), bulk viscosity on, TSSFAC
+    0.9: 3,000 cycles with kinetic + internal + hourglass energy equal to the initial kinetic
+    energy (with LS-DYNA's rule alone, 1.10 times the critical step at nu = 0.49, an element
+    inverts within 27-33 cycles)."""
+    nodes, elements = block_mesh((4, 4, 4), (4.0, 4.0, 4.0))
+    velocities = np.random.default_rng(3).uniform(-1.0, 1.0, nodes.shape)
+    run = run_deck(mesh_deck(tmp_path / "kicked.k", nodes, elements, poisson, formulation, hourglass, None, 3000,
+                             velocities))
+    assert run.status == 0, run.stdout + run.stderr
+    with run.open() as results:
+        assert results["run"].attrs["cycles"] == 3000
+        total = results["history/glstat/total_energy"][...]
+        internal = results["history/glstat/internal_energy"][...]
+    assert np.isfinite(total).all()
+    assert np.abs(total - total[0]).max() < 1e-9 * total[0]
+    assert internal.max() > 0.05 * total[0]
+
+
+@pytest.mark.parametrize("formulation, hourglass", [(1, 1), (2, 1)])
+def test_mesh_interior_keeps_the_lsdyna_rule(tmp_path, run_deck, formulation, hourglass):
+    """A 6^3 mesh whose interior nodes are moved by up to 0.2 of the cell (nu = 0.3): its
+    smallest LS-DYNA step is inside, where the elements are held by their neighbours, and the
+    solver's first step (TSSFAC 1) is that step, not the element bound below it."""
+    nodes, elements = block_mesh((6, 6, 6), (6.0, 6.0, 6.0), perturbation=0.2, seed=4)
+    rule = lsdyna_rule_steps(nodes, elements, 0.3)
+    run = run_deck(mesh_deck(tmp_path / "interior.k", nodes, elements, 0.3, formulation, hourglass, 1.0, 1))
+    assert run.status == 0, run.stdout + run.stderr
+    with run.open() as results:
+        step = results["history/glstat/time_step"][0]
+    assert step == pytest.approx(rule.min(), rel=1e-9)

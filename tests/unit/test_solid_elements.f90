@@ -2,7 +2,8 @@
 !> geometry kernels: volumes and time steps, patch tests (linear velocity fields on distorted
 !> elements give the exact D and spin and no hourglass force), objectivity under rigid rotation,
 !> bulk viscosity, hourglass forces and energies, conservation of linear and angular momentum,
-!> inverted elements, block building and element results.
+!> inverted elements, block building, the elements at a mesh's corners and edges (which get the
+!> eigenvalue bound on their step) and element results.
 program test_solid_elements
   use kinds, only: wp, block_size, long_int
   use model, only: model_t, material_t, law_elastic, law_plastic_kinematic, formulation_fe, formulation_efg
@@ -41,6 +42,7 @@ program test_solid_elements
   call test_energy_balance()
   call test_inverted_elements()
   call test_build_blocks()
+  call test_exposed_elements()
   call test_element_results()
   call finish_suite(suite)
 
@@ -1118,6 +1120,57 @@ contains
     call check(suite, "blocks: zero state", all(blocks(1)%stress == 0.0_wp) .and. all(blocks(1)%history == 0.0_wp) &
                .and. all(blocks(1)%internal_energy == 0.0_wp) .and. all(blocks(1)%hourglass_energy == 0.0_wp))
   end subroutine test_build_blocks
+
+  !> A 3 x 3 x 3 block of unit cubes: the 8 corner and 12 edge elements have a node where the
+  !> solids fill pi / 2 or pi (solid_exposure) and get the eigenvalue bound; the 6 face-centre
+  !> elements (their nodes on a flat surface, 2 pi) and the centre one keep LS-DYNA's rule. The
+  !> block lists the exposed lanes first, each group in input order.
+  subroutine test_exposed_elements()
+    type(model_t) :: model
+    type(solid_block_t), allocatable :: blocks(:)
+    real(wp) :: coordinates(3, 64), time_step(block_size), rule(block_size)
+    integer :: connectivity(8, 27), i, j, k, lane, solid, outer_faces(27)
+    logical :: expected(27)
+    do k = 0, 3
+      do j = 0, 3
+        do i = 0, 3
+          coordinates(:, 1 + i + 4*j + 16*k) = [real(i, wp), real(j, wp), real(k, wp)]
+        end do
+      end do
+    end do
+    do k = 0, 2
+      do j = 0, 2
+        do i = 0, 2
+          solid = 1 + i + 3*j + 9*k
+          connectivity(:, solid) = 1 + [i + 4*j + 16*k, i + 1 + 4*j + 16*k, i + 1 + 4*(j + 1) + 16*k, &
+                                        i + 4*(j + 1) + 16*k, i + 4*j + 16*(k + 1), i + 1 + 4*j + 16*(k + 1), &
+                                        i + 1 + 4*(j + 1) + 16*(k + 1), i + 4*(j + 1) + 16*(k + 1)]
+          ! an element on two or three outer faces of the block is at an edge or a corner
+          outer_faces(solid) = count([i /= 1, j /= 1, k /= 1])
+        end do
+      end do
+    end do
+    expected = outer_faces >= 2
+    call make_model(model, coordinates, connectivity, elastic_steel(), 1, 1)
+    call build_solid_blocks(model, blocks)
+    call check(suite, "exposure: 20 of 27 exposed", blocks(1)%exposed_count == 20 .and. count(expected) == 20)
+    call check(suite, "exposure: exposed lanes first", all(blocks(1)%exposed(1:20)) .and. &
+               .not. any(blocks(1)%exposed(21:)))
+    call check(suite, "exposure: the corner and edge elements, in input order", &
+               all(expected(blocks(1)%elements(1:20))) .and. all(blocks(1)%elements(2:20) > blocks(1)%elements(1:19)))
+    call check(suite, "exposure: the others, in input order", .not. any(expected(blocks(1)%elements(21:27))) .and. &
+               all(blocks(1)%elements(22:27) > blocks(1)%elements(21:26)))
+    call solid_block_time_steps(blocks(1), model%materials(1), model%coordinates, time_step)
+    do lane = 1, 27
+      rule(lane) = lsdyna_step(coordinates(:, connectivity(:, blocks(1)%elements(lane))))
+    end do
+    call check_close(suite, "exposure: LS-DYNA's rule L / c inside and on flat faces", time_step(21:27), rule(21:27), &
+                     rel=1e-12_wp)
+    ! the volumetric mode of the free cube: 2 / omega = sqrt(rho / (3 lambda + 2 mu)) < 0.74 L / c
+    call check_close(suite, "exposure: the cube's bound at corners and edges", time_step(1:20), &
+                     [(sqrt(density/(3.0_wp*lame_lambda() + 2.0_wp*lame_mu())), lane=1, 20)], rel=1e-6_wp)
+  end subroutine test_exposed_elements
+
 
   !> Element results: volume-weighted stress over the Gauss points, mean plastic strain, written
   !> to the element's column.
