@@ -40,9 +40,14 @@ contains
 
   !> Install the handlers (once, before the run starts).
   subroutine catch_stop_signals()
-    call catch(signal_interrupt, c_funloc(on_stop_signal))
-    call catch(signal_terminate, c_funloc(on_stop_signal))
-    call catch(signal_user2, c_funloc(on_progress_signal))
+    type(c_funptr) :: stop_handler, progress_handler
+    ! (addresses taken at run time: as constant arguments they would sit in read-only data that
+    ! the position-independent executable must relocate)
+    stop_handler = c_funloc(on_stop_signal)
+    progress_handler = c_funloc(on_progress_signal)
+    call catch(signal_interrupt, stop_handler)
+    call catch(signal_terminate, stop_handler)
+    call catch(signal_user2, progress_handler)
   end subroutine catch_stop_signals
 
   !> Install `handler` for `number` unless the signal is ignored (SIG_IGN, the address 1), which

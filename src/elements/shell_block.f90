@@ -589,7 +589,9 @@ contains
     type(shell_block_t), intent(in) :: block
     type(material_t), intent(in) :: material
     integer, intent(in) :: i
-    real(wp), intent(in) :: area, xl(4), yl(4), b1(4), b2(4)
+    real(wp), intent(in) :: area
+    ! (assumed shape: the callers pass a lane's row of the block arrays without copying it)
+    real(wp), intent(in) :: xl(:), yl(:), b1(:), b2(:)
     real(wp), parameter :: h(4) = [1.0_wp, -1.0_wp, 1.0_wp, -1.0_wp]
     real(wp) :: g1(4), g2(4), gamma(4), mass(4), s11, s22, s12, t, youngs, nu, shear_modulus, plane_lambda
     real(wp) :: stiffness, omega2, damping, gamma_mass
@@ -645,7 +647,9 @@ contains
     type(shell_block_t), intent(in) :: block
     type(material_t), intent(in) :: material
     integer, intent(in) :: i
-    real(wp), intent(in) :: area, xl(4), yl(4), b1(4), b2(4)
+    real(wp), intent(in) :: area
+    ! (assumed shape: the callers pass a lane's row of the block arrays without copying it)
+    real(wp), intent(in) :: xl(:), yl(:), b1(:), b2(:)
     real(wp), parameter :: h(4) = [1.0_wp, -1.0_wp, 1.0_wp, -1.0_wp]
     real(wp) :: g1(4), g2(4), n(4), gamma(4), mass(4), inertia(4)
     real(wp) :: t, youngs, nu, shear_modulus, plane_lambda, norm_squared
@@ -815,7 +819,7 @@ contains
   !> Global components (xx, yy, zz, xy, yz, zx) of a local shell stress (xx, yy, xy, yz, zx;
   !> zz = 0): sigma = E^T s E with the rows of E the frame vectors.
   pure function global_stress(frame, local) result(stress)
-    real(wp), intent(in) :: frame(3, 3), local(5)
+    real(wp), intent(in) :: frame(:, :), local(:)   ! (3, 3), (5): assumed shape, passed without a copy
     real(wp) :: stress(6), s(3, 3), g(3, 3)
     s = reshape([local(1), local(3), local(5), local(3), local(2), local(4), local(5), local(4), 0.0_wp], [3, 3])
     g = matmul(transpose(frame), matmul(s, frame))
