@@ -2,7 +2,7 @@
 !>
 !> A parallel loop adds its terms into partial sums over fixed chunks of `sum_chunk_size`
 !> items (one chunk per iteration of the parallel loop, each summed in item order); the
-!> partial sums are then added in chunk order by `sum_in_order`. An OpenMP `reduction(+:...)`
+!> partial sums are then added in chunk order by `sum_in_order`. An OpenMP sum reduction
 !> instead adds in an order that follows the threads, so its last bits change with `ncpu`.
 module fixed_order_sum
   use kinds, only: wp
