@@ -90,6 +90,14 @@ module file_system
       integer(c_long) :: position
     end function c_lseek
 
+    !> ftruncate(2): with the file's own size it frees the blocks reserved beyond its end.
+    function c_ftruncate(descriptor, length) bind(c, name="ftruncate") result(status)
+      import :: c_int, c_long
+      integer(c_int), value :: descriptor
+      integer(c_long), value :: length
+      integer(c_int) :: status
+    end function c_ftruncate
+
     !> Linux fallocate(2).
     function c_fallocate(descriptor, mode, offset, length) bind(c, name="fallocate") result(status)
       import :: c_int, c_long
@@ -257,8 +265,10 @@ contains
     ignored = c_fclose(stream)
   end subroutine reserve_file_space
 
-  !> Give back what `reserve_file_space` reserved beyond the end of `path` and was not used
-  !> (a hole punched from the end of the file on), so a finished run occupies its size only.
+  !> Give back what `reserve_file_space` reserved beyond the end of `path` and was not used, so
+  !> a finished run occupies its size only: a hole punched from the end of the file on, and a
+  !> truncation to the file's own size, which frees blocks beyond the end on file systems whose
+  !> punch ignores them (ext4). The file's content and size do not change.
   subroutine release_file_space(path, bytes)
     character(len=*), intent(in) :: path
     integer(long_int), intent(in) :: bytes
@@ -270,9 +280,11 @@ contains
     stream = c_fopen(path//c_null_char, "r+"//c_null_char)
     if (.not. c_associated(stream)) return
     end_of_file = c_lseek(c_fileno(stream), 0_c_long, seek_end)
-    if (end_of_file >= 0) status = c_fallocate(c_fileno(stream), &
-                                               ior(fallocate_keep_size, fallocate_punch_hole), &
-                                               end_of_file, int(bytes, c_long))
+    if (end_of_file >= 0) then
+      status = c_fallocate(c_fileno(stream), ior(fallocate_keep_size, fallocate_punch_hole), end_of_file, &
+                           int(bytes, c_long))
+      status = c_ftruncate(c_fileno(stream), end_of_file)
+    end if
     status = c_fclose(stream)
   end subroutine release_file_space
 
@@ -299,7 +311,7 @@ contains
     type(c_ptr) :: pointer
     integer :: length, position
     pointer = c_strerror(int(number, c_int))
-    if (.not. c_associated(pointer, c_null_ptr)) then
+    if (c_associated(pointer)) then
       length = int(c_strlen(pointer))
       call c_f_pointer(pointer, characters, [length])
       allocate (character(len=length) :: text)

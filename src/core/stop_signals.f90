@@ -1,6 +1,8 @@
-!> SIGINT and SIGTERM end a run cleanly; SIGUSR2 asks for a progress line.
+!> SIGINT and SIGTERM end the time loop cleanly; SIGUSR2 asks for a progress line.
 !>
-!> A batch system's kill (SIGTERM) or a Ctrl-C (SIGINT) during a run sets a flag that the time
+!> The handlers are installed when the time loop starts (before, while the deck is read and the
+!> model set up, the signals keep their default action and end the process at once: nothing is
+!> written yet). A batch system's kill (SIGTERM) or a Ctrl-C (SIGINT) during the loop sets a flag that the time
 !> loop reads once per cycle: it finishes the cycle, writes the state, closes the results and
 !> ends with error termination (exit 1), so the results are complete up to that time. Further
 !> SIGINT or SIGTERM while that is done are the same request (a second Ctrl-C would otherwise

@@ -12,6 +12,7 @@ module deck_file_io
                                          c_char, c_ptr, c_null_ptr, c_null_char, c_associated, &
                                          c_size_t
   use, intrinsic :: iso_fortran_env, only: int64
+  use file_system, only: system_error_number
   implicit none
   private
 
@@ -38,8 +39,14 @@ module deck_file_io
     integer(c_int64_t) :: rest(24) = 0
   end type statx_t
 
-  !> statx arguments: paths relative to the working directory, the type and size wanted.
-  integer(c_int), parameter :: at_current_directory = -100, statx_type_and_size = 513
+  !> errno of an interrupted system call (EINTR, Linux).
+  integer, parameter :: interrupted_call = 4
+
+  !> statx arguments: paths relative to the working directory; the type, size and modification
+  !> time wanted (STATX_TYPE | STATX_MODE | STATX_SIZE | STATX_MTIME).
+  integer(c_int), parameter :: at_current_directory = -100, statx_type_and_size = 577
+  !> struct statx's stx_mtime (seconds, then nanoseconds) is at byte 112: rest(7) and rest(8).
+  integer, parameter :: modification_seconds = 7, modification_nanoseconds = 8
   !> File type bits of a mode (S_IFMT) and their values.
   integer, parameter :: type_bits = int(o'170000'), type_regular = int(o'100000'), &
                         type_directory = int(o'040000'), type_fifo = int(o'010000'), &
@@ -89,18 +96,23 @@ module deck_file_io
 contains
 
   !> The kind of file `path` names (symbolic links followed) and, for a regular file, its
-  !> size in bytes.
-  subroutine inspect_file(path, kind, size)
+  !> size in bytes and its modification time (nanoseconds since 1970, to see whether the file
+  !> changed while the deck was read).
+  subroutine inspect_file(path, kind, size, modified)
     character(len=*), intent(in) :: path
     integer, intent(out) :: kind
     integer(int64), intent(out) :: size
+    integer(int64), intent(out), optional :: modified
     type(statx_t) :: status_buffer
     integer :: file_type
 
     kind = file_missing
     size = 0
+    if (present(modified)) modified = 0
     if (c_statx(at_current_directory, path//c_null_char, 0_c_int, statx_type_and_size, &
                 status_buffer) /= 0) return
+    if (present(modified)) modified = status_buffer%rest(modification_seconds)*1000000000_int64 + &
+                                      iand(status_buffer%rest(modification_nanoseconds), 4294967295_int64)
     file_type = iand(iand(int(status_buffer%mode), 65535), type_bits)
     select case (file_type)
     case (type_regular)
@@ -128,22 +140,32 @@ contains
   end subroutine open_file
 
   !> Read up to len(buffer) bytes from byte `offset` (0 = the first byte) of the file into
-  !> `buffer`; `count` is the number read (0 at the end of the file or on a read error).
-  subroutine read_bytes(handle, offset, buffer, count)
+  !> `buffer`; `count` is the number read (fewer at the end of the file). A read error other
+  !> than an interruption sets `failed` (the bytes read before it are kept).
+  subroutine read_bytes(handle, offset, buffer, count, failed)
     type(file_handle_t), intent(in) :: handle
     integer(int64), intent(in) :: offset
     character(len=*), intent(inout) :: buffer
     integer, intent(out) :: count
+    logical, intent(out), optional :: failed
     integer(c_long) :: bytes
-    integer :: filled
+    integer :: filled, interruptions
 
     ! pread may return fewer bytes than asked (signals, some file systems): read on until the
-    ! buffer is full or the file ends.
+    ! buffer is full or the file ends; an interrupted call (EINTR) is tried again.
     filled = 0
+    interruptions = 0
+    if (present(failed)) failed = .false.
     do while (filled < len(buffer))
       bytes = c_pread(handle%descriptor, buffer(filled + 1:), &
                       int(len(buffer) - filled, c_size_t), int(offset + filled, c_long))
-      if (bytes <= 0) exit
+      if (bytes == 0) exit
+      if (bytes < 0) then
+        interruptions = interruptions + 1
+        if (system_error_number() == interrupted_call .and. interruptions < 100) cycle
+        if (present(failed)) failed = .true.
+        exit
+      end if
       filled = filled + int(bytes)
     end do
     count = filled

@@ -24,7 +24,7 @@ module deck_lexer
   implicit none
   private
 
-  public :: deck_t, keyword_block_t, deck_parameter_t, load_deck, release_deck
+  public :: deck_t, keyword_block_t, deck_parameter_t, load_deck, check_files_unchanged, release_deck
   public :: line_location, find_parameter, trim_blanks, is_blank_line, card_text, block_of_line
   public :: load_line_text
 
@@ -35,6 +35,7 @@ module deck_lexer
   type :: source_file_t
     character(len=:), allocatable :: path      !< as opened (include paths resolved)
     integer(int64) :: size = 0                 !< bytes
+    integer(int64) :: modified = 0             !< modification time when scanned (ns since 1970)
   end type source_file_t
 
   !> One keyword and its data lines (indices into the line table; none when last < first).
@@ -189,15 +190,15 @@ contains
     character(len=:), allocatable :: buffer
     integer(int64) :: buffer_start
     integer :: filled, position, newline, remainder, count
-    logical :: end_of_file, unusual
+    logical :: end_of_file, unusual, read_failed
 
     call open_source(deck, path, include_line, state%file, handle, log, warnings)
     if (state%file == 0) return
     state%file_format = format
     allocate (character(len=scan_chunk + max_line_length) :: buffer)
     buffer_start = 0
-    call read_bytes(handle, buffer_start, buffer(1:scan_chunk), filled)
-    end_of_file = filled < scan_chunk
+    call read_bytes(handle, buffer_start, buffer(1:scan_chunk), filled, read_failed)
+    end_of_file = filled < scan_chunk .or. read_failed
     call check_file_start(deck, path, include_line, buffer(1:filled), position, state%ended, &
                           log)
     if (include_line == 0) deck%main_file_read = .not. state%ended
@@ -223,7 +224,7 @@ contains
         exit
       end if
       remainder = filled - position + 1
-      if (remainder >= max_line_length) then
+      if (remainder > max_line_length) then
         call skip_long_line(deck, handle, buffer, buffer_start, position, filled, &
                             end_of_file, state, log)
         cycle
@@ -233,11 +234,22 @@ contains
       buffer_start = buffer_start + (position - 1)
       position = 1
       call read_bytes(handle, buffer_start + remainder, buffer(remainder + 1:remainder + &
-                      scan_chunk), count)
+                      scan_chunk), count, read_failed)
       filled = remainder + count
-      end_of_file = count < scan_chunk
+      end_of_file = count < scan_chunk .or. read_failed
     end do
     call close_file(handle)
+    ! a read error, or a file that changed size while it was scanned, must not leave a silently
+    ! shorter deck
+    if (read_failed) then
+      call report_problem(log, deck%files(state%file)%path//": a read error after "// &
+                          byte_text(buffer_start + filled)//" of its "//byte_text(deck%files(state%file)%size)// &
+                          " bytes", unreadable=.true.)
+    else if (buffer_start + filled /= deck%files(state%file)%size) then
+      call report_problem(log, deck%files(state%file)%path//": it changed while it was read ("// &
+                          byte_text(buffer_start + filled)//" bytes read, "// &
+                          byte_text(deck%files(state%file)%size)//" expected); run again", unreadable=.true.)
+    end if
     deallocate (buffer)
     call close_block(deck, state%file, state%file_format, chain, state%block, log, warnings)
     call report_file_totals(deck, state, log)
@@ -254,11 +266,11 @@ contains
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
     integer :: kind
-    integer(int64) :: file_size
+    integer(int64) :: file_size, modified
     logical :: opened
 
     file = 0
-    call inspect_file(path, kind, file_size)
+    call inspect_file(path, kind, file_size, modified)
     select case (kind)
     case (file_missing)
       call source_problem(deck, path, include_line, "does not exist (or a directory on its "// &
@@ -302,6 +314,7 @@ contains
     file = deck%file_count
     deck%files(file)%path = path
     deck%files(file)%size = file_size
+    deck%files(file)%modified = modified
   end subroutine open_source
 
   !> A file that cannot be read: `path: what` for the main deck, at the *INCLUDE card for an
@@ -931,6 +944,7 @@ contains
     do k = 1, deck%file_count
       call move_alloc(deck%files(k)%path, larger(k)%path)
       larger(k)%size = deck%files(k)%size
+      larger(k)%modified = deck%files(k)%modified
     end do
     call move_alloc(larger, deck%files)
   end subroutine grow_files
@@ -1072,6 +1086,31 @@ contains
     window%length = 0
     if (window%file == file) call read_bytes(window%handle, start, window%buffer, window%length)
   end subroutine fill_window
+
+  !> Whether any file of the deck changed (size or modification time) since it was scanned: its
+  !> cards, read again at their byte offsets, would no longer be the ones scanned. Checked after
+  !> the keyword readers ran; a changed file is reported and the deck refused.
+  subroutine check_files_unchanged(deck, log)
+    type(deck_t), intent(in) :: deck
+    type(problem_log_t), intent(inout) :: log
+    integer :: file, kind
+    integer(int64) :: size, modified
+    do file = 1, deck%file_count
+      call inspect_file(deck%files(file)%path, kind, size, modified)
+      if (kind == file_regular .and. size == deck%files(file)%size .and. modified == deck%files(file)%modified) cycle
+      call report_problem(log, deck%files(file)%path//": the file changed (or went away) while the deck was "// &
+                          "read; run again once it is written", unreadable=.true.)
+    end do
+  end subroutine check_files_unchanged
+
+  !> A byte count or offset as text.
+  pure function byte_text(value) result(text)
+    integer(int64), intent(in) :: value
+    character(len=:), allocatable :: text
+    character(len=24) :: buffer
+    write (buffer, '(i0)') value
+    text = trim(buffer)
+  end function byte_text
 
   !> Position of the first character that is neither blank nor tab (0 if none).
   pure integer function first_nonblank(text)

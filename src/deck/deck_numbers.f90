@@ -169,6 +169,11 @@ contains
       if (status /= number_ok) return
       value = abs(value)
     end if
+    if (value > 1.0e30_wp) then      ! 1e30 < value < 1e31 passed the magnitude test above
+      value = 0.0_wp
+      status = number_out_of_range
+      return
+    end if
     if (negative) value = -value
     status = number_ok
   end subroutine parse_real

@@ -16,7 +16,7 @@ module deck_reader
   use deck_problems, only: problem_log_t, report_problem, has_problems, problems_to_error, &
                            printable
   use deck_numbers, only: integer_text
-  use deck_lexer, only: deck_t, load_deck, release_deck, line_location
+  use deck_lexer, only: deck_t, load_deck, release_deck, line_location, check_files_unchanged
   use deck_keywords, only: keyword_t, identify_keyword, suggest_keyword, keyword_count, &
     keyword_unknown, keyword_title, keyword_node, keyword_element_solid, keyword_part, &
     keyword_section_solid, keyword_section_solid_efg, keyword_mat_elastic, &
@@ -89,6 +89,7 @@ contains
     do block = 1, deck%block_count
       call read_block(deck, block, keywords(block), input, log, warnings)
     end do
+    call check_files_unchanged(deck, log)
     if (.not. log%unreadable) call check_and_build(deck, input, model, log, warnings)
     call release_deck(deck)
     if (has_problems(log)) then

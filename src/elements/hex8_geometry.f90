@@ -354,7 +354,7 @@ contains
     real(wp), intent(out) :: dndx(block_size, 8), dndy(block_size, 8), dndz(block_size, 8)
     real(wp), intent(out) :: determinant(block_size)
     real(wp) :: j11, j12, j13, j21, j22, j23, j31, j32, j33
-    real(wp) :: i11, i12, i13, i21, i22, i23, i31, i32, i33, inverse_determinant, size
+    real(wp) :: i11, i12, i13, i21, i22, i23, i31, i32, i33, inverse_determinant, largest_entry
     integer :: node, i
 
     do i = 1, nel
@@ -385,8 +385,8 @@ contains
       i33 = j11*j22 - j12*j21
       determinant(i) = j11*i11 + j12*i21 + j13*i31
       ! a flattened point keeps finite derivatives: det J ~ (largest |J_ka|)^3, floored at 1e-15 of it
-      size = max(abs(j11), abs(j12), abs(j13), abs(j21), abs(j22), abs(j23), abs(j31), abs(j32), abs(j33))
-      inverse_determinant = 1.0_wp/sign(max(abs(determinant(i)), 1.0e-15_wp*size**3, tiny(1.0_wp)), determinant(i))
+      largest_entry = max(abs(j11), abs(j12), abs(j13), abs(j21), abs(j22), abs(j23), abs(j31), abs(j32), abs(j33))
+      inverse_determinant = 1.0_wp/sign(max(abs(determinant(i)), 1.0e-15_wp*largest_entry**3, tiny(1.0_wp)), determinant(i))
       ! dN_I/dx_k = sum_a dN_I/dxi_a (J^-1)_ak
       do node = 1, 8
         dndx(i, node) = (natural(node, 1)*i11 + natural(node, 2)*i21 + natural(node, 3)*i31)*inverse_determinant

@@ -366,7 +366,7 @@ contains
     real(wp) :: inverse(block_size, 9)
     real(wp) :: j11, j12, j13, j21, j22, j23, j31, j32, j33
     real(wp) :: i11, i12, i13, i21, i22, i23, i31, i32, i33
-    real(wp) :: determinant, scale, px, py, pz, c1, c2, c3, size
+    real(wp) :: determinant, scale, px, py, pz, c1, c2, c3, largest_entry
     integer :: node, mode, i
 
     do i = 1, nel
@@ -403,8 +403,8 @@ contains
       ! J^-1 / 8 = (8 J)^-1, kept finite for inverted elements (reported by the caller)
       ! (a flattened element keeps finite shape vectors: det(8 J) ~ (largest |8 J_ka|)^3, floored
       ! at 1e-12 of it)
-      size = max(abs(j11), abs(j12), abs(j13), abs(j21), abs(j22), abs(j23), abs(j31), abs(j32), abs(j33))
-      scale = 1.0_wp/sign(max(abs(determinant), 1.0e-12_wp*size**3, tiny(1.0_wp)), determinant)
+      largest_entry = max(abs(j11), abs(j12), abs(j13), abs(j21), abs(j22), abs(j23), abs(j31), abs(j32), abs(j33))
+      scale = 1.0_wp/sign(max(abs(determinant), 1.0e-12_wp*largest_entry**3, tiny(1.0_wp)), determinant)
       inverse(i, 1) = i11*scale
       inverse(i, 2) = i12*scale
       inverse(i, 3) = i13*scale

@@ -400,9 +400,9 @@ contains
   !> pumps energy into it: a single hexahedron at nu = 0 went unstable that way at TSSFAC 0.9
   !> when the bound counted the element's full bulk damping, a 17% alternation; over three
   !> cycles the smallest step holds still while the element rings). inverted_element: 0, or the
-  !> model solid index of the
-  !> first element whose volume (ELFORM 2: any Gauss point Jacobian) is <= 0; the state of the
-  !> block is then not meaningful and the solver should stop. Allocates nothing.
+  !> model solid index of the first element whose volume (ELFORM 2: any Gauss point Jacobian)
+  !> is <= 0; the state of the block is then not meaningful and the solver should stop.
+  !> Allocates nothing.
   subroutine compute_solid_block(block, material, coordinates, velocities, dt, corner_force, &
                                  critical_time_step, critical_element, inverted_element)
     type(solid_block_t), intent(inout) :: block

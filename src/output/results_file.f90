@@ -100,7 +100,7 @@ module results_file
     integer :: xdmf_writes = 0                    !< times the XDMF file was written
     real(wp) :: xdmf_written_at = 0.0_wp          !< wall clock (s) of its last writing
     real(wp) :: xdmf_seconds = 0.0_wp             !< how long that took
-    integer :: xdmf_bytes = 0                     !< size of the last XDMF file built
+    integer(long_int) :: xdmf_bytes = 0           !< size of the last XDMF file built
     integer(long_int) :: output_bytes = 0         !< bytes of state and history values written
     integer(long_int) :: reserved_bytes = 0       !< largest reservation asked for beyond the end
     integer(long_int) :: reserved_end = 0         !< end of the disk space reserved (0: none)
@@ -440,8 +440,11 @@ contains
     type(error_t), allocatable :: problem
     character(len=:), allocatable :: final_status
     integer :: status
+    logical :: failed_before
 
     if (.not. results%is_open) return
+    ! a failure that happens first here has no run error to report it: keep its reason
+    failed_before = results%failed
     ! The XDMF first, so that /timing counts it; it lists the complete states only.
     if (results%xdmf_state_count /= results%state_count .or. results%xdmf_writes == 0) &
       call write_xdmf_now(results, problem)
@@ -477,10 +480,11 @@ contains
     results%is_open = .false.
     results%file_id = -1
 
-    ! After any failure, what the user has: the run's own error said what went wrong first.
+    ! After any failure, what the user has; the reason too unless the run's own error said what
+    ! went wrong first (a failure during the run).
     if (allocated(problem) .or. results%failed) then
       call make_error(error, "")
-      if (allocated(problem) .and. .not. results%failed) error%message = problem%message//"; "
+      if (allocated(problem) .and. .not. failed_before) error%message = problem%message//"; "
       error%message = error%message//results%h5_path//" keeps "//state_range(results%state_count)// &
                       " with /run status """//final_status//""", "//results%xdmf_path//" lists "// &
                       state_range(results%xdmf_state_count)
@@ -581,9 +585,12 @@ contains
     if (allocated(xdmf_error)) then
       ! The previous XDMF file is still there, complete; the .h5 is not affected.
       results%failed = .true.
-      if (disk_full()) xdmf_error%message = lower_reason()//" while writing "//results%xdmf_path// &
-        " after state "//integer_text(results%state_count - 1)//" at time "// &
-        real_text(results%state_times(results%state_count))
+      if (disk_full() .and. results%state_count > 0) then
+        xdmf_error%message = lower_reason()//" while writing "//results%xdmf_path//" after state "// &
+          integer_text(results%state_count - 1)//" at time "//real_text(results%state_times(results%state_count))
+      else if (disk_full()) then
+        xdmf_error%message = lower_reason()//" while writing "//results%xdmf_path//" before any state"
+      end if
       if (.not. allocated(error)) call move_alloc(xdmf_error, error)
       return
     end if

@@ -28,6 +28,7 @@
 !>   `shell_plastic_strain_peak`, `shell_id` and `part_id`;
 !> - a model with neither (not produced by the solver today) still opens, as points.
 module xdmf_writer
+  use, intrinsic :: iso_fortran_env, only: int64
   use kinds, only: wp
   use error_handling, only: error_t, make_error
   use file_system, only: write_text_file, rename_file, remove_file
@@ -42,7 +43,7 @@ module xdmf_writer
   !> The XML text being built; written to the file in one piece at the end (see write_xdmf).
   type :: xml_output_t
     character(len=:), allocatable :: text
-    integer :: length = 0                 !< characters of `text` in use
+    integer(int64) :: length = 0          !< characters of `text` in use (a million states pass 2**31)
   end type xml_output_t
 
 contains
@@ -51,8 +52,10 @@ contains
   !> The HDF5 writer uses it too, so the names in both files agree.
   pure function state_group_name(state_index) result(name)
     integer, intent(in) :: state_index
-    character(len=6) :: name
-    write (name, '(i6.6)') state_index - 1
+    character(len=:), allocatable :: name
+    character(len=16) :: buffer
+    write (buffer, '(i0.6)') state_index - 1   ! six digits, more from the millionth state on
+    name = trim(buffer)
   end function state_group_name
 
   !> Write (replace) the XDMF file `xdmf_path` describing the states whose times are given.
@@ -65,13 +68,13 @@ contains
     integer, intent(in) :: node_count, solid_count, shell_count
     real(wp), intent(in) :: state_times(:)         !< time of each state written so far
     type(error_t), allocatable, intent(out) :: error
-    integer, intent(out), optional :: bytes        !< size of the file (written or not)
+    integer(int64), intent(out), optional :: bytes !< size of the file (written or not)
     type(xml_output_t) :: output
     character(len=:), allocatable :: temporary_path
     integer :: state_index
 
     ! About 2 kB per state (3 kB with solids and shells), whatever the mesh.
-    allocate (character(len=4096 + 2048*size(state_times)) :: output%text)
+    allocate (character(len=4096_int64 + 2048_int64*size(state_times)) :: output%text)
     call write_line(output, '<?xml version="1.0" encoding="utf-8"?>')
     call write_line(output, '<Xdmf Version="3.0" xmlns:xi="http://www.w3.org/2001/XInclude">')
     call write_line(output, '  <Domain>')
@@ -249,8 +252,8 @@ contains
     type(xml_output_t), intent(inout) :: output
     character(len=*), intent(in) :: line
     character(len=:), allocatable :: grown
-    if (output%length + len(line) + 1 > len(output%text)) then
-      allocate (character(len=2*len(output%text) + len(line) + 1) :: grown)
+    if (output%length + len(line) + 1 > len(output%text, int64)) then
+      allocate (character(len=2_int64*len(output%text, int64) + len(line) + 1) :: grown)
       grown(1:output%length) = output%text(1:output%length)
       call move_alloc(grown, output%text)
     end if

@@ -1,7 +1,7 @@
 !> Energies of the whole model and of each part (glstat, matsum), summed in a fixed order.
 module energy_balance
   use kinds, only: wp, block_size
-  use fixed_order_sum, only: sum_chunk_size, chunk_count
+  use fixed_order_sum, only: sum_chunk_size
   use model, only: model_t
   use explicit_state, only: explicit_state_t
   use rigid_bodies, only: rigid_body_energy
@@ -12,8 +12,6 @@ module energy_balance
 
 contains
 
-  !> Kinetic energy and momentum at the integer step and the sums of the element energies.
-  !>
   !> Kinetic energy and momentum at the integer step and the sums of the element energies.
   !>
   !> Central differences conserve 1/2 m v^{n-1/2} . v^{n+1/2} plus the strain energy exactly for
@@ -30,7 +28,7 @@ contains
     type(explicit_state_t), intent(inout) :: state
     real(wp) :: body_kinetic, body_momentum(3), body_angular_momentum(3), body_velocity(3)
     integer :: chunk, first, last, node, b, k
-    real(wp) :: partial(5, chunk_count(state%node_count)), velocity(3)
+    real(wp) :: velocity(3)
     real(wp) :: half_step, average_step, step_correction
 
     half_step = 0.5_wp*state%time_step
@@ -38,31 +36,33 @@ contains
     ! the elements book the newest forces' work with the step just taken; the kinetic energy
     ! above uses the mean of that step and the next (see solid_block)
     step_correction = 0.25_wp*(state%next_time_step - state%time_step)
-    !$omp parallel do schedule(static) default(shared) private(chunk, first, last, node, velocity)
-    do chunk = 1, size(partial, 2)
-      first = (chunk - 1)*sum_chunk_size + 1
-      last = min(chunk*sum_chunk_size, state%node_count)
-      partial(:, chunk) = 0.0_wp
-      do node = first, last
-        if (state%is_rigid_node(node)) cycle   ! moves with its body (below)
-        call add_kinetic_energy(state%mass(node), state%velocity(:, node), state%acceleration(:, node), &
-                                average_step, partial(1, chunk), partial(5, chunk))
-        if (state%rotary_inertia(node) > 0.0_wp) &
-          call add_kinetic_energy(state%rotary_inertia(node), state%angular_velocity(:, node), &
-                                  state%angular_acceleration(:, node), average_step, partial(1, chunk), partial(5, chunk))
-        velocity = state%velocity(:, node) + half_step*state%acceleration(:, node)
-        partial(2:4, chunk) = partial(2:4, chunk) + state%mass(node)*velocity
+    associate (partial => state%chunk_sums)
+      !$omp parallel do schedule(static) default(shared) private(chunk, first, last, node, velocity)
+      do chunk = 1, size(partial, 2)
+        first = (chunk - 1)*sum_chunk_size + 1
+        last = min(chunk*sum_chunk_size, state%node_count)
+        partial(:, chunk) = 0.0_wp
+        do node = first, last
+          if (state%is_rigid_node(node)) cycle   ! moves with its body (below)
+          call add_kinetic_energy(state%mass(node), state%velocity(:, node), state%acceleration(:, node), &
+                                  average_step, partial(1, chunk), partial(5, chunk))
+          if (state%rotary_inertia(node) > 0.0_wp) &
+            call add_kinetic_energy(state%rotary_inertia(node), state%angular_velocity(:, node), &
+                                    state%angular_acceleration(:, node), average_step, partial(1, chunk), partial(5, chunk))
+          velocity = state%velocity(:, node) + half_step*state%acceleration(:, node)
+          partial(2:4, chunk) = partial(2:4, chunk) + state%mass(node)*velocity
+        end do
       end do
-    end do
-    !$omp end parallel do
-    state%energy%kinetic = 0.0_wp
-    state%energy%momentum = 0.0_wp
-    state%energy%internal = 0.0_wp
-    do chunk = 1, size(partial, 2)
-      state%energy%kinetic = state%energy%kinetic + partial(1, chunk)
-      state%energy%momentum = state%energy%momentum + partial(2:4, chunk)
-      state%energy%internal = state%energy%internal + partial(5, chunk)
-    end do
+      !$omp end parallel do
+      state%energy%kinetic = 0.0_wp
+      state%energy%momentum = 0.0_wp
+      state%energy%internal = 0.0_wp
+      do chunk = 1, size(partial, 2)
+        state%energy%kinetic = state%energy%kinetic + partial(1, chunk)
+        state%energy%momentum = state%energy%momentum + partial(2:4, chunk)
+        state%energy%internal = state%energy%internal + partial(5, chunk)
+      end do
+    end associate
     ! rigid bodies: translation and rotation of each body
     do b = 1, size(state%rigid)
       call rigid_body_energy(model, b, state%rigid(b), state%acceleration, state%mass, half_step, average_step, &

@@ -2,6 +2,7 @@
 !> masses, the node -> corner gather list, the initial state and the first stable time step.
 module explicit_setup
   use kinds, only: wp, block_size
+  use fixed_order_sum, only: chunk_count
   use error_handling, only: error_t, make_error
   use block_colouring, only: colour_blocks_by_nodes
   use model, only: model_t, formulation_efg, boundary_full_transformation, integration_gauss_conventional
@@ -73,6 +74,7 @@ contains
     allocate (state%shell_normal_sum(3, node_count), state%shell_area_sum(node_count))
     state%shell_normal_sum = 0.0_wp
     state%shell_area_sum = 0.0_wp
+    allocate (state%chunk_sums(5, chunk_count(node_count)))
 
     call scale_masses(model, state)
     call colour_blocks(state)

@@ -3,7 +3,7 @@
 !> external loads -> accelerations -> next time step -> output.
 module explicit_solver
   use kinds, only: wp
-  use fixed_order_sum, only: sum_chunk_size, chunk_count, sum_in_order
+  use fixed_order_sum, only: sum_chunk_size, sum_in_order
   use error_handling, only: error_t, make_error
   use model, only: model_t
   use explicit_state, only: explicit_state_t
@@ -276,30 +276,31 @@ contains
     real(wp), intent(out) :: work
     real(wp), parameter :: coplanar = 0.94_wp   ! cos 20 degrees
     real(wp) :: normal(3), length, drilling, previous(3)
-    real(wp) :: partial(chunk_count(state%node_count))
     integer :: node, chunk
     ! the work is summed over fixed chunks of nodes, then chunk by chunk: the same sum for any
     ! thread count (an OpenMP reduction would add in an order that depends on it)
-    !$omp parallel do schedule(static) default(shared) private(chunk, node, normal, length, drilling, previous)
-    do chunk = 1, size(partial)
-      partial(chunk) = 0.0_wp
-      do node = (chunk - 1)*sum_chunk_size + 1, min(chunk*sum_chunk_size, state%node_count)
-        if (state%rotary_inertia(node) <= 0.0_wp .or. state%shell_area_sum(node) <= 0.0_wp) cycle
-        length = norm2(state%shell_normal_sum(:, node))
-        if (length < coplanar*state%shell_area_sum(node)) cycle
-        ! within the rotations an SPC leaves free (fixed ones stay zero)
-        normal = merge(0.0_wp, state%shell_normal_sum(:, node)/length, state%fixed_rotation(:, node))
-        length = dot_product(normal, normal)
-        if (length < 0.25_wp) cycle
-        normal = normal/sqrt(length)
-        drilling = dot_product(state%angular_velocity(:, node), normal)
-        previous = state%angular_velocity(:, node) - average_step*state%angular_acceleration(:, node)
-        state%angular_velocity(:, node) = state%angular_velocity(:, node) - drilling*normal
-        partial(chunk) = partial(chunk) - 0.5_wp*state%rotary_inertia(node)*drilling*dot_product(previous, normal)
+    associate (partial => state%chunk_sums(1, :))
+      !$omp parallel do schedule(static) default(shared) private(chunk, node, normal, length, drilling, previous)
+      do chunk = 1, size(partial)
+        partial(chunk) = 0.0_wp
+        do node = (chunk - 1)*sum_chunk_size + 1, min(chunk*sum_chunk_size, state%node_count)
+          if (state%rotary_inertia(node) <= 0.0_wp .or. state%shell_area_sum(node) <= 0.0_wp) cycle
+          length = norm2(state%shell_normal_sum(:, node))
+          if (length < coplanar*state%shell_area_sum(node)) cycle
+          ! within the rotations an SPC leaves free (fixed ones stay zero)
+          normal = merge(0.0_wp, state%shell_normal_sum(:, node)/length, state%fixed_rotation(:, node))
+          length = dot_product(normal, normal)
+          if (length < 0.25_wp) cycle
+          normal = normal/sqrt(length)
+          drilling = dot_product(state%angular_velocity(:, node), normal)
+          previous = state%angular_velocity(:, node) - average_step*state%angular_acceleration(:, node)
+          state%angular_velocity(:, node) = state%angular_velocity(:, node) - drilling*normal
+          partial(chunk) = partial(chunk) - 0.5_wp*state%rotary_inertia(node)*drilling*dot_product(previous, normal)
+        end do
       end do
-    end do
-    !$omp end parallel do
-    work = sum_in_order(partial)
+      !$omp end parallel do
+      work = sum_in_order(partial)
+    end associate
   end subroutine remove_drilling_rates
 
   !> v^{n+1/2} = v^{n-1/2} + a^n (dt^{n-1/2} + dt^{n+1/2}) / 2, and the same for the angular
@@ -329,6 +330,16 @@ contains
     end do
     !$omp end parallel do
   end subroutine update_positions
+
+  !> Whether a meshfree block's stable step is NaN (the comparisons that find the smallest skip it).
+  logical function meshfree_step_not_a_number(state)
+    type(explicit_state_t), intent(in) :: state
+    integer :: k
+    meshfree_step_not_a_number = .false.
+    do k = 1, size(state%efg)
+      if (any(state%efg(k)%block_time_step /= state%efg(k)%block_time_step)) meshfree_step_not_a_number = .true.
+    end do
+  end function meshfree_step_not_a_number
 
   !> Next step: TSSFAC times the smallest stable element step, cut so that the last step ends
   !> at ENDTIM (never below |DT2MS| times TSSFAC
@@ -374,7 +385,8 @@ contains
       state%next_time_step = min(state%next_time_step, model%initial_time_step)
     ! a step that no element set, or a NaN that the comparisons above skipped, is not a step
     if (smallest >= huge(1.0_wp) .or. any(state%block_time_step /= state%block_time_step) .or. &
-        any(state%shell_time_step /= state%shell_time_step)) then
+        any(state%shell_time_step /= state%shell_time_step) .or. &
+        state%rigid_time_step /= state%rigid_time_step .or. meshfree_step_not_a_number(state)) then
       state%next_time_step = -huge(1.0_wp)
       state%stable_time_step = -huge(1.0_wp)
     end if

@@ -111,6 +111,8 @@ module explicit_state
     logical, allocatable :: is_rigid_node(:)
     real(wp) :: rigid_time_step = huge(1.0_wp)           !< smallest stable step of the rigid elements
     ! bookkeeping
+    real(wp), allocatable :: chunk_sums(:, :)            !< (5, chunks of nodes): scratch of the fixed-order
+                                                         !< sums (fixed_order_sum), allocated once
     type(energy_totals_t) :: energy
     type(run_watch_t) :: watch
     real(wp) :: added_mass = 0.0_wp                      !< by mass scaling

@@ -44,8 +44,6 @@ contains
 
     started = seconds_now()
     exit_status = 2
-    ! from here on SIGINT / SIGTERM end the run after a cycle, with the results written
-    call catch_stop_signals()
     if (allocated(options%restart_file)) then
       write (error_unit, '(a)') "crashfree: r=: restarts are not supported yet"
       return
@@ -86,6 +84,10 @@ contains
     if (model%implicit_static) then
       call run_static(model, results, summary, error)
     else
+      ! from here on SIGINT / SIGTERM end the run after a cycle, with the results written (before,
+      ! while the deck is read and the model set up, they end the process at once: nothing has
+      ! been written yet, and a previous results file of the job is still whole)
+      call catch_stop_signals()
       call run_explicit(model, state, results, summary, error)
     end if
 

@@ -19,6 +19,7 @@
 !> - A falling time step is reported at every tenth of its first value it passes, naming the
 !>   element that sets it.
 module run_checks
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp
   use error_handling, only: error_t, make_error
   use model, only: model_t, law_null
@@ -148,6 +149,7 @@ contains
     !$omp parallel do schedule(static) default(shared) private(node, speed) &
     !$omp& reduction(min:first, first_turning)
     do node = 1, state%node_count
+      if (state%is_rigid_node(node)) cycle   ! moves with its body (check_rigid_body_rotation)
       speed = abs(state%velocity(:, node) + average_step*state%acceleration(:, node))
       if (beyond(speed, limit)) first = min(first, node)
       speed = abs(state%angular_velocity(:, node) + average_step*state%angular_acceleration(:, node))
@@ -206,6 +208,14 @@ contains
     end do
   end subroutine check_rigid_body_rotation
 
+  !> Whether x is finite and above zero, without an ordered comparison on NaN (which raises the
+  !> invalid-operation flag that the checked build traps).
+  elemental logical function positive_finite(x)
+    real(wp), intent(in) :: x
+    positive_finite = .false.
+    if (ieee_is_finite(x)) positive_finite = x > 0.0_wp .and. x < huge(1.0_wp)
+  end function positive_finite
+
   !> Whether a speed is NaN or above the limit. NaN is tested first, with the quiet comparison
   !> (/=): an ordered comparison with NaN raises the invalid-operation flag, which the checked
   !> build traps.
@@ -251,8 +261,8 @@ contains
     end do
     ! rigid bodies set no element step: their motion must be finite too
     do b = 1, size(state%rigid)
-      if (all(abs(state%rigid(b)%velocity) < huge(1.0_wp)) .and. &
-          all(abs(state%rigid(b)%angular_velocity) < huge(1.0_wp))) cycle
+      if (all(ieee_is_finite(state%rigid(b)%velocity)) .and. all(ieee_is_finite(state%rigid(b)%angular_velocity))) &
+        cycle
       call make_error(error, "the motion of rigid body "//integer_text(model%rigid_bodies(b)%id)// &
                       " is no longer finite"//time_text(state))
       return
@@ -274,7 +284,8 @@ contains
 
     associate (watch => state%watch)
       step = model%time_step_scale*stable_step
-      if (.not. (stable_step > 0.0_wp .and. step < huge(1.0_wp) .and. state%next_time_step >= 0.0_wp)) then
+      if (.not. (positive_finite(stable_step) .and. positive_finite(step) .and. &
+                 (positive_finite(state%next_time_step) .or. state%next_time_step == 0.0_wp))) then
         call make_error(error, "no finite stable time step ("//step_setter(model, state)//")"//time_text(state))
         return
       end if
@@ -340,7 +351,7 @@ contains
     associate (watch => state%watch)
       watch%largest_energy_supplied = max(watch%largest_energy_supplied, abs(state%energy%initial_total), &
                                           abs(state%energy%external_work), abs(supplied))
-      if (.not. (abs(total) < huge(1.0_wp) .and. abs(supplied) < huge(1.0_wp))) then
+      if (.not. (ieee_is_finite(total) .and. ieee_is_finite(supplied))) then
         call make_error(error, "the energies are no longer finite ("//energy_text(state)//")"//time_text(state))
         return
       end if
@@ -396,18 +407,18 @@ contains
       text = "set by "//describe_element(model, state%controlling_element)
       return
     end if
-    if (state%stable_time_step > 0.0_wp .and. state%stable_time_step < huge(1.0_wp)) then
+    if (positive_finite(state%stable_time_step)) then
       text = "set by the elements of the rigid bodies"
       return
     end if
     do b = 1, size(state%blocks)
-      if (.not. (state%block_time_step(b) < huge(1.0_wp))) then
+      if (.not. positive_finite(state%block_time_step(b))) then
         text = "the step of the block of "//describe_element(model, state%blocks(b)%elements(1))//" is not finite"
         return
       end if
     end do
     do b = 1, size(state%shells)
-      if (.not. (state%shell_time_step(b) < huge(1.0_wp))) then
+      if (.not. positive_finite(state%shell_time_step(b))) then
         text = "the step of the block of "//describe_element(model, -state%shells(b)%elements(1))//" is not finite"
         return
       end if

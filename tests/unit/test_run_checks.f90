@@ -56,6 +56,7 @@ contains
     allocate (state%blocks(0), state%shells(0), state%efg(0), state%rigid(0), state%walls(0))
     allocate (state%block_time_step(0), state%shell_time_step(0), state%is_rigid_node(2), state%mass(2), &
               state%rotary_inertia(2))
+    allocate (state%chunk_sums(5, 1))
     state%is_rigid_node = .false.
     state%mass = 1.0_wp
     state%rotary_inertia = 0.0_wp
