@@ -229,3 +229,23 @@ def test_two_solver_runs_and_a_killed_one(tmp_path):
     assert third.returncode == 0, third.stderr
     listed, readable, status = readable_states(output / "results.h5")
     assert listed == readable == 11 and status == "normal termination"
+
+
+def test_every_full_disk_failure_says_so(tmp_path, disk_shim):
+    """Disks of 40 to 200 kB without fallocate under a run of 20 states: wherever the disk fills
+    (a state, the histories, the XDMF file or the run status at the end), a run that does not end
+    normally says "no space left on device" (a failure that first happened while the file was
+    closed was reported only as what the file keeps)."""
+    deck = cube_deck(tmp_path / "cube.k", 20)
+    endings = set()
+    for size in range(40000, 200000, 4000):
+        output = tmp_path / f"disk_{size}"
+        output.mkdir()
+        run = run_solver(BINARY, deck, output, {"LD_PRELOAD": str(disk_shim), "CRASHFREE_TEST_DISK_DIR": str(output),
+                                                "CRASHFREE_TEST_DISK_BYTES": str(size),
+                                                "CRASHFREE_TEST_NO_FALLOCATE": "1"})
+        assert run.returncode in (0, 1, 2), (size, run.stderr)
+        if run.returncode != 0:
+            assert "no space left on device" in run.stderr, (size, run.stderr)
+        endings.add(run.returncode)
+    assert endings == {0, 1}        # (a disk too small to start is refused: its own test)

@@ -14,6 +14,8 @@ program test_deck
                    integration_gauss, integration_gauss_conventional, formulation_rigid, &
                    section_shell, section_solid
   use deck_reader, only: read_deck, identify_any_keyword
+  use deck_lexer, only: deck_t, load_deck, check_files_unchanged, release_deck
+  use deck_problems, only: problem_log_t, has_problems
   use deck_keywords, only: keyword_t, keyword_unknown, suggest_keyword, known_keyword_count, &
                            known_keyword
   use deck_line_table, only: line_table_t, start_table, append_line, line_file, line_number, &
@@ -63,6 +65,7 @@ program test_deck
   call test_line_table_beyond_2_gib()
   call test_keyword_suggestions()
   call test_known_keywords_are_read()
+  call test_file_changed_while_read()
   call execute_command_line("rm -rf "//directory)
   call finish_suite(suite)
 
@@ -165,6 +168,22 @@ contains
     path = trim(name)
     call execute_command_line("mkdir -p "//path//"/sub/nested")
   end function make_directory
+
+  !> A deck edited after it was scanned: its cards are read again at their byte offsets, so the
+  !> reader must notice the change instead of reading other text.
+  subroutine test_file_changed_while_read()
+    type(deck_t) :: deck
+    type(problem_log_t) :: log
+    type(error_list_t) :: warnings
+    call write_file("changing.k", [character(len=20) :: "*KEYWORD", "*NODE", "1 0.0 0.0 0.0", "*END"])
+    call load_deck(directory//"/changing.k", deck, log, warnings)
+    call check_files_unchanged(deck, log)
+    call check(suite, "an unchanged deck passes", .not. has_problems(log))
+    call write_file("changing.k", [character(len=20) :: "*KEYWORD", "*NODE", "1 0.0 0.0 1.0", "2 0 0 0", "*END"])
+    call check_files_unchanged(deck, log)
+    call check(suite, "a deck changed after its scan is refused", has_problems(log))
+    call release_deck(deck)
+  end subroutine test_file_changed_while_read
 
   subroutine write_file(name, lines)
     character(len=*), intent(in) :: name
