@@ -29,7 +29,7 @@ LIBRARY := $(BUILD)/lib/libcrashfree.a
 PROGRAM := $(BUILD)/bin/crashfree
 FFLAGS += -J$(MOD) -I$(MOD) -I$(HDF5_INCLUDE)
 
-LIBRARY_SOURCES := $(sort $(shell find src -name '*.f90' ! -path 'src/app/*'))
+LIBRARY_SOURCES := $(sort $(shell find src -name '*.f90' ! -path 'src/app/crashfree.f90'))
 LIBRARY_OBJECTS := $(patsubst %.f90,$(OBJ)/%.o,$(notdir $(LIBRARY_SOURCES)))
 TEST_SUPPORT := tests/unit/testing.f90
 TEST_SOURCES := $(sort $(wildcard tests/unit/test_*.f90))

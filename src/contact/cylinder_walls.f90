@@ -25,7 +25,7 @@ module cylinder_walls
   use kinds, only: wp
   use curves, only: curve_t, curve_value
   use model, only: rigid_wall_t, wall_cylinder
-  use explicit_state, only: wall_state_t
+  use wall_state, only: wall_state_t
   use planar_rigid_walls, only: apply_wall_friction
   implicit none
   private

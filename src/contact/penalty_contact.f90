@@ -90,7 +90,7 @@ module penalty_contact
     integer :: pass_count = 0
     type(contact_pass_t) :: passes(2)
     real(wp) :: force(3) = 0.0_wp                 !< force on the SURFA side in the last cycle
-    real(wp) :: impulse(3) = 0.0_wp               !< since the last rcforc sample
+    real(wp) :: impulse(3) = 0.0_wp               !< since the start of the run
   end type contact_state_t
 
 contains

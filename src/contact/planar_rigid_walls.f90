@@ -12,7 +12,7 @@
 module planar_rigid_walls
   use kinds, only: wp
   use model, only: rigid_wall_t, wall_planar
-  use explicit_state, only: wall_state_t
+  use wall_state, only: wall_state_t
   implicit none
   private
 

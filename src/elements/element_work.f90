@@ -1,12 +1,12 @@
 !> Work of element forces integrated the way central differences integrate the kinetic energy
 !> (see the comment at the top of solid_block), and the block's smallest stable step: shared by
-!> the solid and shell blocks.
+!> the solid and shell blocks; and the shares of energy every element kind reports the same way.
 module element_work
   use kinds, only: wp, block_size
   implicit none
   private
 
-  public :: add_force_work, smallest_time_step
+  public :: add_force_work, smallest_time_step, booked_energy, add_kinetic_energy, scale_block_density
 
 contains
 
@@ -49,4 +49,44 @@ contains
     critical_element = 0
     if (lane > 0) critical_element = elements(lane)
   end subroutine smallest_time_step
+
+  !> Energy of the first `count` lanes of a block as the solver reports it: the work booked by
+  !> the elements plus the step correction of their newest forces' power (see solid_block).
+  pure real(wp) function booked_energy(energy, power, count, step_correction)
+    real(wp), intent(in) :: energy(:), power(:), step_correction
+    integer, intent(in) :: count
+    booked_energy = sum(energy(1:count)) + step_correction*sum(power(1:count))
+  end function booked_energy
+
+  !> Add a mass's share of the conserved kinetic energy 1/2 m v^{n-1/2} . v^{n+1/2}, split as
+  !> explained at energy_balance: 1/2 m (v^n)^2 to `kinetic`, -1/8 m (dt a)^2 to `internal`.
+  !> `velocity` is v^{n-1/2}, `average_step` the mean of the steps around t^n.
+  pure subroutine add_kinetic_energy(mass, velocity, acceleration, average_step, kinetic, internal)
+    real(wp), intent(in) :: mass, velocity(3), acceleration(3), average_step
+    real(wp), intent(inout) :: kinetic, internal
+    real(wp) :: half_change(3), midpoint(3)
+    half_change = 0.5_wp*average_step*acceleration
+    midpoint = velocity + half_change
+    kinetic = kinetic + 0.5_wp*mass*dot_product(midpoint, midpoint)
+    internal = internal - 0.5_wp*mass*dot_product(half_change, half_change)
+  end subroutine add_kinetic_energy
+
+  !> One block of mass scaling: its physical mass, then each lane whose step is below
+  !> `target_step` (> 0) gets the density that brings its step to it (the step scales with
+  !> 1/sqrt(rho)), and the mass added.
+  subroutine scale_block_density(nel, volume, target_step, element_time_step, density, physical_mass, added_mass)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: volume(block_size), target_step, element_time_step(block_size)
+    real(wp), intent(inout) :: density(block_size), physical_mass, added_mass
+    real(wp) :: factor
+    integer :: i
+    physical_mass = physical_mass + sum(density(1:nel)*volume(1:nel))
+    if (target_step <= 0.0_wp) return
+    do i = 1, nel
+      if (element_time_step(i) >= target_step) cycle
+      factor = (target_step/element_time_step(i))**2
+      added_mass = added_mass + (factor - 1.0_wp)*density(i)*volume(i)
+      density(i) = density(i)*factor
+    end do
+  end subroutine scale_block_density
 end module element_work

@@ -500,11 +500,13 @@ contains
   !> One rbdout row: time, displacement and velocity of the centre of mass, the force of the
   !> model on the body averaged over the interval since the last row (impulse / interval, so
   !> that the history integrates to the impulse), angular momentum about the centre.
-  subroutine rigid_body_history_row(model, b, body, acceleration, mass, time, half_step, interval, row)
+  subroutine rigid_body_history_row(model, b, body, acceleration, mass, time, half_step, interval, sampled_impulse, &
+                                    row)
     type(model_t), intent(in) :: model
     integer, intent(in) :: b
-    type(rigid_body_state_t), intent(inout) :: body
+    type(rigid_body_state_t), intent(in) :: body
     real(wp), intent(in) :: acceleration(:, :), mass(:), time, half_step, interval
+    real(wp), intent(inout) :: sampled_impulse(3)   !< the body's impulse at the last row; now at this one
     real(wp), intent(out) :: row(13)
     real(wp) :: kinetic, momentum(3), angular_momentum(3), velocity(3)
     call rigid_body_energy(model, b, body, acceleration, mass, half_step, 0.0_wp, kinetic, momentum, &
@@ -513,9 +515,9 @@ contains
     row(2:4) = body%centre - body%initial_centre
     row(5:7) = velocity
     row(8:10) = 0.0_wp
-    if (interval > 0.0_wp) row(8:10) = body%impulse/interval
+    if (interval > 0.0_wp) row(8:10) = (body%impulse - sampled_impulse)/interval
     row(11:13) = angular_momentum
-    body%impulse = 0.0_wp
+    sampled_impulse = body%impulse
   end subroutine rigid_body_history_row
 
   !> Cayley transform of the rotation vector a: (1 - [a]/2)^-1 (1 + [a]/2), orthogonal.

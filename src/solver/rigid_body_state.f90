@@ -23,7 +23,7 @@ module rigid_body_state
     real(wp) :: rotation_angle(3) = 0.0_wp       !< integral of omega (prescribed rotations, VAD = 2)
     real(wp) :: force(3) = 0.0_wp                !< resultant of the model's forces on it, last step
     real(wp) :: moment(3) = 0.0_wp               !< their moment about the centre, last step
-    real(wp) :: impulse(3) = 0.0_wp              !< impulse of those forces since the last rbdout row
+    real(wp) :: impulse(3) = 0.0_wp              !< impulse of those forces since the start of the run
     logical :: held(6) = .false.                 !< dofs held by a constraint or motion in the last step
     real(wp) :: held_acceleration(6) = 0.0_wp    !< their acceleration (VAD = 1; zero otherwise)
     real(wp) :: time_step = huge(1.0_wp)         !< smallest stable step of its elements (E, PR, RO)

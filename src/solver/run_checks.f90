@@ -23,8 +23,9 @@ module run_checks
   use kinds, only: wp
   use error_handling, only: error_t, make_error
   use model, only: model_t, law_null
-  use explicit_state, only: explicit_state_t
-  use energy_balance, only: update_energy_totals, total_energy, energy_ratio, part_energies
+  use explicit_state, only: explicit_state_t, energy_totals_t
+  use element_groups, only: group_failure
+  use energy_balance, only: measured_energies, total_energy, energy_ratio, part_energies
   implicit none
   private
 
@@ -66,8 +67,8 @@ contains
     if (speed > 0.0_wp) state%watch%velocity_limit = min(wave_speed_multiple*speed, largest_meaningful_value)
     ! a shell node turning at w moves its faces at w t/2
     thinnest = huge(1.0_wp)
-    do k = 1, size(state%shells)
-      thinnest = min(thinnest, minval(state%shells(k)%thickness(1:state%shells(k)%element_count)))
+    do k = 1, size(state%groups)
+      thinnest = min(thinnest, state%groups(k)%group%thinnest())
     end do
     state%watch%angular_velocity_limit = largest_meaningful_value
     if (thinnest < huge(1.0_wp) .and. thinnest > 0.0_wp) &
@@ -85,31 +86,17 @@ contains
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(in) :: state
     character(len=:), allocatable :: text
-    real(wp) :: factor, largest
-    integer :: b, lane, element
+    real(wp) :: largest, before
+    integer :: k, element, group
     largest = 0.0_wp
     element = 0
-    do b = 1, size(state%blocks)
-      do lane = 1, state%blocks(b)%element_count
-        if (.not. model%materials(state%blocks(b)%material)%density > 0.0_wp) cycle
-        factor = state%blocks(b)%density(lane)/model%materials(state%blocks(b)%material)%density
-        if (factor > largest) then
-          largest = factor
-          element = state%blocks(b)%elements(lane)
-        end if
-      end do
+    group = 0
+    do k = 1, size(state%groups)
+      before = largest
+      call state%groups(k)%group%most_scaled(model, largest, element)
+      if (largest > before) group = k
     end do
-    do b = 1, size(state%shells)
-      do lane = 1, state%shells(b)%element_count
-        if (.not. model%materials(state%shells(b)%material)%density > 0.0_wp) cycle
-        factor = state%shells(b)%density(lane)/model%materials(state%shells(b)%material)%density
-        if (factor > largest) then
-          largest = factor
-          element = -state%shells(b)%elements(lane)
-        end if
-      end do
-    end do
-    text = describe_element(model, element)//", its density raised "//real_text(largest)//" times"
+    text = describe_element(model, state, group, element)//", its density raised "//real_text(largest)//" times"
   end function most_scaled_element
 
   !> sqrt((K + 4G/3) / rho) of a material from its E, PR and RO (0 when it has none: *MAT_NULL
@@ -148,11 +135,11 @@ contains
     first_turning = huge(1)
     !$omp parallel do schedule(static) default(shared) private(node, speed) &
     !$omp& reduction(min:first, first_turning)
-    do node = 1, state%node_count
-      if (state%is_rigid_node(node)) cycle   ! moves with its body (check_rigid_body_rotation)
-      speed = abs(state%velocity(:, node) + average_step*state%acceleration(:, node))
+    do node = 1, state%nodes%count
+      if (state%nodes%is_rigid_node(node)) cycle   ! moves with its body (check_rigid_body_rotation)
+      speed = abs(state%nodes%velocity(:, node) + average_step*state%nodes%acceleration(:, node))
       if (beyond(speed, limit)) first = min(first, node)
-      speed = abs(state%angular_velocity(:, node) + average_step*state%angular_acceleration(:, node))
+      speed = abs(state%nodes%angular_velocity(:, node) + average_step*state%nodes%angular_acceleration(:, node))
       if (beyond(speed, angular_limit)) first_turning = min(first_turning, node)
     end do
     !$omp end parallel do
@@ -163,13 +150,13 @@ contains
 
     if (first <= first_turning) then
       node = first
-      speed = state%velocity(:, node) + average_step*state%acceleration(:, node)
+      speed = state%nodes%velocity(:, node) + average_step*state%nodes%acceleration(:, node)
       what = "velocity"
       bound = " (the limit is 100 times the fastest wave speed of the model's materials, "// &
               real_text(state%watch%largest_wave_speed)//")"
     else
       node = first_turning
-      speed = state%angular_velocity(:, node) + average_step*state%angular_acceleration(:, node)
+      speed = state%nodes%angular_velocity(:, node) + average_step*state%nodes%angular_acceleration(:, node)
       what = "angular velocity"
       limit = angular_limit
       bound = " (the limit is 100 times the fastest wave speed of the model's materials over the thinnest shell)"
@@ -235,30 +222,12 @@ contains
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(in) :: state
     type(error_t), allocatable, intent(out) :: error
-    integer :: b, k, element, point
-    do b = 1, size(state%blocks)
-      element = state%block_inverted_element(b)
-      if (element == 0) cycle
-      call make_error(error, "negative volume in "//describe_element(model, element)//time_text(state))
+    integer :: b, k
+    k = group_failure(state%groups)
+    if (k > 0) then
+      call make_error(error, state%groups(k)%group%failure_text(model)//time_text(state))
       return
-    end do
-    do b = 1, size(state%shells)
-      element = state%shell_degenerate_element(b)
-      if (element == 0) cycle
-      call make_error(error, describe_element(model, -element)//" has lost its area"//time_text(state))
-      return
-    end do
-    do k = 1, size(state%efg)
-      do b = 1, size(state%efg(k)%blocks)
-        point = state%efg(k)%block_inverted_point(b)
-        if (point == 0) cycle
-        element = state%efg(k)%geometry%point_cell(point)
-        call make_error(error, "negative volume at an integration point of meshfree part "// &
-                        integer_text(model%parts(state%efg(k)%geometry%part)%id)//" (background cell "// &
-                        integer_text(model%solid_ids(element))//")"//time_text(state))
-        return
-      end do
-    end do
+    end if
     ! rigid bodies set no element step: their motion must be finite too
     do b = 1, size(state%rigid)
       if (all(ieee_is_finite(state%rigid(b)%velocity)) .and. all(ieee_is_finite(state%rigid(b)%angular_velocity))) &
@@ -339,14 +308,18 @@ contains
   !> created by the run (total minus initial energy and external work) below energy_excess_limit
   !> times the largest energy put in so far, and |energy ratio - 1| below ENDENG percent when
   !> the deck gives one.
-  subroutine check_energy(model, state, error)
+  subroutine check_energy(model, state, scratch, error)
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(inout) :: state
+    real(wp), intent(inout) :: scratch(:, :)     !< (5, chunks of nodes) for the sums
     type(error_t), allocatable, intent(out) :: error
     real(wp) :: total, supplied, ratio
+    type(energy_totals_t) :: energy
 
-    call update_energy_totals(model, state)
-    total = total_energy(state)
+    energy = state%energy
+    call measured_energies(model, state, scratch, energy)
+    state%energy = energy
+    total = total_energy(state%energy)
     supplied = state%energy%initial_total + state%energy%external_work
     associate (watch => state%watch)
       watch%largest_energy_supplied = max(watch%largest_energy_supplied, abs(state%energy%initial_total), &
@@ -363,7 +336,7 @@ contains
         return
       end if
       if (model%energy_ratio_change_limit > 0.0_wp) then
-        ratio = energy_ratio(state)
+        ratio = energy_ratio(state%energy)
         if (100.0_wp*abs(ratio - 1.0_wp) > model%energy_ratio_change_limit) then
           call make_error(error, "the energy ratio "//real_text(ratio)//" differs from 1 by more than ENDENG = "// &
                           real_text(model%energy_ratio_change_limit)//" percent"//time_text(state))
@@ -402,41 +375,35 @@ contains
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(in) :: state
     character(len=:), allocatable :: text
-    integer :: b
-    if (state%controlling_element /= 0) then
-      text = "set by "//describe_element(model, state%controlling_element)
+    integer :: k
+    if (state%controlling_group /= 0) then
+      text = "set by "//describe_element(model, state, state%controlling_group, state%controlling_element)
       return
     end if
     if (positive_finite(state%stable_time_step)) then
       text = "set by the elements of the rigid bodies"
       return
     end if
-    do b = 1, size(state%blocks)
-      if (.not. positive_finite(state%block_time_step(b))) then
-        text = "the step of the block of "//describe_element(model, state%blocks(b)%elements(1))//" is not finite"
+    do k = 1, size(state%groups)
+      associate (group => state%groups(k)%group)
+        if (.not. group%step_not_finite) cycle
+        text = "the step of a block of "//trim(group%name)//" elements is not finite"
+        if (group%critical_element /= 0) text = text//" (smallest finite step: "// &
+                                                group%describe(model, group%critical_element)//")"
         return
-      end if
-    end do
-    do b = 1, size(state%shells)
-      if (.not. positive_finite(state%shell_time_step(b))) then
-        text = "the step of the block of "//describe_element(model, -state%shells(b)%elements(1))//" is not finite"
-        return
-      end if
+      end associate
     end do
     text = "no element sets a step"
   end function step_setter
 
-  !> "solid 12 (part 3)" for a solid index > 0, "shell 7 (part 2)" for minus a shell index.
-  function describe_element(model, element) result(text)
+  !> "solid element 12 (part 3)": element `element` of group `group` (0: "no element").
+  function describe_element(model, state, group, element) result(text)
     type(model_t), intent(in) :: model
-    integer, intent(in) :: element
+    type(explicit_state_t), intent(in) :: state
+    integer, intent(in) :: group, element
     character(len=:), allocatable :: text
-    if (element > 0) then
-      text = "solid element "//integer_text(model%solid_ids(element))//" (part "// &
-             integer_text(model%parts(model%solid_part(element))%id)//")"
-    else if (element < 0) then
-      text = "shell element "//integer_text(model%shell_ids(-element))//" (part "// &
-             integer_text(model%parts(model%shell_part(-element))%id)//")"
+    if (group > 0 .and. element /= 0) then
+      text = state%groups(group)%group%describe(model, element)
     else
       text = "no element"
     end if

@@ -8,10 +8,11 @@ module job
   use kinds, only: wp
   use command_line, only: run_options_t
   use error_handling, only: error_t, error_list_t
-  use model, only: model_t
+  use model, only: model_t, formulation_efg
   use deck_reader, only: read_deck
   use explicit_state, only: explicit_state_t
-  use explicit_setup, only: set_up_explicit_state, set_up_warnings
+  use run_state, only: run_state_t
+  use explicit_setup, only: set_up_run_state, set_up_warnings
   use explicit_solver, only: run_explicit
   use static_analysis, only: run_static
   use results_file, only: results_file_t, open_results, close_results
@@ -34,7 +35,7 @@ contains
     type(run_options_t), intent(in) :: options
     integer, intent(out) :: exit_status
     type(model_t) :: model
-    type(explicit_state_t) :: state
+    type(run_state_t) :: run
     type(results_file_t) :: results
     type(run_summary_t) :: summary
     type(error_list_t) :: warnings
@@ -59,7 +60,7 @@ contains
       write (error_unit, '(a)') "crashfree: the deck was rejected; nothing was run"
       return
     end if
-    if (.not. model%implicit_static) call set_up_explicit_state(model, state, error)
+    if (.not. model%implicit_static) call set_up_run_state(model, run, error)
     if (allocated(error)) then
       write (error_unit, '(a)') "crashfree: "//error%message
       return
@@ -75,8 +76,8 @@ contains
       return
     end if
     if (.not. model%implicit_static) then
-      call describe_model(model, state, summary)
-      warning_text = set_up_warnings(model, state)
+      call describe_model(model, run%state, summary)
+      warning_text = set_up_warnings(model, run%state)
       if (len(warning_text) > 0) write (error_unit, '(a)') warning_text
     end if
     summary%setup_s = seconds_now() - started
@@ -88,7 +89,7 @@ contains
       ! while the deck is read and the model set up, they end the process at once: nothing has
       ! been written yet, and a previous results file of the job is still whole)
       call catch_stop_signals()
-      call run_explicit(model, state, results, summary, error)
+      call run_explicit(model, run, results, summary, error)
     end if
 
     summary%wall_s = seconds_now() - started
@@ -150,24 +151,19 @@ contains
     type(run_summary_t), intent(inout) :: summary
     character(len=200) :: line
     integer :: k
-    summary%fe_solids = sum(state%blocks%element_count)
-    summary%fe_shells = sum(state%shells%element_count)
-    summary%fe_elements = summary%fe_solids + summary%fe_shells
-    summary%dofs_total = 3*size(model%node_ids) + 3*count(state%rotary_inertia > 0.0_wp)
-    summary%efg_particles = 0
-    summary%dofs_efg = 0
-    do k = 1, size(state%efg)
-      summary%efg_setup_s = summary%efg_setup_s + state%efg(k)%geometry%setup_seconds
-      summary%efg_particles = summary%efg_particles + size(state%efg(k)%geometry%particles)
-      summary%dofs_efg = summary%dofs_efg + 3*size(state%efg(k)%geometry%mass_node)
+    do k = 1, size(state%groups)
+      call state%groups(k)%group%add_to_summary(summary)
     end do
+    summary%fe_elements = summary%fe_solids + summary%fe_shells
+    summary%dofs_total = 3*size(model%node_ids) + 3*count(state%nodes%rotary_inertia > 0.0_wp)
     write (line, '(a,i0,a,i0,a,i0,a,i0,a)') "model: ", size(model%node_ids), " nodes, ", size(model%solid_ids), &
       " solids, ", size(model%shell_ids), " shells in ", size(model%parts), " parts"
     write (*, '(a)') trim(line)
     write (line, '(a,es12.5)') "mass: ", state%physical_mass
     write (*, '(a)') trim(line)
-    if (size(state%efg) > 0) then
-      write (line, '(a,i0,a,i0,a,f0.1,a,f0.3,a)') "meshfree: ", size(state%efg), " EFG part(s), ", &
+    if (summary%dofs_efg > 0) then
+      write (line, '(a,i0,a,i0,a,f0.1,a,f0.3,a)') "meshfree: ", count(model%parts%formulation == formulation_efg), &
+        " EFG part(s), ", &
         summary%efg_particles, " interior particles, ", 100.0_wp*real(summary%dofs_efg, wp)/real(summary%dofs_total, wp), &
         "% of the dofs; set-up ", summary%efg_setup_s, " s"
       write (*, '(a)') trim(line)

@@ -7,18 +7,13 @@ module distortion_check
   use kinds, only: wp
   use model, only: model_t
   use solid_block, only: solid_block_t
+  use element_group, only: distortion_t
   use hex8_quality, only: corner_jacobian_ratio
   implicit none
   private
 
-  public :: distortion_t, check_solid_distortion
+  public :: check_solid_distortion
 
-  type :: distortion_t
-    integer :: tangled = 0                  !< FE solids with an inverted corner at the last check
-    integer :: reported = 0                 !< the count of the last warning
-    real(wp) :: worst_ratio = 1.0_wp        !< smallest corner Jacobian ratio of any check
-    integer :: worst_element = 0            !< its solid index (0: no FE solid)
-  end type distortion_t
 
 contains
 

@@ -1,0 +1,274 @@
+!> The meshfree (EFG) parts as an element group (element_group): one efg_solver_t per part,
+!> set up once on the undeformed mesh (shape functions, smoothed gradients, row-sum masses,
+!> formulation sections 2-5). Their elements are the integration points, reported by their
+!> background cell (a solid element of the deck). Interior particles carry generalized values;
+!> `to_physical` transforms a nodal field for output (eq. 16). Mass scaling leaves them alone.
+module efg_group
+  use kinds, only: wp
+  use error_handling, only: error_t, make_error
+  use run_summary, only: run_summary_t
+  use model, only: model_t, formulation_efg, boundary_full_transformation, integration_gauss_conventional
+  use nodal_state, only: nodal_state_t
+  use element_group, only: element_group_t, element_results_t
+  use element_work, only: booked_energy, add_kinetic_energy
+  use efg_part, only: efg_part_t
+  use efg_setup, only: build_efg_part
+  use efg_forces, only: efg_solver_t, set_up_efg_solver, compute_efg_forces, efg_point_results, &
+                        transform_to_physical
+  implicit none
+  private
+
+  public :: efg_group_t, new_efg_group
+
+  type, extends(element_group_t) :: efg_group_t
+    type(efg_solver_t), allocatable :: parts(:)
+    integer :: failed_part = 0                     !< the part of failed_element (model part index)
+  contains
+    procedure :: element_count
+    procedure :: scale_masses
+    procedure :: lump_masses
+    procedure :: add_internal_forces
+    procedure :: add_energies
+    procedure :: add_part_energies
+    procedure :: element_results
+    procedure :: describe
+    procedure :: add_to_summary
+    procedure :: failure_text
+    procedure :: to_physical
+  end type efg_group_t
+
+contains
+
+  !> Every EFG part some solid element uses. (A part no element uses has nothing to set up, as
+  !> in the static analysis: found by fuzzing, an unused *PART on an EFG section stopped the run
+  !> with a message naming no deck line, where an unused FE part is accepted.)
+  !> A new group of this kind (its constructor for element_groups).
+  subroutine new_efg_group(model, group, error)
+    type(model_t), intent(in) :: model
+    class(element_group_t), allocatable, intent(out) :: group
+    type(error_t), allocatable, intent(out) :: error
+    allocate (efg_group_t :: group)
+    select type (group)
+    type is (efg_group_t)
+      call build_group(model, group, error)
+    end select
+  end subroutine new_efg_group
+
+  subroutine build_group(model, group, error)
+    type(model_t), intent(in) :: model
+    type(efg_group_t), intent(inout) :: group
+    type(error_t), allocatable, intent(out) :: error
+    type(efg_part_t) :: geometry
+    integer :: part, count, k
+    logical, allocatable :: used(:)
+
+    group%name = "meshfree"
+    allocate (used(size(model%parts)))
+    used = .false.
+    do k = 1, size(model%solid_part)
+      used(model%solid_part(k)) = .true.
+    end do
+    count = 0
+    do part = 1, size(model%parts)
+      if (model%parts(part)%formulation == formulation_efg .and. used(part)) count = count + 1
+    end do
+    allocate (group%parts(count))
+    count = 0
+    do part = 1, size(model%parts)
+      if (model%parts(part)%formulation /= formulation_efg .or. .not. used(part)) cycle
+      count = count + 1
+      if (model%sections(model%parts(part)%section)%boundary_treatment == boundary_full_transformation) then
+        call make_error(error, "part "//integer_text(model%parts(part)%id)//": IEBT = 1 (full transformation) is "// &
+                        "a verification variant of the linear static analysis; explicit runs need the coupled "// &
+                        "boundary treatment IEBT = 3 (the default)")
+        return
+      end if
+      ! the explicit update assumes 8 integration points per cell (sub-cells or 2x2x2 Gauss)
+      if (model%sections(model%parts(part)%section)%domain_integration == integration_gauss_conventional) then
+        call make_error(error, "part "//integer_text(model%parts(part)%id)//": IDIM = 4 (conventional EFG, "// &
+                        "4x4x4 Gauss points) is a verification variant of the linear static analysis; explicit "// &
+                        "runs use IDIM = 1 (the default) or 2")
+        return
+      end if
+      call build_efg_part(model, part, geometry, error)
+      if (allocated(error)) return
+      call set_up_efg_solver(model, geometry, group%parts(count))
+    end do
+  end subroutine build_group
+
+  integer function element_count(self)
+    class(efg_group_t), intent(in) :: self
+    integer :: k, b
+    element_count = 0
+    do k = 1, size(self%parts)
+      do b = 1, size(self%parts(k)%blocks)
+        element_count = element_count + self%parts(k)%blocks(b)%point_count
+      end do
+    end do
+  end function element_count
+
+  !> Meshfree parts keep their density (the warning of explicit_setup says so); their mass
+  !> counts as physical.
+  subroutine scale_masses(self, model, nodes, target_step, physical_mass, added_mass)
+    class(efg_group_t), intent(inout) :: self
+    type(model_t), intent(in) :: model
+    type(nodal_state_t), intent(in) :: nodes
+    real(wp), intent(in) :: target_step
+    real(wp), intent(inout) :: physical_mass, added_mass
+    integer :: k
+    do k = 1, size(self%parts)
+      physical_mass = physical_mass + self%parts(k)%density*sum(self%parts(k)%geometry%mass_volume)
+    end do
+  end subroutine scale_masses
+
+  !> Row-sum masses (eq. 29) and the interior particles.
+  subroutine lump_masses(self, model, nodes)
+    class(efg_group_t), intent(inout) :: self
+    type(model_t), intent(in) :: model
+    type(nodal_state_t), intent(inout) :: nodes
+    integer :: k, j
+    do k = 1, size(self%parts)
+      associate (efg => self%parts(k))
+        do j = 1, size(efg%geometry%mass_node)
+          nodes%mass(efg%geometry%mass_node(j)) = nodes%mass(efg%geometry%mass_node(j)) + &
+                                                  efg%density*efg%geometry%mass_volume(j)
+        end do
+        nodes%is_particle(efg%geometry%particles) = .true.
+      end associate
+    end do
+  end subroutine lump_masses
+
+  !> Part after part (a Gamma node shared with an FE part receives the finite elements' forces
+  !> first, then these, always in this order).
+  subroutine add_internal_forces(self, model, nodes, step)
+    class(efg_group_t), intent(inout) :: self
+    type(model_t), intent(in) :: model
+    type(nodal_state_t), intent(inout) :: nodes
+    real(wp), intent(in) :: step
+    integer :: k, b
+    self%stable_time_step = huge(1.0_wp)
+    self%critical_element = 0
+    self%failed_element = 0
+    self%failed_part = 0
+    self%step_not_finite = .false.
+    do k = 1, size(self%parts)
+      associate (efg => self%parts(k))
+        call compute_efg_forces(model%materials(efg%geometry%material), efg, nodes%displacement, nodes%velocity, &
+                                step, nodes%internal_force)
+        ! meshfree integration points follow the FE rule of their background cell
+        do b = 1, size(efg%blocks)
+          if (efg%block_time_step(b) < self%stable_time_step) then
+            self%stable_time_step = efg%block_time_step(b)
+            self%critical_element = efg%geometry%point_cell(efg%block_critical_point(b))
+          end if
+          if (self%failed_element == 0 .and. efg%block_inverted_point(b) /= 0) then
+            self%failed_element = efg%geometry%point_cell(efg%block_inverted_point(b))
+            self%failed_part = efg%geometry%part
+          end if
+        end do
+        if (any(efg%block_time_step /= efg%block_time_step)) self%step_not_finite = .true.
+      end associate
+    end do
+  end subroutine add_internal_forces
+
+  subroutine add_energies(self, step_correction, internal, hourglass)
+    class(efg_group_t), intent(in) :: self
+    real(wp), intent(in) :: step_correction
+    real(wp), intent(inout) :: internal, hourglass
+    integer :: k, b
+    do k = 1, size(self%parts)
+      do b = 1, size(self%parts(k)%blocks)
+        associate (block => self%parts(k)%blocks(b))
+          internal = internal + booked_energy(block%internal_energy, block%force_power, block%point_count, &
+                                              step_correction)
+        end associate
+      end do
+    end do
+  end subroutine add_energies
+
+  subroutine add_part_energies(self, nodes, average_step, step_correction, kinetic, internal, hourglass)
+    class(efg_group_t), intent(in) :: self
+    type(nodal_state_t), intent(in) :: nodes
+    real(wp), intent(in) :: average_step, step_correction
+    real(wp), intent(inout) :: kinetic(:), internal(:), hourglass(:)
+    integer :: k, b, j, node
+    do k = 1, size(self%parts)
+      associate (efg => self%parts(k), part => self%parts(k)%geometry%part)
+        do b = 1, size(efg%blocks)
+          internal(part) = internal(part) + booked_energy(efg%blocks(b)%internal_energy, efg%blocks(b)%force_power, &
+            efg%blocks(b)%point_count, step_correction)
+        end do
+        do j = 1, size(efg%geometry%mass_node)
+          node = efg%geometry%mass_node(j)
+          call add_kinetic_energy(efg%density*efg%geometry%mass_volume(j), nodes%velocity(:, node), &
+                                  nodes%acceleration(:, node), average_step, kinetic(part), internal(part))
+        end do
+      end associate
+    end do
+  end subroutine add_part_energies
+
+  subroutine element_results(self, model, results)
+    class(efg_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    type(element_results_t), intent(inout) :: results
+    integer :: k
+    do k = 1, size(self%parts)
+      call efg_point_results(model%materials(self%parts(k)%geometry%material), self%parts(k), results%solid_stress, &
+                             results%solid_plastic_strain)
+    end do
+  end subroutine element_results
+
+  !> A point is named by its background cell, a solid element of the deck.
+  function describe(self, model, element) result(text)
+    class(efg_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: element
+    character(len=:), allocatable :: text
+    text = "solid element "//integer_text(model%solid_ids(element))//" (part "// &
+           integer_text(model%parts(model%solid_part(element))%id)//")"
+  end function describe
+
+  function failure_text(self, model) result(text)
+    class(efg_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    character(len=:), allocatable :: text
+    text = "negative volume at an integration point of meshfree part "// &
+           integer_text(model%parts(self%failed_part)%id)//" (background cell "// &
+           integer_text(model%solid_ids(self%failed_element))//")"
+  end function failure_text
+
+  subroutine to_physical(self, field, physical)
+    class(efg_group_t), intent(in) :: self
+    real(wp), intent(in) :: field(:, :)
+    real(wp), intent(inout) :: physical(:, :)
+    integer :: k
+    do k = 1, size(self%parts)
+      call transform_to_physical(self%parts(k), field, physical)
+    end do
+  end subroutine to_physical
+
+  pure function integer_text(value) result(text)
+    integer, intent(in) :: value
+    character(len=:), allocatable :: text
+    character(len=16) :: buffer
+    write (buffer, '(i0)') value
+    text = trim(buffer)
+  end function integer_text
+
+  !> Particles, their dofs and the set-up time of the shape functions as well (set, not added:
+  !> called before and after the run).
+  subroutine add_to_summary(self, summary)
+    class(efg_group_t), intent(in) :: self
+    type(run_summary_t), intent(inout) :: summary
+    integer :: k
+    summary%efg_setup_s = 0.0_wp
+    summary%efg_particles = 0
+    summary%dofs_efg = 0
+    do k = 1, size(self%parts)
+      summary%efg_setup_s = summary%efg_setup_s + self%parts(k)%geometry%setup_seconds
+      summary%efg_particles = summary%efg_particles + size(self%parts(k)%geometry%particles)
+      summary%dofs_efg = summary%dofs_efg + 3*size(self%parts(k)%geometry%mass_node)
+    end do
+    summary%efg_s = self%timer%seconds
+  end subroutine add_to_summary
+end module efg_group

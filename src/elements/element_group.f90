@@ -1,0 +1,193 @@
+!> The contract every element kind of the explicit engine fulfils (solid hexahedra, Belytschko-
+!> Tsay shells, meshfree parts; beams and welds next), in the spirit of OpenRadioss's element
+!> groups and MFEM's integrators.
+!>
+!> An element group holds all elements of one kind in the model: a payload of blocks of at
+!> most `block_size` lanes (each block one part, one material, its node list lane-first and its
+!> state), coloured so that blocks of one colour share no node. The header below is what the
+!> engine reads without knowing the kind: the smallest stable step of the last force call and
+!> the element that set it, an element that failed (inverted, lost its area), the kind's name
+!> for timers and messages. The deferred procedures are the only calls the engine makes; the
+!> engine calls them for every group in a fixed order (element_groups), so each node receives
+!> its contributions in the same order for any thread count.
+!>
+!> Element references: `element` arguments and the header's element fields are the group's own
+!> element numbers (a solid's index in the model's solid list for the solids, a shell's for the
+!> shells, the background cell for meshfree points); `describe` turns one into the words of a
+!> message.
+module element_group
+  use kinds, only: wp
+  use model, only: model_t
+  use nodal_state, only: nodal_state_t
+  use wall_clock, only: phase_timer_t
+  use run_summary, only: run_summary_t
+  implicit none
+  private
+
+  public :: element_group_t, group_holder_t, element_results_t, distortion_t
+
+  !> Elements folded inside out at a corner while their volume stays positive (distortion_check),
+  !> checked at every output state.
+  type :: distortion_t
+    integer :: tangled = 0                  !< elements with an inverted corner at the last check
+    integer :: reported = 0                 !< the count of the last warning
+    real(wp) :: worst_ratio = 1.0_wp        !< smallest corner Jacobian ratio of any check
+    integer :: worst_element = 0            !< its element (0: none)
+  end type distortion_t
+
+  !> The element fields of one output state, filled by the groups (each writes its elements'
+  !> rows; meshfree cells write the solid rows of their background cells).
+  type :: element_results_t
+    real(wp), allocatable :: solid_stress(:, :)          !< (6, solids) xx yy zz xy yz zx
+    real(wp), allocatable :: solid_plastic_strain(:)
+    real(wp), allocatable :: shell_stress(:, :)          !< (6, shells) mid-surface
+    real(wp), allocatable :: shell_stress_peak(:, :)     !< (6, shells) the point of largest von Mises
+    real(wp), allocatable :: shell_plastic_strain(:), shell_plastic_strain_peak(:)
+  end type element_results_t
+
+  type, abstract :: element_group_t
+    character(len=16) :: name = ""                 !< "solid", "shell", "meshfree": timers, summary
+    real(wp) :: stable_time_step = huge(1.0_wp)    !< smallest over the blocks, from the last force call
+    integer :: critical_element = 0                !< the element that sets it (0: none)
+    logical :: step_not_finite = .false.           !< a block's step was NaN (comparisons skip it)
+    integer :: failed_element = 0                  !< an element that inverted or degenerated (0: none)
+    type(phase_timer_t) :: timer                   !< wall-clock time of its force calls
+  contains
+    !> Once before the first cycle: its element count (0: the group is dropped).
+    procedure(count_interface), deferred :: element_count
+    !> Once: mass scaling to `target_step` (> 0; DT2MS), adding to the physical and added mass.
+    procedure(scale_interface), deferred :: scale_masses
+    !> Once: colour the blocks, add the lumped masses (and rotary inertias) into `nodes`.
+    procedure(lump_interface), deferred :: lump_masses
+    !> Every cycle: add the internal forces (and moments) at the current configuration into
+    !> `nodes`, which the engine has cleared; set the header's step, critical and failed element.
+    procedure(forces_interface), deferred :: add_internal_forces
+    !> Internal and hourglass energies, summed block by block (energy_balance).
+    procedure(energy_interface), deferred :: add_energies
+    !> Per part: internal, hourglass, and the kinetic energy of the nodal masses the group gave.
+    procedure(part_energy_interface), deferred :: add_part_energies
+    !> Stresses and plastic strains of its elements for an output state.
+    procedure(results_interface), deferred :: element_results
+    !> "solid element 12 (part 3)"
+    procedure(describe_interface), deferred :: describe
+    !> Its counts and seconds in the run summary (after the run: the time of its force calls).
+    procedure(summary_interface), deferred :: add_to_summary
+    !> Optional: the failure message of `failed_element` (default: "<describe> inverted").
+    procedure :: failure_text
+    !> Optional: transform a nodal field from solver values to physical ones (meshfree parts).
+    procedure :: to_physical
+    !> Optional: the element whose density mass scaling raised most, and the factor.
+    procedure :: most_scaled
+    !> Optional: the thinnest element (shells; bounds the angular velocities of the run checks).
+    procedure :: thinnest
+    !> Optional: count the elements folded at a corner, warn when more are (solids).
+    procedure :: check_distortion
+  end type element_group_t
+
+  !> An array element holding one group of any kind.
+  type :: group_holder_t
+    class(element_group_t), allocatable :: group
+  end type group_holder_t
+
+  abstract interface
+    integer function count_interface(self)
+      import :: element_group_t
+      class(element_group_t), intent(in) :: self
+    end function count_interface
+
+    subroutine scale_interface(self, model, nodes, target_step, physical_mass, added_mass)
+      import :: element_group_t, model_t, nodal_state_t, wp
+      class(element_group_t), intent(inout) :: self
+      type(model_t), intent(in) :: model
+      type(nodal_state_t), intent(in) :: nodes
+      real(wp), intent(in) :: target_step
+      real(wp), intent(inout) :: physical_mass, added_mass
+    end subroutine scale_interface
+
+    subroutine lump_interface(self, model, nodes)
+      import :: element_group_t, model_t, nodal_state_t
+      class(element_group_t), intent(inout) :: self
+      type(model_t), intent(in) :: model
+      type(nodal_state_t), intent(inout) :: nodes
+    end subroutine lump_interface
+
+    subroutine forces_interface(self, model, nodes, step)
+      import :: element_group_t, model_t, nodal_state_t, wp
+      class(element_group_t), intent(inout) :: self
+      type(model_t), intent(in) :: model
+      type(nodal_state_t), intent(inout) :: nodes
+      real(wp), intent(in) :: step          !< the step just taken (0 at the start)
+    end subroutine forces_interface
+
+    subroutine energy_interface(self, step_correction, internal, hourglass)
+      import :: element_group_t, wp
+      class(element_group_t), intent(in) :: self
+      real(wp), intent(in) :: step_correction
+      real(wp), intent(inout) :: internal, hourglass
+    end subroutine energy_interface
+
+    subroutine part_energy_interface(self, nodes, average_step, step_correction, kinetic, internal, hourglass)
+      import :: element_group_t, nodal_state_t, wp
+      class(element_group_t), intent(in) :: self
+      type(nodal_state_t), intent(in) :: nodes
+      real(wp), intent(in) :: average_step, step_correction
+      real(wp), intent(inout) :: kinetic(:), internal(:), hourglass(:)
+    end subroutine part_energy_interface
+
+    subroutine results_interface(self, model, results)
+      import :: element_group_t, model_t, element_results_t
+      class(element_group_t), intent(in) :: self
+      type(model_t), intent(in) :: model
+      type(element_results_t), intent(inout) :: results
+    end subroutine results_interface
+
+    function describe_interface(self, model, element) result(text)
+      import :: element_group_t, model_t
+      class(element_group_t), intent(in) :: self
+      type(model_t), intent(in) :: model
+      integer, intent(in) :: element
+      character(len=:), allocatable :: text
+    end function describe_interface
+
+    subroutine summary_interface(self, summary)
+      import :: element_group_t, run_summary_t
+      class(element_group_t), intent(in) :: self
+      type(run_summary_t), intent(inout) :: summary
+    end subroutine summary_interface
+  end interface
+
+contains
+
+  function failure_text(self, model) result(text)
+    class(element_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    character(len=:), allocatable :: text
+    text = self%describe(model, self%failed_element)//" inverted"
+  end function failure_text
+
+  subroutine to_physical(self, field, physical)
+    class(element_group_t), intent(in) :: self
+    real(wp), intent(in) :: field(:, :)
+    real(wp), intent(inout) :: physical(:, :)
+  end subroutine to_physical
+
+  subroutine most_scaled(self, model, largest, element)
+    class(element_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    real(wp), intent(inout) :: largest    !< the largest factor so far (raised when this group has one)
+    integer, intent(inout) :: element     !< its element, set when raised
+  end subroutine most_scaled
+
+  subroutine check_distortion(self, model, nodes, time, distortion)
+    class(element_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    type(nodal_state_t), intent(in) :: nodes
+    real(wp), intent(in) :: time
+    type(distortion_t), intent(inout) :: distortion
+  end subroutine check_distortion
+
+  real(wp) function thinnest(self)
+    class(element_group_t), intent(in) :: self
+    thinnest = huge(1.0_wp)
+  end function thinnest
+end module element_group

@@ -1,0 +1,292 @@
+!> The Belytschko-Tsay shells as an element group (element_group): the blocks of shell_block,
+!> their colouring, corner masses and rotary inertias, and the per-block results of the last
+!> force call. Besides forces the shells add moments and, for the drilling-rate removal of the
+!> time loop, each node's sums of area x normal and area.
+module shell_group
+  use kinds, only: wp, block_size
+  use gather_list, only: gather_list_t
+  use block_colouring, only: colour_blocks_by_nodes
+  use model, only: model_t
+  use run_summary, only: run_summary_t
+  use nodal_state, only: nodal_state_t
+  use element_group, only: element_group_t, element_results_t
+  use element_work, only: booked_energy, add_kinetic_energy, scale_block_density
+  use shell_block, only: shell_block_t, build_shell_blocks, shell_block_masses, shell_block_time_steps, &
+                         compute_shell_block, shell_block_element_results
+  implicit none
+  private
+
+  public :: shell_group_t, new_shell_group
+
+  type, extends(element_group_t) :: shell_group_t
+    type(shell_block_t), allocatable :: blocks(:)
+    real(wp), allocatable :: corner_mass(:, :, :)        !< (block_size, 4, blocks)
+    real(wp), allocatable :: corner_inertia(:, :, :)
+    real(wp), allocatable :: block_time_step(:)
+    integer, allocatable :: block_critical_element(:)
+    integer, allocatable :: block_degenerate_element(:)
+    type(gather_list_t) :: colours
+  contains
+    procedure :: element_count
+    procedure :: scale_masses
+    procedure :: lump_masses
+    procedure :: add_internal_forces
+    procedure :: add_energies
+    procedure :: add_part_energies
+    procedure :: element_results
+    procedure :: describe
+    procedure :: add_to_summary
+    procedure :: failure_text
+    procedure :: most_scaled
+    procedure :: thinnest
+  end type shell_group_t
+
+contains
+
+  !> A new group of this kind (its constructor for element_groups).
+  subroutine new_shell_group(model, group)
+    type(model_t), intent(in) :: model
+    class(element_group_t), allocatable, intent(out) :: group
+    allocate (shell_group_t :: group)
+    select type (group)
+    type is (shell_group_t)
+      call build_group(model, group)
+    end select
+  end subroutine new_shell_group
+
+  subroutine build_group(model, group)
+    type(model_t), intent(in) :: model
+    type(shell_group_t), intent(inout) :: group
+    integer :: count
+    group%name = "shell"
+    call build_shell_blocks(model, group%blocks)
+    count = size(group%blocks)
+    allocate (group%corner_mass(block_size, 4, count), group%corner_inertia(block_size, 4, count), &
+              group%block_time_step(count), group%block_critical_element(count), &
+              group%block_degenerate_element(count))
+    group%corner_mass = 0.0_wp
+    group%corner_inertia = 0.0_wp
+    group%block_time_step = huge(1.0_wp)
+    group%block_critical_element = 0
+    group%block_degenerate_element = 0
+  end subroutine build_group
+
+  integer function element_count(self)
+    class(shell_group_t), intent(in) :: self
+    integer :: b
+    element_count = 0
+    do b = 1, size(self%blocks)
+      element_count = element_count + self%blocks(b)%element_count
+    end do
+  end function element_count
+
+  subroutine scale_masses(self, model, nodes, target_step, physical_mass, added_mass)
+    class(shell_group_t), intent(inout) :: self
+    type(model_t), intent(in) :: model
+    type(nodal_state_t), intent(in) :: nodes
+    real(wp), intent(in) :: target_step
+    real(wp), intent(inout) :: physical_mass, added_mass
+    real(wp) :: element_time_step(block_size), volume(block_size)
+    integer :: b, nel
+    element_time_step = huge(1.0_wp)
+    do b = 1, size(self%blocks)
+      associate (shell => self%blocks(b))
+        nel = shell%element_count
+        volume(1:nel) = shell%thickness(1:nel)*shell%reference_area(1:nel)
+        if (target_step > 0.0_wp) &
+          call shell_block_time_steps(shell, model%materials(shell%material), nodes%coordinates, element_time_step)
+        call scale_block_density(nel, volume, target_step, element_time_step, shell%density, physical_mass, &
+                                 added_mass)
+      end associate
+    end do
+  end subroutine scale_masses
+
+  !> Colour the blocks, then add the corner masses and rotary inertias to the nodes (serially,
+  !> in block, corner and lane order).
+  subroutine lump_masses(self, model, nodes)
+    class(shell_group_t), intent(inout) :: self
+    type(model_t), intent(in) :: model
+    type(nodal_state_t), intent(inout) :: nodes
+    integer, allocatable :: block_nodes(:, :, :), counts(:)
+    integer :: b, corner, lane, node
+    allocate (block_nodes(block_size, 4, size(self%blocks)), counts(size(self%blocks)))
+    do b = 1, size(self%blocks)
+      block_nodes(:, :, b) = self%blocks(b)%nodes
+      counts(b) = self%blocks(b)%element_count
+    end do
+    call colour_blocks_by_nodes(nodes%count, block_nodes, counts, self%colours)
+    do b = 1, size(self%blocks)
+      call shell_block_masses(self%blocks(b), self%corner_mass(:, :, b), self%corner_inertia(:, :, b))
+      do corner = 1, 4
+        do lane = 1, self%blocks(b)%element_count
+          node = self%blocks(b)%nodes(lane, corner)
+          nodes%mass(node) = nodes%mass(node) + self%corner_mass(lane, corner, b)
+          nodes%rotary_inertia(node) = nodes%rotary_inertia(node) + self%corner_inertia(lane, corner, b)
+        end do
+      end do
+    end do
+  end subroutine lump_masses
+
+  !> Forces and moments, colour by colour as the solids (solid_group).
+  subroutine add_internal_forces(self, model, nodes, step)
+    class(shell_group_t), intent(inout) :: self
+    type(model_t), intent(in) :: model
+    type(nodal_state_t), intent(inout) :: nodes
+    real(wp), intent(in) :: step
+    real(wp) :: shell_force(block_size, 4, 6)
+    integer :: colour, k, b
+    do colour = 1, size(self%colours%offsets) - 1
+      !$omp parallel do schedule(dynamic, 2) default(shared) private(k, b, shell_force)
+      do k = self%colours%offsets(colour), self%colours%offsets(colour + 1) - 1
+        b = self%colours%corners(k)
+        call compute_shell_block(self%blocks(b), model%materials(self%blocks(b)%material), nodes%coordinates, &
+                                 nodes%velocity, nodes%angular_velocity, step, shell_force, self%block_time_step(b), &
+                                 self%block_critical_element(b), self%block_degenerate_element(b))
+        call add_shell_forces(self%blocks(b), shell_force, nodes%internal_force, nodes%internal_moment, &
+                              nodes%shell_normal_sum, nodes%shell_area_sum)
+      end do
+      !$omp end parallel do
+    end do
+    self%stable_time_step = huge(1.0_wp)
+    self%critical_element = 0
+    self%failed_element = 0
+    do b = 1, size(self%blocks)
+      if (self%block_time_step(b) < self%stable_time_step) then
+        self%stable_time_step = self%block_time_step(b)
+        self%critical_element = self%block_critical_element(b)
+      end if
+      if (self%failed_element == 0) self%failed_element = self%block_degenerate_element(b)
+    end do
+    self%step_not_finite = any(self%block_time_step /= self%block_time_step)
+  end subroutine add_internal_forces
+
+  !> internal_force and internal_moment of the block's nodes += the shells' nodal forces and
+  !> moments, corner by corner, lane by lane; and each node's sums of area x normal and area of
+  !> its shells (for the drilling projection of the time loop).
+  subroutine add_shell_forces(block, shell_force, internal_force, internal_moment, normal_sum, area_sum)
+    type(shell_block_t), intent(in) :: block
+    real(wp), intent(in) :: shell_force(block_size, 4, 6)
+    real(wp), intent(inout) :: internal_force(:, :), internal_moment(:, :), normal_sum(:, :), area_sum(:)
+    integer :: corner, lane, node
+    do corner = 1, 4
+      do lane = 1, block%element_count
+        if (.not. (corner == 4 .and. block%nodes(lane, 4) == block%nodes(lane, 3))) then
+          node = block%nodes(lane, corner)
+          normal_sum(:, node) = normal_sum(:, node) + block%area(lane)*block%frame(lane, 3, :)
+          area_sum(node) = area_sum(node) + block%area(lane)
+        end if
+        node = block%nodes(lane, corner)
+        internal_force(:, node) = internal_force(:, node) + shell_force(lane, corner, 1:3)
+        internal_moment(:, node) = internal_moment(:, node) + shell_force(lane, corner, 4:6)
+      end do
+    end do
+  end subroutine add_shell_forces
+
+  subroutine add_energies(self, step_correction, internal, hourglass)
+    class(shell_group_t), intent(in) :: self
+    real(wp), intent(in) :: step_correction
+    real(wp), intent(inout) :: internal, hourglass
+    integer :: b
+    do b = 1, size(self%blocks)
+      associate (shell => self%blocks(b))
+        internal = internal + booked_energy(shell%internal_energy, shell%force_power, shell%element_count, &
+                                            step_correction)
+        hourglass = hourglass + booked_energy(shell%hourglass_energy, shell%hourglass_power, shell%element_count, &
+                                              step_correction)
+      end associate
+    end do
+  end subroutine add_energies
+
+  subroutine add_part_energies(self, nodes, average_step, step_correction, kinetic, internal, hourglass)
+    class(shell_group_t), intent(in) :: self
+    type(nodal_state_t), intent(in) :: nodes
+    real(wp), intent(in) :: average_step, step_correction
+    real(wp), intent(inout) :: kinetic(:), internal(:), hourglass(:)
+    integer :: b, corner, lane, node
+    do b = 1, size(self%blocks)
+      associate (shell => self%blocks(b))
+        internal(shell%part) = internal(shell%part) + booked_energy(shell%internal_energy, shell%force_power, &
+          shell%element_count, step_correction)
+        hourglass(shell%part) = hourglass(shell%part) + booked_energy(shell%hourglass_energy, shell%hourglass_power, &
+          shell%element_count, step_correction)
+        do corner = 1, 4
+          do lane = 1, shell%element_count
+            node = shell%nodes(lane, corner)
+            call add_kinetic_energy(self%corner_mass(lane, corner, b), nodes%velocity(:, node), &
+                                    nodes%acceleration(:, node), average_step, kinetic(shell%part), internal(shell%part))
+            call add_kinetic_energy(self%corner_inertia(lane, corner, b), nodes%angular_velocity(:, node), &
+                                    nodes%angular_acceleration(:, node), average_step, kinetic(shell%part), &
+                                    internal(shell%part))
+          end do
+        end do
+      end associate
+    end do
+  end subroutine add_part_energies
+
+  subroutine element_results(self, model, results)
+    class(shell_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    type(element_results_t), intent(inout) :: results
+    integer :: b
+    do b = 1, size(self%blocks)
+      call shell_block_element_results(self%blocks(b), model%materials(self%blocks(b)%material), &
+                                       results%shell_stress, results%shell_stress_peak, results%shell_plastic_strain, &
+                                       results%shell_plastic_strain_peak)
+    end do
+  end subroutine element_results
+
+  function describe(self, model, element) result(text)
+    class(shell_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: element
+    character(len=:), allocatable :: text
+    character(len=32) :: id, part
+    write (id, '(i0)') model%shell_ids(element)
+    write (part, '(i0)') model%parts(model%shell_part(element))%id
+    text = "shell element "//trim(id)//" (part "//trim(part)//")"
+  end function describe
+
+  function failure_text(self, model) result(text)
+    class(shell_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    character(len=:), allocatable :: text
+    text = self%describe(model, self%failed_element)//" has lost its area"
+  end function failure_text
+
+  subroutine most_scaled(self, model, largest, element)
+    class(shell_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    real(wp), intent(inout) :: largest
+    integer, intent(inout) :: element
+    real(wp) :: factor
+    integer :: b, lane
+    do b = 1, size(self%blocks)
+      do lane = 1, self%blocks(b)%element_count
+        if (.not. model%materials(self%blocks(b)%material)%density > 0.0_wp) cycle
+        factor = self%blocks(b)%density(lane)/model%materials(self%blocks(b)%material)%density
+        if (factor > largest) then
+          largest = factor
+          element = self%blocks(b)%elements(lane)
+        end if
+      end do
+    end do
+  end subroutine most_scaled
+
+  real(wp) function thinnest(self)
+    class(shell_group_t), intent(in) :: self
+    integer :: b
+    thinnest = huge(1.0_wp)
+    do b = 1, size(self%blocks)
+      thinnest = min(thinnest, minval(self%blocks(b)%thickness(1:self%blocks(b)%element_count)))
+    end do
+  end function thinnest
+
+  !> Its element count and the seconds of its force calls (set, not added: called before and
+  !> after the run).
+  subroutine add_to_summary(self, summary)
+    class(shell_group_t), intent(in) :: self
+    type(run_summary_t), intent(inout) :: summary
+    summary%fe_shells = self%element_count()
+    summary%fe_shell_s = self%timer%seconds
+  end subroutine add_to_summary
+end module shell_group

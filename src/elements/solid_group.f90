@@ -1,0 +1,284 @@
+!> The FE solid hexahedra as an element group (element_group): the blocks of solid_block, their
+!> colouring, corner masses and the per-block results of the last force call.
+module solid_group
+  use kinds, only: wp, block_size
+  use gather_list, only: gather_list_t
+  use block_colouring, only: colour_blocks_by_nodes
+  use model, only: model_t
+  use run_summary, only: run_summary_t
+  use nodal_state, only: nodal_state_t
+  use element_group, only: element_group_t, element_results_t, distortion_t
+  use element_work, only: booked_energy, add_kinetic_energy, scale_block_density
+  use solid_block, only: solid_block_t, build_solid_blocks, solid_block_corner_masses, solid_block_time_steps, &
+                         compute_solid_block, solid_block_element_results
+  use distortion_check, only: check_solid_distortion
+  implicit none
+  private
+
+  public :: solid_group_t, new_solid_group
+
+  type, extends(element_group_t) :: solid_group_t
+    type(solid_block_t), allocatable :: blocks(:)
+    real(wp), allocatable :: corner_mass(:, :, :)        !< (block_size, 8, blocks)
+    real(wp), allocatable :: block_time_step(:)          !< per block, from its kernel
+    integer, allocatable :: block_critical_element(:)
+    integer, allocatable :: block_inverted_element(:)
+    type(gather_list_t) :: colours                       !< colour -> blocks (CSR)
+  contains
+    procedure :: element_count
+    procedure :: scale_masses
+    procedure :: lump_masses
+    procedure :: add_internal_forces
+    procedure :: add_energies
+    procedure :: add_part_energies
+    procedure :: element_results
+    procedure :: describe
+    procedure :: add_to_summary
+    procedure :: failure_text
+    procedure :: most_scaled
+    procedure :: check_distortion
+  end type solid_group_t
+
+contains
+
+  !> The model's FE solids in blocks (solid_block's order), nothing computed yet.
+  !> A new group of this kind (its constructor for element_groups).
+  subroutine new_solid_group(model, group)
+    type(model_t), intent(in) :: model
+    class(element_group_t), allocatable, intent(out) :: group
+    allocate (solid_group_t :: group)
+    select type (group)
+    type is (solid_group_t)
+      call build_group(model, group)
+    end select
+  end subroutine new_solid_group
+
+  subroutine build_group(model, group)
+    type(model_t), intent(in) :: model
+    type(solid_group_t), intent(inout) :: group
+    integer :: count
+    group%name = "solid"
+    call build_solid_blocks(model, group%blocks)
+    count = size(group%blocks)
+    allocate (group%corner_mass(block_size, 8, count), group%block_time_step(count), &
+              group%block_critical_element(count), group%block_inverted_element(count))
+    group%corner_mass = 0.0_wp
+    group%block_time_step = huge(1.0_wp)
+    group%block_critical_element = 0
+    group%block_inverted_element = 0
+  end subroutine build_group
+
+  integer function element_count(self)
+    class(solid_group_t), intent(in) :: self
+    integer :: b
+    element_count = 0
+    do b = 1, size(self%blocks)
+      element_count = element_count + self%blocks(b)%element_count
+    end do
+  end function element_count
+
+  !> Mass scaling (*CONTROL_TIMESTEP DT2MS): each element whose stable step on the undeformed
+  !> mesh is below `target_step` gets the density that brings its step to it.
+  subroutine scale_masses(self, model, nodes, target_step, physical_mass, added_mass)
+    class(solid_group_t), intent(inout) :: self
+    type(model_t), intent(in) :: model
+    type(nodal_state_t), intent(in) :: nodes
+    real(wp), intent(in) :: target_step
+    real(wp), intent(inout) :: physical_mass, added_mass
+    real(wp) :: element_time_step(block_size)
+    integer :: b
+    element_time_step = huge(1.0_wp)
+    do b = 1, size(self%blocks)
+      associate (block => self%blocks(b))
+        if (target_step > 0.0_wp) &
+          call solid_block_time_steps(block, model%materials(block%material), nodes%coordinates, element_time_step)
+        call scale_block_density(block%element_count, block%reference_volume, target_step, element_time_step, &
+                                 block%density, physical_mass, added_mass)
+      end associate
+    end do
+  end subroutine scale_masses
+
+  !> Colour the blocks, then add their corner masses to the nodes (serially, in block, corner
+  !> and lane order).
+  subroutine lump_masses(self, model, nodes)
+    class(solid_group_t), intent(inout) :: self
+    type(model_t), intent(in) :: model
+    type(nodal_state_t), intent(inout) :: nodes
+    integer, allocatable :: block_nodes(:, :, :), counts(:)
+    integer :: b, corner, lane, node
+    allocate (block_nodes(block_size, 8, size(self%blocks)), counts(size(self%blocks)))
+    do b = 1, size(self%blocks)
+      block_nodes(:, :, b) = self%blocks(b)%nodes
+      counts(b) = self%blocks(b)%element_count
+    end do
+    call colour_blocks_by_nodes(nodes%count, block_nodes, counts, self%colours)
+    do b = 1, size(self%blocks)
+      call solid_block_corner_masses(self%blocks(b), self%corner_mass(:, :, b))
+      do corner = 1, 8
+        do lane = 1, self%blocks(b)%element_count
+          node = self%blocks(b)%nodes(lane, corner)
+          nodes%mass(node) = nodes%mass(node) + self%corner_mass(lane, corner, b)
+        end do
+      end do
+    end do
+  end subroutine lump_masses
+
+  !> The blocks of a colour compute their corner forces in parallel and add them straight into
+  !> the nodal forces; colours follow one another. Each node receives its contributions in a
+  !> fixed order (colour, then lane and corner): the same sum for any thread count, with no
+  !> atomics and no per-corner force array in memory.
+  subroutine add_internal_forces(self, model, nodes, step)
+    class(solid_group_t), intent(inout) :: self
+    type(model_t), intent(in) :: model
+    type(nodal_state_t), intent(inout) :: nodes
+    real(wp), intent(in) :: step
+    real(wp) :: block_force(block_size, 8, 3)
+    integer :: colour, k, b
+    do colour = 1, size(self%colours%offsets) - 1
+      !$omp parallel do schedule(dynamic, 2) default(shared) private(k, b, block_force)
+      do k = self%colours%offsets(colour), self%colours%offsets(colour + 1) - 1
+        b = self%colours%corners(k)
+        call compute_solid_block(self%blocks(b), model%materials(self%blocks(b)%material), &
+                                 nodes%coordinates, nodes%velocity, step, block_force, &
+                                 self%block_time_step(b), self%block_critical_element(b), &
+                                 self%block_inverted_element(b))
+        call add_block_forces(self%blocks(b)%element_count, self%blocks(b)%nodes, block_force, &
+                              nodes%internal_force)
+      end do
+      !$omp end parallel do
+    end do
+    ! the header, in block order (the same element for any thread count)
+    self%stable_time_step = huge(1.0_wp)
+    self%critical_element = 0
+    self%failed_element = 0
+    do b = 1, size(self%blocks)
+      if (self%block_time_step(b) < self%stable_time_step) then
+        self%stable_time_step = self%block_time_step(b)
+        self%critical_element = self%block_critical_element(b)
+      end if
+      if (self%failed_element == 0) self%failed_element = self%block_inverted_element(b)
+    end do
+    self%step_not_finite = any(self%block_time_step /= self%block_time_step)
+  end subroutine add_internal_forces
+
+  subroutine add_energies(self, step_correction, internal, hourglass)
+    class(solid_group_t), intent(in) :: self
+    real(wp), intent(in) :: step_correction
+    real(wp), intent(inout) :: internal, hourglass
+    integer :: b
+    do b = 1, size(self%blocks)
+      associate (block => self%blocks(b))
+        internal = internal + booked_energy(block%internal_energy, block%force_power, block%element_count, &
+                                            step_correction)
+        hourglass = hourglass + booked_energy(block%hourglass_energy, block%hourglass_power, block%element_count, &
+                                              step_correction)
+      end associate
+    end do
+  end subroutine add_energies
+
+  !> A node's kinetic energy is shared among parts in proportion to the corner masses.
+  subroutine add_part_energies(self, nodes, average_step, step_correction, kinetic, internal, hourglass)
+    class(solid_group_t), intent(in) :: self
+    type(nodal_state_t), intent(in) :: nodes
+    real(wp), intent(in) :: average_step, step_correction
+    real(wp), intent(inout) :: kinetic(:), internal(:), hourglass(:)
+    integer :: b, corner, lane, node
+    do b = 1, size(self%blocks)
+      associate (block => self%blocks(b))
+        internal(block%part) = internal(block%part) + booked_energy(block%internal_energy, block%force_power, &
+          block%element_count, step_correction)
+        hourglass(block%part) = hourglass(block%part) + booked_energy(block%hourglass_energy, block%hourglass_power, &
+          block%element_count, step_correction)
+        do corner = 1, 8
+          do lane = 1, block%element_count
+            node = block%nodes(lane, corner)
+            call add_kinetic_energy(self%corner_mass(lane, corner, b), nodes%velocity(:, node), &
+                                    nodes%acceleration(:, node), average_step, kinetic(block%part), internal(block%part))
+          end do
+        end do
+      end associate
+    end do
+  end subroutine add_part_energies
+
+  subroutine element_results(self, model, results)
+    class(solid_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    type(element_results_t), intent(inout) :: results
+    integer :: b
+    do b = 1, size(self%blocks)
+      call solid_block_element_results(self%blocks(b), results%solid_stress, results%solid_plastic_strain)
+    end do
+  end subroutine element_results
+
+  function describe(self, model, element) result(text)
+    class(solid_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: element
+    character(len=:), allocatable :: text
+    character(len=32) :: id, part
+    write (id, '(i0)') model%solid_ids(element)
+    write (part, '(i0)') model%parts(model%solid_part(element))%id
+    text = "solid element "//trim(id)//" (part "//trim(part)//")"
+  end function describe
+
+  function failure_text(self, model) result(text)
+    class(solid_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    character(len=:), allocatable :: text
+    text = "negative volume in "//self%describe(model, self%failed_element)
+  end function failure_text
+
+  subroutine most_scaled(self, model, largest, element)
+    class(solid_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    real(wp), intent(inout) :: largest
+    integer, intent(inout) :: element
+    real(wp) :: factor
+    integer :: b, lane
+    do b = 1, size(self%blocks)
+      do lane = 1, self%blocks(b)%element_count
+        if (.not. model%materials(self%blocks(b)%material)%density > 0.0_wp) cycle
+        factor = self%blocks(b)%density(lane)/model%materials(self%blocks(b)%material)%density
+        if (factor > largest) then
+          largest = factor
+          element = self%blocks(b)%elements(lane)
+        end if
+      end do
+    end do
+  end subroutine most_scaled
+
+  subroutine check_distortion(self, model, nodes, time, distortion)
+    class(solid_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    type(nodal_state_t), intent(in) :: nodes
+    real(wp), intent(in) :: time
+    type(distortion_t), intent(inout) :: distortion
+    call check_solid_distortion(model, self%blocks, nodes%coordinates, time, distortion)
+  end subroutine check_distortion
+
+  !> internal_force(:, node) += the block's corner forces, corner by corner, lane by lane.
+  subroutine add_block_forces(element_count, nodes, block_force, internal_force)
+    integer, intent(in) :: element_count
+    integer, intent(in) :: nodes(block_size, 8)
+    real(wp), intent(in) :: block_force(block_size, 8, 3)
+    real(wp), intent(inout) :: internal_force(:, :)
+    integer :: corner, lane, node
+    do corner = 1, 8
+      do lane = 1, element_count
+        node = nodes(lane, corner)
+        internal_force(1, node) = internal_force(1, node) + block_force(lane, corner, 1)
+        internal_force(2, node) = internal_force(2, node) + block_force(lane, corner, 2)
+        internal_force(3, node) = internal_force(3, node) + block_force(lane, corner, 3)
+      end do
+    end do
+  end subroutine add_block_forces
+
+  !> Its element count and the seconds of its force calls (set, not added: called before and
+  !> after the run).
+  subroutine add_to_summary(self, summary)
+    class(solid_group_t), intent(in) :: self
+    type(run_summary_t), intent(inout) :: summary
+    summary%fe_solids = self%element_count()
+    summary%fe_solid_s = self%timer%seconds
+  end subroutine add_to_summary
+end module solid_group

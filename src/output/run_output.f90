@@ -1,0 +1,163 @@
+!> The output step of the time loop: records the history rows and writes the state that the
+!> output plan (output_plan) says are due, reading the run state and changing only the plan,
+!> the histories and the results file.
+module run_output
+  use kinds, only: wp
+  use error_handling, only: error_t
+  use model, only: model_t
+  use explicit_state, only: explicit_state_t, energy_totals_t
+  use output_plan, only: output_plan_t, clock_due
+  use history_buffer, only: history_set_t, append_history_row
+  use element_groups, only: collect_element_results
+  use energy_balance, only: measured_energies, part_energies, total_energy, energy_ratio
+  use results_file, only: results_file_t, write_state
+  use rigid_bodies, only: rigid_body_history_row
+  implicit none
+  private
+
+  public :: write_due_output
+
+contains
+
+  !> Record the histories and write the state that are due at the state's time. `last` marks
+  !> the final cycle (normal or error termination): everything is written then.
+  subroutine write_due_output(model, state, plan, histories, scratch, results, last, error)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(in) :: state
+    type(output_plan_t), intent(inout) :: plan
+    type(history_set_t), intent(inout) :: histories
+    real(wp), intent(inout) :: scratch(:, :)     !< (5, chunks of nodes) for the energy sums
+    type(results_file_t), intent(inout) :: results
+    logical, intent(in) :: last
+    type(error_t), allocatable, intent(out) :: error
+    type(energy_totals_t) :: energy
+    logical :: glstat_due, matsum_due, nodout_due, states_due
+    integer :: k
+
+    glstat_due = clock_due(plan%glstat, state%time, last)
+    matsum_due = clock_due(plan%matsum, state%time, last)
+    if (glstat_due) then
+      energy = state%energy
+      call measured_energies(model, state, scratch, energy)
+      call append_history_row(histories%series(plan%glstat_series), [state%time, &
+        merge(state%next_time_step, state%time_step, state%cycle == 0), &
+        energy%kinetic, energy%internal, energy%hourglass, energy%contact, &
+        energy%external_work, total_energy(energy), energy%rigid_wall, energy_ratio(energy), &
+        state%added_mass, energy%momentum])
+    end if
+    if (matsum_due) then
+      call part_energies(model, state, size(model%parts), plan%part_kinetic, plan%part_internal, plan%part_hourglass)
+      do k = 1, size(model%parts)
+        call append_history_row(histories%series(plan%matsum_series(k)), [state%time, plan%part_kinetic(k), &
+                                plan%part_internal(k), plan%part_hourglass(k)])
+      end do
+    end if
+    nodout_due = clock_due(plan%nodout, state%time, last)
+    states_due = clock_due(plan%states, state%time, last)
+    if (nodout_due .or. states_due) call physical_node_fields(state, plan)
+    if (nodout_due) then
+      do k = 1, size(plan%nodout_series)
+        associate (node => model%output%history_nodes(k))
+          call append_history_row(histories%series(plan%nodout_series(k)), [state%time, &
+            plan%node_displacement(:, node), plan%node_velocity(:, node), plan%node_acceleration(:, node)])
+        end associate
+      end do
+    end if
+    if (clock_due(plan%rwforc, state%time, last)) call record_wall_forces(state, plan, histories)
+    if (clock_due(plan%rcforc, state%time, last)) call record_contact_forces(state, plan, histories)
+    if (clock_due(plan%rbdout, state%time, last)) call record_rigid_bodies(model, state, plan, histories)
+    ! the state and the history rows recorded since the previous one, as one commit
+    if (states_due) call write_current_state(model, state, plan, histories, results, error)
+  end subroutine write_due_output
+
+  !> Wall force averaged over the sampling interval (impulse / interval), so that integrating
+  !> the rwforc history gives the impulse exactly; at t = 0 the force of the first cycle is 0.
+  subroutine record_wall_forces(state, plan, histories)
+    type(explicit_state_t), intent(in) :: state
+    type(output_plan_t), intent(inout) :: plan
+    type(history_set_t), intent(inout) :: histories
+    integer :: k
+    real(wp) :: interval, force(3)
+    interval = state%time - plan%last_rwforc_time
+    do k = 1, size(plan%rwforc_series)
+      force = 0.0_wp
+      if (interval > 0.0_wp) force = (state%walls(k)%impulse - plan%wall_impulse(:, k))/interval
+      call append_history_row(histories%series(plan%rwforc_series(k)), [state%time, force])
+      plan%wall_impulse(:, k) = state%walls(k)%impulse
+    end do
+    plan%last_rwforc_time = state%time
+  end subroutine record_wall_forces
+
+  !> Contact force on the SURFA side averaged over the sampling interval (impulse / interval),
+  !> as rwforc; at t = 0 the force is 0.
+  subroutine record_contact_forces(state, plan, histories)
+    type(explicit_state_t), intent(in) :: state
+    type(output_plan_t), intent(inout) :: plan
+    type(history_set_t), intent(inout) :: histories
+    integer :: k
+    real(wp) :: interval, force(3)
+    interval = state%time - plan%last_rcforc_time
+    do k = 1, size(plan%rcforc_series)
+      force = 0.0_wp
+      if (interval > 0.0_wp) force = (state%contacts(k)%impulse - plan%contact_impulse(:, k))/interval
+      call append_history_row(histories%series(plan%rcforc_series(k)), [state%time, force])
+      plan%contact_impulse(:, k) = state%contacts(k)%impulse
+    end do
+    plan%last_rcforc_time = state%time
+  end subroutine record_contact_forces
+
+  !> One rbdout row per rigid body (the force is the impulse since the last row / interval).
+  subroutine record_rigid_bodies(model, state, plan, histories)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(in) :: state
+    type(output_plan_t), intent(inout) :: plan
+    type(history_set_t), intent(inout) :: histories
+    real(wp) :: row(13)
+    integer :: k
+    do k = 1, size(plan%rbdout_series)
+      call rigid_body_history_row(model, k, state%rigid(k), state%nodes%acceleration, state%nodes%mass, state%time, &
+                                  0.5_wp*state%time_step, state%time - plan%last_rbdout_time, plan%rigid_impulse(:, k), &
+                                  row)
+      call append_history_row(histories%series(plan%rbdout_series(k)), row)
+    end do
+    plan%last_rbdout_time = state%time
+  end subroutine record_rigid_bodies
+
+  !> Physical nodal displacements, integer-step velocities and accelerations: the solver's values, with the
+  !> interior particles of meshfree parts transformed (eq. 16) so that the output shows the
+  !> real deformed shape.
+  subroutine physical_node_fields(state, plan)
+    type(explicit_state_t), intent(in) :: state
+    type(output_plan_t), intent(inout) :: plan
+    integer :: k
+    plan%generalized_velocity = state%nodes%velocity + 0.5_wp*state%time_step*state%nodes%acceleration
+    plan%node_displacement = state%nodes%displacement
+    plan%node_velocity = plan%generalized_velocity
+    plan%node_acceleration = state%nodes%acceleration
+    do k = 1, size(state%groups)
+      call state%groups(k)%group%to_physical(state%nodes%displacement, plan%node_displacement)
+      call state%groups(k)%group%to_physical(plan%generalized_velocity, plan%node_velocity)
+      call state%groups(k)%group%to_physical(state%nodes%acceleration, plan%node_acceleration)
+    end do
+  end subroutine physical_node_fields
+
+  subroutine write_current_state(model, state, plan, histories, results, error)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(in) :: state
+    type(output_plan_t), intent(inout) :: plan
+    type(history_set_t), intent(in) :: histories
+    type(results_file_t), intent(inout) :: results
+    type(error_t), allocatable, intent(out) :: error
+    call collect_element_results(model, state%groups, plan%element_results)
+    associate (fields => plan%element_results)
+      if (size(model%shell_ids) > 0) then
+        call write_state(results, state%time, plan%node_displacement, plan%node_velocity, fields%solid_stress, &
+                         fields%solid_plastic_strain, error, fields%shell_stress, fields%shell_plastic_strain, &
+                         fields%shell_stress_peak, fields%shell_plastic_strain_peak, histories=histories)
+      else
+        call write_state(results, state%time, plan%node_displacement, plan%node_velocity, fields%solid_stress, &
+                         fields%solid_plastic_strain, error, histories=histories)
+      end if
+    end associate
+  end subroutine write_current_state
+end module run_output
