@@ -450,18 +450,11 @@ def test_rigid_bodies_are_identical_for_one_two_and_three_threads(tmp_path, run_
         assert np.abs(bodies[body]["velocity"][0]).max() == 0.0
         assert np.abs(bodies[body]["displacement"][-1]).max() > 1e-3
     assert contact[:, 2].max() > 0.0 and slab_energy > 0.0
-    # Known defect: the solid_stress and solid_plastic_strain rows of the elements of rigid
-    # parts are never set (src/solver/run_output.f90 allocates them and leaves them as the
-    # heap had them; only the deformable blocks and EFG cells fill theirs), so they differ
-    # between any two runs, also on one thread. They are left out of the comparison here and
-    # the test is marked as an expected failure until they are written as zeros.
+    assert_identical_results(runs)
+    # the elements of rigid parts have no stress: their rows are zero (they were uninitialised
+    # memory, different on every run)
     rows = np.flatnonzero(rigid_elements)
-    assert_identical_results(runs, leave_out_rows={"solid_stress": rows, "solid_plastic_strain": rows})
     with runs[0].open() as results:
-        unset = [name for name in sorted(results["states"])
-                 if np.any(results[f"states/{name}/solid_stress"][...][rows] != 0.0) or
-                 np.any(results[f"states/{name}/solid_plastic_strain"][...][rows] != 0.0)]
-    if unset:
-        pytest.xfail(f"states/{unset[0]}/solid_stress and solid_plastic_strain of the {len(rows)} elements of the "
-                     f"rigid parts hold uninitialised memory in {len(unset)} states: plan_output "
-                     "(src/solver/run_output.f90) must set plan%solid_stress and plan%solid_plastic_strain to 0")
+        for name in results["states"]:
+            assert not np.any(results[f"states/{name}/solid_stress"][...][rows])
+            assert not np.any(results[f"states/{name}/solid_plastic_strain"][...][rows])
