@@ -3,7 +3,9 @@
 #   make run        install what is missing, build, run the default job (the ODB component test,
 #                   coupled FE/EFG, about 2 min on one core), plot and tabulate (ODB_FE=1: run fe.k too)
 #   make taylor     the same for the Taylor bar
-#   make test       install what is missing, build, unit tests (debug build) and regression tests
+#   make test       install what is missing, build, layer check, unit tests (debug build) and
+#                   regression tests
+#   make layers     check that each folder of src/ uses only the folders below it
 #   make bench      performance figures (ns per element per cycle)
 #   make verify     verification studies (patch test, cantilever): docs/verification.md (NCPU=n)
 #   make MODE=debug checked build in build/debug
@@ -38,7 +40,7 @@ ALL_SOURCES := $(LIBRARY_SOURCES) src/app/crashfree.f90 $(TEST_SUPPORT) $(TEST_S
 
 vpath %.f90 $(sort $(dir $(ALL_SOURCES)))
 
-.PHONY: all deps run taylor test unit regression bench clean debug verify fuzz
+.PHONY: all deps run taylor test unit regression bench clean debug verify fuzz layers
 # The release build is also published as bin/crashfree and lib/ (library and .mod files).
 ifeq ($(MODE),release)
 all: bin/crashfree
@@ -86,6 +88,10 @@ unit: $(TEST_PROGRAMS)
 
 regression: all
 	@$(PYTHON) -m pytest -q tests/regression
+
+# The layering of src/ (tools/check_layers.py lists the order and every use against it).
+layers:
+	@$(PYTHON) tools/check_layers.py
 
 run: deps
 	@$(MAKE) --no-print-directory all
