@@ -11,7 +11,7 @@ module deck_contact
                    contact_surface_to_surface, contact_single_surface, surface_segment_set, &
                    surface_part_set, surface_part, surface_node_set, surface_all_parts
   use deck_problems, only: problem_log_t
-  use deck_numbers, only: integer_text, real_text
+  use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t, line_location
   use deck_keywords, only: keyword_t, keyword_unknown
   use deck_fields, only: card_t, open_card, next_line, require_card, get_integer, get_real, &

@@ -4,7 +4,7 @@ module deck_controls
   use kinds, only: wp
   use error_handling, only: error_list_t
   use deck_problems, only: problem_log_t
-  use deck_numbers, only: integer_text, real_text
+  use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t
   use deck_fields, only: card_t, next_line, require_card, get_integer, get_real, &
                          card_problem, warn_if_set, line_title, located_warning

@@ -3,7 +3,8 @@ module deck_database
   use kinds, only: wp
   use error_handling, only: error_list_t
   use deck_problems, only: problem_log_t
-  use deck_numbers, only: integer_text, real_text, digit
+  use deck_numbers, only: digit
+  use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t
   use deck_keywords, only: keyword_t, keyword_glstat, keyword_matsum, keyword_nodout, &
                            keyword_rwforc

@@ -8,7 +8,7 @@ module deck_loads_bcs
   use error_handling, only: error_list_t
   use model, only: rigid_wall_t, wall_cylinder, motion_velocity, motion_acceleration, motion_displacement
   use deck_problems, only: problem_log_t
-  use deck_numbers, only: integer_text, real_text
+  use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t
   use deck_keywords, only: keyword_t
   use deck_fields, only: card_t, open_card, next_line, require_card, has_data, get_integer, &

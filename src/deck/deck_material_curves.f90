@@ -10,7 +10,7 @@ module deck_material_curves
   use model, only: model_t, material_t, law_honeycomb, law_modified_honeycomb, law_low_density_foam, &
                    law_piecewise_linear, law_null, law_rigid, section_shell, piecewise_hardening_curve
   use deck_problems, only: problem_log_t
-  use deck_numbers, only: integer_text, real_text
+  use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t
   use deck_fields, only: located_problem
   use deck_id_index, only: id_index_t, build_id_index, find_id

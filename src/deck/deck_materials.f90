@@ -15,7 +15,7 @@ module deck_materials
                    law_low_density_foam, law_piecewise_linear, law_null, piecewise_hardening_curve
   use curves, only: curve_t
   use deck_problems, only: problem_log_t
-  use deck_numbers, only: integer_text, real_text
+  use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t
   use deck_keywords, only: keyword_t, keyword_unknown
   use deck_fields, only: card_t, require_card, next_definition, get_integer, get_real, &

@@ -4,7 +4,7 @@ module deck_nodes_elements
   use kinds, only: wp
   use deck_problems, only: problem_log_t
   use deck_columns, only: field_width
-  use deck_numbers, only: integer_text, real_text
+  use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t, card_text, trim_blanks, is_blank_line
   use deck_fields, only: card_t, open_card, next_line, require_card, get_integer, get_real, &
                          card_problem

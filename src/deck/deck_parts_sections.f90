@@ -5,7 +5,7 @@ module deck_parts_sections
   use error_handling, only: error_list_t
   use model, only: formulation_fe, section_solid, section_shell
   use deck_problems, only: problem_log_t
-  use deck_numbers, only: integer_text, real_text
+  use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t
   use deck_keywords, only: keyword_t
   use deck_fields, only: card_t, open_card, next_line, require_card, next_definition, &

@@ -15,7 +15,7 @@ module deck_reader
   use model, only: model_t
   use deck_problems, only: problem_log_t, report_problem, has_problems, problems_to_error, &
                            printable
-  use deck_numbers, only: integer_text
+  use text_format, only: integer_text
   use deck_lexer, only: deck_t, load_deck, release_deck, line_location, check_files_unchanged
   use deck_keywords, only: keyword_t, identify_keyword, suggest_keyword, keyword_count, &
     keyword_unknown, keyword_title, keyword_node, keyword_element_solid, keyword_part, &

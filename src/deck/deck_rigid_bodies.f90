@@ -13,7 +13,7 @@ module deck_rigid_bodies
   use model, only: material_t, rigid_body_t, rigid_motion_t, law_rigid, formulation_rigid, &
                    motion_velocity, motion_acceleration, motion_displacement
   use deck_problems, only: problem_log_t, report_problem
-  use deck_numbers, only: integer_text, real_text
+  use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t
   use deck_keywords, only: keyword_t, keyword_unknown
   use deck_fields, only: card_t, next_definition, next_line, open_card, get_integer, get_real, &

@@ -3,7 +3,8 @@ module deck_sets_curves
   use kinds, only: wp
   use error_handling, only: error_list_t
   use deck_problems, only: problem_log_t
-  use deck_numbers, only: integer_text, real_text, to_upper, digit
+  use deck_numbers, only: to_upper, digit
+  use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t
   use deck_keywords, only: keyword_t
   use deck_fields, only: card_t, open_card, next_line, next_definition, get_integer, get_real, &

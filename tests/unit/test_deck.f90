@@ -7,6 +7,7 @@ program test_deck
   use kinds, only: wp
   use testing, only: test_suite_t, check, check_close, finish_suite
   use error_handling, only: error_t, error_list_t
+  use text_format, only: integer_text
   use model, only: model_t, formulation_fe, formulation_efg, law_elastic, law_plastic_kinematic, &
                    law_honeycomb, law_modified_honeycomb, law_low_density_foam, &
                    motion_displacement, motion_velocity, kernel_cubic_box, kernel_cubic_sphere, &
@@ -245,7 +246,7 @@ contains
       call check(suite, name//": "//wanted, index(error%message, wanted) > 0, &
                  "message was:"//new_line("a")//error%message)
     end do
-    if (present(message_lines)) call check(suite, name//": "//trim(count_text(message_lines))// &
+    if (present(message_lines)) call check(suite, name//": "//integer_text(message_lines)// &
       " problems listed", count_lines(error%message) == message_lines, &
       "message was:"//new_line("a")//error%message)
   end subroutine read_bad
@@ -258,12 +259,6 @@ contains
       if (text(k:k) == new_line("a")) count_lines = count_lines + 1
     end do
   end function count_lines
-
-  function count_text(value) result(text)
-    integer, intent(in) :: value
-    character(len=12) :: text
-    write (text, '(i0)') value
-  end function count_text
 
   ! ---------------------------------------------------------------- values read
 
@@ -1148,7 +1143,7 @@ contains
       call check_close(suite, "segments: death (DT blank: never)", [(loads(k)%death, k=1, 8)], [never, never, &
         never, never, never, 0.9_wp, 0.9_wp, never], thr=0.0_wp)
       do k = 1, 5
-        call check_close(suite, "segments: uniform values "//count_text(k), &
+        call check_close(suite, "segments: uniform values "//integer_text(k), &
                          loads(k)%nodal_values, [1.0_wp, 1.0_wp, 1.0_wp, 1.0_wp], thr=0.0_wp)
       end do
       call check_close(suite, "nonuniform: values", loads(6)%nodal_values, [1.0_wp, 2.0_wp, &
@@ -1648,7 +1643,7 @@ contains
     ! runs: lines 1-3 | 4-5 (line 4 is more than 2**31 - 1 bytes after line 1, line 5 less
     ! after line 4) | 6 (line number 9 after 5) | 7-8 (file 2) | 9 (file 1 again)
     call check(suite, "line table: five runs", table%run_count == 5, &
-               "found "//trim(count_text(table%run_count)))
+               "found "//integer_text(table%run_count))
     call check(suite, "line table: 4 bytes per line", storage_size(table%offset)/8 == 4)
   end subroutine test_line_table_beyond_2_gib
 
