@@ -3,6 +3,7 @@
 !> (by node or by set) before they are expanded per node.
 module deck_input
   use kinds, only: wp
+  use integer_lists, only: reserve_integers
   use model, only: model_t, rigid_wall_t, segment_load_t
   use deck_rigid_input, only: rigid_input_t
   use deck_contact_input, only: contact_input_t
@@ -209,26 +210,13 @@ contains
                                   lines(keyword_load_segment_nonuniform)))
   end subroutine prepare_input
 
-  !> Append one id with its origin, growing the list by doubling.
+  !> Append one id with its origin (the list grows as needed).
   pure subroutine append_id(list, id, line, field)
     type(id_list_t), intent(inout) :: list
     integer, intent(in) :: id, line, field
-    integer, allocatable :: larger(:)
-    integer :: capacity
-    if (.not. allocated(list%ids)) then
-      allocate (list%ids(16), list%lines(16), list%fields(16))
-    else if (list%count == size(list%ids)) then
-      capacity = 2*size(list%ids)
-      allocate (larger(capacity))
-      larger(1:list%count) = list%ids(1:list%count)
-      call move_alloc(larger, list%ids)
-      allocate (larger(capacity))
-      larger(1:list%count) = list%lines(1:list%count)
-      call move_alloc(larger, list%lines)
-      allocate (larger(capacity))
-      larger(1:list%count) = list%fields(1:list%count)
-      call move_alloc(larger, list%fields)
-    end if
+    call reserve_integers(list%ids, list%count, list%count + 1)
+    call reserve_integers(list%lines, list%count, list%count + 1)
+    call reserve_integers(list%fields, list%count, list%count + 1)
     list%count = list%count + 1
     list%ids(list%count) = id
     list%lines(list%count) = line
