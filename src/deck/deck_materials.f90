@@ -11,8 +11,9 @@
 module deck_materials
   use kinds, only: wp
   use error_handling, only: error_list_t
-  use model, only: material_t, law_elastic, law_plastic_kinematic, law_honeycomb, law_modified_honeycomb, &
-                   law_low_density_foam, law_piecewise_linear, law_null, piecewise_hardening_curve
+  use model, only: material_t, piecewise_hardening_curve
+  use material_laws, only: law_elastic, law_plastic_kinematic, law_honeycomb, law_modified_honeycomb, &
+                           law_low_density_foam, law_piecewise_linear, law_null
   use curves, only: curve_t
   use deck_problems, only: problem_log_t
   use text_format, only: integer_text, real_text

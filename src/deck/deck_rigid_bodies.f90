@@ -10,8 +10,9 @@
 module deck_rigid_bodies
   use kinds, only: wp
   use error_handling, only: error_list_t
-  use model, only: material_t, rigid_body_t, rigid_motion_t, law_rigid, formulation_rigid, &
-                   motion_velocity, motion_acceleration, motion_displacement
+  use model, only: material_t, rigid_body_t, rigid_motion_t, formulation_rigid, motion_velocity, &
+                   motion_acceleration, motion_displacement
+  use material_laws, only: law_rigid
   use deck_problems, only: problem_log_t, report_problem
   use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t

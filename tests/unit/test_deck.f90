@@ -8,12 +8,12 @@ program test_deck
   use testing, only: test_suite_t, check, check_close, finish_suite
   use error_handling, only: error_t, error_list_t
   use text_format, only: integer_text
-  use model, only: model_t, formulation_fe, formulation_efg, law_elastic, law_plastic_kinematic, &
-                   law_honeycomb, law_modified_honeycomb, law_low_density_foam, &
-                   motion_displacement, motion_velocity, kernel_cubic_box, kernel_cubic_sphere, &
-                   boundary_coupled, boundary_full_transformation, integration_local_boundary, &
-                   integration_gauss, integration_gauss_conventional, formulation_rigid, &
-                   section_shell, section_solid
+  use model, only: model_t, formulation_fe, formulation_efg, motion_displacement, motion_velocity, &
+                   kernel_cubic_box, kernel_cubic_sphere, boundary_coupled, &
+                   boundary_full_transformation, integration_local_boundary, integration_gauss, &
+                   integration_gauss_conventional, formulation_rigid, section_shell, section_solid
+  use material_laws, only: law_elastic, law_plastic_kinematic, law_honeycomb, &
+                           law_modified_honeycomb, law_low_density_foam
   use deck_reader, only: read_deck, identify_any_keyword
   use deck_lexer, only: deck_t, load_deck, check_files_unchanged, release_deck
   use deck_problems, only: problem_log_t, has_problems

@@ -10,7 +10,8 @@ program test_deck_materials
   use kinds, only: wp
   use testing, only: test_suite_t, check, check_close, finish_suite
   use error_handling, only: error_t, error_list_t
-  use model, only: model_t, law_piecewise_linear, law_null, piecewise_hardening_curve, piecewise_rate_curve
+  use model, only: model_t, piecewise_hardening_curve, piecewise_rate_curve
+  use material_laws, only: law_piecewise_linear, law_null
   use deck_reader, only: read_deck
   implicit none
 

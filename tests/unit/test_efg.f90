@@ -14,8 +14,9 @@ program test_efg
   use kinds, only: wp, long_int, block_size
   use error_handling, only: error_t
   use model, only: model_t, formulation_efg, formulation_fe, kernel_cubic_box, kernel_cubic_sphere, &
-                   boundary_full_transformation, boundary_coupled, integration_local_boundary, integration_gauss, &
-                   integration_gauss_conventional, law_elastic
+                   boundary_full_transformation, boundary_coupled, integration_local_boundary, &
+                   integration_gauss, integration_gauss_conventional
+  use material_laws, only: law_elastic
   use efg_part, only: efg_part_t
   use efg_setup, only: build_efg_part
   use efg_forces, only: efg_solver_t, set_up_efg_solver

@@ -10,8 +10,9 @@ program test_plane_stress
   use kinds, only: wp, block_size
   use curves, only: curve_t, curve_value
   use error_handling, only: error_t, error_list_t
-  use model, only: model_t, material_t, law_elastic, law_plastic_kinematic, law_piecewise_linear, law_null, &
-                   law_honeycomb, piecewise_hardening_curve, piecewise_rate_curve
+  use model, only: model_t, material_t, piecewise_hardening_curve, piecewise_rate_curve
+  use material_laws, only: law_elastic, law_plastic_kinematic, law_piecewise_linear, law_null, &
+                           law_honeycomb
   use deck_reader, only: read_deck
   use plane_stress_dispatch, only: plane_stress_history_count, initialize_plane_stress_history, &
                                    update_plane_stress_block, plane_stress_plastic_strain

@@ -6,7 +6,8 @@
 !> eigenvalue bound on their step) and element results.
 program test_solid_elements
   use kinds, only: wp, block_size, long_int
-  use model, only: model_t, material_t, law_elastic, law_plastic_kinematic, formulation_fe, formulation_efg
+  use model, only: model_t, material_t, formulation_fe, formulation_efg
+  use material_laws, only: law_elastic, law_plastic_kinematic
   use material_dispatch, only: elastic_moduli
   use objective_rotation, only: incremental_rotation
   use hex8_geometry, only: hex8_volume_derivatives, hex8_velocity_gradient, hex8_gauss_natural_derivatives, &

@@ -15,10 +15,11 @@
 program test_static
   use kinds, only: wp, long_int
   use error_handling, only: error_t
-  use model, only: model_t, law_elastic, formulation_fe, formulation_efg, kernel_cubic_box, kernel_cubic_sphere, &
-                   boundary_coupled, boundary_full_transformation, integration_local_boundary, integration_gauss, &
-                   integration_gauss_conventional, &
-                   motion_displacement, motion_velocity, prescribed_motion_t, spc_t, nodal_load_t, segment_load_t
+  use model, only: model_t, formulation_fe, formulation_efg, kernel_cubic_box, kernel_cubic_sphere, &
+                   boundary_coupled, boundary_full_transformation, integration_local_boundary, &
+                   integration_gauss, integration_gauss_conventional, motion_displacement, &
+                   motion_velocity, prescribed_motion_t, spc_t, nodal_load_t, segment_load_t
+  use material_laws, only: law_elastic
   use static_solution, only: static_solution_t
   use static_analysis, only: solve_static, run_static
   use static_loads, only: segment_consistent_forces
