@@ -53,7 +53,11 @@ all: $(PROGRAM)
 endif
 
 $(OBJ)/%.o: %.f90 | $(OBJ) $(MOD)
-	$(FC) $(FFLAGS) -c $< -o $@
+	$(FC) $(FFLAGS) $(SOURCE_FLAGS) -c $< -o $@
+
+# The keyword readers share one interface (deck_keyword_table's keyword_reader): not every
+# reader needs every argument. (`private`: not passed on to the modules they use.)
+$(OBJ)/deck_%.o: private SOURCE_FLAGS := -Wno-unused-dummy-argument
 
 $(OBJ) $(MOD) $(BUILD)/tests $(dir $(LIBRARY)) $(dir $(PROGRAM)):
 	@mkdir -p $@
