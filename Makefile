@@ -33,7 +33,7 @@ FFLAGS += -J$(MOD) -I$(MOD) -I$(HDF5_INCLUDE)
 
 LIBRARY_SOURCES := $(sort $(shell find src -name '*.f90' ! -path 'src/app/*'))
 LIBRARY_OBJECTS := $(patsubst %.f90,$(OBJ)/%.o,$(notdir $(LIBRARY_SOURCES)))
-TEST_SUPPORT := tests/unit/testing.f90
+TEST_SUPPORT := tests/unit/testing.f90 tests/unit/fixtures.f90
 TEST_SOURCES := $(sort $(wildcard tests/unit/test_*.f90))
 TEST_PROGRAMS := $(patsubst tests/unit/%.f90,$(BUILD)/tests/%,$(TEST_SOURCES))
 ALL_SOURCES := $(LIBRARY_SOURCES) src/app/crashfree.f90 $(TEST_SUPPORT) $(TEST_SOURCES)
@@ -69,8 +69,8 @@ $(LIBRARY): $(LIBRARY_OBJECTS) | $(dir $(LIBRARY))
 $(PROGRAM): $(OBJ)/crashfree.o $(LIBRARY) | $(dir $(PROGRAM))
 	$(FC) $(FFLAGS) $< $(LIBRARY) $(LIBS) -o $@
 
-$(BUILD)/tests/%: $(OBJ)/%.o $(OBJ)/testing.o $(LIBRARY) | $(BUILD)/tests
-	$(FC) $(FFLAGS) $< $(OBJ)/testing.o $(LIBRARY) $(LIBS) -o $@
+$(BUILD)/tests/%: $(OBJ)/%.o $(OBJ)/testing.o $(OBJ)/fixtures.o $(LIBRARY) | $(BUILD)/tests
+	$(FC) $(FFLAGS) $< $(OBJ)/testing.o $(OBJ)/fixtures.o $(LIBRARY) $(LIBS) -o $@
 
 $(BUILD)/deps.mk: $(ALL_SOURCES) tools/fortran_deps.py
 	@mkdir -p $(BUILD)

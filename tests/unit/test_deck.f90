@@ -6,6 +6,7 @@
 program test_deck
   use kinds, only: wp
   use testing, only: test_suite_t, check, check_close, finish_suite
+  use fixtures, only: make_scratch_directory
   use error_handling, only: error_t, error_list_t
   use text_format, only: integer_text
   use model, only: model_t, formulation_fe, formulation_efg, motion_displacement, motion_velocity, &
@@ -30,7 +31,7 @@ program test_deck
   character(len=:), allocatable :: directory
 
   suite%name = "deck"
-  directory = make_directory()
+  directory = make_scratch_directory("crashfree_test_deck", "sub/nested")
   call test_fixed_format()
   call test_free_format_parameters_include()
   call test_long_format()
@@ -157,19 +158,6 @@ contains
     character(len=line_length) :: line(1)
     line(1) = text
   end function text_line
-
-  function make_directory() result(path)
-    character(len=:), allocatable :: path
-    real :: random
-    integer :: clock
-    character(len=40) :: name
-    call random_seed()
-    call random_number(random)
-    call system_clock(clock)
-    write (name, '("/tmp/crashfree_test_deck_",i0,"_",i0)') clock, int(random*1.0e6)
-    path = trim(name)
-    call execute_command_line("mkdir -p "//path//"/sub/nested")
-  end function make_directory
 
   !> A deck edited after it was scanned: its cards are read again at their byte offsets, so the
   !> reader must notice the change instead of reading other text.

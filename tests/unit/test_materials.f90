@@ -26,6 +26,7 @@ program test_materials
                                plastic_hardening_modulus
   use objective_rotation, only: incremental_rotation
   use testing, only: test_suite_t, check, check_close, finish_suite
+  use fixtures, only: piecewise_steel, make_curve
   implicit none
 
   type(test_suite_t) :: suite
@@ -332,15 +333,6 @@ contains
     call check_close(suite, "back stress rotates with the element (quarter turn about z)", history(1, :), &
                      [0.5_wp, 20.0_wp, 10.0_wp, -30.0_wp, -4.0_wp, 6.0_wp, -5.0_wp], thr=1e-13_wp)
   end subroutine test_back_stress_rotation
-  function make_curve(id, abscissa, ordinate) result(curve)
-    integer, intent(in) :: id
-    real(wp), intent(in) :: abscissa(:), ordinate(:)
-    type(curve_t) :: curve
-    curve%id = id
-    allocate (curve%abscissa, source=abscissa)
-    allocate (curve%ordinate, source=ordinate)
-  end function make_curve
-
   !> Honeycomb with distinct yield curves per axis (plateaus 1.0, 0.5, 2.0 rising towards
   !> compaction; shear 0.3, 0.2, 0.1), compacted E = 1000, PR = 0.3, VF = 0.2, material axes
   !> a = (1, 1, 0)/sqrt 2, b = (-1, 1, 0)/sqrt 2, c = z (AOPT 2).
@@ -637,21 +629,6 @@ contains
   end function real_image
 
   ! ---------------------------------------------------------------- *MAT_024, *MAT_NULL
-
-  !> *MAT_024 as the deck builds it: hardening curve slot (no points: bilinear SIGY, ETAN) and
-  !> rate curve slot (no points: C, P).
-  function piecewise_steel(etan) result(material)
-    real(wp), intent(in) :: etan
-    type(material_t) :: material
-    material%law = law_piecewise_linear
-    material%density = 7.85e-9_wp
-    material%youngs_modulus = youngs
-    material%poissons_ratio = poisson
-    material%yield_stress = yield
-    material%tangent_modulus = etan
-    allocate (material%curve_ids(2), material%curves(2))
-    material%curve_ids(:) = 0
-  end function piecewise_steel
 
   !> Static yield Y(eps_p) of a *MAT_024 material.
   function piecewise_yield(material, eps) result(value)
