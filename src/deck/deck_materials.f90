@@ -307,12 +307,7 @@ contains
     end do
   end subroutine read_plastic_kinematic_materials
 
-  !> *MAT_HONEYCOMB (026, `modified` false) and *MAT_MODIFIED_HONEYCOMB (126): cards 1-5
-  !> (126: 1-8, cards 6-8 optional; a 126 keyword therefore holds one material).
-  !> C1 MID RO E PR SIGY VF MU BULK; C2 LCA LCB LCC LCS LCAB LCBC LCCA LCSR;
-  !> C3 EAAU EBBU ECCU GABU GBCU GCAU AOPT MACF; C4 XP YP ZP A1 A2 A3 (126: RFAC PRU);
-  !> C5 D1 D2 D3 TSEF SSEF (026: V1 V2 V3; 126: VREF TREF SHDFLG); 126: C6 V1 V2 V3,
-  !> C7 LCSRA ... LCSRCA, C8 PRUAB ... PRUCB.
+  !> *MAT_HONEYCOMB (026): see read_honeycombs.
   subroutine read_honeycomb_materials(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
@@ -334,6 +329,12 @@ contains
     call read_honeycombs(deck, block, keyword, .true., input, log)
   end subroutine read_modified_honeycomb_materials
 
+  !> *MAT_HONEYCOMB (026, `modified` false) and *MAT_MODIFIED_HONEYCOMB (126): cards 1-5
+  !> (126: 1-8, cards 6-8 optional; a 126 keyword therefore holds one material).
+  !> C1 MID RO E PR SIGY VF MU BULK; C2 LCA LCB LCC LCS LCAB LCBC LCCA LCSR;
+  !> C3 EAAU EBBU ECCU GABU GBCU GCAU AOPT MACF; C4 XP YP ZP A1 A2 A3 (126: RFAC PRU);
+  !> C5 D1 D2 D3 TSEF SSEF (026: V1 V2 V3; 126: VREF TREF SHDFLG); 126: C6 V1 V2 V3,
+  !> C7 LCSRA ... LCSRCA, C8 PRUAB ... PRUCB.
   subroutine read_honeycombs(deck, block, keyword, modified, input, log)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
