@@ -3,7 +3,9 @@
 #   make run        install what is missing, build, run the default job (the ODB component test,
 #                   coupled FE/EFG, about 2 min on one core), plot and tabulate (ODB_FE=1: run fe.k too)
 #   make taylor     the same for the Taylor bar
-#   make test       install what is missing, build, unit tests (debug build) and regression tests
+#   make test       install what is missing, build, layer check, unit tests (debug build) and
+#                   regression tests
+#   make layers     check that each folder of src/ uses only the folders below it
 #   make bench      performance figures (ns per element per cycle)
 #   make verify     verification studies (patch test, cantilever): docs/verification.md (NCPU=n)
 #   make MODE=debug checked build in build/debug
@@ -31,14 +33,14 @@ FFLAGS += -J$(MOD) -I$(MOD) -I$(HDF5_INCLUDE)
 
 LIBRARY_SOURCES := $(sort $(shell find src -name '*.f90' ! -path 'src/app/crashfree.f90'))
 LIBRARY_OBJECTS := $(patsubst %.f90,$(OBJ)/%.o,$(notdir $(LIBRARY_SOURCES)))
-TEST_SUPPORT := tests/unit/testing.f90
+TEST_SUPPORT := tests/unit/testing.f90 tests/unit/fixtures.f90
 TEST_SOURCES := $(sort $(wildcard tests/unit/test_*.f90))
 TEST_PROGRAMS := $(patsubst tests/unit/%.f90,$(BUILD)/tests/%,$(TEST_SOURCES))
 ALL_SOURCES := $(LIBRARY_SOURCES) src/app/crashfree.f90 $(TEST_SUPPORT) $(TEST_SOURCES)
 
 vpath %.f90 $(sort $(dir $(ALL_SOURCES)))
 
-.PHONY: all deps run taylor test unit regression bench clean debug verify fuzz
+.PHONY: all deps run taylor test unit regression bench clean debug verify fuzz layers
 # The release build is also published as bin/crashfree and lib/ (library and .mod files).
 ifeq ($(MODE),release)
 all: bin/crashfree
@@ -51,7 +53,11 @@ all: $(PROGRAM)
 endif
 
 $(OBJ)/%.o: %.f90 | $(OBJ) $(MOD)
-	$(FC) $(FFLAGS) -c $< -o $@
+	$(FC) $(FFLAGS) $(SOURCE_FLAGS) -c $< -o $@
+
+# The keyword readers share one interface (deck_keyword_table's keyword_reader): not every
+# reader needs every argument. (`private`: not passed on to the modules they use.)
+$(OBJ)/deck_%.o: private SOURCE_FLAGS := -Wno-unused-dummy-argument
 
 $(OBJ) $(MOD) $(BUILD)/tests $(dir $(LIBRARY)) $(dir $(PROGRAM)):
 	@mkdir -p $@
@@ -63,8 +69,8 @@ $(LIBRARY): $(LIBRARY_OBJECTS) | $(dir $(LIBRARY))
 $(PROGRAM): $(OBJ)/crashfree.o $(LIBRARY) | $(dir $(PROGRAM))
 	$(FC) $(FFLAGS) $< $(LIBRARY) $(LIBS) -o $@
 
-$(BUILD)/tests/%: $(OBJ)/%.o $(OBJ)/testing.o $(LIBRARY) | $(BUILD)/tests
-	$(FC) $(FFLAGS) $< $(OBJ)/testing.o $(LIBRARY) $(LIBS) -o $@
+$(BUILD)/tests/%: $(OBJ)/%.o $(OBJ)/testing.o $(OBJ)/fixtures.o $(LIBRARY) | $(BUILD)/tests
+	$(FC) $(FFLAGS) $< $(OBJ)/testing.o $(OBJ)/fixtures.o $(LIBRARY) $(LIBS) -o $@
 
 $(BUILD)/deps.mk: $(ALL_SOURCES) tools/fortran_deps.py
 	@mkdir -p $(BUILD)
@@ -86,6 +92,10 @@ unit: $(TEST_PROGRAMS)
 
 regression: all
 	@$(PYTHON) -m pytest -q tests/regression
+
+# The layering of src/ (tools/check_layers.py lists the order and every use against it).
+layers:
+	@$(PYTHON) tools/check_layers.py
 
 run: deps
 	@$(MAKE) --no-print-directory all

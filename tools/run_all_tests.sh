@@ -1,11 +1,19 @@
 #!/usr/bin/env bash
-# make test: release build, Fortran unit tests in the checked (debug) build, then the pytest
-# regression tests on the release binary, then a short deck fuzzing run with both builds (each
-# mutant deck and each stored reproducer of tests/fuzz/findings is one test). The last line adds
-# them up: "N passed, N failed".
+# make test: release build, the layer check of src/ (tools/check_layers.py: one test), Fortran
+# unit tests in the checked (debug) build, then the pytest regression tests on the release
+# binary, then a short deck fuzzing run with both builds (each mutant deck and each stored
+# reproducer of tests/fuzz/findings is one test). The last line adds them up: "N passed, N failed".
 set -u
 jobs=$(nproc 2>/dev/null || echo 2)
 make --no-print-directory -s -j"$jobs" all || { echo "0 passed, 1 failed"; exit 1; }
+
+echo "== layers (tools/check_layers.py: a folder of src/ uses only the folders below it) =="
+layers_passed=0
+layers_failed=1
+if ${PYTHON:-python3} tools/check_layers.py; then
+  layers_passed=1
+  layers_failed=0
+fi
 
 echo "== unit tests (MODE=debug: -std=f2008 -fcheck=all -ffpe-trap=invalid,zero,overflow) =="
 unit_log=$(mktemp)
@@ -44,7 +52,7 @@ if make --no-print-directory -s -j"$jobs" MODE=debug all; then
 fi
 rm -f "$fuzz_log"
 
-passed=$((unit_passed + regression_passed + fuzz_passed))
-failed=$((unit_failed + regression_failed + fuzz_failed))
+passed=$((layers_passed + unit_passed + regression_passed + fuzz_passed))
+failed=$((layers_failed + unit_failed + regression_failed + fuzz_failed))
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -5,6 +5,7 @@
 !> needs of one segment (area, owner volume).
 module contact_surfaces
   use kinds, only: wp
+  use integer_lists, only: reserve_integers, reserve_integer_columns
   implicit none
   private
 
@@ -83,28 +84,14 @@ contains
         end do
       end do
     end do
-    call reserve(count + count_false(shared))
+    call reserve_integer_columns(segments, 4, count, count + count_false(shared))
+    call reserve_integers(owners, count, count + count_false(shared))
     do f = 1, face_count
       if (shared(f)) cycle
       count = count + 1
       segments(:, count) = faces(:, f)
       owners(count) = face_owner(f)
     end do
-  contains
-    subroutine reserve(needed)
-      integer, intent(in) :: needed
-      integer, allocatable :: grown_segments(:, :), grown_owners(:)
-      if (.not. allocated(segments)) then
-        allocate (segments(4, max(16, needed)), owners(max(16, needed)))
-        return
-      end if
-      if (size(owners) >= needed) return
-      allocate (grown_segments(4, max(needed, 2*size(owners))), grown_owners(max(needed, 2*size(owners))))
-      grown_segments(:, 1:count) = segments(:, 1:count)
-      grown_owners(1:count) = owners(1:count)
-      call move_alloc(grown_segments, segments)
-      call move_alloc(grown_owners, owners)
-    end subroutine reserve
   end subroutine append_exterior_faces
 
   !> Append the shells of part `part` as segments, owners minus the shell index.
@@ -112,18 +99,10 @@ contains
     integer, intent(in) :: shell_nodes(:, :), shell_part(:), part
     integer, allocatable, intent(inout) :: segments(:, :), owners(:)
     integer, intent(inout) :: count
-    integer, allocatable :: grown_segments(:, :), grown_owners(:)
     integer :: shell, needed
     needed = count + count_part(shell_part, part)
-    if (.not. allocated(segments)) then
-      allocate (segments(4, max(16, needed)), owners(max(16, needed)))
-    else if (size(owners) < needed) then
-      allocate (grown_segments(4, max(needed, 2*size(owners))), grown_owners(max(needed, 2*size(owners))))
-      grown_segments(:, 1:count) = segments(:, 1:count)
-      grown_owners(1:count) = owners(1:count)
-      call move_alloc(grown_segments, segments)
-      call move_alloc(grown_owners, owners)
-    end if
+    call reserve_integer_columns(segments, 4, count, needed)
+    call reserve_integers(owners, count, needed)
     do shell = 1, size(shell_part)
       if (shell_part(shell) /= part) cycle
       count = count + 1

@@ -13,6 +13,7 @@ module file_lock
                                          c_associated, c_size_t, c_loc
   use error_handling, only: error_t, make_error
   use file_system, only: clear_system_error, system_error_number, system_error_text
+  use text_format, only: integer_text
   implicit none
   private
 
@@ -87,7 +88,7 @@ contains
     type(error_t), allocatable, intent(out) :: error
     character(len=:), allocatable, intent(out) :: holder
     character(kind=c_char, len=1), allocatable, target :: pid_text(:)
-    character(len=24) :: buffer
+    character(len=:), allocatable :: digits
     integer(c_int) :: status
     integer(c_long) :: written
     integer :: number, k
@@ -116,10 +117,10 @@ contains
     end if
     lock%path = path
     ! Our pid for the next one refused. Not writing it (a full disk) does not weaken the lock.
-    write (buffer, '(i0)') c_getpid()
-    allocate (pid_text(len_trim(buffer) + 1))
-    do k = 1, len_trim(buffer)
-      pid_text(k) = buffer(k:k)
+    digits = integer_text(int(c_getpid()))
+    allocate (pid_text(len(digits) + 1))
+    do k = 1, len(digits)
+      pid_text(k) = digits(k:k)
     end do
     pid_text(size(pid_text)) = achar(10)
     status = c_ftruncate(c_fileno(lock%stream), 0_c_long)
@@ -141,7 +142,6 @@ contains
   function holder_pid(path) result(text)
     character(len=*), intent(in) :: path
     character(len=:), allocatable :: text
-    character(len=32) :: line
     integer :: unit, status, pid
     text = "unknown"
     open (newunit=unit, file=path, status="old", action="read", iostat=status)
@@ -149,7 +149,6 @@ contains
     read (unit, *, iostat=status) pid
     close (unit)
     if (status /= 0) return
-    write (line, '(i0)') pid
-    text = trim(line)
+    text = integer_text(pid)
   end function holder_pid
 end module file_lock

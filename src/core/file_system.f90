@@ -9,6 +9,7 @@ module file_system
                                          c_associated, c_f_pointer, c_size_t
   use kinds, only: long_int
   use error_handling, only: error_t, make_error
+  use text_format, only: integer_text
   implicit none
   private
 
@@ -331,12 +332,4 @@ contains
       if (text(1:1) >= "A" .and. text(1:1) <= "Z") lowered(1:1) = achar(iachar(text(1:1)) + 32)
     end if
   end function lower_first
-
-  pure function integer_text(value) result(text)
-    integer, intent(in) :: value
-    character(len=:), allocatable :: text
-    character(len=24) :: buffer
-    write (buffer, '(i0)') value
-    text = trim(buffer)
-  end function integer_text
 end module file_system

@@ -2,8 +2,8 @@
 !> _SINGLE_SURFACE (each with _ID / _TITLE), *CONTROL_CONTACT and *DATABASE_RCFORC, and the
 !> cross-check that resolves the contact sides and stores the segment sets in the model.
 !>
-!> The keyword codes live here (`contact_keyword_first`..) rather than in deck_keywords, as
-!> for the rigid-body keywords.
+!> The readers are those of the keyword table's rows (deck_keyword_table); the contacts list
+!> holds one entry per contact keyword block (deck_input).
 module deck_contact
   use kinds, only: wp
   use error_handling, only: error_list_t
@@ -11,9 +11,9 @@ module deck_contact
                    contact_surface_to_surface, contact_single_surface, surface_segment_set, &
                    surface_part_set, surface_part, surface_node_set, surface_all_parts
   use deck_problems, only: problem_log_t
-  use deck_numbers, only: integer_text, real_text
+  use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t, line_location
-  use deck_keywords, only: keyword_t, keyword_unknown
+  use deck_keywords, only: keyword_t
   use deck_fields, only: card_t, open_card, next_line, require_card, get_integer, get_real, &
                          card_problem, warn_if_set, id_heading, line_problem, located_problem, &
                          located_warning
@@ -23,86 +23,48 @@ module deck_contact
   implicit none
   private
 
-  public :: identify_contact_keyword, read_contact_block, build_contacts
-
-  integer, parameter, public :: keyword_contact_nodes_to_surface = 1101, &
-    keyword_contact_surface_to_surface = 1102, keyword_contact_single_surface = 1103, &
-    keyword_control_contact = 1104, keyword_rcforc = 1105
-  integer, parameter, public :: contact_keyword_first = 1101, contact_keyword_last = 1105
+  public :: read_nodes_to_surface_contacts, read_surface_to_surface_contacts, read_single_surface_contacts
+  public :: read_control_contact, read_rcforc, build_contacts
 
   integer, parameter :: standard_widths(8) = 10
 
 contains
 
-  !> The contact keyword `name` (upper case, no `*`) with its options, or `keyword_unknown`.
-  pure function identify_contact_keyword(name) result(keyword)
-    character(len=*), intent(in) :: name
-    type(keyword_t) :: keyword
-    character(len=:), allocatable :: base
-    integer :: last
-    base = name
-    last = len(base)
-    if (last > 3) then
-      if (base(last - 2:last) == "_ID") then
-        keyword%id = .true.
-        base = base(1:last - 3)
-      end if
-    end if
-    last = len(base)
-    if (.not. keyword%id .and. last > 6) then
-      if (base(last - 5:last) == "_TITLE") then
-        keyword%title = .true.
-        base = base(1:last - 6)
-      end if
-    end if
-    select case (base)
-    case ("CONTACT_AUTOMATIC_NODES_TO_SURFACE")
-      keyword%code = keyword_contact_nodes_to_surface
-    case ("CONTACT_AUTOMATIC_SURFACE_TO_SURFACE")
-      keyword%code = keyword_contact_surface_to_surface
-    case ("CONTACT_AUTOMATIC_SINGLE_SURFACE")
-      keyword%code = keyword_contact_single_surface
-    case ("CONTROL_CONTACT", "DATABASE_RCFORC")
-      if (keyword%id .or. keyword%title) then
-        keyword%code = keyword_unknown
-      else if (base == "CONTROL_CONTACT") then
-        keyword%code = keyword_control_contact
-      else
-        keyword%code = keyword_rcforc
-      end if
-    case default
-      keyword%code = keyword_unknown
-    end select
-    if (keyword%code == keyword_unknown) then
-      keyword%id = .false.
-      keyword%title = .false.
-    end if
-  end function identify_contact_keyword
-
-  !> Read one block of a contact keyword.
-  subroutine read_contact_block(deck, block, keyword, input, log, warnings)
+  !> *CONTACT_AUTOMATIC_NODES_TO_SURFACE: see read_contact_cards.
+  subroutine read_nodes_to_surface_contacts(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
     type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
-    select case (keyword%code)
-    case (keyword_contact_nodes_to_surface)
-      call read_contact(deck, block, keyword, contact_nodes_to_surface, input, log, warnings)
-    case (keyword_contact_surface_to_surface)
-      call read_contact(deck, block, keyword, contact_surface_to_surface, input, log, warnings)
-    case (keyword_contact_single_surface)
-      call read_contact(deck, block, keyword, contact_single_surface, input, log, warnings)
-    case (keyword_control_contact)
-      call read_control_contact(deck, block, input, log, warnings)
-    case (keyword_rcforc)
-      call read_rcforc(deck, block, input, log)
-    end select
-  end subroutine read_contact_block
+    call read_contact_cards(deck, block, keyword, contact_nodes_to_surface, input, log, warnings)
+  end subroutine read_nodes_to_surface_contacts
+
+  !> *CONTACT_AUTOMATIC_SURFACE_TO_SURFACE: see read_contact_cards.
+  subroutine read_surface_to_surface_contacts(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_contact_cards(deck, block, keyword, contact_surface_to_surface, input, log, warnings)
+  end subroutine read_surface_to_surface_contacts
+
+  !> *CONTACT_AUTOMATIC_SINGLE_SURFACE: see read_contact_cards.
+  subroutine read_single_surface_contacts(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_contact_cards(deck, block, keyword, contact_single_surface, input, log, warnings)
+  end subroutine read_single_surface_contacts
 
   !> One contact: [ID card] C1 C2 C3 [A] (cards B-G are read over with a warning).
-  subroutine read_contact(deck, block, keyword, kind, input, log, warnings)
+  subroutine read_contact_cards(deck, block, keyword, kind, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
     type(keyword_t), intent(in) :: keyword
@@ -241,19 +203,10 @@ contains
   contains
     subroutine append_contact(new_entry)
       type(contact_entry_t), intent(in) :: new_entry
-      type(contact_entry_t), allocatable :: grown(:)
-      associate (list => input%contact)
-        if (.not. allocated(list%entries)) allocate (list%entries(4))
-        if (list%count == size(list%entries)) then
-          allocate (grown(2*list%count))
-          grown(1:list%count) = list%entries(1:list%count)
-          call move_alloc(grown, list%entries)
-        end if
-        list%count = list%count + 1
-        list%entries(list%count) = new_entry
-      end associate
+      input%contact%count = input%contact%count + 1
+      input%contact%entries(input%contact%count) = new_entry
     end subroutine append_contact
-  end subroutine read_contact
+  end subroutine read_contact_cards
 
   !> Whether surface type `code` may be given for side `side` (1 SURFA, 2 SURFB) of `kind`.
   pure logical function type_allowed(kind, side, code)
@@ -281,9 +234,10 @@ contains
 
   !> *CONTROL_CONTACT card 1: SLSFAC is used; the options that change LS-DYNA's behaviour but
   !> are not available give warnings. Further cards are read over.
-  subroutine read_control_contact(deck, block, input, log, warnings)
+  subroutine read_control_contact(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
@@ -307,11 +261,13 @@ contains
   end subroutine read_control_contact
 
   !> *DATABASE_RCFORC: DT BINARY LCUR IOOPT, as the other history databases.
-  subroutine read_rcforc(deck, block, input, log)
+  subroutine read_rcforc(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
     integer :: line, interval_curve
     real(wp) :: interval

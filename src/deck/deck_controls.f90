@@ -4,11 +4,12 @@ module deck_controls
   use kinds, only: wp
   use error_handling, only: error_list_t
   use deck_problems, only: problem_log_t
-  use deck_numbers, only: integer_text, real_text
+  use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t
   use deck_fields, only: card_t, next_line, require_card, get_integer, get_real, &
                          card_problem, warn_if_set, line_title, located_warning
   use deck_input, only: deck_input_t
+  use deck_keywords, only: keyword_t
   implicit none
   private
 
@@ -21,10 +22,13 @@ module deck_controls
 contains
 
   !> *TITLE: the next line is the title.
-  subroutine read_title(deck, block, input)
+  subroutine read_title(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
     integer :: line
     line = 0
     if (next_line(deck, block, line, .false.)) input%model%title = line_title(deck, line)
@@ -32,9 +36,10 @@ contains
 
   !> *CONTROL_TERMINATION: ENDTIM ENDCYC DTMIN ENDENG ENDMAS NOSOL. Whether ENDTIM is usable
   !> is checked once the whole deck is read (ENDCYC may stand in for it).
-  subroutine read_termination(deck, block, input, log, warnings)
+  subroutine read_termination(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
@@ -67,9 +72,10 @@ contains
 
   !> *CONTROL_TIMESTEP card 1: DTINIT TSSFAC ISDO TSLIMT DT2MS LCTM ERODE MS1ST (the optional
   !> cards 2 and 3 are not read). TSSFAC 0 or blank means 0.9.
-  subroutine read_time_step(deck, block, input, log, warnings)
+  subroutine read_time_step(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
@@ -103,11 +109,13 @@ contains
 
   !> *CONTROL_HOURGLASS: IHQ QH, the defaults of parts without their own *HOURGLASS type
   !> (IHQ 0 or blank: 1; QH 0 or blank: 0.1).
-  subroutine read_hourglass_control(deck, block, input, log)
+  subroutine read_hourglass_control(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
     integer :: line
     line = 0
@@ -130,11 +138,13 @@ contains
 
   !> *CONTROL_BULK_VISCOSITY: Q1 Q2 TYPE, the bulk-viscosity defaults (0 or blank: 1.5 and
   !> 0.06). TYPE is not used: bulk viscosity acts on solids, which is LS-DYNA's default.
-  subroutine read_bulk_viscosity(deck, block, input, log)
+  subroutine read_bulk_viscosity(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
     integer :: line
     line = 0
@@ -153,11 +163,13 @@ contains
 
   !> *CONTROL_ENERGY: HGEN RWEN SLNTEN RYLEN ...; 1 = not in the energy balance, 2 = in it.
   !> HGEN and RWEN are used; the others concern features crashfree does not have.
-  subroutine read_energy_control(deck, block, input, log)
+  subroutine read_energy_control(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
     integer :: line, hourglass, wall
     line = 0
@@ -180,9 +192,10 @@ contains
   !> geometric stiffness (IGS 1 or < 0) is an error, since it belongs to a nonlinear analysis;
   !> DT0 and CNSTN are ignored with a warning. IMFORM, NSBS, FORM and ZERO_V concern springback
   !> and the switching between explicit and implicit (IMFLAG 2, 4, 5) and are not used.
-  subroutine read_implicit_general(deck, block, input, log, warnings)
+  subroutine read_implicit_general(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
@@ -246,11 +259,13 @@ contains
   !> *CONTROL_IMPLICIT_GENERAL asks for the implicit analysis. The other fields and the further
   !> cards steer nonlinear iterations, which a linear analysis does not do: they are read
   !> (card 1) or skipped (cards 2-4) and not used.
-  subroutine read_implicit_solution(deck, block, input, log)
+  subroutine read_implicit_solution(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
     integer :: line, k, iterations, reformations
     real(wp) :: tolerance

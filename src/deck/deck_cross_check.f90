@@ -8,7 +8,8 @@ module deck_cross_check
                    rigid_wall_t, formulation_fe, formulation_efg, boundary_full_transformation, &
                    integration_gauss_conventional
   use deck_problems, only: problem_log_t, report_problem, has_problems
-  use deck_numbers, only: integer_text, real_text, digit
+  use deck_numbers, only: digit
+  use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t, line_location
   use deck_fields, only: located_problem, located_warning
   use deck_input, only: deck_input_t, set_input_t, velocity_input_t, velocity_by_set, &

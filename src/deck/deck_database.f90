@@ -3,27 +3,31 @@ module deck_database
   use kinds, only: wp
   use error_handling, only: error_list_t
   use deck_problems, only: problem_log_t
-  use deck_numbers, only: integer_text, real_text, digit
+  use deck_numbers, only: digit
+  use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t
-  use deck_keywords, only: keyword_t, keyword_glstat, keyword_matsum, keyword_nodout, &
-                           keyword_rwforc
+  use deck_keywords, only: keyword_t
   use deck_fields, only: card_t, open_card, next_line, require_card, get_integer, get_real, &
                          card_problem, warn_if_set, id_heading, line_problem
   use deck_input, only: deck_input_t, append_id
   implicit none
   private
 
-  public :: read_plot_output, read_history_output, read_history_nodes
+  public :: read_plot_output, read_glstat_output, read_matsum_output, read_nodout_output, read_rwforc_output
+  public :: read_history_nodes, read_history_node_sets
 
   integer, parameter :: standard_widths(8) = 10
+  !> The history outputs read by read_history_output.
+  integer, parameter :: history_glstat = 1, history_matsum = 2, history_nodout = 3, history_rwforc = 4
 
 contains
 
   !> *DATABASE_BINARY_D3PLOT card 1: DT LCDT BEAM NPLTC PSETID (card 2, filtering, is not
   !> read). NPLTC > 0 gives DT = ENDTIM/NPLTC once ENDTIM is known.
-  subroutine read_plot_output(deck, block, input, log, warnings)
+  subroutine read_plot_output(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
@@ -43,11 +47,55 @@ contains
     call warn_if_set(deck, card, 5, "PSETID", "every part is written", warnings)
   end subroutine read_plot_output
 
+  !> *DATABASE_GLSTAT: see read_history_output_card.
+  subroutine read_glstat_output(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_history_output_card(deck, block, history_glstat, input, log, warnings)
+  end subroutine read_glstat_output
+
+  !> *DATABASE_MATSUM: see read_history_output_card.
+  subroutine read_matsum_output(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_history_output_card(deck, block, history_matsum, input, log, warnings)
+  end subroutine read_matsum_output
+
+  !> *DATABASE_NODOUT: see read_history_output_card.
+  subroutine read_nodout_output(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_history_output_card(deck, block, history_nodout, input, log, warnings)
+  end subroutine read_nodout_output
+
+  !> *DATABASE_RWFORC: see read_history_output_card.
+  subroutine read_rwforc_output(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_history_output_card(deck, block, history_rwforc, input, log, warnings)
+  end subroutine read_rwforc_output
+
   !> *DATABASE_GLSTAT / _MATSUM / _NODOUT / _RWFORC: DT BINARY LCUR IOOPT (NODOUT: OPTION1
   !> OPTION2 for nodouthf). BINARY is not used: every history goes to results.h5.
-  subroutine read_history_output(deck, block, code, input, log, warnings)
+  subroutine read_history_output_card(deck, block, history, input, log, warnings)
     type(deck_t), intent(in) :: deck
-    integer, intent(in) :: block, code
+    integer, intent(in) :: block, history
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
@@ -61,19 +109,19 @@ contains
     call get_integer(deck, card, 3, "LCUR", interval_curve, log)
     if (card%failed) return
     call check_interval(deck, card, interval, interval_curve, log)
-    select case (code)
-    case (keyword_glstat)
+    select case (history)
+    case (history_glstat)
       input%model%output%glstat_interval = interval
-    case (keyword_matsum)
+    case (history_matsum)
       input%model%output%matsum_interval = interval
-    case (keyword_nodout)
+    case (history_nodout)
       input%model%output%nodout_interval = interval
       input%nodout_line = line
       call warn_if_set(deck, card, 5, "OPTION1", "no high-frequency nodouthf output", warnings)
-    case (keyword_rwforc)
+    case (history_rwforc)
       input%model%output%rwforc_interval = interval
     end select
-  end subroutine read_history_output
+  end subroutine read_history_output_card
 
   subroutine check_interval(deck, card, interval, interval_curve, log)
     type(deck_t), intent(in) :: deck
@@ -88,9 +136,31 @@ contains
       "curve are not available; give DT")
   end subroutine check_interval
 
+  !> *DATABASE_HISTORY_NODE: see read_history_node_cards.
+  subroutine read_history_nodes(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_history_node_cards(deck, block, keyword, .false., input, log)
+  end subroutine read_history_nodes
+
+  !> *DATABASE_HISTORY_NODE_SET: see read_history_node_cards.
+  subroutine read_history_node_sets(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_history_node_cards(deck, block, keyword, .true., input, log)
+  end subroutine read_history_node_sets
+
   !> *DATABASE_HISTORY_NODE (ids 8 per line), _NODE_ID (one id and a heading per line) and
   !> _NODE_SET (set ids 8 per line).
-  subroutine read_history_nodes(deck, block, keyword, by_set, input, log)
+  subroutine read_history_node_cards(deck, block, keyword, by_set, input, log)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
     type(keyword_t), intent(in) :: keyword
@@ -124,5 +194,5 @@ contains
         end if
       end do
     end do
-  end subroutine read_history_nodes
+  end subroutine read_history_node_cards
 end module deck_database

@@ -15,7 +15,7 @@ module deck_efg_cards
                    boundary_full_transformation, boundary_coupled, integration_local_boundary, &
                    integration_gauss, integration_gauss_conventional
   use deck_problems, only: problem_log_t
-  use deck_numbers, only: integer_text, real_text
+  use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t
   use deck_fields, only: card_t, get_integer, get_real, card_problem, warn_if_set
   implicit none

@@ -9,7 +9,8 @@ module deck_fields
   use error_handling, only: error_list_t, add_error
   use deck_problems, only: problem_log_t, report_problem
   use deck_numbers, only: parse_integer, parse_real, number_ok, number_not_integral, &
-                          number_out_of_range, integer_text, real_text
+                          number_out_of_range
+  use text_format, only: integer_text, real_text
   use deck_columns, only: field_spans_t, split_fields
   use deck_lexer, only: deck_t, line_location, find_parameter, trim_blanks, is_blank_line, &
                         block_of_line, load_line_text, card_text

@@ -3,27 +3,29 @@
 !> (by node or by set) before they are expanded per node.
 module deck_input
   use kinds, only: wp
+  use integer_lists, only: reserve_integers
   use model, only: model_t, rigid_wall_t, segment_load_t
   use deck_rigid_input, only: rigid_input_t
   use deck_contact_input, only: contact_input_t
-  use deck_keywords, only: keyword_count, keyword_node, keyword_element_solid, keyword_part, &
-    keyword_section_solid, keyword_section_solid_efg, keyword_mat_elastic, &
-    keyword_mat_plastic_kinematic, keyword_hourglass, keyword_define_curve, &
-    keyword_mat_honeycomb, keyword_mat_modified_honeycomb, keyword_mat_low_density_foam, &
-    keyword_set_node_list, keyword_set_node_list_generate, keyword_set_part_list, &
-    keyword_spc_node, keyword_spc_set, keyword_motion_node, keyword_motion_set, &
-    keyword_load_node_point, keyword_load_node_set, keyword_initial_velocity, &
-    keyword_initial_velocity_node, keyword_initial_velocity_generation, keyword_rigidwall_planar, &
-    keyword_rigidwall_cylinder, &
-    keyword_load_segment, keyword_load_segment_set, keyword_load_segment_nonuniform, &
-    keyword_set_segment, keyword_element_shell, keyword_element_shell_thickness, &
-    keyword_section_shell
   implicit none
   private
 
   public :: id_list_t, set_input_t, spc_input_t, motion_input_t, load_input_t
   public :: velocity_input_t, wall_input_t, segment_set_input_t, segment_load_input_t
   public :: deck_input_t, prepare_input, append_id
+
+  !> The lists of definitions the keyword readers fill, one entry per definition. Each keyword
+  !> table row names the lists its definitions go to (deck_keyword_table), and prepare_input
+  !> sizes every list from the data lines (or blocks) of the keywords that fill it, so that no
+  !> reader needs to grow one. Lists of ids (set members, history nodes) grow (append_id).
+  integer, parameter, public :: list_none = 0, list_nodes = 1, list_solids = 2, list_shells = 3, &
+    list_parts = 4, list_sections = 5, list_materials = 6, list_hourglasses = 7, list_curves = 8, &
+    list_node_sets = 9, list_part_sets = 10, list_spcs = 11, list_motions = 12, list_loads = 13, &
+    list_velocities = 14, list_walls = 15, list_segment_sets = 16, list_segment_loads = 17, &
+    list_rigid_materials = 18, list_rigid_motions = 19, list_nodal_rigid_bodies = 20, &
+    list_element_masses = 21, list_contacts = 22
+  !> Number of lists.
+  integer, parameter, public :: list_count = 22
 
   !> How an initial velocity was given.
   integer, parameter, public :: velocity_by_set = 1, velocity_by_node = 2, &
@@ -121,7 +123,7 @@ module deck_input
     integer :: motion_line = 0        !< the MOTION card of a cylinder (LCID)
   end type wall_input_t
 
-  !> Everything read, before ids are resolved. Arrays are sized from line counts and hold
+  !> Everything read, before ids are resolved. Arrays are sized by prepare_input and hold
   !> `*_count` entries.
   type :: deck_input_t
     type(model_t) :: model
@@ -165,70 +167,55 @@ module deck_input
 
 contains
 
-  !> Allocate every list for at most the given numbers of data lines and blocks per keyword
-  !> (each definition takes at least one line, so these bound the counts).
-  subroutine prepare_input(lines, blocks, input)
-    integer, intent(in) :: lines(keyword_count), blocks(keyword_count)
+  !> Allocate every list for `capacity(list)` definitions (an upper bound: deck_reader counts
+  !> them from the data lines or blocks of the keywords that fill each list).
+  subroutine prepare_input(capacity, input)
+    integer, intent(in) :: capacity(list_count)
     type(deck_input_t), intent(out) :: input
     integer :: n
 
-    n = lines(keyword_node)
+    n = capacity(list_nodes)
     allocate (input%model%node_ids(n), input%model%coordinates(3, n), input%node_lines(n), &
               input%node_constraints(n), input%node_rotation_constraints(n))
-    n = lines(keyword_element_solid)
+    n = capacity(list_solids)
     allocate (input%model%solid_ids(n), input%model%solid_part(n), input%model%solid_nodes(8, n), &
               input%solid_lines(n), input%solid_node_lines(n))
-    ! *ELEMENT_SHELL_THICKNESS: two lines per element, but for the last one of a block
-    n = lines(keyword_element_shell) + (lines(keyword_element_shell_thickness) + &
-                                        blocks(keyword_element_shell_thickness))/2
+    n = capacity(list_shells)
     allocate (input%model%shell_ids(n), input%model%shell_part(n), input%model%shell_nodes(4, n), &
               input%model%shell_thickness(4, n), input%shell_lines(n), input%shell_thickness_lines(n))
-    n = lines(keyword_part)
+    n = capacity(list_parts)
     allocate (input%model%parts(n), input%part_lines(n))
-    n = lines(keyword_section_solid) + lines(keyword_section_solid_efg) + lines(keyword_section_shell)
+    n = capacity(list_sections)
     allocate (input%model%sections(n), input%section_lines(n))
-    n = lines(keyword_mat_elastic) + lines(keyword_mat_plastic_kinematic) + lines(keyword_mat_honeycomb) &
-        + lines(keyword_mat_modified_honeycomb) + lines(keyword_mat_low_density_foam)
+    n = capacity(list_materials)
     allocate (input%model%materials(n), input%material_lines(n))
-    n = lines(keyword_hourglass)
+    n = capacity(list_hourglasses)
     allocate (input%model%hourglasses(n), input%hourglass_lines(n))
-    n = blocks(keyword_define_curve)
+    n = capacity(list_curves)
     allocate (input%model%curves(n), input%curve_lines(n))
-    allocate (input%node_sets(blocks(keyword_set_node_list) + &
-                              blocks(keyword_set_node_list_generate)))
-    allocate (input%part_sets(blocks(keyword_set_part_list)))
-    allocate (input%spcs(lines(keyword_spc_node) + lines(keyword_spc_set)))
-    allocate (input%motions(lines(keyword_motion_node) + lines(keyword_motion_set)))
-    allocate (input%loads(lines(keyword_load_node_point) + lines(keyword_load_node_set)))
-    allocate (input%velocities(lines(keyword_initial_velocity) + &
-                               lines(keyword_initial_velocity_node) + &
-                               lines(keyword_initial_velocity_generation)))
-    allocate (input%walls(lines(keyword_rigidwall_planar) + lines(keyword_rigidwall_cylinder)))
-    allocate (input%segment_sets(blocks(keyword_set_segment)))
-    allocate (input%segment_loads(lines(keyword_load_segment) + lines(keyword_load_segment_set) + &
-                                  lines(keyword_load_segment_nonuniform)))
+    allocate (input%node_sets(capacity(list_node_sets)))
+    allocate (input%part_sets(capacity(list_part_sets)))
+    allocate (input%spcs(capacity(list_spcs)))
+    allocate (input%motions(capacity(list_motions)))
+    allocate (input%loads(capacity(list_loads)))
+    allocate (input%velocities(capacity(list_velocities)))
+    allocate (input%walls(capacity(list_walls)))
+    allocate (input%segment_sets(capacity(list_segment_sets)))
+    allocate (input%segment_loads(capacity(list_segment_loads)))
+    allocate (input%rigid%materials(capacity(list_rigid_materials)))
+    allocate (input%rigid%motions(capacity(list_rigid_motions)))
+    allocate (input%rigid%nodal(capacity(list_nodal_rigid_bodies)))
+    allocate (input%rigid%masses(capacity(list_element_masses)))
+    allocate (input%contact%entries(capacity(list_contacts)))
   end subroutine prepare_input
 
-  !> Append one id with its origin, growing the list by doubling.
+  !> Append one id with its origin (the list grows as needed).
   pure subroutine append_id(list, id, line, field)
     type(id_list_t), intent(inout) :: list
     integer, intent(in) :: id, line, field
-    integer, allocatable :: larger(:)
-    integer :: capacity
-    if (.not. allocated(list%ids)) then
-      allocate (list%ids(16), list%lines(16), list%fields(16))
-    else if (list%count == size(list%ids)) then
-      capacity = 2*size(list%ids)
-      allocate (larger(capacity))
-      larger(1:list%count) = list%ids(1:list%count)
-      call move_alloc(larger, list%ids)
-      allocate (larger(capacity))
-      larger(1:list%count) = list%lines(1:list%count)
-      call move_alloc(larger, list%lines)
-      allocate (larger(capacity))
-      larger(1:list%count) = list%fields(1:list%count)
-      call move_alloc(larger, list%fields)
-    end if
+    call reserve_integers(list%ids, list%count, list%count + 1)
+    call reserve_integers(list%lines, list%count, list%count + 1)
+    call reserve_integers(list%fields, list%count, list%count + 1)
     list%count = list%count + 1
     list%ids(list%count) = id
     list%lines(list%count) = line

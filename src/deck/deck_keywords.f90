@@ -1,38 +1,20 @@
-!> The keywords crashfree reads: names, options (`_TITLE`, `_ID`, rigid-wall options) and a
-!> spelling suggestion for a name that is not one of them.
+!> A keyword name taken apart (`keyword_t`: its row in the keyword table and the options given
+!> with it) and the spelling tools for keyword names: options read against the ones a keyword
+!> accepts, and the "did you mean" suggestion for a name that is not known. The names
+!> themselves, with their options and readers, are rows of the keyword table
+!> (deck_keyword_table).
 module deck_keywords
   implicit none
   private
 
-  public :: keyword_t, identify_keyword, suggest_keyword, known_keyword_count, known_keyword
+  public :: keyword_t, read_options, suggest_keyword
 
-  !> Keyword codes (one per reader entry; aliases such as *MAT_001 share a code).
-  integer, parameter, public :: keyword_unknown = 0, keyword_title = 1, keyword_node = 2, &
-    keyword_element_solid = 3, keyword_part = 4, keyword_section_solid = 5, &
-    keyword_section_solid_efg = 6, keyword_mat_elastic = 7, keyword_mat_plastic_kinematic = 8, &
-    keyword_hourglass = 9, keyword_control_hourglass = 10, keyword_control_bulk_viscosity = 11, &
-    keyword_control_termination = 12, keyword_control_timestep = 13, keyword_control_energy = 14, &
-    keyword_set_node_list = 15, keyword_set_node_list_generate = 16, keyword_set_part_list = 17, &
-    keyword_spc_node = 18, keyword_spc_set = 19, keyword_initial_velocity = 20, &
-    keyword_initial_velocity_node = 21, keyword_initial_velocity_generation = 22, &
-    keyword_define_curve = 23, keyword_motion_node = 24, keyword_motion_set = 25, &
-    keyword_load_node_point = 26, keyword_load_node_set = 27, keyword_rigidwall_planar = 28, &
-    keyword_d3plot = 29, keyword_glstat = 30, keyword_matsum = 31, keyword_nodout = 32, &
-    keyword_rwforc = 33, keyword_history_node = 34, keyword_history_node_set = 35, &
-    keyword_control_implicit_general = 36, keyword_control_implicit_solution = 37, &
-    keyword_load_segment = 38, keyword_load_segment_set = 39, &
-    keyword_load_segment_nonuniform = 40, keyword_set_segment = 41, keyword_mat_honeycomb = 42, &
-    keyword_mat_modified_honeycomb = 43, keyword_mat_low_density_foam = 44, &
-    keyword_rigidwall_cylinder = 45
-  !> Shell elements and sections.
-  integer, parameter, public :: keyword_element_shell = 46, keyword_element_shell_thickness = 47, &
-    keyword_section_shell = 48
-  !> Number of keyword codes.
-  integer, parameter, public :: keyword_count = 48
+  !> `keyword_t%entry` of a name that is not a keyword crashfree reads.
+  integer, parameter, public :: keyword_unknown = 0
 
-  !> A keyword name taken apart: its code and the options given with it.
+  !> A keyword name taken apart: its row in the keyword table and the options given with it.
   type :: keyword_t
-    integer :: code = keyword_unknown
+    integer :: entry = keyword_unknown  !< row of the keyword table (keyword_unknown: none)
     logical :: title = .false.     !< _TITLE: a title line before the first card
     logical :: id = .false.        !< _ID: an id/heading line before the first card
     logical :: finite = .false.    !< *RIGIDWALL_PLANAR_FINITE
@@ -41,133 +23,24 @@ module deck_keywords
     logical :: motion = .false.    !< *RIGIDWALL_GEOMETRIC_CYLINDER_MOTION
   end type keyword_t
 
-  integer, parameter :: entry_count = 58
-  character(len=*), parameter :: base_names(entry_count) = [character(len=36) :: &
-    "TITLE", "NODE", "ELEMENT_SOLID", "PART", "SECTION_SOLID", "SECTION_SOLID_EFG", &
-    "MAT_ELASTIC", "MAT_001", "MAT_PLASTIC_KINEMATIC", "MAT_003", "HOURGLASS", &
-    "CONTROL_HOURGLASS", "CONTROL_BULK_VISCOSITY", "CONTROL_TERMINATION", "CONTROL_TIMESTEP", &
-    "CONTROL_ENERGY", "SET_NODE_LIST", "SET_NODE_LIST_GENERATE", "SET_PART_LIST", &
-    "BOUNDARY_SPC_NODE", "BOUNDARY_SPC_SET", "INITIAL_VELOCITY", "INITIAL_VELOCITY_NODE", &
-    "INITIAL_VELOCITY_GENERATION", "DEFINE_CURVE", "BOUNDARY_PRESCRIBED_MOTION_NODE", &
-    "BOUNDARY_PRESCRIBED_MOTION_SET", "LOAD_NODE_POINT", "LOAD_NODE_SET", "RIGIDWALL_PLANAR", &
-    "DATABASE_BINARY_D3PLOT", "DATABASE_GLSTAT", "DATABASE_MATSUM", "DATABASE_NODOUT", &
-    "DATABASE_RWFORC", "DATABASE_HISTORY_NODE", "DATABASE_HISTORY_NODE_SET", &
-    "CONTROL_IMPLICIT_GENERAL", "CONTROL_IMPLICIT_SOLUTION", "LOAD_SEGMENT", &
-    "LOAD_SEGMENT_SET", "LOAD_SEGMENT_NONUNIFORM", "SET_SEGMENT", &
-    "MAT_HONEYCOMB", "MAT_026", "MAT_MODIFIED_HONEYCOMB", "MAT_126", "MAT_LOW_DENSITY_FOAM", "MAT_057", &
-    "RIGIDWALL_GEOMETRIC_CYLINDER", "ELEMENT_SHELL", "ELEMENT_SHELL_THICKNESS", "SECTION_SHELL", &
-    "KEYWORD", "INCLUDE", "PARAMETER", "COMMENT", "END"]
-  integer, parameter :: base_codes(entry_count) = [keyword_title, keyword_node, &
-    keyword_element_solid, keyword_part, keyword_section_solid, keyword_section_solid_efg, &
-    keyword_mat_elastic, keyword_mat_elastic, keyword_mat_plastic_kinematic, &
-    keyword_mat_plastic_kinematic, keyword_hourglass, keyword_control_hourglass, &
-    keyword_control_bulk_viscosity, keyword_control_termination, keyword_control_timestep, &
-    keyword_control_energy, keyword_set_node_list, keyword_set_node_list_generate, &
-    keyword_set_part_list, keyword_spc_node, keyword_spc_set, keyword_initial_velocity, &
-    keyword_initial_velocity_node, keyword_initial_velocity_generation, keyword_define_curve, &
-    keyword_motion_node, keyword_motion_set, keyword_load_node_point, keyword_load_node_set, &
-    keyword_rigidwall_planar, keyword_d3plot, keyword_glstat, keyword_matsum, keyword_nodout, &
-    keyword_rwforc, keyword_history_node, keyword_history_node_set, &
-    keyword_control_implicit_general, keyword_control_implicit_solution, keyword_load_segment, &
-    keyword_load_segment_set, keyword_load_segment_nonuniform, keyword_set_segment, &
-    keyword_mat_honeycomb, keyword_mat_honeycomb, keyword_mat_modified_honeycomb, &
-    keyword_mat_modified_honeycomb, keyword_mat_low_density_foam, keyword_mat_low_density_foam, &
-    keyword_rigidwall_cylinder, keyword_element_shell, keyword_element_shell_thickness, &
-    keyword_section_shell, keyword_unknown, keyword_unknown, keyword_unknown, keyword_unknown, keyword_unknown]
-  !> Options each entry accepts (blank-separated).
-  character(len=*), parameter :: base_options(entry_count) = [character(len=28) :: &
-    "", "", "", "", "TITLE", "TITLE", &
-    "TITLE", "TITLE", "TITLE", "TITLE", "TITLE", &
-    "", "", "", "", &
-    "", "TITLE", "TITLE", "TITLE", &
-    "ID", "ID", "", "", &
-    "", "TITLE", "ID", &
-    "ID", "", "", "FINITE MOVING FORCES ID", &
-    "", "", "", "", &
-    "", "ID", "", &
-    "", "", "ID", &
-    "ID", "ID", "TITLE", &
-    "TITLE", "TITLE", "TITLE", "TITLE", "TITLE", "TITLE", &
-    "MOTION ID", "", "", "TITLE", "", "", "", "", ""]
-
-  !> The keywords read by other modules (deck_rigid_bodies, deck_contact, deck_materials), with
-  !> their options: spelling suggestions are taken from these and the entries above, and the
-  !> unit tests check that every name listed here is read.
-  integer, parameter :: other_count = 14
-  character(len=*), parameter :: other_names(other_count) = [character(len=36) :: &
-    "MAT_RIGID", "MAT_020", "BOUNDARY_PRESCRIBED_MOTION_RIGID", "CONSTRAINED_NODAL_RIGID_BODY", &
-    "ELEMENT_MASS", "CONTACT_AUTOMATIC_NODES_TO_SURFACE", "CONTACT_AUTOMATIC_SURFACE_TO_SURFACE", &
-    "CONTACT_AUTOMATIC_SINGLE_SURFACE", "CONTROL_CONTACT", "DATABASE_RCFORC", &
-    "MAT_PIECEWISE_LINEAR_PLASTICITY", "MAT_024", "MAT_NULL", "MAT_009"]
-  character(len=*), parameter :: other_options(other_count) = [character(len=28) :: &
-    "TITLE", "TITLE", "ID", "TITLE", "", "ID TITLE", "ID TITLE", "ID TITLE", "", "", "TITLE", &
-    "TITLE", "TITLE", "TITLE"]
-  !> Number of names suggestions are taken from.
-  integer, parameter :: known_count = entry_count + other_count
   !> Longest keyword name a suggestion is looked for (longer ones are no typing slip).
   integer, parameter :: longest_suggested = 80
 
 contains
 
-  !> Number of keyword names crashfree knows (those it reads and those the lexer handles).
-  pure integer function known_keyword_count()
-    known_keyword_count = known_count
-  end function known_keyword_count
-
-  !> Known keyword name `k` (1 .. known_keyword_count()) and the options it accepts
-  !> (blank-separated).
-  pure subroutine known_keyword(k, name, options)
-    integer, intent(in) :: k
-    character(len=:), allocatable, intent(out) :: name, options
-    if (k <= entry_count) then
-      name = trim(base_names(k))
-      options = trim(base_options(k))
-    else
-      name = trim(other_names(k - entry_count))
-      options = trim(other_options(k - entry_count))
-    end if
-  end subroutine known_keyword
-
-  !> Take keyword `name` (upper case, no `*`) apart; `code` stays `keyword_unknown` when it is
-  !> not a keyword crashfree reads. The longest base name whose options all fit wins, so
-  !> *SET_NODE_LIST_GENERATE is not read as *SET_NODE_LIST with an option GENERATE.
-  pure function identify_keyword(name) result(keyword)
-    character(len=*), intent(in) :: name
-    type(keyword_t) :: keyword
-    type(keyword_t) :: candidate
-    integer :: k, base_length, best_length
-    logical :: fits
-
-    best_length = 0
-    do k = 1, entry_count
-      if (base_codes(k) == keyword_unknown) cycle
-      base_length = len_trim(base_names(k))
-      if (name == base_names(k)(:base_length)) then
-        candidate = keyword_t(code=base_codes(k))
-        fits = .true.
-      else if (len(name) > base_length + 1) then
-        if (name(:base_length + 1) /= base_names(k)(:base_length)//"_") cycle
-        call read_options(name(base_length + 2:), trim(base_options(k)), candidate, fits)
-        candidate%code = base_codes(k)
-      else
-        cycle
-      end if
-      if (fits .and. base_length > best_length) then
-        keyword = candidate
-        best_length = base_length
-      end if
-    end do
-  end function identify_keyword
-
-  !> Options `text` ("MOVING_FORCES") against the allowed list; each at most once.
-  pure subroutine read_options(text, allowed, keyword, fits)
+  !> Options `text` ("MOVING_FORCES") against the `allowed` ones (blank-separated): each at
+  !> most once, in any order, and with `one_option` at most one of them. `fits` is false when
+  !> an option is not allowed or repeated; `keyword` then holds no options.
+  pure subroutine read_options(text, allowed, one_option, keyword, fits)
     character(len=*), intent(in) :: text, allowed
+    logical, intent(in) :: one_option
     type(keyword_t), intent(out) :: keyword
     logical, intent(out) :: fits
-    integer :: start, finish
+    integer :: start, finish, given
     character(len=:), allocatable :: option
 
     fits = .false.
+    given = 0
     start = 1
     do while (start <= len(text))
       finish = index(text(start:), "_")
@@ -180,6 +53,8 @@ contains
       start = finish + 2
       if (len(option) == 0) return
       if (index(" "//allowed//" ", " "//option//" ") == 0) return
+      given = given + 1
+      if (one_option .and. given > 1) return
       select case (option)
       case ("TITLE")
         if (keyword%title) return
@@ -210,8 +85,11 @@ contains
   !> distance counts insertions, deletions, substitutions and swaps of neighbours; the
   !> nearest name wins, a name of the same family (*MAT_..., *DATABASE_...) on a tie. A
   !> keyword crashfree reads, but not with the options given, gets `base` alone.
-  pure subroutine suggest_keyword(name, suggestion, base)
+  !> The known names and their options are `names(k)` and `options_of(k)` (blank-separated, both
+  !> trimmed here), in the keyword table's order: on equal distance the first one wins.
+  pure subroutine suggest_keyword(name, names, options_of, suggestion, base)
     character(len=*), intent(in) :: name
+    character(len=*), intent(in) :: names(:), options_of(:)
     character(len=:), allocatable, intent(out) :: suggestion, base
     character(len=:), allocatable :: candidate, options, corrected
     integer :: k, split, distance, best_score, option_distance
@@ -221,8 +99,9 @@ contains
     base = ""
     if (len(name) == 0 .or. len(name) > longest_suggested) return
     best_score = huge(best_score)
-    do k = 1, known_count
-      call known_keyword(k, candidate, options)
+    do k = 1, size(names)
+      candidate = trim(names(k))
+      options = trim(options_of(k))
       ! the whole name as the base name
       distance = spelling_distance(name, candidate)
       if (distance > 0 .and. close_enough(name, candidate, distance)) &
@@ -244,8 +123,8 @@ contains
     ! a keyword read without these options: name it alone
     do split = len(name) - 1, 2, -1
       if (name(split:split) /= "_") cycle
-      do k = 1, known_count
-        call known_keyword(k, candidate, options)
+      do k = 1, size(names)
+        candidate = trim(names(k))
         if (name(:split - 1) /= candidate) cycle
         suggestion = candidate
         base = candidate

@@ -15,7 +15,8 @@ module deck_lexer
   use, intrinsic :: iso_fortran_env, only: int64
   use error_handling, only: error_list_t, add_error
   use deck_problems, only: problem_log_t, report_problem, control_character_name
-  use deck_numbers, only: to_upper, parse_integer, parse_real, number_ok, integer_text
+  use deck_numbers, only: to_upper, parse_integer, parse_real, number_ok
+  use text_format, only: integer_text
   use deck_columns, only: field_spans_t, split_fields, format_standard, format_long, format_i10
   use deck_line_table, only: line_table_t, start_table, append_line, line_file, line_number, &
                              line_place
@@ -243,12 +244,12 @@ contains
     ! shorter deck
     if (read_failed) then
       call report_problem(log, deck%files(state%file)%path//": a read error after "// &
-                          byte_text(buffer_start + filled)//" of its "//byte_text(deck%files(state%file)%size)// &
+                          integer_text(buffer_start + filled)//" of its "//integer_text(deck%files(state%file)%size)// &
                           " bytes", unreadable=.true.)
     else if (buffer_start + filled /= deck%files(state%file)%size) then
       call report_problem(log, deck%files(state%file)%path//": it changed while it was read ("// &
-                          byte_text(buffer_start + filled)//" bytes read, "// &
-                          byte_text(deck%files(state%file)%size)//" expected); run again", unreadable=.true.)
+                          integer_text(buffer_start + filled)//" bytes read, "// &
+                          integer_text(deck%files(state%file)%size)//" expected); run again", unreadable=.true.)
     end if
     deallocate (buffer)
     call close_block(deck, state%file, state%file_format, chain, state%block, log, warnings)
@@ -1102,15 +1103,6 @@ contains
                           "read; run again once it is written", unreadable=.true.)
     end do
   end subroutine check_files_unchanged
-
-  !> A byte count or offset as text.
-  pure function byte_text(value) result(text)
-    integer(int64), intent(in) :: value
-    character(len=:), allocatable :: text
-    character(len=24) :: buffer
-    write (buffer, '(i0)') value
-    text = trim(buffer)
-  end function byte_text
 
   !> Position of the first character that is neither blank nor tab (0 if none).
   pure integer function first_nonblank(text)

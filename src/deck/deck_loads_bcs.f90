@@ -8,7 +8,7 @@ module deck_loads_bcs
   use error_handling, only: error_list_t
   use model, only: rigid_wall_t, wall_cylinder, motion_velocity, motion_acceleration, motion_displacement
   use deck_problems, only: problem_log_t
-  use deck_numbers, only: integer_text, real_text
+  use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t
   use deck_keywords, only: keyword_t
   use deck_fields, only: card_t, open_card, next_line, require_card, has_data, get_integer, &
@@ -20,7 +20,8 @@ module deck_loads_bcs
   implicit none
   private
 
-  public :: read_spcs, read_motions, read_loads, read_initial_velocities
+  public :: read_node_spcs, read_set_spcs, read_node_motions, read_set_motions, read_node_loads
+  public :: read_set_loads, read_initial_velocities
   public :: read_initial_velocity_nodes, read_velocity_generations, read_planar_walls
   public :: read_cylinder_walls
   public :: read_segment_loads, read_segment_set_loads, read_nonuniform_segment_loads
@@ -32,9 +33,31 @@ module deck_loads_bcs
 
 contains
 
+  !> *BOUNDARY_SPC_NODE: see read_spc_cards.
+  subroutine read_node_spcs(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_spc_cards(deck, block, keyword, .false., input, log)
+  end subroutine read_node_spcs
+
+  !> *BOUNDARY_SPC_SET: see read_spc_cards.
+  subroutine read_set_spcs(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_spc_cards(deck, block, keyword, .true., input, log)
+  end subroutine read_set_spcs
+
   !> *BOUNDARY_SPC_NODE / _SET: NID|NSID CID DOFX DOFY DOFZ DOFRX DOFRY DOFRZ per line. The
   !> rotations act on shell nodes; the cross-check warns when they name no shell node.
-  subroutine read_spcs(deck, block, keyword, by_set, input, log)
+  subroutine read_spc_cards(deck, block, keyword, by_set, input, log)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
     type(keyword_t), intent(in) :: keyword
@@ -71,10 +94,32 @@ contains
         spc%fixed_rotation = fixed(4:6)
       end associate
     end do
-  end subroutine read_spcs
+  end subroutine read_spc_cards
+
+  !> *BOUNDARY_PRESCRIBED_MOTION_NODE: see read_motion_cards.
+  subroutine read_node_motions(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_motion_cards(deck, block, keyword, .false., input, log)
+  end subroutine read_node_motions
+
+  !> *BOUNDARY_PRESCRIBED_MOTION_SET: see read_motion_cards.
+  subroutine read_set_motions(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_motion_cards(deck, block, keyword, .true., input, log)
+  end subroutine read_set_motions
 
   !> *BOUNDARY_PRESCRIBED_MOTION_NODE / _SET: NID|NSID DOF VAD LCID SF VID DEATH BIRTH.
-  subroutine read_motions(deck, block, keyword, by_set, input, log)
+  subroutine read_motion_cards(deck, block, keyword, by_set, input, log)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
     type(keyword_t), intent(in) :: keyword
@@ -122,7 +167,7 @@ contains
           real_text(motion%birth))
       end associate
     end do
-  end subroutine read_motions
+  end subroutine read_motion_cards
 
   !> DOF of a prescribed motion: 1-3 only, since solid nodes carry no rotations.
   subroutine check_motion_direction(deck, card, direction, log)
@@ -147,8 +192,30 @@ contains
     end select
   end subroutine check_motion_direction
 
+  !> *LOAD_NODE_POINT: see read_load_cards.
+  subroutine read_node_loads(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_load_cards(deck, block, .false., input, log)
+  end subroutine read_node_loads
+
+  !> *LOAD_NODE_SET: see read_load_cards.
+  subroutine read_set_loads(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_load_cards(deck, block, .true., input, log)
+  end subroutine read_set_loads
+
   !> *LOAD_NODE_POINT / _SET: NID|NSID DOF LCID SF CID M1 M2 M3.
-  subroutine read_loads(deck, block, by_set, input, log)
+  subroutine read_load_cards(deck, block, by_set, input, log)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
     logical, intent(in) :: by_set
@@ -188,17 +255,18 @@ contains
         if (system /= 0) call card_problem(deck, log, card, "CID", no_local_systems)
       end associate
     end do
-  end subroutine read_loads
+  end subroutine read_load_cards
 
   !> *LOAD_SEGMENT(_ID): one segment per line, LCID SF AT N1 N2 N3 N4 N5: a pressure, uniform
   !> over the segment, SF*curve(t - AT). A line that sets nothing is skipped: pydyna writes a card
   !> of mid-side nodes N6 N7 N8 after every segment, which would otherwise be read as a segment.
-  subroutine read_segment_loads(deck, block, keyword, input, log)
+  subroutine read_segment_loads(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
     type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
     type(segment_load_input_t) :: given
     integer :: line, k, mid_side, nodes(4)
@@ -231,12 +299,13 @@ contains
 
   !> *LOAD_SEGMENT_SET(_ID): SSID LCID SF AT per line, a uniform pressure on every segment of
   !> the *SET_SEGMENT SSID.
-  subroutine read_segment_set_loads(deck, block, keyword, input, log)
+  subroutine read_segment_set_loads(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
     type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
     type(segment_load_input_t) :: given
     integer :: line, set
@@ -398,9 +467,10 @@ contains
 
   !> *INITIAL_VELOCITY: card 1 NSID NSIDEX BOXID IRIGID ICID, card 2 VX VY VZ VXR VYR VZR,
   !> card 3 (when NSIDEX > 0) the velocities of the exempted nodes.
-  subroutine read_initial_velocities(deck, block, input, log, warnings)
+  subroutine read_initial_velocities(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
@@ -438,9 +508,10 @@ contains
   end subroutine read_initial_velocities
 
   !> *INITIAL_VELOCITY_NODE: NID VX VY VZ VXR VYR VZR ICID per line.
-  subroutine read_initial_velocity_nodes(deck, block, input, log, warnings)
+  subroutine read_initial_velocity_nodes(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
@@ -464,9 +535,10 @@ contains
   !> *INITIAL_VELOCITY_GENERATION: card 1 ID STYP OMEGA VX VY VZ IVATN ICID, card 2 XC YC ZC
   !> NX NY NZ PHASE IRIGID. The velocity is V + OMEGA n x (x - c): a rotation about the axis
   !> through c along n plus a translation. NX = -999 makes NY and NZ two nodes on the axis.
-  subroutine read_velocity_generations(deck, block, input, log, warnings)
+  subroutine read_velocity_generations(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
@@ -628,12 +700,13 @@ contains
   !> BIRTH DEATH, card 2 XT YT ZT XH YH ZH FRIC (tail and head of the axis), card 3 RADCYL
   !> LENCYL NSEGS, then the MOTION card LCID OPT VX VY VZ. Subsections (NSEGS > 0, whose
   !> VL HEIGHT cards are skipped) and boxes are reported as not available.
-  subroutine read_cylinder_walls(deck, block, keyword, input, log)
+  subroutine read_cylinder_walls(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
     type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
     integer :: line, n, segments, k
     real(wp) :: length

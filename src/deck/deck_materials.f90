@@ -5,19 +5,20 @@
 !> errors naming each field whose LS-DYNA feature crashfree does not build (docs/materials.md).
 !> Curve ids are resolved by deck_material_curves after all keywords are read.
 !>
-!> *MAT_024 and *MAT_009 are identified here (codes `material_keyword_first`..), not in
-!> deck_keywords, as the rigid-body and contact keywords are: their codes stay out of the
-!> per-keyword line counts, and their materials are appended with `reserve_material`.
+!> Each reader is the reader of its law's row in the keyword table (deck_keyword_table), and
+!> has the table's reader interface. The materials list is sized from the data lines of every
+!> material keyword, *MAT_RIGID's too (deck_input).
 module deck_materials
   use kinds, only: wp
   use error_handling, only: error_list_t
-  use model, only: material_t, law_elastic, law_plastic_kinematic, law_honeycomb, law_modified_honeycomb, &
-                   law_low_density_foam, law_piecewise_linear, law_null, piecewise_hardening_curve
+  use model, only: material_t, piecewise_hardening_curve
+  use material_laws, only: law_elastic, law_plastic_kinematic, law_honeycomb, law_modified_honeycomb, &
+                           law_low_density_foam, law_piecewise_linear, law_null
   use curves, only: curve_t
   use deck_problems, only: problem_log_t
-  use deck_numbers, only: integer_text, real_text
+  use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t
-  use deck_keywords, only: keyword_t, keyword_unknown
+  use deck_keywords, only: keyword_t
   use deck_fields, only: card_t, require_card, next_definition, get_integer, get_real, &
                          card_problem, field_is_blank, warn_if_set, next_line, open_card
   use deck_input, only: deck_input_t
@@ -25,12 +26,8 @@ module deck_materials
   private
 
   public :: read_elastic_materials, read_plastic_kinematic_materials, read_honeycomb_materials
-  public :: read_low_density_foam_materials, read_piecewise_linear_materials, read_null_materials
-  public :: identify_material_keyword, read_material_block, reserve_material
-
-  !> Codes of *MAT_PIECEWISE_LINEAR_PLASTICITY and *MAT_NULL (beyond deck_keywords' range).
-  integer, parameter, public :: keyword_mat_piecewise_linear = 1201, keyword_mat_null = 1202
-  integer, parameter, public :: material_keyword_first = 1201, material_keyword_last = 1202
+  public :: read_modified_honeycomb_materials, read_low_density_foam_materials
+  public :: read_piecewise_linear_materials, read_null_materials, append_material
 
   integer, parameter :: standard_widths(8) = 10
   !> Largest FAIL that still means "no failure" (LS-DYNA's default is 1e21).
@@ -38,67 +35,11 @@ module deck_materials
 
 contains
 
-  !> The material keyword `name` (upper case, no `*`) read here with its options, or code
-  !> `keyword_unknown`: *MAT_PIECEWISE_LINEAR_PLASTICITY / *MAT_024 and *MAT_NULL / *MAT_009,
-  !> each also with _TITLE.
-  pure function identify_material_keyword(name) result(keyword)
-    character(len=*), intent(in) :: name
-    type(keyword_t) :: keyword
-    select case (name)
-    case ("MAT_PIECEWISE_LINEAR_PLASTICITY", "MAT_024")
-      keyword%code = keyword_mat_piecewise_linear
-    case ("MAT_PIECEWISE_LINEAR_PLASTICITY_TITLE", "MAT_024_TITLE")
-      keyword%code = keyword_mat_piecewise_linear
-      keyword%title = .true.
-    case ("MAT_NULL", "MAT_009")
-      keyword%code = keyword_mat_null
-    case ("MAT_NULL_TITLE", "MAT_009_TITLE")
-      keyword%code = keyword_mat_null
-      keyword%title = .true.
-    case default
-      keyword%code = keyword_unknown
-    end select
-  end function identify_material_keyword
-
-  !> Read one block of a keyword identified by identify_material_keyword.
-  subroutine read_material_block(deck, block, keyword, input, log, warnings)
-    type(deck_t), intent(in) :: deck
-    integer, intent(in) :: block
-    type(keyword_t), intent(in) :: keyword
-    type(deck_input_t), intent(inout) :: input
-    type(problem_log_t), intent(inout) :: log
-    type(error_list_t), intent(inout) :: warnings
-    select case (keyword%code)
-    case (keyword_mat_piecewise_linear)
-      call read_piecewise_linear_materials(deck, block, keyword, input, log, warnings)
-    case (keyword_mat_null)
-      call read_null_materials(deck, block, keyword, input, log, warnings)
-    end select
-  end subroutine read_material_block
-
-  !> Room for one more material: the lists are sized from the line counts of deck_keywords'
-  !> material keywords, so the keywords read here grow them (by a few entries at a time).
-  subroutine reserve_material(input)
-    type(deck_input_t), intent(inout) :: input
-    type(material_t), allocatable :: materials(:)
-    integer, allocatable :: lines(:)
-    integer :: n
-    n = input%material_count
-    if (n < size(input%model%materials)) return
-    allocate (materials(n + 8), lines(n + 8))
-    materials(1:n) = input%model%materials(1:n)
-    lines(1:n) = input%material_lines(1:n)
-    lines(n + 1:) = 0
-    call move_alloc(materials, input%model%materials)
-    call move_alloc(lines, input%material_lines)
-  end subroutine reserve_material
-
-  !> Index of a new material of law `law` whose card 1 is at `line` (lists grown as needed).
+  !> Index of a new material of law `law` whose card 1 is at `line`.
   integer function append_material(input, line, law, title) result(n)
     type(deck_input_t), intent(inout) :: input
     integer, intent(in) :: line, law
     character(len=*), intent(in) :: title
-    call reserve_material(input)
     n = input%material_count + 1
     input%material_count = n
     input%material_lines(n) = line
@@ -306,12 +247,13 @@ contains
   end subroutine read_null_materials
 
   !> *MAT_ELASTIC: MID RO E PR DA DB K, one card per material (DA, DB: beams; K: fluids).
-  subroutine read_elastic_materials(deck, block, keyword, input, log)
+  subroutine read_elastic_materials(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
     type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
     integer :: line, n
     character(len=:), allocatable :: title
@@ -319,13 +261,8 @@ contains
     line = 0
     do while (next_definition(deck, block, keyword%title, line, standard_widths, card, title, &
                               log, "card 1 (MID RO E PR DA DB K)", "MID"))
-      call reserve_material(input)
-      n = input%material_count + 1
-      input%material_count = n
-      input%material_lines(n) = line
+      n = append_material(input, line, law_elastic, title)
       associate (material => input%model%materials(n))
-        material%law = law_elastic
-        material%title = title
         call read_elastic_constants(deck, card, material, log)
       end associate
     end do
@@ -346,13 +283,8 @@ contains
     line = 0
     do while (next_definition(deck, block, keyword%title, line, standard_widths, card, title, &
                               log, "card 1 (MID RO E PR SIGY ETAN BETA)", "MID"))
-      call reserve_material(input)
-      n = input%material_count + 1
-      input%material_count = n
-      input%material_lines(n) = line
+      n = append_material(input, line, law_plastic_kinematic, title)
       associate (material => input%model%materials(n))
-        material%law = law_plastic_kinematic
-        material%title = title
         call read_elastic_constants(deck, card, material, log)
         call get_real(deck, card, 5, "SIGY", material%yield_stress, log)
         call get_real(deck, card, 6, "ETAN", material%tangent_modulus, log)
@@ -375,13 +307,35 @@ contains
     end do
   end subroutine read_plastic_kinematic_materials
 
+  !> *MAT_HONEYCOMB (026): see read_honeycombs.
+  subroutine read_honeycomb_materials(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_honeycombs(deck, block, keyword, .false., input, log)
+  end subroutine read_honeycomb_materials
+
+  !> *MAT_MODIFIED_HONEYCOMB (126): see read_honeycombs.
+  subroutine read_modified_honeycomb_materials(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_honeycombs(deck, block, keyword, .true., input, log)
+  end subroutine read_modified_honeycomb_materials
+
   !> *MAT_HONEYCOMB (026, `modified` false) and *MAT_MODIFIED_HONEYCOMB (126): cards 1-5
   !> (126: 1-8, cards 6-8 optional; a 126 keyword therefore holds one material).
   !> C1 MID RO E PR SIGY VF MU BULK; C2 LCA LCB LCC LCS LCAB LCBC LCCA LCSR;
   !> C3 EAAU EBBU ECCU GABU GBCU GCAU AOPT MACF; C4 XP YP ZP A1 A2 A3 (126: RFAC PRU);
   !> C5 D1 D2 D3 TSEF SSEF (026: V1 V2 V3; 126: VREF TREF SHDFLG); 126: C6 V1 V2 V3,
   !> C7 LCSRA ... LCSRCA, C8 PRUAB ... PRUCB.
-  subroutine read_honeycomb_materials(deck, block, keyword, modified, input, log)
+  subroutine read_honeycombs(deck, block, keyword, modified, input, log)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
     type(keyword_t), intent(in) :: keyword
@@ -400,13 +354,8 @@ contains
     line = 0
     do while (next_definition(deck, block, keyword%title, line, standard_widths, card, title, &
                               log, "card 1 (MID RO E PR SIGY VF MU BULK)", "MID"))
-      call reserve_material(input)
-      n = input%material_count + 1
-      input%material_count = n
-      input%material_lines(n) = line
+      n = append_material(input, line, merge(law_modified_honeycomb, law_honeycomb, modified), title)
       associate (material => input%model%materials(n))
-        material%law = merge(law_modified_honeycomb, law_honeycomb, modified)
-        material%title = title
         call read_elastic_constants(deck, card, material, log)
         call get_real(deck, card, 5, "SIGY", material%yield_stress, log)
         call get_real(deck, card, 6, "VF", material%compaction_volume, log)
@@ -532,7 +481,7 @@ contains
         end if
       end associate
     end do
-  end subroutine read_honeycomb_materials
+  end subroutine read_honeycombs
 
   !> *MAT_LOW_DENSITY_FOAM: C1 MID RO E LCID TC HU BETA DAMP; C2 (optional; a keyword with
   !> card 2 holds one material) SHAPE FAIL BVFLAG ED BETA1 KCON REF.
@@ -551,13 +500,8 @@ contains
     line = 0
     do while (next_definition(deck, block, keyword%title, line, standard_widths, card, title, &
                               log, "card 1 (MID RO E LCID TC HU BETA DAMP)", "MID"))
-      call reserve_material(input)
-      n = input%material_count + 1
-      input%material_count = n
-      input%material_lines(n) = line
+      n = append_material(input, line, law_low_density_foam, title)
       associate (material => input%model%materials(n))
-        material%law = law_low_density_foam
-        material%title = title
         material%bulk_viscosity = .false.
         call get_integer(deck, card, 1, "MID", material%id, log)
         call get_real(deck, card, 2, "RO", material%density, log)

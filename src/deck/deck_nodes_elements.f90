@@ -4,15 +4,17 @@ module deck_nodes_elements
   use kinds, only: wp
   use deck_problems, only: problem_log_t
   use deck_columns, only: field_width
-  use deck_numbers, only: integer_text, real_text
+  use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t, card_text, trim_blanks, is_blank_line
   use deck_fields, only: card_t, open_card, next_line, require_card, get_integer, get_real, &
                          card_problem
   use deck_input, only: deck_input_t
+  use deck_keywords, only: keyword_t
+  use error_handling, only: error_list_t
   implicit none
   private
 
-  public :: read_nodes, read_solid_elements, read_shell_elements
+  public :: read_nodes, read_solid_elements, read_shell_elements, read_thick_shell_elements
 
   !> *NODE columns: NID 8, X Y Z 16 each, TC 8, RC 8.
   integer, parameter :: node_widths(6) = [8, 16, 16, 16, 8, 8]
@@ -30,11 +32,13 @@ contains
   !> *NODE: one node per line (NID X Y Z TC RC). TC and RC codes become constraints of the
   !> translations and rotations, as in LS-DYNA (rotations act on shell nodes only; the
   !> cross-check warns about RC on a node of no shell).
-  subroutine read_nodes(deck, block, input, log)
+  subroutine read_nodes(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
     integer :: line, n, id, constraint, rotation
 
@@ -71,11 +75,13 @@ contains
   !> *ELEMENT_SOLID: EID PID N1..N8 on one line, or EID PID on one line and N1..N10 on the
   !> next (LS-DYNA's "ten nodes" layout, N9 and N10 blank for hexahedra). As in LS-DYNA the
   !> layout is decided from the first line of the keyword. Degenerate shapes repeat nodes.
-  subroutine read_solid_elements(deck, block, input, log)
+  subroutine read_solid_elements(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
     integer :: line, n, first_node_field
     logical :: one_line
@@ -115,13 +121,35 @@ contains
     end do
   end subroutine read_solid_elements
 
+  !> *ELEMENT_SHELL: see read_shells.
+  subroutine read_shell_elements(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_shells(deck, block, .false., input, log)
+  end subroutine read_shell_elements
+
+  !> *ELEMENT_SHELL_THICKNESS: see read_shells.
+  subroutine read_thick_shell_elements(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_shells(deck, block, .true., input, log)
+  end subroutine read_thick_shell_elements
+
   !> *ELEMENT_SHELL: EID PID N1 N2 N3 N4 N5 N6 N7 N8 on one line per element (8 columns each, or
   !> comma separated). N4 blank or 0 is a triangle and becomes N3, LS-DYNA's way of writing
   !> one; N5-N8 must be blank (8-node shells are not available). With `with_thickness`
   !> (*ELEMENT_SHELL_THICKNESS) a second line holds THIC1 THIC2 THIC3 THIC4 BETA, 16 columns
   !> each: a THIC of 0 takes the section's thickness in the cross-check; BETA (a material angle,
   !> which no available shell material uses) is read and not used.
-  subroutine read_shell_elements(deck, block, with_thickness, input, log)
+  subroutine read_shells(deck, block, with_thickness, input, log)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
     logical, intent(in) :: with_thickness
@@ -168,7 +196,7 @@ contains
         if (.not. next_line(deck, block, line, .false.)) exit
       end if
     end do
-  end subroutine read_shell_elements
+  end subroutine read_shells
 
   !> N1-N4 of a shell from fields 3-6, and the check that N5-N8 (fields 7-10) are blank;
   !> `eight_nodes` tells that one of N5-N8 was given (and reported). Node ids <= 0 and nodes

@@ -1,4 +1,5 @@
-!> Strict conversion of field text to numbers, and the small text helpers the deck reader shares.
+!> Strict conversion of field text to numbers, and the small text helpers the deck reader shares
+!> (numbers as text: text_format).
 !>
 !> List-directed reads accept "1 2" as 1 and "1,2" as 1, so every field is checked character by
 !> character here instead. Reals take Fortran's forms, as LS-DYNA reads them: `1.5`, `-.5`,
@@ -11,7 +12,7 @@ module deck_numbers
   implicit none
   private
 
-  public :: parse_integer, parse_real, to_upper, integer_text, real_text, digit
+  public :: parse_integer, parse_real, to_upper, digit
 
   !> Status codes of `parse_integer` and `parse_real`.
   integer, parameter, public :: number_ok = 0, number_invalid = 1, number_not_integral = 2, &
@@ -213,54 +214,4 @@ contains
     integer, intent(in) :: value
     digit = achar(iachar("0") + modulo(value, 10))
   end function digit
-
-  !> `value` as text without blanks, for messages.
-  pure function integer_text(value) result(text)
-    integer, intent(in) :: value
-    character(len=:), allocatable :: text
-    character(len=24) :: buffer
-    write (buffer, '(i0)') value
-    text = trim(buffer)
-  end function integer_text
-
-  !> `value` as short text for messages: plain decimals for ordinary magnitudes, otherwise
-  !> scientific notation, trailing zeros removed (0.3, 210.0, 7.8e-6).
-  pure function real_text(value) result(text)
-    real(wp), intent(in) :: value
-    character(len=:), allocatable :: text
-    character(len=40) :: buffer
-    integer :: mark
-    if (value == 0.0_wp .or. (abs(value) >= 1.0e-3_wp .and. abs(value) < 1.0e7_wp)) then
-      write (buffer, '(f0.10)') value
-      text = without_trailing_zeros(trim(adjustl(buffer)))
-      if (text(1:1) == ".") text = "0"//text
-      if (text(1:2) == "-.") text = "-0"//text(2:)
-    else
-      write (buffer, '(es24.14e3)') value
-      buffer = adjustl(buffer)
-      mark = index(buffer, "E")
-      text = without_trailing_zeros(buffer(1:mark - 1))//"e"// &
-             integer_text(exponent_value(buffer(mark + 1:)))
-    end if
-  end function real_text
-
-  !> "2.500" -> "2.5", "3.000" -> "3.0".
-  pure function without_trailing_zeros(text) result(short)
-    character(len=*), intent(in) :: text
-    character(len=:), allocatable :: short
-    integer :: last
-    last = len(text)
-    do while (last > 1 .and. text(last:last) == "0")
-      last = last - 1
-    end do
-    if (text(last:last) == ".") last = min(last + 1, len(text))
-    short = text(1:last)
-  end function without_trailing_zeros
-
-  pure integer function exponent_value(text)
-    character(len=*), intent(in) :: text
-    integer :: status
-    read (text, *, iostat=status) exponent_value
-    if (status /= 0) exponent_value = 0
-  end function exponent_value
 end module deck_numbers

@@ -5,7 +5,7 @@ module deck_parts_sections
   use error_handling, only: error_list_t
   use model, only: formulation_fe, section_solid, section_shell
   use deck_problems, only: problem_log_t
-  use deck_numbers, only: integer_text, real_text
+  use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t
   use deck_keywords, only: keyword_t
   use deck_fields, only: card_t, open_card, next_line, require_card, next_definition, &
@@ -17,16 +17,17 @@ module deck_parts_sections
   implicit none
   private
 
-  public :: read_parts, read_solid_sections, read_shell_sections, read_hourglasses
+  public :: read_parts, read_solid_sections, read_efg_sections, read_shell_sections, read_hourglasses
 
   integer, parameter :: standard_widths(8) = 10
 
 contains
 
   !> *PART: a heading line, then PID SECID MID EOSID HGID GRAV ADPOPT TMID; repeated.
-  subroutine read_parts(deck, block, input, log, warnings)
+  subroutine read_parts(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
@@ -72,6 +73,28 @@ contains
     end do
   end subroutine read_parts
 
+  !> *SECTION_SOLID: see read_solid_section_cards.
+  subroutine read_solid_sections(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_solid_section_cards(deck, block, keyword, .false., input, log, warnings)
+  end subroutine read_solid_sections
+
+  !> *SECTION_SOLID_EFG: see read_solid_section_cards.
+  subroutine read_efg_sections(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_solid_section_cards(deck, block, keyword, .true., input, log, warnings)
+  end subroutine read_efg_sections
+
   !> *SECTION_SOLID and *SECTION_SOLID_EFG (with _TITLE: a title line before card 1).
   !>
   !> Card 1 is SECID ELFORM AET. ELFORM 1 and 2 are finite elements; ELFORM 41 is the meshfree
@@ -84,7 +107,7 @@ contains
   !>   card, and an optional card 3 (IPS STIME IKEN SF CMID IBR DS ECUT). Further cards are
   !>   accepted only when they set nothing (the user-element cards that pydyna writes for
   !>   every section); any other further card is an error.
-  subroutine read_solid_sections(deck, block, keyword, meshfree_keyword, input, log, warnings)
+  subroutine read_solid_section_cards(deck, block, keyword, meshfree_keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
     type(keyword_t), intent(in) :: keyword
@@ -136,7 +159,7 @@ contains
         exit
       end if
     end do
-  end subroutine read_solid_sections
+  end subroutine read_solid_section_cards
 
   !> *SECTION_SHELL (with _TITLE: a title line before each section). Sections repeat until the
   !> next keyword; each is two cards:
@@ -295,12 +318,13 @@ contains
   !> *HOURGLASS: HGID IHQ QM IBQ Q1 Q2 QB/VDC QW, one card per definition. Values are kept as
   !> written (blank = 0); the cross-check turns IHQ 0 and blank QM, Q1, Q2 into the global
   !> defaults.
-  subroutine read_hourglasses(deck, block, keyword, input, log)
+  subroutine read_hourglasses(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
     type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
     integer :: line, n
     character(len=:), allocatable :: title

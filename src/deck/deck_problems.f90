@@ -2,6 +2,7 @@
 !> (a shifted column in a million node cards) gives a readable report instead of a million lines.
 module deck_problems
   use error_handling, only: error_t, error_list_t, add_error, take_errors
+  use text_format, only: integer_text
   implicit none
   private
 
@@ -42,10 +43,8 @@ contains
   subroutine problems_to_error(log, error)
     type(problem_log_t), intent(inout) :: log
     type(error_t), allocatable, intent(inout) :: error
-    character(len=24) :: count_text
     if (log%total > listed_limit) then
-      write (count_text, '(i0)') log%total - listed_limit
-      call add_error(log%list, "... and "//trim(count_text)//" more problems not listed")
+      call add_error(log%list, "... and "//integer_text(log%total - listed_limit)//" more problems not listed")
     end if
     call take_errors(log%list, error)
     log%total = 0

@@ -4,34 +4,30 @@
 !>
 !> A part whose material is *MAT_RIGID gets `formulation_rigid`: its elements give the body
 !> its mass and inertia and get no finite-element block (LS-DYNA Keyword Manual, *MAT_RIGID;
-!> LS-DYNA Theory Manual, "Rigid Body Dynamics"). The keywords are identified here, not in
-!> deck_keywords, so that their codes (`rigid_keyword_first`..) stay out of the per-keyword
-!> line counts; deck_reader hands their blocks to `read_rigid_block`.
+!> LS-DYNA Theory Manual, "Rigid Body Dynamics"). The readers are those of the keyword table's
+!> rows (deck_keyword_table); their lists are sized from the keywords' data lines (deck_input).
 module deck_rigid_bodies
   use kinds, only: wp
   use error_handling, only: error_list_t
-  use model, only: material_t, rigid_body_t, rigid_motion_t, law_rigid, formulation_rigid, &
-                   motion_velocity, motion_acceleration, motion_displacement
+  use model, only: material_t, rigid_body_t, rigid_motion_t, formulation_rigid, motion_velocity, &
+                   motion_acceleration, motion_displacement
+  use material_laws, only: law_rigid
   use deck_problems, only: problem_log_t, report_problem
-  use deck_numbers, only: integer_text, real_text
+  use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t
-  use deck_keywords, only: keyword_t, keyword_unknown
+  use deck_keywords, only: keyword_t
   use deck_fields, only: card_t, next_definition, next_line, open_card, get_integer, get_real, &
                          card_problem, field_is_blank, warn_if_set, id_heading, located_problem
   use deck_id_index, only: id_index_t, build_id_index, find_id
   use deck_input, only: deck_input_t
-  use deck_materials, only: reserve_material
+  use deck_materials, only: append_material
   use deck_rigid_input, only: rigid_material_input_t, rigid_motion_input_t, nodal_rigid_input_t, &
                               element_mass_input_t
   implicit none
   private
 
-  public :: identify_rigid_keyword, read_rigid_block, build_rigid_bodies
-
-  !> Codes of the rigid-body keywords (beyond deck_keywords' range).
-  integer, parameter, public :: keyword_mat_rigid = 1001, keyword_motion_rigid = 1002, &
-    keyword_nodal_rigid_body = 1003, keyword_element_mass = 1004
-  integer, parameter, public :: rigid_keyword_first = 1001, rigid_keyword_last = 1004
+  public :: read_rigid_materials, read_rigid_motions, read_nodal_rigid_bodies, read_element_masses
+  public :: build_rigid_bodies
 
   integer, parameter :: standard_widths(8) = 10
   integer, parameter :: mass_widths(4) = [8, 8, 16, 8]
@@ -43,54 +39,6 @@ module deck_rigid_bodies
   character(len=2), parameter :: dof_names(6) = ["x ", "y ", "z ", "rx", "ry", "rz"]
 
 contains
-
-  !> The rigid-body keyword `name` (upper case, no `*`) with its options, or code
-  !> `keyword_unknown`.
-  pure function identify_rigid_keyword(name) result(keyword)
-    character(len=*), intent(in) :: name
-    type(keyword_t) :: keyword
-    select case (name)
-    case ("MAT_RIGID", "MAT_020")
-      keyword%code = keyword_mat_rigid
-    case ("MAT_RIGID_TITLE", "MAT_020_TITLE")
-      keyword%code = keyword_mat_rigid
-      keyword%title = .true.
-    case ("BOUNDARY_PRESCRIBED_MOTION_RIGID")
-      keyword%code = keyword_motion_rigid
-    case ("BOUNDARY_PRESCRIBED_MOTION_RIGID_ID")
-      keyword%code = keyword_motion_rigid
-      keyword%id = .true.
-    case ("CONSTRAINED_NODAL_RIGID_BODY")
-      keyword%code = keyword_nodal_rigid_body
-    case ("CONSTRAINED_NODAL_RIGID_BODY_TITLE")
-      keyword%code = keyword_nodal_rigid_body
-      keyword%title = .true.
-    case ("ELEMENT_MASS")
-      keyword%code = keyword_element_mass
-    case default
-      keyword%code = keyword_unknown
-    end select
-  end function identify_rigid_keyword
-
-  !> Read one block of a rigid-body keyword.
-  subroutine read_rigid_block(deck, block, keyword, input, log, warnings)
-    type(deck_t), intent(in) :: deck
-    integer, intent(in) :: block
-    type(keyword_t), intent(in) :: keyword
-    type(deck_input_t), intent(inout) :: input
-    type(problem_log_t), intent(inout) :: log
-    type(error_list_t), intent(inout) :: warnings
-    select case (keyword%code)
-    case (keyword_mat_rigid)
-      call read_rigid_materials(deck, block, keyword, input, log, warnings)
-    case (keyword_motion_rigid)
-      call read_rigid_motions(deck, block, keyword, input, log)
-    case (keyword_nodal_rigid_body)
-      call read_nodal_rigid_bodies(deck, block, keyword, input, log, warnings)
-    case (keyword_element_mass)
-      call read_element_masses(deck, block, input, log, warnings)
-    end select
-  end subroutine read_rigid_block
 
   !> *MAT_RIGID: card 1 MID RO E PR N COUPLE M ALIAS; card 2 CMO CON1 CON2 SPCNID XSPC YSPC
   !> ZSPC; card 3 LCO/A1 A2 A3 V1 V2 V3 BNDLCO (read over: output axes only). Cards 2 and 3
@@ -112,14 +60,9 @@ contains
     line = 0
     do while (next_definition(deck, block, keyword%title, line, standard_widths, card, title, &
                               log, "card 1 (MID RO E PR N COUPLE M ALIAS)", "MID"))
-      call reserve_material(input)
-      n = input%material_count + 1
-      input%material_count = n
-      input%material_lines(n) = line
+      n = append_material(input, line, law_rigid, title)
       entry = rigid_material_input_t(material=n)
       associate (material => input%model%materials(n))
-        material%law = law_rigid
-        material%title = title
         call get_integer(deck, card, 1, "MID", material%id, log)
         call get_real(deck, card, 2, "RO", material%density, log)
         call get_real(deck, card, 3, "E", material%youngs_modulus, log)
@@ -203,12 +146,13 @@ contains
   end subroutine read_rigid_materials
 
   !> *BOUNDARY_PRESCRIBED_MOTION_RIGID(_ID): PID DOF VAD LCID SF VID DEATH BIRTH per line.
-  subroutine read_rigid_motions(deck, block, keyword, input, log)
+  subroutine read_rigid_motions(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
     type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
     type(rigid_motion_input_t) :: motion
     integer :: line, vector, id
@@ -304,9 +248,10 @@ contains
   end subroutine read_nodal_rigid_bodies
 
   !> *ELEMENT_MASS: EID (8) NID (8) MASS (16) PID (8) per line.
-  subroutine read_element_masses(deck, block, input, log, warnings)
+  subroutine read_element_masses(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
@@ -564,13 +509,6 @@ contains
   subroutine append_rigid_material(input, entry)
     type(deck_input_t), intent(inout) :: input
     type(rigid_material_input_t), intent(in) :: entry
-    type(rigid_material_input_t), allocatable :: larger(:)
-    if (.not. allocated(input%rigid%materials)) allocate (input%rigid%materials(4))
-    if (input%rigid%material_count == size(input%rigid%materials)) then
-      allocate (larger(2*size(input%rigid%materials)))
-      larger(1:input%rigid%material_count) = input%rigid%materials
-      call move_alloc(larger, input%rigid%materials)
-    end if
     input%rigid%material_count = input%rigid%material_count + 1
     input%rigid%materials(input%rigid%material_count) = entry
   end subroutine append_rigid_material
@@ -578,13 +516,6 @@ contains
   subroutine append_rigid_motion(input, entry)
     type(deck_input_t), intent(inout) :: input
     type(rigid_motion_input_t), intent(in) :: entry
-    type(rigid_motion_input_t), allocatable :: larger(:)
-    if (.not. allocated(input%rigid%motions)) allocate (input%rigid%motions(4))
-    if (input%rigid%motion_count == size(input%rigid%motions)) then
-      allocate (larger(2*size(input%rigid%motions)))
-      larger(1:input%rigid%motion_count) = input%rigid%motions
-      call move_alloc(larger, input%rigid%motions)
-    end if
     input%rigid%motion_count = input%rigid%motion_count + 1
     input%rigid%motions(input%rigid%motion_count) = entry
   end subroutine append_rigid_motion
@@ -592,13 +523,6 @@ contains
   subroutine append_nodal_body(input, entry)
     type(deck_input_t), intent(inout) :: input
     type(nodal_rigid_input_t), intent(in) :: entry
-    type(nodal_rigid_input_t), allocatable :: larger(:)
-    if (.not. allocated(input%rigid%nodal)) allocate (input%rigid%nodal(4))
-    if (input%rigid%nodal_count == size(input%rigid%nodal)) then
-      allocate (larger(2*size(input%rigid%nodal)))
-      larger(1:input%rigid%nodal_count) = input%rigid%nodal
-      call move_alloc(larger, input%rigid%nodal)
-    end if
     input%rigid%nodal_count = input%rigid%nodal_count + 1
     input%rigid%nodal(input%rigid%nodal_count) = entry
   end subroutine append_nodal_body
@@ -606,13 +530,6 @@ contains
   subroutine append_element_mass(input, entry)
     type(deck_input_t), intent(inout) :: input
     type(element_mass_input_t), intent(in) :: entry
-    type(element_mass_input_t), allocatable :: larger(:)
-    if (.not. allocated(input%rigid%masses)) allocate (input%rigid%masses(16))
-    if (input%rigid%mass_count == size(input%rigid%masses)) then
-      allocate (larger(2*size(input%rigid%masses)))
-      larger(1:input%rigid%mass_count) = input%rigid%masses
-      call move_alloc(larger, input%rigid%masses)
-    end if
     input%rigid%mass_count = input%rigid%mass_count + 1
     input%rigid%masses(input%rigid%mass_count) = entry
   end subroutine append_element_mass

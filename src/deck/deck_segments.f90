@@ -4,7 +4,8 @@
 module deck_segments
   use kinds, only: wp
   use deck_problems, only: problem_log_t
-  use deck_numbers, only: integer_text, digit
+  use deck_numbers, only: digit
+  use text_format, only: integer_text
   use deck_lexer, only: deck_t
   use deck_fields, only: card_t, get_integer, card_problem
   implicit none

@@ -3,7 +3,8 @@ module deck_sets_curves
   use kinds, only: wp
   use error_handling, only: error_list_t
   use deck_problems, only: problem_log_t
-  use deck_numbers, only: integer_text, real_text, to_upper, digit
+  use deck_numbers, only: to_upper, digit
+  use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t
   use deck_keywords, only: keyword_t
   use deck_fields, only: card_t, open_card, next_line, next_definition, get_integer, get_real, &
@@ -13,7 +14,7 @@ module deck_sets_curves
   implicit none
   private
 
-  public :: read_node_set, read_part_set, read_segment_set, read_curve
+  public :: read_node_set, read_generated_node_set, read_part_set, read_segment_set, read_curve
 
   integer, parameter :: standard_widths(8) = 10
   !> *DEFINE_CURVE points: abscissa and ordinate, 20 columns each.
@@ -21,9 +22,31 @@ module deck_sets_curves
 
 contains
 
+  !> *SET_NODE_LIST: see read_node_set_cards.
+  subroutine read_node_set(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_node_set_cards(deck, block, keyword, .false., input, log, warnings)
+  end subroutine read_node_set
+
+  !> *SET_NODE_LIST_GENERATE: see read_node_set_cards.
+  subroutine read_generated_node_set(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_node_set_cards(deck, block, keyword, .true., input, log, warnings)
+  end subroutine read_generated_node_set
+
   !> *SET_NODE_LIST (ids, 8 per line) or *SET_NODE_LIST_GENERATE (`generated`: up to four
   !> ranges B1BEG B1END ... per line).
-  subroutine read_node_set(deck, block, keyword, generated, input, log, warnings)
+  subroutine read_node_set_cards(deck, block, keyword, generated, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
     type(keyword_t), intent(in) :: keyword
@@ -43,7 +66,7 @@ contains
         call read_members(deck, block, line, "NID", set, log)
       end if
     end associate
-  end subroutine read_node_set
+  end subroutine read_node_set_cards
 
   !> *SET_PART_LIST: SID card, then part ids 8 per line.
   subroutine read_part_set(deck, block, keyword, input, log, warnings)
@@ -183,12 +206,13 @@ contains
   !> *DEFINE_CURVE: [title], LCID SIDR SFA SFO OFFA OFFO DATTYP LCINT, then one point per line
   !> (A, O in 20 columns each). Stored points are SFA*(A + OFFA), SFO*(O + OFFO), LS-DYNA's
   !> rule (scale after offset); SFA, SFO of 0 mean 1.
-  subroutine read_curve(deck, block, keyword, input, log)
+  subroutine read_curve(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
     type(keyword_t), intent(in) :: keyword
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
     integer :: line, relaxation, data_type, n
     real(wp) :: scale(2), offset(2)

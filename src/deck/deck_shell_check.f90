@@ -11,7 +11,8 @@ module deck_shell_check
   use kinds, only: wp
   use model, only: section_solid, section_shell
   use deck_problems, only: problem_log_t
-  use deck_numbers, only: integer_text, real_text, digit
+  use deck_numbers, only: digit
+  use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t
   use deck_fields, only: located_problem
   use deck_input, only: deck_input_t

@@ -11,6 +11,7 @@
 !> everything built from them is deterministic.
 module efg_neighbour_search
   use kinds, only: wp
+  use integer_lists, only: append_integer
   use efg_kernel, only: kernel_weight
   implicit none
   private
@@ -121,7 +122,7 @@ contains
             if (any([i, j, l] /= max(first, grid%first_bin(:, particle)))) cycle
             if (any(centres(:, particle) - radius(:, particle) > high)) cycle
             if (any(centres(:, particle) + radius(:, particle) < low)) cycle
-            call append(found, count, particle)
+            call append_integer(found, count, particle)
           end do
         end do
       end do
@@ -165,21 +166,6 @@ contains
     integer, intent(in) :: bin(3)
     bin_number = bin(1) + grid%bins(1)*((bin(2) - 1) + grid%bins(2)*(bin(3) - 1))
   end function bin_number
-
-  subroutine append(list, count, value)
-    integer, allocatable, intent(inout) :: list(:)
-    integer, intent(inout) :: count
-    integer, intent(in) :: value
-    integer, allocatable :: longer(:)
-
-    if (count == size(list)) then
-      allocate (longer(2*size(list)))
-      longer(1:count) = list(1:count)
-      call move_alloc(longer, list)
-    end if
-    count = count + 1
-    list(count) = value
-  end subroutine append
 
   !> Ascending heap sort (the lists are short but may reach a few thousand entries).
   pure subroutine sort_integers(values)

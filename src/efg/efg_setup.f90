@@ -12,6 +12,7 @@
 module efg_setup
   use kinds, only: wp
   use error_handling, only: error_t, make_error
+  use text_format, only: integer_text, scientific_text, fixed_text
   use wall_clock, only: seconds_now
   use model, only: model_t, formulation_efg, kernel_cubic_box, kernel_cubic_sphere, boundary_full_transformation, &
                    boundary_coupled, integration_local_boundary, integration_gauss, &
@@ -77,7 +78,7 @@ contains
       call build_part_supports(model, part, section%support_scale, section%kernel, &
                                section%boundary_treatment == boundary_full_transformation, supports)
       if (size(supports%cells) == 0) then
-        call make_error(error, "EFG part "//text(model%parts(part)%id)//" has no solid elements")
+        call make_error(error, "EFG part "//integer_text(model%parts(part)%id)//" has no solid elements")
         return
       end if
       domain_integration = section%domain_integration
@@ -300,10 +301,10 @@ contains
     character(len=:), allocatable :: where
 
     if (part < 1 .or. part > size(model%parts)) then
-      call make_error(error, "EFG set-up: part index "//text(part)//" is not a part of the model")
+      call make_error(error, "EFG set-up: part index "//integer_text(part)//" is not a part of the model")
       return
     end if
-    where = "EFG part "//text(model%parts(part)%id)
+    where = "EFG part "//integer_text(model%parts(part)%id)
     if (model%parts(part)%formulation /= formulation_efg) then
       call make_error(error, where//": the part is not meshfree (its section is not ELFORM 41)")
       return
@@ -313,7 +314,7 @@ contains
       return
     end if
     associate (section => model%sections(model%parts(part)%section))
-      where = where//", section "//text(section%id)
+      where = where//", section "//integer_text(section%id)
       if (any(section%support_scale <= 1.0_wp)) then
         call make_error(error, where//": DX, DY and DZ must be greater than 1 (at 1.0 a vertex "// &
                         "weight vanishes on the cell's far corner)")
@@ -347,10 +348,10 @@ contains
     real(wp) :: worst
     integer :: k, worst_cell, bad, j
 
-    where = "EFG part "//text(model%parts(part)%id)
+    where = "EFG part "//integer_text(model%parts(part)%id)
     do k = 1, size(results)
       if (any(results(k)%point_volume <= 0.0_wp)) then
-        call make_error(error, where//": element "//text(model%solid_ids(supports%cells(k)))// &
+        call make_error(error, where//": element "//integer_text(model%solid_ids(supports%cells(k)))// &
                         " has a non-positive (sub-)cell volume: it is inverted or degenerate")
         return
       end if
@@ -365,9 +366,9 @@ contains
       end if
     end do
     if (worst > moment_residual_tolerance) then
-      call make_error(error, where//": element "//text(model%solid_ids(supports%cells(worst_cell)))// &
+      call make_error(error, where//": element "//integer_text(model%solid_ids(supports%cells(worst_cell)))// &
                       ": the moment equations M alpha = b are not solved to round-off (residual "// &
-                      real_text(worst)//"): b(X) is not in the range of M(X), so an interior vertex of "// &
+                      scientific_text(worst, 3)//"): b(X) is not in the range of M(X), so an interior vertex of "// &
                       "the cell does not cover it; each particle's support must be DX times the largest "// &
                       "distance to the nodes sharing an element with it (formulation section 2)")
       return
@@ -378,41 +379,17 @@ contains
     do j = 1, size(efg%mass_volume)
       if (efg%mass_volume(j) > 0.0_wp) cycle
       bad = bad + 1
-      if (bad <= 5) listed = listed//" "//text(model%node_ids(efg%mass_node(j)))// &
-                             " ("//real_text(efg%mass_volume(j))//")"
+      if (bad <= 5) listed = listed//" "//integer_text(model%node_ids(efg%mass_node(j)))// &
+                             " ("//scientific_text(efg%mass_volume(j), 3)//")"
     end do
     if (bad > 0) then
       associate (section => model%sections(model%parts(part)%section))
-        call make_error(error, where//": "//text(bad)//" node(s) get a non-positive row-sum mass; "// &
+        call make_error(error, where//": "//integer_text(bad)//" node(s) get a non-positive row-sum mass; "// &
                         "node id (volume share):"//listed//". Likely cause: the supports are too large "// &
-                        "for the part's thickness (DX "//fixed_text(section%support_scale(1))//", "// &
+                        "for the part's thickness (DX "//fixed_text(section%support_scale(1), 2)//", "// &
                         trim(merge("spherical", "box      ", section%kernel == kernel_cubic_sphere))// &
                         " kernel): reduce DX or use the box kernel (ISPLINE 0)")
       end associate
     end if
   end subroutine check_results
-
-  pure function text(value) result(string)
-    integer, intent(in) :: value
-    character(len=:), allocatable :: string
-    character(len=16) :: buffer
-    write (buffer, '(i0)') value
-    string = trim(buffer)
-  end function text
-
-  pure function fixed_text(value) result(string)
-    real(wp), intent(in) :: value
-    character(len=:), allocatable :: string
-    character(len=24) :: buffer
-    write (buffer, '(f0.2)') value
-    string = trim(adjustl(buffer))
-  end function fixed_text
-
-  pure function real_text(value) result(string)
-    real(wp), intent(in) :: value
-    character(len=:), allocatable :: string
-    character(len=24) :: buffer
-    write (buffer, '(es10.3)') value
-    string = trim(adjustl(buffer))
-  end function real_text
 end module efg_setup

@@ -1,7 +1,9 @@
 !> One entry point per material operation for a block of lanes (elements or integration
 !> points of one material); each selects the law by `material%law` and calls the law's kernel
-!> with plain arrays and scalar constants. A new law is a new module plus one case in each
-!> procedure here.
+!> with plain arrays and scalar constants. The law codes and what each law has (its history
+!> size, the element families it takes) are rows of material_laws' law_table; a new law is a
+!> new module, one row there and its case in update_material_block (and in the procedures here
+!> that treat its history or stiffness specially).
 !>
 !> Conventions shared by every law:
 !> - stress: Cauchy stress (block_size, 6), order xx, yy, zz, xy, yz, zx, already rotated by the
@@ -14,17 +16,15 @@
 !>   time step, the linear bulk viscosity and the hourglass stiffness (lambda + 2 mu).
 module material_dispatch
   use kinds, only: wp, block_size
-  use model, only: material_t, law_elastic, law_plastic_kinematic, law_honeycomb, law_modified_honeycomb, &
-                   law_low_density_foam, law_piecewise_linear, law_null, honeycomb_rate_curve, foam_loading_curve, &
-                   piecewise_hardening_curve, piecewise_rate_curve
+  use model, only: material_t, honeycomb_rate_curve, foam_loading_curve, piecewise_hardening_curve, &
+                   piecewise_rate_curve
+  use material_laws, only: law_table, find_law, law_elastic, law_plastic_kinematic, law_honeycomb, &
+                           law_modified_honeycomb, law_low_density_foam, law_piecewise_linear, law_null
   use material_elastic, only: elastic_update
-  use material_plastic_kinematic, only: plastic_kinematic_update, plastic_kinematic_history_count, &
-                                        plastic_strain_slot, back_stress_first_slot
-  use material_honeycomb, only: honeycomb_update, honeycomb_initialize_axes, honeycomb_history_count, &
-                                honeycomb_axes_first_slot
-  use material_piecewise_linear, only: piecewise_linear_update, piecewise_linear_history_count, &
-                                       piecewise_plastic_strain_slot
-  use material_low_density_foam, only: low_density_foam_update, low_density_foam_initialize, foam_history_count, &
+  use material_plastic_kinematic, only: plastic_kinematic_update, plastic_strain_slot, back_stress_first_slot
+  use material_honeycomb, only: honeycomb_update, honeycomb_initialize_axes, honeycomb_axes_first_slot
+  use material_piecewise_linear, only: piecewise_linear_update, piecewise_plastic_strain_slot
+  use material_low_density_foam, only: low_density_foam_update, low_density_foam_initialize, &
                                        foam_left_cauchy_green_first_slot
   use objective_rotation, only: rotate_symmetric_tensors, rotate_vectors
   implicit none
@@ -36,22 +36,15 @@ module material_dispatch
 
 contains
 
-  !> Number of history variables per integration point of the material's law.
+  !> Number of history variables per integration point of the material's law (law_table; 0
+  !> for a code that is not a law).
   pure function material_history_count(material) result(count)
     type(material_t), intent(in) :: material
     integer :: count
-    select case (material%law)
-    case (law_plastic_kinematic)
-      count = plastic_kinematic_history_count
-    case (law_honeycomb, law_modified_honeycomb)
-      count = honeycomb_history_count
-    case (law_low_density_foam)
-      count = foam_history_count
-    case (law_piecewise_linear)
-      count = piecewise_linear_history_count
-    case default
-      count = 0
-    end select
+    integer :: law
+    law = find_law(material%law)
+    count = 0
+    if (law > 0) count = law_table(law)%history_count
   end function material_history_count
 
   !> Initial history of lanes 1..nel (virgin material: no plastic strain, no back stress).
@@ -127,6 +120,10 @@ contains
     real(wp) :: bulk_modulus, shear_modulus
 
     call elastic_moduli(material, bulk_modulus, shear_modulus)
+    ! A select case on the integer law code: the fastest dispatch here (a jump table, with the
+    ! kernels free to take their own constants and be inlined). A procedure pointer per law
+    ! would need one kernel interface taking material_t. The codes and what each law has come
+    ! from law_table (material_laws).
     select case (material%law)
     case (law_elastic)
       call elastic_update(nel, bulk_modulus, shear_modulus, strain_increment, stress)

@@ -9,8 +9,7 @@ module material_elastic
 
   public :: elastic_update
 
-  !> Number of history variables per integration point: the law needs none.
-  integer, parameter, public :: elastic_history_count = 0
+  ! No history variables (law_table in material_laws: history_count 0).
 
 contains
 

@@ -40,8 +40,8 @@ module material_honeycomb
 
   public :: honeycomb_update, honeycomb_initialize_axes
 
-  !> History variables per integration point.
-  integer, parameter, public :: honeycomb_history_count = 23
+  ! History variables per integration point: 23 in all (law_table in material_laws), laid out
+  ! as follows.
   !> ln(V/V0), accumulated from the trace of the strain increments.
   integer, parameter, public :: honeycomb_log_volume_slot = 1
   !> 1 once fully compacted, else 0.

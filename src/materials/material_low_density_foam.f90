@@ -28,8 +28,8 @@ module material_low_density_foam
 
   public :: low_density_foam_update, low_density_foam_initialize
 
-  !> History variables per integration point: B (6, xx yy zz xy yz zx), then e_max.
-  integer, parameter, public :: foam_history_count = 7
+  ! History variables per integration point (7 in all: law_table in material_laws): B (6, xx yy
+  ! zz xy yz zx), then e_max.
   integer, parameter, public :: foam_left_cauchy_green_first_slot = 1
   integer, parameter, public :: foam_largest_compression_slot = 7
 

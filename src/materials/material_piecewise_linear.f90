@@ -34,8 +34,8 @@ module material_piecewise_linear
   public :: piecewise_linear_update, solve_plastic_multiplier, static_yield_stress, rate_scale_factor
   public :: effective_strain_rate
 
-  !> History variables per integration point: the effective plastic strain.
-  integer, parameter, public :: piecewise_linear_history_count = 1
+  ! History variables per integration point (1 in all: law_table in material_laws): the
+  ! effective plastic strain.
   !> Slot of the effective plastic strain in the history.
   integer, parameter, public :: piecewise_plastic_strain_slot = 1
 

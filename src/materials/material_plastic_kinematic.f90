@@ -28,8 +28,8 @@ module material_plastic_kinematic
 
   public :: plastic_kinematic_update
 
-  !> History variables per integration point: effective plastic strain, then the back stress.
-  integer, parameter, public :: plastic_kinematic_history_count = 7
+  ! History variables per integration point (7 in all: law_table in material_laws): effective
+  ! plastic strain, then the back stress.
   !> Slot of the effective plastic strain in the history.
   integer, parameter, public :: plastic_strain_slot = 1
   !> First of the six slots of the back stress (xx, yy, zz, xy, yz, zx).

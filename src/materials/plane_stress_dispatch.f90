@@ -20,8 +20,9 @@
 module plane_stress_dispatch
   use kinds, only: wp, block_size
   use curves, only: curve_t
-  use model, only: material_t, law_elastic, law_plastic_kinematic, law_piecewise_linear, law_null, &
-                   piecewise_hardening_curve, piecewise_rate_curve
+  use model, only: material_t, piecewise_hardening_curve, piecewise_rate_curve
+  use material_laws, only: law_table, find_law, no_plane_stress_kernel, law_elastic, law_plastic_kinematic, &
+                           law_piecewise_linear, law_null
   use material_dispatch, only: plastic_hardening_modulus
   use plane_stress_plasticity, only: plane_stress_elastic_update, plane_stress_plasticity_update
   implicit none
@@ -31,7 +32,7 @@ module plane_stress_dispatch
   public :: plane_stress_plastic_strain
 
   !> History count returned for a law without a plane-stress kernel.
-  integer, parameter, public :: plane_stress_unsupported = -1
+  integer, parameter, public :: plane_stress_unsupported = no_plane_stress_kernel
   !> Slot of the effective plastic strain (laws 3 and 24).
   integer, parameter, public :: plane_stress_plastic_strain_slot = 1
   !> First of the three back-stress slots of law 3 (beta_xx, beta_yy, beta_xy; beta_zz = 0 and
@@ -40,21 +41,15 @@ module plane_stress_dispatch
 
 contains
 
-  !> History variables per integration point for shells of this material: 0 (laws 1, 9),
-  !> 4 (law 3), 1 (law 24), or plane_stress_unsupported (-1) for a law without a plane-stress
-  !> kernel (the shell part must then be rejected).
+  !> History variables per integration point for shells of this material (law_table: 0 for
+  !> laws 1, 9, 4 for law 3, 1 for law 24), or plane_stress_unsupported (-1) for a law without
+  !> a plane-stress kernel (the shell part must then be rejected).
   pure integer function plane_stress_history_count(material)
     type(material_t), intent(in) :: material
-    select case (material%law)
-    case (law_elastic, law_null)
-      plane_stress_history_count = 0
-    case (law_plastic_kinematic)
-      plane_stress_history_count = 4
-    case (law_piecewise_linear)
-      plane_stress_history_count = 1
-    case default
-      plane_stress_history_count = plane_stress_unsupported
-    end select
+    integer :: law
+    law = find_law(material%law)
+    plane_stress_history_count = plane_stress_unsupported
+    if (law > 0) plane_stress_history_count = law_table(law)%shell_history_count
   end function plane_stress_history_count
 
   !> Virgin history for lanes 1..nel: no plastic strain, no back stress.
@@ -81,6 +76,7 @@ contains
     type(curve_t) :: no_curve
     real(wp) :: hardening_modulus
 
+    ! A select case on the integer law code, as in update_material_block (material_dispatch).
     select case (material%law)
     case (law_elastic)
       call plane_stress_elastic_update(nel, material%youngs_modulus, material%poissons_ratio, strain_increment, &

@@ -6,6 +6,7 @@
 module model
   use kinds, only: wp
   use curves, only: curve_t
+  use material_laws, only: law_null
   implicit none
   private
 
@@ -14,15 +15,10 @@ module model
   public :: rigid_body_t, rigid_motion_t
   public :: segment_set_t, contact_t, contact_surface_t
 
-  !> Material laws, numbered as LS-DYNA numbers them.
-  integer, parameter, public :: law_elastic = 1
-  integer, parameter, public :: law_plastic_kinematic = 3
-  integer, parameter, public :: law_honeycomb = 26            !< *MAT_HONEYCOMB
-  integer, parameter, public :: law_low_density_foam = 57     !< *MAT_LOW_DENSITY_FOAM
-  integer, parameter, public :: law_modified_honeycomb = 126  !< *MAT_MODIFIED_HONEYCOMB
-  integer, parameter, public :: law_rigid = 20                !< *MAT_RIGID (parts become rigid bodies)
-  integer, parameter, public :: law_null = 9                  !< *MAT_NULL (shells: contact surface only)
-  integer, parameter, public :: law_piecewise_linear = 24     !< *MAT_PIECEWISE_LINEAR_PLASTICITY
+  !> The law codes and what each law can do are in material_laws' law_table. law_null is also
+  !> reachable here for src/elements/shell_block.f90 and src/solver/run_checks.f90, which are
+  !> being rewritten on another branch (they switch to material_laws after the merge).
+  public :: law_null
 
   !> Curve slots of the crushable laws in material_t%curves (after the deck's defaults, such as
   !> LCB = 0 -> LCA, are applied): the six yield curves in stress order aa, bb, cc, ab, bc, ca,
@@ -42,7 +38,7 @@ module model
   !> One material (*MAT_...). Fields not used by a law stay zero.
   type :: material_t
     integer :: id = 0
-    integer :: law = 0                      !< law_elastic, law_plastic_kinematic, ...
+    integer :: law = 0                      !< law code (LS-DYNA's number): a row of law_table
     character(len=:), allocatable :: title
     real(wp) :: density = 0.0_wp            !< RO
     real(wp) :: youngs_modulus = 0.0_wp     !< E

@@ -32,6 +32,7 @@ module xdmf_writer
   use kinds, only: wp
   use error_handling, only: error_t, make_error
   use file_system, only: write_text_file, rename_file, remove_file
+  use text_format, only: integer_text, scientific_text
   implicit none
   private
 
@@ -115,7 +116,7 @@ contains
     if (solid_count > 0 .and. shell_count > 0) then
       call write_line(output, '      <Grid Name="'//name// &
                       '" GridType="Collection" CollectionType="Spatial">')
-      call write_line(output, '        <Time Value="'//real_text(time)//'"/>')
+      call write_line(output, '        <Time Value="'//scientific_text(time, 16, 3)//'"/>')
       ! The time again in each member: readers that look at the leaves (VisIt, ParaView's
       ! older XDMF reader) find it there.
       call write_uniform_grid(output, "        ", "solids", h5_reference, state_index, time, &
@@ -152,7 +153,7 @@ contains
     cells = integer_text(cell_count)
     inner = indent//"  "
     call write_line(output, indent//'<Grid Name="'//name//'" GridType="Uniform">')
-    call write_line(output, inner//'<Time Value="'//real_text(time)//'"/>')
+    call write_line(output, inner//'<Time Value="'//scientific_text(time, 16, 3)//'"/>')
     select case (kind)
     case (grid_solids)
       call write_line(output, inner//'<Topology TopologyType="Hexahedron" NumberOfElements="'// &
@@ -261,24 +262,6 @@ contains
     output%text(output%length + len(line) + 1:output%length + len(line) + 1) = new_line("a")
     output%length = output%length + len(line) + 1
   end subroutine write_line
-
-  !> Decimal text of an integer, without blanks.
-  pure function integer_text(value) result(text)
-    integer, intent(in) :: value
-    character(len=:), allocatable :: text
-    character(len=24) :: buffer
-    write (buffer, '(i0)') value
-    text = trim(buffer)
-  end function integer_text
-
-  !> A real with 17 significant digits, so that ParaView's times are the states' exact times.
-  pure function real_text(value) result(text)
-    real(wp), intent(in) :: value
-    character(len=:), allocatable :: text
-    character(len=32) :: buffer
-    write (buffer, '(es24.16e3)') value
-    text = trim(adjustl(buffer))
-  end function real_text
 
   !> Escape the characters XML reserves, for a file name placed in element text.
   pure function xml_escape(text) result(escaped)

@@ -7,7 +7,8 @@
 program bench_solid_kernels
   use, intrinsic :: iso_fortran_env, only: int64, output_unit
   use kinds, only: wp, block_size
-  use model, only: model_t, law_plastic_kinematic
+  use model, only: model_t
+  use material_laws, only: law_plastic_kinematic
   use solid_block, only: solid_block_t, build_solid_blocks, compute_solid_block
   implicit none
 

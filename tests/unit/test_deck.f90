@@ -6,18 +6,21 @@
 program test_deck
   use kinds, only: wp
   use testing, only: test_suite_t, check, check_close, finish_suite
+  use fixtures, only: make_scratch_directory
   use error_handling, only: error_t, error_list_t
-  use model, only: model_t, formulation_fe, formulation_efg, law_elastic, law_plastic_kinematic, &
-                   law_honeycomb, law_modified_honeycomb, law_low_density_foam, &
-                   motion_displacement, motion_velocity, kernel_cubic_box, kernel_cubic_sphere, &
-                   boundary_coupled, boundary_full_transformation, integration_local_boundary, &
-                   integration_gauss, integration_gauss_conventional, formulation_rigid, &
-                   section_shell, section_solid
-  use deck_reader, only: read_deck, identify_any_keyword
+  use text_format, only: integer_text
+  use model, only: model_t, formulation_fe, formulation_efg, motion_displacement, motion_velocity, &
+                   kernel_cubic_box, kernel_cubic_sphere, boundary_coupled, &
+                   boundary_full_transformation, integration_local_boundary, integration_gauss, &
+                   integration_gauss_conventional, formulation_rigid, section_shell, section_solid
+  use material_laws, only: law_elastic, law_plastic_kinematic, law_honeycomb, &
+                           law_modified_honeycomb, law_low_density_foam
+  use deck_reader, only: read_deck
   use deck_lexer, only: deck_t, load_deck, check_files_unchanged, release_deck
   use deck_problems, only: problem_log_t, has_problems
-  use deck_keywords, only: keyword_t, keyword_unknown, suggest_keyword, known_keyword_count, &
-                           known_keyword
+  use deck_keywords, only: keyword_t, keyword_unknown
+  use deck_keyword_table, only: keyword_entry_t, keyword_table, identify_keyword, handled_by_lexer, &
+                                suggest_known_keyword, known_keyword_count, known_keyword
   use deck_line_table, only: line_table_t, start_table, append_line, line_file, line_number, &
                              line_start
   use, intrinsic :: iso_fortran_env, only: int64
@@ -28,7 +31,7 @@ program test_deck
   character(len=:), allocatable :: directory
 
   suite%name = "deck"
-  directory = make_directory()
+  directory = make_scratch_directory("crashfree_test_deck", "sub/nested")
   call test_fixed_format()
   call test_free_format_parameters_include()
   call test_long_format()
@@ -156,19 +159,6 @@ contains
     line(1) = text
   end function text_line
 
-  function make_directory() result(path)
-    character(len=:), allocatable :: path
-    real :: random
-    integer :: clock
-    character(len=40) :: name
-    call random_seed()
-    call random_number(random)
-    call system_clock(clock)
-    write (name, '("/tmp/crashfree_test_deck_",i0,"_",i0)') clock, int(random*1.0e6)
-    path = trim(name)
-    call execute_command_line("mkdir -p "//path//"/sub/nested")
-  end function make_directory
-
   !> A deck edited after it was scanned: its cards are read again at their byte offsets, so the
   !> reader must notice the change instead of reading other text.
   subroutine test_file_changed_while_read()
@@ -245,7 +235,7 @@ contains
       call check(suite, name//": "//wanted, index(error%message, wanted) > 0, &
                  "message was:"//new_line("a")//error%message)
     end do
-    if (present(message_lines)) call check(suite, name//": "//trim(count_text(message_lines))// &
+    if (present(message_lines)) call check(suite, name//": "//integer_text(message_lines)// &
       " problems listed", count_lines(error%message) == message_lines, &
       "message was:"//new_line("a")//error%message)
   end subroutine read_bad
@@ -258,12 +248,6 @@ contains
       if (text(k:k) == new_line("a")) count_lines = count_lines + 1
     end do
   end function count_lines
-
-  function count_text(value) result(text)
-    integer, intent(in) :: value
-    character(len=12) :: text
-    write (text, '(i0)') value
-  end function count_text
 
   ! ---------------------------------------------------------------- values read
 
@@ -1148,7 +1132,7 @@ contains
       call check_close(suite, "segments: death (DT blank: never)", [(loads(k)%death, k=1, 8)], [never, never, &
         never, never, never, 0.9_wp, 0.9_wp, never], thr=0.0_wp)
       do k = 1, 5
-        call check_close(suite, "segments: uniform values "//count_text(k), &
+        call check_close(suite, "segments: uniform values "//integer_text(k), &
                          loads(k)%nodal_values, [1.0_wp, 1.0_wp, 1.0_wp, 1.0_wp], thr=0.0_wp)
       end do
       call check_close(suite, "nonuniform: values", loads(6)%nodal_values, [1.0_wp, 2.0_wp, &
@@ -1648,7 +1632,7 @@ contains
     ! runs: lines 1-3 | 4-5 (line 4 is more than 2**31 - 1 bytes after line 1, line 5 less
     ! after line 4) | 6 (line number 9 after 5) | 7-8 (file 2) | 9 (file 1 again)
     call check(suite, "line table: five runs", table%run_count == 5, &
-               "found "//trim(count_text(table%run_count)))
+               "found "//integer_text(table%run_count))
     call check(suite, "line table: 4 bytes per line", storage_size(table%offset)/8 == 4)
   end subroutine test_line_table_beyond_2_gib
 
@@ -1683,7 +1667,7 @@ contains
     character(len=:), allocatable :: suggestion, base
     integer :: k
     do k = 1, size(typos, 2)
-      call suggest_keyword(trim(typos(1, k)), suggestion, base)
+      call suggest_known_keyword(trim(typos(1, k)), suggestion, base)
       call check(suite, "suggestion for *"//trim(typos(1, k)), suggestion == trim(typos(2, k)), &
                  "found '"//suggestion//"'")
     end do
@@ -1693,20 +1677,19 @@ contains
   !> keywords aside), so that the list cannot drift from the readers.
   subroutine test_known_keywords_are_read()
     character(len=:), allocatable :: name, options, option
+    type(keyword_entry_t), allocatable :: table(:)
     type(keyword_t) :: keyword
     integer :: k, start, finish
     logical :: all_read
     character(len=:), allocatable :: missing
     all_read = .true.
     missing = ""
+    table = keyword_table()
     do k = 1, known_keyword_count()
       call known_keyword(k, name, options)
-      select case (name)
-      case ("KEYWORD", "INCLUDE", "PARAMETER", "COMMENT", "END")
-        cycle
-      end select
-      keyword = identify_any_keyword(name)
-      if (keyword%code == keyword_unknown) missing = missing//" "//name
+      if (handled_by_lexer(name, table)) cycle
+      keyword = identify_keyword(name, table)
+      if (keyword%entry == keyword_unknown) missing = missing//" "//name
       start = 1
       do while (start <= len(options))
         finish = index(options(start:), " ")
@@ -1717,8 +1700,8 @@ contains
         end if
         option = options(start:finish)
         start = finish + 2
-        keyword = identify_any_keyword(name//"_"//option)
-        if (keyword%code == keyword_unknown) missing = missing//" "//name//"_"//option
+        keyword = identify_keyword(name//"_"//option, table)
+        if (keyword%entry == keyword_unknown) missing = missing//" "//name//"_"//option
       end do
     end do
     all_read = len(missing) == 0

@@ -9,8 +9,10 @@
 program test_deck_materials
   use kinds, only: wp
   use testing, only: test_suite_t, check, check_close, finish_suite
+  use fixtures, only: make_scratch_directory
   use error_handling, only: error_t, error_list_t
-  use model, only: model_t, law_piecewise_linear, law_null, piecewise_hardening_curve, piecewise_rate_curve
+  use model, only: model_t, piecewise_hardening_curve, piecewise_rate_curve
+  use material_laws, only: law_piecewise_linear, law_null
   use deck_reader, only: read_deck
   implicit none
 
@@ -19,7 +21,7 @@ program test_deck_materials
   character(len=:), allocatable :: directory
 
   suite%name = "deck materials"
-  directory = make_directory()
+  directory = make_scratch_directory("crashfree_test_deck_materials")
   call test_values()
   call test_reader_errors()
   call test_cross_check_errors()
@@ -43,19 +45,6 @@ contains
       "*ELEMENT_SOLID", "1,1,1,2,3,4,5,6,7,8", "*PART", "cube", "1,1,"//material_id, "*SECTION_SOLID", "1,1"]
     lines = [base, extra, [character(len=line_length) :: "*END"]]
   end function cube_deck
-
-  function make_directory() result(path)
-    character(len=:), allocatable :: path
-    real :: random
-    integer :: clock
-    character(len=60) :: name
-    call random_seed()
-    call random_number(random)
-    call system_clock(clock)
-    write (name, '("/tmp/crashfree_test_deck_materials_",i0,"_",i0)') clock, int(random*1.0e6)
-    path = trim(name)
-    call execute_command_line("mkdir -p "//path)
-  end function make_directory
 
   !> Write `lines` as deck `name` and read it.
   subroutine read_lines(name, lines, model, warnings, error)

@@ -11,11 +11,12 @@
 !> Blocks of hexahedra have their interior nodes moved randomly by up to 25% of the cell size
 !> (the outer surface stays a box, so the part volume is known exactly).
 program test_efg
-  use kinds, only: wp, long_int, block_size
+  use kinds, only: wp, block_size
   use error_handling, only: error_t
   use model, only: model_t, formulation_efg, formulation_fe, kernel_cubic_box, kernel_cubic_sphere, &
-                   boundary_full_transformation, boundary_coupled, integration_local_boundary, integration_gauss, &
-                   integration_gauss_conventional, law_elastic
+                   boundary_full_transformation, boundary_coupled, integration_local_boundary, &
+                   integration_gauss, integration_gauss_conventional
+  use material_laws, only: law_elastic
   use efg_part, only: efg_part_t
   use efg_setup, only: build_efg_part
   use efg_forces, only: efg_solver_t, set_up_efg_solver
@@ -27,6 +28,7 @@ program test_efg
                                determinant_3
   use hex8_geometry, only: hex8_volume
   use testing, only: test_suite_t, check, check_close, finish_suite
+  use fixtures, only: random_uniform
   implicit none
 
   interface
@@ -114,13 +116,6 @@ contains
   ! ----------------------------------------------------------------------------------------
   ! helpers
 
-  !> Deterministic uniform numbers in [-1, 1] (Park-Miller), the same on every compiler.
-  function random_uniform() result(value)
-    real(wp) :: value
-    random_state = int(mod(16807_long_int*int(random_state, long_int), 2147483647_long_int))
-    value = 2.0_wp*real(random_state, wp)/2147483647.0_wp - 1.0_wp
-  end function random_uniform
-
   pure integer function node_at(block, i, j, k)
     type(block_t), intent(in) :: block
     integer, intent(in) :: i, j, k
@@ -164,9 +159,9 @@ contains
             model%node_ids(node) = 1000 + node
             model%coordinates(:, node) = real(index, wp)*spacing
             if (all(index > 0 .and. index < block%cells)) then
-              model%coordinates(1, node) = model%coordinates(1, node) + perturbation*spacing(1)*random_uniform()
-              model%coordinates(2, node) = model%coordinates(2, node) + perturbation*spacing(2)*random_uniform()
-              model%coordinates(3, node) = model%coordinates(3, node) + perturbation*spacing(3)*random_uniform()
+              model%coordinates(1, node) = model%coordinates(1, node) + perturbation*spacing(1)*random_uniform(random_state)
+              model%coordinates(2, node) = model%coordinates(2, node) + perturbation*spacing(2)*random_uniform(random_state)
+              model%coordinates(3, node) = model%coordinates(3, node) + perturbation*spacing(3)*random_uniform(random_state)
             end if
           end associate
         end do
@@ -331,8 +326,9 @@ contains
     logical :: same
 
     do particle = 1, particle_count
-      centres(:, particle) = [random_uniform(), random_uniform(), random_uniform()]
-      radius(:, particle) = 0.15_wp + 0.1_wp*abs([random_uniform(), random_uniform(), random_uniform()])
+      centres(:, particle) = [random_uniform(random_state), random_uniform(random_state), random_uniform(random_state)]
+      radius(:, particle) = 0.15_wp + 0.1_wp*abs([random_uniform(random_state), random_uniform(random_state), &
+                                                   random_uniform(random_state)])
     end do
     radius(:, 7) = 1.5_wp   ! one very large support
     same = .true.
@@ -340,7 +336,7 @@ contains
       if (kernel == kernel_cubic_sphere) radius(2:3, :) = spread(radius(1, :), 1, 2)
       call build_particle_grid(centres, radius, grid)
       do trial = 1, 200
-        point = 1.1_wp*[random_uniform(), random_uniform(), random_uniform()]
+        point = 1.1_wp*[random_uniform(random_state), random_uniform(random_state), random_uniform(random_state)]
         expected_count = 0
         do particle = 1, particle_count
           if (kernel_weight(kernel, centres(:, particle), radius(:, particle), point) > 0.0_wp) then
@@ -464,7 +460,7 @@ contains
     call part_shape_data(model, supports, grid)
     allocate (nodal(size(model%coordinates, 2)))
     do a = 1, size(nodal)
-      nodal(a) = random_uniform()
+      nodal(a) = random_uniform(random_state)
     end do
     scale_of_field = maxval(abs(nodal))
     unity_error = 0.0_wp
@@ -487,7 +483,7 @@ contains
           allocate (plus_values(context%node_count), minus_values(context%node_count))
           ! direct gradients (Gauss variant): consistency (sum dPsi = 0, sum dPsi X_J = I) and
           ! agreement with central differences of the values along the parametric directions
-          parametric = 0.9_wp*[random_uniform(), random_uniform(), random_uniform()]
+          parametric = 0.9_wp*[random_uniform(random_state), random_uniform(random_state), random_uniform(random_state)]
           call evaluate_shape_functions(context, parametric, point, values, rank, residual, gradients)
           gradient_residual = max(gradient_residual, residual)
           scale_of_gradient = maxval(abs(gradients(:, 1:context%node_count)))
@@ -507,7 +503,7 @@ contains
           end do
           ! 1. partition of unity and linear reproduction at random points
           do trial = 1, 4
-            parametric = [random_uniform(), random_uniform(), random_uniform()]
+            parametric = [random_uniform(random_state), random_uniform(random_state), random_uniform(random_state)]
             call evaluate_shape_functions(context, parametric, point, values, rank, residual)
             if (rank > 0 .and. rank < 4) singular = singular + 1
             worst_residual = max(worst_residual, residual)
@@ -532,7 +528,7 @@ contains
               neighbour = [i, j, k]
               neighbour(direction) = neighbour(direction) + side
               do trial = 1, 2
-                parametric = [random_uniform(), random_uniform(), random_uniform()]
+                parametric = [random_uniform(random_state), random_uniform(random_state), random_uniform(random_state)]
                 parametric(direction) = real(side, wp)
                 call evaluate_shape_functions(context, parametric, point, values, rank, residual)
                 if (any(neighbour < 0) .or. any(neighbour >= cells)) then
@@ -611,7 +607,7 @@ contains
       if (allocated(nodal)) deallocate (nodal)
       allocate (nodal(size(model%coordinates, 2)))
       do a = 1, size(nodal)
-        nodal(a) = random_uniform()
+        nodal(a) = random_uniform(random_state)
       end do
       field_scale = maxval(abs(nodal))
       interface_error = 0.0_wp
@@ -623,7 +619,7 @@ contains
             if (allocated(values)) deallocate (values)
             allocate (values(context%node_count))
             do trial = 1, 4
-              parametric = [1.0_wp, random_uniform(), random_uniform()]
+              parametric = [1.0_wp, random_uniform(random_state), random_uniform(random_state)]
               call evaluate_shape_functions(context, parametric, point, values, rank, residual)
               call trilinear_functions([-1.0_wp, parametric(2), parametric(3)], phi)
               fe_point = matmul(model%coordinates(:, model%solid_nodes(:, fe_cell)), phi)

@@ -8,9 +8,16 @@
 !> and the viscoplastic consistency (VP = 1); *MAT_NULL carries no stress.
 program test_materials
   use kinds, only: wp, block_size
-  use model, only: material_t, law_elastic, law_plastic_kinematic, law_honeycomb, law_modified_honeycomb, &
-                   law_low_density_foam, law_piecewise_linear, law_null, piecewise_hardening_curve, &
-                   piecewise_rate_curve
+  use model, only: material_t, piecewise_hardening_curve, piecewise_rate_curve
+  use material_laws, only: law_elastic, law_plastic_kinematic, law_honeycomb, &
+                           law_modified_honeycomb, law_low_density_foam, law_piecewise_linear, &
+                           law_null, law_rigid, law_table, find_law, law_keyword_name, law_number_name, &
+                           law_curve_field, no_plane_stress_kernel
+  use material_plastic_kinematic, only: plastic_strain_slot, back_stress_first_slot
+  use material_piecewise_linear, only: piecewise_plastic_strain_slot
+  use material_low_density_foam, only: foam_left_cauchy_green_first_slot, foam_largest_compression_slot
+  use material_honeycomb, only: honeycomb_strain_first_slot
+  use plane_stress_dispatch, only: plane_stress_plastic_strain_slot, plane_stress_back_stress_first_slot
   use curves, only: curve_t, curve_value, smallest_magnitude_from
   use material_dispatch, only: material_wave_modulus
   use material_honeycomb, only: honeycomb_log_volume_slot, honeycomb_compacted_slot, honeycomb_axes_first_slot
@@ -19,6 +26,7 @@ program test_materials
                                plastic_hardening_modulus
   use objective_rotation, only: incremental_rotation
   use testing, only: test_suite_t, check, check_close, finish_suite
+  use fixtures, only: piecewise_steel, make_curve
   implicit none
 
   type(test_suite_t) :: suite
@@ -46,6 +54,7 @@ program test_materials
   call test_piecewise_viscoplastic()
   call test_null_no_stress()
   call test_curve_lower_bound()
+  call test_law_table()
   call finish_suite(suite)
 
 contains
@@ -324,15 +333,6 @@ contains
     call check_close(suite, "back stress rotates with the element (quarter turn about z)", history(1, :), &
                      [0.5_wp, 20.0_wp, 10.0_wp, -30.0_wp, -4.0_wp, 6.0_wp, -5.0_wp], thr=1e-13_wp)
   end subroutine test_back_stress_rotation
-  function make_curve(id, abscissa, ordinate) result(curve)
-    integer, intent(in) :: id
-    real(wp), intent(in) :: abscissa(:), ordinate(:)
-    type(curve_t) :: curve
-    curve%id = id
-    allocate (curve%abscissa, source=abscissa)
-    allocate (curve%ordinate, source=ordinate)
-  end function make_curve
-
   !> Honeycomb with distinct yield curves per axis (plateaus 1.0, 0.5, 2.0 rising towards
   !> compaction; shear 0.3, 0.2, 0.1), compacted E = 1000, PR = 0.3, VF = 0.2, material axes
   !> a = (1, 1, 0)/sqrt 2, b = (-1, 1, 0)/sqrt 2, c = z (AOPT 2).
@@ -630,21 +630,6 @@ contains
 
   ! ---------------------------------------------------------------- *MAT_024, *MAT_NULL
 
-  !> *MAT_024 as the deck builds it: hardening curve slot (no points: bilinear SIGY, ETAN) and
-  !> rate curve slot (no points: C, P).
-  function piecewise_steel(etan) result(material)
-    real(wp), intent(in) :: etan
-    type(material_t) :: material
-    material%law = law_piecewise_linear
-    material%density = 7.85e-9_wp
-    material%youngs_modulus = youngs
-    material%poissons_ratio = poisson
-    material%yield_stress = yield
-    material%tangent_modulus = etan
-    allocate (material%curve_ids(2), material%curves(2))
-    material%curve_ids(:) = 0
-  end function piecewise_steel
-
   !> Static yield Y(eps_p) of a *MAT_024 material.
   function piecewise_yield(material, eps) result(value)
     type(material_t), intent(in) :: material
@@ -886,4 +871,41 @@ contains
     end do
     call check(suite, "curve bound: below every value of the curve", smallest_magnitude_from(rising, 0.0_wp) <= lowest)
   end subroutine test_curve_lower_bound
+  !> The law table: codes unique, keyword names, curve fields, and the history counts matching
+  !> the last slot of each kernel's layout.
+  subroutine test_law_table()
+    integer :: k
+    logical :: unique
+    unique = .true.
+    do k = 1, size(law_table)
+      if (count(law_table%code == law_table(k)%code) /= 1) unique = .false.
+      if (find_law(law_table(k)%code) /= k) unique = .false.
+    end do
+    call check(suite, "law table: one row per code", unique .and. find_law(2) == 0)
+    call check(suite, "law table: keyword names", law_keyword_name(find_law(law_elastic)) == "MAT_ELASTIC" &
+               .and. law_number_name(find_law(law_elastic)) == "MAT_001" .and. &
+               law_number_name(find_law(law_modified_honeycomb)) == "MAT_126" .and. &
+               law_keyword_name(find_law(law_piecewise_linear)) == "MAT_PIECEWISE_LINEAR_PLASTICITY")
+    call check(suite, "law table: curve fields", law_curve_field(find_law(law_honeycomb), 1) == "LCA" .and. &
+               law_curve_field(find_law(law_honeycomb), 7) == "LCSR" .and. &
+               law_curve_field(find_law(law_low_density_foam), 1) == "LCID" .and. &
+               law_curve_field(find_law(law_piecewise_linear), 2) == "LCSR")
+    associate (laws => law_table)
+      call check(suite, "law table: history counts match the kernels' layouts", &
+                 laws(find_law(law_plastic_kinematic))%history_count == back_stress_first_slot + 5 .and. &
+                 plastic_strain_slot == 1 .and. &
+                 laws(find_law(law_piecewise_linear))%history_count == piecewise_plastic_strain_slot .and. &
+                 laws(find_law(law_low_density_foam))%history_count == foam_largest_compression_slot .and. &
+                 foam_left_cauchy_green_first_slot + 5 < foam_largest_compression_slot .and. &
+                 laws(find_law(law_honeycomb))%history_count == honeycomb_strain_first_slot + 5 .and. &
+                 laws(find_law(law_modified_honeycomb))%history_count == honeycomb_strain_first_slot + 5 .and. &
+                 laws(find_law(law_plastic_kinematic))%shell_history_count == &
+                   plane_stress_back_stress_first_slot + 2 .and. &
+                 laws(find_law(law_piecewise_linear))%shell_history_count == plane_stress_plastic_strain_slot)
+      call check(suite, "law table: families", laws(find_law(law_null))%shells .and. &
+                 .not. laws(find_law(law_null))%solids .and. .not. laws(find_law(law_honeycomb))%shells .and. &
+                 laws(find_law(law_rigid))%shells .and. &
+                 laws(find_law(law_rigid))%shell_history_count == no_plane_stress_kernel)
+    end associate
+  end subroutine test_law_table
 end program test_materials

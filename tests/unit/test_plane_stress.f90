@@ -10,12 +10,14 @@ program test_plane_stress
   use kinds, only: wp, block_size
   use curves, only: curve_t, curve_value
   use error_handling, only: error_t, error_list_t
-  use model, only: model_t, material_t, law_elastic, law_plastic_kinematic, law_piecewise_linear, law_null, &
-                   law_honeycomb, piecewise_hardening_curve, piecewise_rate_curve
+  use model, only: model_t, material_t, piecewise_hardening_curve, piecewise_rate_curve
+  use material_laws, only: law_elastic, law_plastic_kinematic, law_piecewise_linear, law_null, &
+                           law_honeycomb
   use deck_reader, only: read_deck
   use plane_stress_dispatch, only: plane_stress_history_count, initialize_plane_stress_history, &
                                    update_plane_stress_block, plane_stress_plastic_strain
   use testing, only: test_suite_t, check, check_close, finish_suite
+  use fixtures, only: piecewise_steel, make_curve
   implicit none
 
   type(test_suite_t) :: suite
@@ -51,29 +53,6 @@ contains
     material%tangent_modulus = tangent
     material%hardening_beta = beta
   end function kinematic_steel
-
-  !> *MAT_024 with bilinear hardening (no curve points) and no LCSR, as the deck builds it.
-  function piecewise_steel(etan) result(material)
-    real(wp), intent(in) :: etan
-    type(material_t) :: material
-    material%law = law_piecewise_linear
-    material%density = 7.85e-9_wp
-    material%youngs_modulus = youngs
-    material%poissons_ratio = poisson
-    material%yield_stress = yield
-    material%tangent_modulus = etan
-    allocate (material%curve_ids(2), material%curves(2))
-    material%curve_ids(:) = 0
-  end function piecewise_steel
-
-  function make_curve(id, abscissa, ordinate) result(curve)
-    integer, intent(in) :: id
-    real(wp), intent(in) :: abscissa(:), ordinate(:)
-    type(curve_t) :: curve
-    curve%id = id
-    allocate (curve%abscissa, source=abscissa)
-    allocate (curve%ordinate, source=ordinate)
-  end function make_curve
 
   !> Static yield stress of a material at effective plastic strain `eps`.
   function static_yield(material, eps) result(value)

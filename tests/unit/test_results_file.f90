@@ -23,6 +23,7 @@ program test_results_file
   use history_buffer, only: history_set_t, add_history_series, append_history_row
   use results_file, only: results_file_t, open_results, write_state, write_histories, close_results
   use testing, only: test_suite_t, check, check_close, finish_suite
+  use fixtures, only: error_message
   implicit none
 
   interface
@@ -218,26 +219,26 @@ contains
     character(len=:), allocatable :: xdmf_text
 
     call open_results(results, directory, "job", model, 4, error)
-    call check(suite, "open_results succeeds", .not. allocated(error), message_of(error))
+    call check(suite, "open_results succeeds", .not. allocated(error), error_message(error))
     if (allocated(error)) return
 
     call write_state(results, 0.0_wp, nodal_field(0.0_wp)*0.0_wp, nodal_field(0.0_wp)*0.0_wp, &
                      stress_field(0.0_wp)*0.0_wp, [0.0_wp, 0.0_wp], error)
-    call check(suite, "write_state 0 succeeds", .not. allocated(error), message_of(error))
+    call check(suite, "write_state 0 succeeds", .not. allocated(error), error_message(error))
     call make_histories(histories, 3)
     call write_histories(results, histories, error)
-    call check(suite, "write_histories (first) succeeds", .not. allocated(error), message_of(error))
+    call check(suite, "write_histories (first) succeeds", .not. allocated(error), error_message(error))
 
     plastic = [0.03125_wp, 0.0625_wp]
     call write_state(results, 1.5e-3_wp, nodal_field(1.0_wp), nodal_field(-20.0_wp), &
                      stress_field(1000.0_wp), plastic, error)
-    call check(suite, "write_state 1 succeeds", .not. allocated(error), message_of(error))
+    call check(suite, "write_state 1 succeeds", .not. allocated(error), error_message(error))
     call check(suite, "two states counted", results%state_count == 2)
     ! The second call holds more rows: the datasets must show exactly these.
     call make_histories(histories, 5)
     call write_histories(results, histories, error)
     call check(suite, "write_histories (second) succeeds", .not. allocated(error), &
-               message_of(error))
+               error_message(error))
 
     summary%status = status_normal
     summary%message = ""
@@ -254,7 +255,7 @@ contains
     summary%dofs_total = 36
     summary%dofs_efg = 36
     call close_results(results, summary, error)
-    call check(suite, "close_results succeeds", .not. allocated(error), message_of(error))
+    call check(suite, "close_results succeeds", .not. allocated(error), error_message(error))
     call check(suite, "file marked closed", .not. results%is_open)
 
     call h5fopen_f(directory//"/job.h5", H5F_ACC_RDONLY_F, file_id, status)
@@ -444,7 +445,7 @@ contains
     call check(suite, "write_histories on a closed file is an error", allocated(error))
 
     call open_results(results, directory, "again", model, 1, error)
-    call check(suite, "second file opens", .not. allocated(error), message_of(error))
+    call check(suite, "second file opens", .not. allocated(error), error_message(error))
     call write_state(results, 0.0_wp, wrong, wrong, stress_field(0.0_wp), [0.0_wp, 0.0_wp], error)
     call check(suite, "wrong node count is an error", allocated(error))
     if (allocated(error)) call check(suite, "size error names the mesh", &
@@ -469,21 +470,21 @@ contains
     integer :: status
 
     call open_results(results, directory//"/", "again", model, 2, error)
-    call check(suite, "reopen after close succeeds", .not. allocated(error), message_of(error))
+    call check(suite, "reopen after close succeeds", .not. allocated(error), error_message(error))
     if (allocated(error)) return
     call write_state(results, 0.0_wp, nodal_field(2.0_wp), nodal_field(3.0_wp), &
                      stress_field(4.0_wp), [0.0_wp, 0.0_wp], error)
-    call check(suite, "state in reopened file", .not. allocated(error), message_of(error))
+    call check(suite, "state in reopened file", .not. allocated(error), error_message(error))
     ! Histories written again with fewer rows shrink: the file holds the last call only.
     call make_histories(histories, 5)
     call write_histories(results, histories, error)
     call make_histories(histories, 2)
     call write_histories(results, histories, error)
     call check(suite, "histories rewritten with fewer rows", .not. allocated(error), &
-               message_of(error))
+               error_message(error))
     ! No status given: the file must not claim a normal termination.
     call close_results(results, summary, error)
-    call check(suite, "close reopened file", .not. allocated(error), message_of(error))
+    call check(suite, "close reopened file", .not. allocated(error), error_message(error))
     call close_results(results, summary, error)
     call check(suite, "closing twice is harmless", .not. allocated(error))
 
@@ -533,12 +534,12 @@ contains
     shell_stress = stress_field(7.0_wp)
 
     call open_results(results, directory, "mixed", mixed, 1, error)
-    call check(suite, "solids and shells: file opens", .not. allocated(error), message_of(error))
+    call check(suite, "solids and shells: file opens", .not. allocated(error), error_message(error))
     if (allocated(error)) return
     call write_state(results, 0.0_wp, nodal_field(0.0_wp), nodal_field(1.0_wp), stress_field(0.0_wp), &
                      [0.0_wp, 0.0_wp], error, shell_stress, [0.5_wp, 0.25_wp], shell_stress, &
                      [0.5_wp, 0.25_wp])
-    call check(suite, "solids and shells: state written", .not. allocated(error), message_of(error))
+    call check(suite, "solids and shells: state written", .not. allocated(error), error_message(error))
     summary%status = status_normal
     summary%message = ""
     call close_results(results, summary, error)
@@ -585,13 +586,13 @@ contains
     allocate (plates%parts(1))
     plates%parts(1) = mixed%parts(2)
     call open_results(results, directory, "plates", plates, 1, error)
-    call check(suite, "shells only: file opens", .not. allocated(error), message_of(error))
+    call check(suite, "shells only: file opens", .not. allocated(error), error_message(error))
     if (allocated(error)) return
     plate_field = 0.0_wp
     call write_state(results, 0.0_wp, plate_field, plate_field, &
                      no_solid_stress, no_solid_strain, error, shell_stress, [0.5_wp, 0.25_wp], &
                      shell_stress, [0.5_wp, 0.25_wp])
-    call check(suite, "shells only: state written", .not. allocated(error), message_of(error))
+    call check(suite, "shells only: state written", .not. allocated(error), error_message(error))
     call close_results(results, summary, error)
     call read_text_file(directory//"/plates.xdmf", xdmf_text)
     call check(suite, "xdmf shells only: one quadrilateral grid per state", &
@@ -622,7 +623,7 @@ contains
     logical :: exists, all_written
 
     call open_results(results, directory, "commits", model, 1, error)
-    call check(suite, "commits: file opens", .not. allocated(error), message_of(error))
+    call check(suite, "commits: file opens", .not. allocated(error), error_message(error))
     if (allocated(error)) return
 
     write (pid_text, '(i0)') c_getpid()
@@ -648,7 +649,7 @@ contains
     summary%status = status_normal
     summary%message = ""
     call close_results(results, summary, error)
-    call check(suite, "commits: close", .not. allocated(error), message_of(error))
+    call check(suite, "commits: close", .not. allocated(error), error_message(error))
 
     call h5fopen_f(directory//"/commits.h5", H5F_ACC_RDONLY_F, file_id, status)
     call check(suite, "commits: file readable", status == 0)
@@ -670,19 +671,12 @@ contains
     call check(suite, "commits: no temporary XDMF file left", .not. exists)
 
     call open_results(second, directory, "commits", model, 1, error)
-    call check(suite, "lock: released by the close", .not. allocated(error), message_of(error))
+    call check(suite, "lock: released by the close", .not. allocated(error), error_message(error))
     call close_results(second, summary, error)
   end subroutine test_commits_schedule_and_lock
 
   ! ---------------------------------------------------------------------------------------------
   ! Readers
-
-  function message_of(error) result(message)
-    type(error_t), allocatable, intent(in) :: error
-    character(len=:), allocatable :: message
-    message = ""
-    if (allocated(error)) message = error%message
-  end function message_of
 
   logical function same_dims(actual, expected)
     integer(hsize_t), intent(in) :: actual(:)

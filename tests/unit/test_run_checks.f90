@@ -4,7 +4,8 @@
 program test_run_checks
   use kinds, only: wp
   use error_handling, only: error_t
-  use model, only: model_t, part_t, material_t, law_elastic
+  use model, only: model_t, part_t, material_t
+  use material_laws, only: law_elastic
   use explicit_state, only: explicit_state_t
   use nodal_state, only: allocate_nodal_state
   use run_checks, only: set_up_run_checks, check_runaway_motion, check_time_step, check_energy

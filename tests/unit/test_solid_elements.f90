@@ -5,8 +5,9 @@
 !> inverted elements, block building, the elements at a mesh's corners and edges (which get the
 !> eigenvalue bound on their step) and element results.
 program test_solid_elements
-  use kinds, only: wp, block_size, long_int
-  use model, only: model_t, material_t, law_elastic, law_plastic_kinematic, formulation_fe, formulation_efg
+  use kinds, only: wp, block_size
+  use model, only: model_t, material_t, formulation_fe, formulation_efg
+  use material_laws, only: law_elastic, law_plastic_kinematic
   use material_dispatch, only: elastic_moduli
   use objective_rotation, only: incremental_rotation
   use hex8_geometry, only: hex8_volume_derivatives, hex8_velocity_gradient, hex8_gauss_natural_derivatives, &
@@ -16,6 +17,7 @@ program test_solid_elements
   use solid_block, only: solid_block_t, build_solid_blocks, solid_block_corner_masses, solid_block_time_steps, &
                          compute_solid_block, solid_block_element_results
   use testing, only: test_suite_t, check, check_close, finish_suite
+  use fixtures, only: random_uniform, cross
   implicit none
 
   type(test_suite_t) :: suite
@@ -50,13 +52,6 @@ contains
 
   ! ----------------------------------------------------------------------------------------
   ! helpers
-
-  !> Deterministic uniform numbers in [-1, 1] (Park-Miller), the same on every compiler.
-  function random_uniform() result(value)
-    real(wp) :: value
-    random_state = int(mod(16807_long_int*int(random_state, long_int), 2147483647_long_int))
-    value = 2.0_wp*real(random_state, wp)/2147483647.0_wp - 1.0_wp
-  end function random_uniform
 
   function elastic_steel() result(material)
     type(material_t) :: material
@@ -253,7 +248,7 @@ contains
     real(wp) :: vector(6)
     integer :: k
     do k = 1, 6
-      vector(k) = scale*random_uniform()
+      vector(k) = scale*random_uniform(random_state)
     end do
   end function random_symmetric
 
@@ -263,7 +258,7 @@ contains
     integer :: i, j
     do j = 1, 3
       do i = 1, 3
-        a(i, j) = scale*random_uniform()
+        a(i, j) = scale*random_uniform(random_state)
       end do
     end do
   end function random_matrix
@@ -276,7 +271,7 @@ contains
     coordinates = unit_cube
     do node = 1, 8
       do k = 1, 3
-        coordinates(k, node) = coordinates(k, node) + amount*random_uniform()
+        coordinates(k, node) = coordinates(k, node) + amount*random_uniform(random_state)
       end do
     end do
   end function distorted_cube
@@ -436,17 +431,11 @@ contains
     end do
   end subroutine test_distorted_volumes
 
-  pure function cross(a, b) result(c)
-    real(wp), intent(in) :: a(3), b(3)
-    real(wp) :: c(3)
-    c = [a(2)*b(3) - a(3)*b(2), a(3)*b(1) - a(1)*b(3), a(1)*b(2) - a(2)*b(1)]
-  end function cross
-
   subroutine test_incremental_rotation()
     real(wp) :: spin(block_size, 3), rotation(block_size, 9), r(3, 3), omega(3, 3), expected(3, 3)
     integer :: lane
     do lane = 1, block_size
-      spin(lane, :) = 0.7_wp*[random_uniform(), random_uniform(), random_uniform()]
+      spin(lane, :) = 0.7_wp*[random_uniform(random_state), random_uniform(random_state), random_uniform(random_state)]
     end do
     call incremental_rotation(block_size, spin, rotation)
     do lane = 1, 4
@@ -569,7 +558,8 @@ contains
       do j = 0, 2
         do i = 0, 2
           node = 1 + i + 3*j + 9*k
-          coordinates(:, node) = real([i, j, k], wp) + 0.2_wp*[random_uniform(), random_uniform(), random_uniform()]
+          coordinates(:, node) = real([i, j, k], wp) + 0.2_wp*[random_uniform(random_state), &
+                                 random_uniform(random_state), random_uniform(random_state)]
         end do
       end do
     end do
@@ -887,7 +877,7 @@ contains
       worst_moment = 0.0_wp
       do step = 1, 3
         do node = 1, 27
-          velocities(:, node) = 50.0_wp*[random_uniform(), random_uniform(), random_uniform()]
+          velocities(:, node) = 50.0_wp*[random_uniform(random_state), random_uniform(random_state), random_uniform(random_state)]
         end do
         current = current + dt*velocities
         call compute_solid_block(blocks(1), model%materials(1), current, velocities, dt, force, critical, &

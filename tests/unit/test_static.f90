@@ -13,12 +13,13 @@
 !> - reverse Cuthill-McKee on a shuffled numbering; singular models rejected with a message;
 !>   a complete run into a results file.
 program test_static
-  use kinds, only: wp, long_int
+  use kinds, only: wp
   use error_handling, only: error_t
-  use model, only: model_t, law_elastic, formulation_fe, formulation_efg, kernel_cubic_box, kernel_cubic_sphere, &
-                   boundary_coupled, boundary_full_transformation, integration_local_boundary, integration_gauss, &
-                   integration_gauss_conventional, &
-                   motion_displacement, motion_velocity, prescribed_motion_t, spc_t, nodal_load_t, segment_load_t
+  use model, only: model_t, formulation_fe, formulation_efg, kernel_cubic_box, kernel_cubic_sphere, &
+                   boundary_coupled, boundary_full_transformation, integration_local_boundary, &
+                   integration_gauss, integration_gauss_conventional, motion_displacement, &
+                   motion_velocity, prescribed_motion_t, spc_t, nodal_load_t, segment_load_t
+  use material_laws, only: law_elastic
   use static_solution, only: static_solution_t
   use static_analysis, only: solve_static, run_static
   use static_loads, only: segment_consistent_forces
@@ -30,6 +31,7 @@ program test_static
   use error_handling, only: error_list_t
   use static_stiffness, only: add_point_stiffness, strain_displacement_matrix, elasticity_matrix
   use testing, only: test_suite_t, check, check_close, finish_suite
+  use fixtures, only: random_uniform, cross, error_message
   implicit none
 
   type(test_suite_t) :: suite
@@ -74,13 +76,6 @@ contains
   ! ----------------------------------------------------------------------------------------
   ! model building
 
-  !> Deterministic uniform numbers in [-1, 1] (Park-Miller minimal standard generator).
-  function random_uniform() result(value)
-    real(wp) :: value
-    random_state = int(mod(16807_long_int*int(random_state, long_int), 2147483647_long_int))
-    value = 2.0_wp*real(random_state, wp)/2147483647.0_wp - 1.0_wp
-  end function random_uniform
-
   pure integer function node_at(cells, i, j, k)
     integer, intent(in) :: cells(3), i, j, k
     node_at = 1 + i + (cells(1) + 1)*(j + (cells(2) + 1)*k)
@@ -115,7 +110,7 @@ contains
           model%node_ids(node) = 100 + node
           model%coordinates(:, node) = real(index, wp)*spacing
           if (all(index > 0 .and. index < cells)) model%coordinates(:, node) = model%coordinates(:, node) + &
-            perturbation*spacing*[random_uniform(), random_uniform(), random_uniform()]
+            perturbation*spacing*[random_uniform(random_state), random_uniform(random_state), random_uniform(random_state)]
         end do
       end do
     end do
@@ -259,13 +254,6 @@ contains
     stress(6) = 2.0_wp*mu*strain(3, 1)
   end function linear_field_stress
 
-  function message_of(error) result(text)
-    type(error_t), allocatable, intent(in) :: error
-    character(len=:), allocatable :: text
-    text = "no error"
-    if (allocated(error)) text = error%message
-  end function message_of
-
   function label_of(kernel, scale, domain_integration, boundary_treatment, fe_cells) result(text)
     integer, intent(in) :: kernel, domain_integration, boundary_treatment, fe_cells
     real(wp), intent(in) :: scale
@@ -306,7 +294,7 @@ contains
     call support(model, node_at([1, 1, 1], 0, 1, 0), [.false., .false., .true.])
     call support(model, node_at([1, 1, 1], 0, 0, 1), [.false., .true., .false.])
     call solve_static(model, solution, error)
-    call check(suite, name//"solves", .not. allocated(error), message_of(error))
+    call check(suite, name//"solves", .not. allocated(error), error_message(error, "no error"))
     if (allocated(error)) return
     worst = 0.0_wp
     do node = 1, 8
@@ -359,7 +347,7 @@ contains
         model%segment_loads(1)%direction = [1.0_wp, 0.0_wp, 0.0_wp]
       end if
       call solve_static(model, solution, error)
-      call check(suite, name//"solves", .not. allocated(error), message_of(error))
+      call check(suite, name//"solves", .not. allocated(error), error_message(error, "no error"))
       if (allocated(error)) return
       worst = 0.0_wp
       do node = 1, 8
@@ -378,7 +366,7 @@ contains
     integer :: a, c
     do a = 1, 5
       do c = 1, 3
-        gradients(c, a) = random_uniform()
+        gradients(c, a) = random_uniform(random_state)
       end do
     end do
     shear = youngs_modulus/(2.0_wp*(1.0_wp + poissons_ratio))
@@ -450,13 +438,13 @@ contains
     close (unit)
 
     call read_deck(path, model, warnings, error, .false.)
-    call check(suite, "deck: read", .not. allocated(error), message_of(error))
+    call check(suite, "deck: read", .not. allocated(error), error_message(error, "no error"))
     open (newunit=unit, file=path, status="old", iostat=status)
     if (status == 0) close (unit, status="delete")
     if (allocated(error)) return
     call check(suite, "deck: IMFLAG 1 selects the static analysis", model%implicit_static)
     call solve_static(model, solution, error)
-    call check(suite, "deck: solves", .not. allocated(error), message_of(error))
+    call check(suite, "deck: solves", .not. allocated(error), error_message(error, "no error"))
     if (allocated(error)) return
     call check_close(suite, "deck: loads at the end time ENDTIM", solution%time, 2.0_wp, thr=0.0_wp)
     worst = 0.0_wp
@@ -557,7 +545,7 @@ contains
     call build_block(cells, [1.2_wp, 1.0_wp, 0.8_wp], 0.25_wp, 0, model)
     call prescribe_linear_field(model, cells)
     call solve_static(model, solution, error)
-    call check(suite, "FE patch test: solves", .not. allocated(error), message_of(error))
+    call check(suite, "FE patch test: solves", .not. allocated(error), error_message(error, "no error"))
     if (allocated(error)) return
     worst = 0.0_wp
     reference = 0.0_wp
@@ -597,7 +585,7 @@ contains
                      scale=scale, domain_integration=domain_integration, boundary_treatment=boundary_treatment)
     call prescribe_linear_field(model, cells)
     call solve_static(model, solution, error)
-    call check(suite, name//"solves", .not. allocated(error), message_of(error))
+    call check(suite, name//"solves", .not. allocated(error), error_message(error, "no error"))
     if (allocated(error)) return
     worst = 0.0_wp
     worst_boundary = 0.0_wp
@@ -673,7 +661,7 @@ contains
     ! a random permutation of the node indices
     permutation = [(k, k=1, size(model%node_ids))]
     do k = size(permutation), 2, -1
-      other = 1 + int(0.5_wp*(random_uniform() + 1.0_wp)*real(k, wp))
+      other = 1 + int(0.5_wp*(random_uniform(random_state) + 1.0_wp)*real(k, wp))
       other = min(max(other, 1), k)
       swap = permutation(k)
       permutation(k) = permutation(other)
@@ -695,9 +683,9 @@ contains
     end do
 
     call solve_static(model, solution, error)
-    call check(suite, "ordering: ordered block solves", .not. allocated(error), message_of(error))
+    call check(suite, "ordering: ordered block solves", .not. allocated(error), error_message(error, "no error"))
     call solve_static(shuffled, shuffled_solution, error)
-    call check(suite, "ordering: shuffled block solves", .not. allocated(error), message_of(error))
+    call check(suite, "ordering: shuffled block solves", .not. allocated(error), error_message(error, "no error"))
     if (allocated(error)) return
     write (*, '(a,3(i0,a))') "  ordering, shuffled 8x3x3 block: half bandwidth reverse Cuthill-McKee ", &
       shuffled_solution%rcm_half_bandwidth, ", coordinate order ", shuffled_solution%coordinate_half_bandwidth, &
@@ -893,7 +881,7 @@ contains
     end do
     call move_alloc(segments, model%segment_loads)
     call solve_static(model, solution, error)
-    call check(suite, "cantilever: solves", .not. allocated(error), message_of(error))
+    call check(suite, "cantilever: solves", .not. allocated(error), error_message(error, "no error"))
     relative_error = huge(1.0_wp)
     if (allocated(error)) return
     exact_tip = beam_load*beam_length**3/(3.0_wp*beam_modulus*beam_inertia) + &
@@ -957,19 +945,19 @@ contains
     if (status /= 0 .or. length == 0) value = "/tmp"
     directory = trim(value)//"/crashfree_test_static"
     call make_directory(directory, error)
-    call check(suite, "results: temporary directory", .not. allocated(error), message_of(error))
+    call check(suite, "results: temporary directory", .not. allocated(error), error_message(error, "no error"))
     if (allocated(error)) return
     call build_block([3, 2, 2], [1.0_wp, 1.0_wp, 1.0_wp], 0.2_wp, 2, model)
     call prescribe_linear_field(model, [3, 2, 2])
     call open_results(results, directory, "static", model, 1, error)
-    call check(suite, "results: file opened", .not. allocated(error), message_of(error))
+    call check(suite, "results: file opened", .not. allocated(error), error_message(error, "no error"))
     if (allocated(error)) return
     call run_static(model, results, summary, error)
-    call check(suite, "results: run_static succeeds", .not. allocated(error), message_of(error))
+    call check(suite, "results: run_static succeeds", .not. allocated(error), error_message(error, "no error"))
     summary%status = status_normal
     summary%message = ""
     call close_results(results, summary, error)
-    call check(suite, "results: file closed", .not. allocated(error), message_of(error))
+    call check(suite, "results: file closed", .not. allocated(error), error_message(error, "no error"))
     call check(suite, "results: summary filled", summary%cycles == 1 .and. summary%end_time == 1.0_wp .and. &
                summary%fe_elements == 4 .and. summary%efg_particles > 0 .and. &
                summary%dofs_total == 3*size(model%node_ids))
@@ -980,9 +968,4 @@ contains
     if (status == 0) close (unit, status="delete")
   end subroutine test_results_written
 
-  pure function cross(a, b) result(c)
-    real(wp), intent(in) :: a(3), b(3)
-    real(wp) :: c(3)
-    c = [a(2)*b(3) - a(3)*b(2), a(3)*b(1) - a(1)*b(3), a(1)*b(2) - a(2)*b(1)]
-  end function cross
 end program test_static

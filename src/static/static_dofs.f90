@@ -22,7 +22,7 @@ module static_dofs
   use model, only: model_t, formulation_fe
   use efg_part, only: efg_part_t
   use static_ordering, only: node_groups_t, add_node_group
-  use static_messages, only: integer_text
+  use text_format, only: integer_text
   implicit none
   private
 

@@ -17,6 +17,7 @@
 !> which suits a sparse factorization, not this one.
 module static_ordering
   use kinds, only: wp
+  use integer_lists, only: reserve_integers
   implicit none
   private
 
@@ -36,7 +37,6 @@ contains
   pure subroutine add_node_group(groups, nodes)
     type(node_groups_t), intent(inout) :: groups
     integer, intent(in) :: nodes(:)
-    integer, allocatable :: grown(:)
     integer :: used
 
     if (.not. allocated(groups%offsets)) then
@@ -44,17 +44,9 @@ contains
       groups%offsets(1) = 1
       groups%count = 0
     end if
-    if (groups%count + 2 > size(groups%offsets)) then
-      allocate (grown(2*size(groups%offsets)))
-      grown(1:groups%count + 1) = groups%offsets(1:groups%count + 1)
-      call move_alloc(grown, groups%offsets)
-    end if
+    call reserve_integers(groups%offsets, groups%count + 1, groups%count + 2)
     used = groups%offsets(groups%count + 1) - 1
-    if (used + size(nodes) > size(groups%nodes)) then
-      allocate (grown(max(2*size(groups%nodes), used + size(nodes))))
-      grown(1:used) = groups%nodes(1:used)
-      call move_alloc(grown, groups%nodes)
-    end if
+    call reserve_integers(groups%nodes, used, used + size(nodes))
     groups%nodes(used + 1:used + size(nodes)) = nodes
     groups%count = groups%count + 1
     groups%offsets(groups%count + 1) = used + size(nodes) + 1

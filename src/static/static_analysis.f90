@@ -33,7 +33,7 @@ module static_analysis
   use static_assembly, only: assemble_stiffness, add_constraint_rows
   use static_recovery, only: recover_static_fields
   use static_output, only: write_static_results, report_static_solution
-  use static_messages, only: integer_text, real_text
+  use text_format, only: integer_text, scientific_text
   implicit none
   private
 
@@ -124,7 +124,7 @@ contains
                             solution%band_megabytes, failed)
     if (failed) then
       call make_error(error, "static analysis: cannot allocate the band matrix ("// &
-                      real_text(solution%band_megabytes)//" MB for "//integer_text(dofs%equation_count)// &
+                      scientific_text(solution%band_megabytes, 3)//" MB for "//integer_text(dofs%equation_count)// &
                       " equations, half bandwidth "//integer_text(solution%half_bandwidth)//")")
       return
     end if
@@ -234,8 +234,8 @@ contains
             material%poissons_ratio >= 0.5_wp) then
           call make_error(error, "static analysis: material "//integer_text(material%id)//" of part "// &
                           integer_text(model%parts(part)%id)//" needs E > 0 and PR in (-1, 0.5) for a "// &
-                          "stiffness (E = "//real_text(material%youngs_modulus)//", PR = "// &
-                          real_text(material%poissons_ratio)//")")
+                          "stiffness (E = "//scientific_text(material%youngs_modulus, 3)//", PR = "// &
+                          scientific_text(material%poissons_ratio, 3)//")")
           return
         end if
       end associate
@@ -389,7 +389,7 @@ contains
       end do
     end do
     call make_error(error, "static analysis: the stiffness matrix is singular (pivot ratio "// &
-                    real_text(pivot_ratio)//" at "//where//"): the model can move without straining. Likely "// &
+                    scientific_text(pivot_ratio, 3)//" at "//where//"): the model can move without straining. Likely "// &
                     "cause: the supports do not prevent every rigid-body motion (three translations and three "// &
                     "rotations of each separate part; check *BOUNDARY_SPC and the prescribed displacements), or a "// &
                     "part is not connected to a supported one")

@@ -21,7 +21,7 @@ module static_assembly
   use static_dofs, only: static_dofs_t, node_particle
   use static_stiffness, only: elasticity_matrix, add_point_stiffness, solid_gauss_gradients
   use static_band_matrix, only: band_matrix_t, add_band_entry, add_band_block, band_diagonal
-  use static_messages, only: integer_text
+  use text_format, only: integer_text
   implicit none
   private
 

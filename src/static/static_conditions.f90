@@ -11,7 +11,7 @@ module static_conditions
   use error_handling, only: error_t, make_error
   use curves, only: curve_value
   use model, only: model_t, motion_displacement, motion_velocity
-  use static_messages, only: integer_text
+  use text_format, only: integer_text
   implicit none
   private
 

@@ -1,0 +1,61 @@
+!> Growable integer lists: an allocatable array whose first `used` entries (or columns) are in
+!> use, grown geometrically (at least doubled) when more room is needed, so that appending n
+!> values costs O(n) in all.
+module integer_lists
+  implicit none
+  private
+
+  public :: reserve_integers, reserve_integer_columns, append_integer
+
+contains
+
+  !> Room for `needed` entries in `list`, keeping the first `used`; `list` may be unallocated
+  !> (it then gets max(`minimum`, needed) entries, by default 16).
+  pure subroutine reserve_integers(list, used, needed, minimum)
+    integer, allocatable, intent(inout) :: list(:)
+    integer, intent(in) :: used, needed
+    integer, intent(in), optional :: minimum
+    integer, allocatable :: grown(:)
+    if (.not. allocated(list)) then
+      allocate (list(max(first_capacity(minimum), needed)))
+      return
+    end if
+    if (size(list) >= needed) return
+    allocate (grown(max(needed, 2*size(list))))
+    grown(1:used) = list(1:used)
+    call move_alloc(grown, list)
+  end subroutine reserve_integers
+
+  !> Room for `needed` columns of `rows` entries in `list`, keeping the first `used` columns;
+  !> `list` may be unallocated (it then gets max(`minimum`, needed) columns, by default 16).
+  pure subroutine reserve_integer_columns(list, rows, used, needed, minimum)
+    integer, allocatable, intent(inout) :: list(:, :)
+    integer, intent(in) :: rows, used, needed
+    integer, intent(in), optional :: minimum
+    integer, allocatable :: grown(:, :)
+    if (.not. allocated(list)) then
+      allocate (list(rows, max(first_capacity(minimum), needed)))
+      return
+    end if
+    if (size(list, 2) >= needed) return
+    allocate (grown(rows, max(needed, 2*size(list, 2))))
+    grown(:, 1:used) = list(:, 1:used)
+    call move_alloc(grown, list)
+  end subroutine reserve_integer_columns
+
+  !> Append `value` to list(1:count) (count + 1 entries afterwards; the list grows as needed).
+  pure subroutine append_integer(list, count, value)
+    integer, allocatable, intent(inout) :: list(:)
+    integer, intent(inout) :: count
+    integer, intent(in) :: value
+    call reserve_integers(list, count, count + 1)
+    count = count + 1
+    list(count) = value
+  end subroutine append_integer
+
+  pure integer function first_capacity(minimum)
+    integer, intent(in), optional :: minimum
+    first_capacity = 16
+    if (present(minimum)) first_capacity = minimum
+  end function first_capacity
+end module integer_lists
