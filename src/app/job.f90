@@ -13,7 +13,7 @@ module job
   use explicit_state, only: explicit_state_t
   use run_state, only: run_state_t
   use explicit_setup, only: set_up_run_state, set_up_warnings
-  use explicit_solver, only: run_explicit
+  use explicit_run, only: run_explicit
   use static_analysis, only: run_static
   use results_file, only: results_file_t, open_results, close_results
   use run_summary, only: run_summary_t, status_normal, status_error

@@ -14,13 +14,14 @@
 !>   state checks             runaway motion, failed elements, time step, energy (run_checks)
 !>   output                   whatever the output plan says is due (run_output)
 !>
-!> Cycle 0 runs the phases from internal_forces to the checks on the initial state. Each phase
-!> owns its timer and books its share of energy in the state's ledger (state%energy); the
-!> output only reads the physics state.
+!> Cycle 0 runs the phases from internal_forces to the checks on the initial state (start_run).
+!> Each phase owns its timer and books its share of energy in the state's ledger
+!> (state%energy). The run itself, cycle after cycle with the output and the stop signals in
+!> between, is driven from above (app/explicit_run): the physics does not know the files.
 module explicit_solver
   use kinds, only: wp
   use fixed_order_sum, only: sum_chunk_size, sum_in_order
-  use error_handling, only: error_t, make_error
+  use error_handling, only: error_t
   use model, only: model_t
   use explicit_state, only: explicit_state_t
   use run_state, only: run_state_t, phase_velocities, phase_constraints, phase_walls, phase_rigid_bodies, &
@@ -37,70 +38,45 @@ module explicit_solver
   use run_checks, only: set_up_run_checks, check_runaway_motion, check_elements, check_time_step, check_energy, &
                         energy_check_interval
   use output_plan, only: clock_is_due
-  use stop_signals, only: received_stop_signal, progress_line_requested, signal_name
-  use run_output, only: write_due_output
-  use results_file, only: results_file_t
   use run_summary, only: run_summary_t
-  use progress_report, only: start_progress, report_progress
   use wall_clock, only: start_phase, stop_phase
   implicit none
   private
 
-  public :: run_explicit
+  public :: start_run, advance_and_check, check_distortion, summarise
 
 contains
 
-  !> Run from the run state's time to the end time (or end cycle): from cycle 0 for a new run.
-  !> On a run-time error (inverted element, runaway motion, exploding energy, collapsing time
-  !> step, a stop signal) the last state is written and `error` says what, where and when.
-  subroutine run_explicit(model, run, results, summary, error)
+  !> Cycle 0: the checks of the initial motion and of mass scaling, then the force phases on the
+  !> initial state, the initial energy and the checks of its state.
+  subroutine start_run(model, run, error)
     type(model_t), intent(in) :: model
     type(run_state_t), intent(inout) :: run
-    type(results_file_t), intent(inout) :: results
-    type(run_summary_t), intent(inout) :: summary
     type(error_t), allocatable, intent(out) :: error
-    type(error_t), allocatable :: output_error
-    logical :: finished
-
-    ! cycle 0: forces and accelerations of the initial state (unless its motion is already
-    ! beyond any physical run, or mass scaling added more than ENDMAS allows)
     call set_up_run_checks(model, run%state, error)
     if (.not. allocated(error)) call check_runaway_motion(model, run%state, 0.0_wp, error)
-    if (.not. allocated(error)) then
-      call forces_and_next_step(model, run, 0.0_wp)
-      call measured_energies(model, run%state, run%energy_scratch, run%state%energy)
-      run%state%energy%initial_total = total_energy(run%state%energy)
-      call check_state(model, run, .true., error)
-    end if
-    finished = allocated(error) .or. model%end_time <= 0.0_wp .and. model%end_cycle <= 0
-    call check_distortion(model, run, finished)
-    call output(model, run, results, finished, output_error)
-    if (allocated(output_error)) then
-      finished = .true.
-      if (.not. allocated(error)) call move_alloc(output_error, error)
-    end if
-    call start_progress(run%progress, model%end_time, model%end_cycle)
+    if (allocated(error)) return
+    call forces_and_next_step(model, run, 0.0_wp)
+    call measured_energies(model, run%state, run%energy_scratch, run%state%energy)
+    run%state%energy%initial_total = total_energy(run%state%energy)
+    call check_state(model, run, .true., error)
+  end subroutine start_run
 
-    do while (.not. finished)
-      call check_runaway_motion(model, run%state, 0.5_wp*(run%state%time_step + run%state%next_time_step), error)
-      if (.not. allocated(error)) then
-        call advance_one_cycle(model, run)
-        finished = run%state%time >= model%end_time*(1.0_wp - 1.0e-12_wp) .or. &
-                   (model%end_cycle > 0 .and. run%state%cycle >= model%end_cycle)
-        call check_state(model, run, finished, error)
-      end if
-      if (.not. allocated(error)) call check_stop_signal(run%state, error)
-      finished = finished .or. allocated(error)
-      call check_distortion(model, run, finished)
-      call output(model, run, results, finished, output_error)
-      if (allocated(output_error)) exit
-      call report_progress(run%progress, run%state%cycle, run%state%time, run%state%time_step, &
-                           finished .or. progress_line_requested())
-    end do
-
-    if (allocated(output_error) .and. .not. allocated(error)) call move_alloc(output_error, error)
-    call summarise(model, run, summary)
-  end subroutine run_explicit
+  !> One cycle and its checks, unless the motion the next velocity update would give is already
+  !> beyond any physical run; `finished` when it reached ENDTIM or ENDCYC.
+  subroutine advance_and_check(model, run, finished, error)
+    type(model_t), intent(in) :: model
+    type(run_state_t), intent(inout) :: run
+    logical, intent(out) :: finished
+    type(error_t), allocatable, intent(out) :: error
+    finished = .false.
+    call check_runaway_motion(model, run%state, 0.5_wp*(run%state%time_step + run%state%next_time_step), error)
+    if (allocated(error)) return
+    call advance_one_cycle(model, run)
+    finished = run%state%time >= model%end_time*(1.0_wp - 1.0e-12_wp) .or. &
+               (model%end_cycle > 0 .and. run%state%cycle >= model%end_cycle)
+    call check_state(model, run, finished, error)
+  end subroutine advance_and_check
 
   !> One central-difference cycle from t^n to t^{n+1} = t^n + dt, dt = state%next_time_step.
   subroutine advance_one_cycle(model, run)
@@ -400,31 +376,6 @@ contains
     end do
     call stop_phase(run%timers(phase_checks))
   end subroutine check_distortion
-
-  !> A SIGINT or SIGTERM ends the run after the cycle: the state is written and the run ends
-  !> with error termination.
-  subroutine check_stop_signal(state, error)
-    type(explicit_state_t), intent(in) :: state
-    type(error_t), allocatable, intent(out) :: error
-    character(len=40) :: text
-    integer :: number
-    number = received_stop_signal()
-    if (number == 0) return
-    write (text, '(es12.5,a,i0)') state%time, ", cycle ", state%cycle
-    call make_error(error, "stopped by "//signal_name(number)//" at time "//trim(adjustl(text))// &
-                    ": the results hold the run up to this time")
-  end subroutine check_stop_signal
-
-  subroutine output(model, run, results, last, error)
-    type(model_t), intent(in) :: model
-    type(run_state_t), intent(inout) :: run
-    type(results_file_t), intent(inout) :: results
-    logical, intent(in) :: last
-    type(error_t), allocatable, intent(out) :: error
-    call start_phase(run%timers(phase_output))
-    call write_due_output(model, run%state, run%plan, run%histories, run%energy_scratch, results, last, error)
-    call stop_phase(run%timers(phase_output))
-  end subroutine output
 
   !> The run summary's times (per element kind, contact with the walls, output) and the
   !> distortion record. (The groups' counts went in before the run, describe_model of job; their

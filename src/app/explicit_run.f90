@@ -1,0 +1,88 @@
+!> The explicit run, cycle after cycle: the physics of a cycle (solver/explicit_solver) with,
+!> between cycles, the stop signals, the output that is due (output/run_output) and the
+!> progress line. It starts at cycle 0 for a new run.
+module explicit_run
+  use kinds, only: wp
+  use error_handling, only: error_t, make_error
+  use model, only: model_t
+  use explicit_state, only: explicit_state_t
+  use run_state, only: run_state_t, phase_output
+  use explicit_solver, only: start_run, advance_and_check, check_distortion, summarise
+  use run_output, only: write_due_output
+  use results_file, only: results_file_t
+  use run_summary, only: run_summary_t
+  use stop_signals, only: received_stop_signal, progress_line_requested, signal_name
+  use progress_report, only: start_progress, report_progress
+  use wall_clock, only: start_phase, stop_phase
+  implicit none
+  private
+
+  public :: run_explicit
+
+contains
+
+  !> Run from the run state's time to the end time (or end cycle): from cycle 0 for a new run.
+  !> On a run-time error (inverted element, runaway motion, exploding energy, collapsing time
+  !> step, a stop signal) the last state is written and `error` says what, where and when.
+  subroutine run_explicit(model, run, results, summary, error)
+    type(model_t), intent(in) :: model
+    type(run_state_t), intent(inout) :: run
+    type(results_file_t), intent(inout) :: results
+    type(run_summary_t), intent(inout) :: summary
+    type(error_t), allocatable, intent(out) :: error
+    type(error_t), allocatable :: output_error
+    logical :: finished
+
+    ! cycle 0: forces and accelerations of the initial state (unless its motion is already
+    ! beyond any physical run, or mass scaling added more than ENDMAS allows)
+    call start_run(model, run, error)
+    finished = allocated(error) .or. model%end_time <= 0.0_wp .and. model%end_cycle <= 0
+    call check_distortion(model, run, finished)
+    call output(model, run, results, finished, output_error)
+    if (allocated(output_error)) then
+      finished = .true.
+      if (.not. allocated(error)) call move_alloc(output_error, error)
+    end if
+    call start_progress(run%progress, model%end_time, model%end_cycle)
+
+    do while (.not. finished)
+      call advance_and_check(model, run, finished, error)
+      if (.not. allocated(error)) call check_stop_signal(run%state, error)
+      finished = finished .or. allocated(error)
+      call check_distortion(model, run, finished)
+      call output(model, run, results, finished, output_error)
+      if (allocated(output_error)) exit
+      call report_progress(run%progress, run%state%cycle, run%state%time, run%state%time_step, &
+                           finished .or. progress_line_requested())
+    end do
+
+    if (allocated(output_error) .and. .not. allocated(error)) call move_alloc(output_error, error)
+    call summarise(model, run, summary)
+  end subroutine run_explicit
+
+  !> A SIGINT or SIGTERM ends the run after the cycle: the state is written and the run ends
+  !> with error termination.
+  subroutine check_stop_signal(state, error)
+    type(explicit_state_t), intent(in) :: state
+    type(error_t), allocatable, intent(out) :: error
+    character(len=40) :: text
+    integer :: number
+    number = received_stop_signal()
+    if (number == 0) return
+    write (text, '(es12.5,a,i0)') state%time, ", cycle ", state%cycle
+    call make_error(error, "stopped by "//signal_name(number)//" at time "//trim(adjustl(text))// &
+                    ": the results hold the run up to this time")
+  end subroutine check_stop_signal
+
+  subroutine output(model, run, results, last, error)
+    type(model_t), intent(in) :: model
+    type(run_state_t), intent(inout) :: run
+    type(results_file_t), intent(inout) :: results
+    logical, intent(in) :: last
+    type(error_t), allocatable, intent(out) :: error
+    call start_phase(run%timers(phase_output))
+    call write_due_output(model, run%state, run%plan, run%histories, run%energy_scratch, results, last, error)
+    call stop_phase(run%timers(phase_output))
+  end subroutine output
+
+end module explicit_run
