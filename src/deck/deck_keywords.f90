@@ -27,8 +27,10 @@ module deck_keywords
   !> Shell elements and sections.
   integer, parameter, public :: keyword_element_shell = 46, keyword_element_shell_thickness = 47, &
     keyword_section_shell = 48
+  !> Restart dumps.
+  integer, parameter, public :: keyword_d3dump = 49, keyword_runrsf = 50
   !> Number of keyword codes.
-  integer, parameter, public :: keyword_count = 48
+  integer, parameter, public :: keyword_count = 50
 
   !> A keyword name taken apart: its code and the options given with it.
   type :: keyword_t
@@ -41,7 +43,7 @@ module deck_keywords
     logical :: motion = .false.    !< *RIGIDWALL_GEOMETRIC_CYLINDER_MOTION
   end type keyword_t
 
-  integer, parameter :: entry_count = 58
+  integer, parameter :: entry_count = 60
   character(len=*), parameter :: base_names(entry_count) = [character(len=36) :: &
     "TITLE", "NODE", "ELEMENT_SOLID", "PART", "SECTION_SOLID", "SECTION_SOLID_EFG", &
     "MAT_ELASTIC", "MAT_001", "MAT_PLASTIC_KINEMATIC", "MAT_003", "HOURGLASS", &
@@ -56,7 +58,7 @@ module deck_keywords
     "LOAD_SEGMENT_SET", "LOAD_SEGMENT_NONUNIFORM", "SET_SEGMENT", &
     "MAT_HONEYCOMB", "MAT_026", "MAT_MODIFIED_HONEYCOMB", "MAT_126", "MAT_LOW_DENSITY_FOAM", "MAT_057", &
     "RIGIDWALL_GEOMETRIC_CYLINDER", "ELEMENT_SHELL", "ELEMENT_SHELL_THICKNESS", "SECTION_SHELL", &
-    "KEYWORD", "INCLUDE", "PARAMETER", "COMMENT", "END"]
+    "DATABASE_BINARY_D3DUMP", "DATABASE_BINARY_RUNRSF", "KEYWORD", "INCLUDE", "PARAMETER", "COMMENT", "END"]
   integer, parameter :: base_codes(entry_count) = [keyword_title, keyword_node, &
     keyword_element_solid, keyword_part, keyword_section_solid, keyword_section_solid_efg, &
     keyword_mat_elastic, keyword_mat_elastic, keyword_mat_plastic_kinematic, &
@@ -73,7 +75,8 @@ module deck_keywords
     keyword_mat_honeycomb, keyword_mat_honeycomb, keyword_mat_modified_honeycomb, &
     keyword_mat_modified_honeycomb, keyword_mat_low_density_foam, keyword_mat_low_density_foam, &
     keyword_rigidwall_cylinder, keyword_element_shell, keyword_element_shell_thickness, &
-    keyword_section_shell, keyword_unknown, keyword_unknown, keyword_unknown, keyword_unknown, keyword_unknown]
+    keyword_section_shell, keyword_d3dump, keyword_runrsf, &
+    keyword_unknown, keyword_unknown, keyword_unknown, keyword_unknown, keyword_unknown]
   !> Options each entry accepts (blank-separated).
   character(len=*), parameter :: base_options(entry_count) = [character(len=28) :: &
     "", "", "", "", "TITLE", "TITLE", &
@@ -88,7 +91,7 @@ module deck_keywords
     "", "", "ID", &
     "ID", "ID", "TITLE", &
     "TITLE", "TITLE", "TITLE", "TITLE", "TITLE", "TITLE", &
-    "MOTION ID", "", "", "TITLE", "", "", "", "", ""]
+    "MOTION ID", "", "", "TITLE", "", "", "", "", "", "", ""]
 
   !> The keywords read by other modules (deck_rigid_bodies, deck_contact, deck_materials), with
   !> their options: spelling suggestions are taken from these and the entries above, and the

@@ -33,7 +33,7 @@ module deck_reader
     keyword_load_segment_set, keyword_load_segment_nonuniform, keyword_set_segment, &
     keyword_mat_honeycomb, keyword_mat_modified_honeycomb, keyword_mat_low_density_foam
   use deck_keywords, only: keyword_element_shell, keyword_element_shell_thickness, &
-    keyword_section_shell
+    keyword_section_shell, keyword_d3dump, keyword_runrsf
   use deck_input, only: deck_input_t, prepare_input
   use deck_nodes_elements, only: read_nodes, read_solid_elements, read_shell_elements
   use deck_parts_sections, only: read_parts, read_solid_sections, read_hourglasses, &
@@ -49,12 +49,13 @@ module deck_reader
   use deck_controls, only: read_title, read_termination, read_time_step, &
     read_hourglass_control, read_bulk_viscosity, read_energy_control, read_implicit_general, &
     read_implicit_solution
-  use deck_database, only: read_plot_output, read_history_output, read_history_nodes
+  use deck_database, only: read_plot_output, read_history_output, read_history_nodes, read_dump_output
   use deck_cross_check, only: check_and_build
   use deck_rigid_bodies, only: identify_rigid_keyword, read_rigid_block, rigid_keyword_first, &
     rigid_keyword_last
   use deck_contact, only: identify_contact_keyword, read_contact_block, contact_keyword_first, &
     contact_keyword_last
+  use deck_signature, only: deck_source_t
   implicit none
   private
 
@@ -66,17 +67,19 @@ contains
   !> lists every problem found, one per line, as `file:line: *KEYWORD: field NAME: what is
   !> wrong`; `model` is then not usable. Unknown keywords are errors, or with
   !> `ignore_unknown` warnings in `warnings` (which also lists fields read but not used).
-  subroutine read_deck(path, model, warnings, error, ignore_unknown)
+  !> `sources`: the files read (main deck and includes, in reading order), for a restart's check.
+  subroutine read_deck(path, model, warnings, error, ignore_unknown, sources)
     character(len=*), intent(in) :: path
     type(model_t), intent(out) :: model
     type(error_list_t), intent(out) :: warnings
     type(error_t), allocatable, intent(out) :: error
     logical, intent(in) :: ignore_unknown
+    type(deck_source_t), allocatable, intent(out), optional :: sources(:)
     type(deck_t) :: deck
     type(deck_input_t) :: input
     type(problem_log_t) :: log
     type(keyword_t), allocatable :: keywords(:)
-    integer :: block
+    integer :: block, file
 
     call load_deck(path, deck, log, warnings)
     allocate (keywords(deck%block_count))
@@ -91,6 +94,14 @@ contains
     end do
     call check_files_unchanged(deck, log)
     if (.not. log%unreadable) call check_and_build(deck, input, model, log, warnings)
+    if (present(sources)) then
+      allocate (sources(deck%file_count))
+      do file = 1, deck%file_count
+        sources(file)%path = deck%files(file)%path
+        sources(file)%size = deck%files(file)%size
+        sources(file)%modified = deck%files(file)%modified
+      end do
+    end if
     call release_deck(deck)
     if (has_problems(log)) then
       call problems_to_error(log, error)
@@ -259,6 +270,8 @@ contains
       call read_plot_output(deck, block, input, log, warnings)
     case (keyword_glstat, keyword_matsum, keyword_nodout, keyword_rwforc)
       call read_history_output(deck, block, keyword%code, input, log, warnings)
+    case (keyword_d3dump, keyword_runrsf)
+      call read_dump_output(deck, block, keyword%code == keyword_runrsf, input, log)
     case (keyword_history_node, keyword_history_node_set)
       call read_history_nodes(deck, block, keyword, keyword%code == keyword_history_node_set, &
                               input, log)

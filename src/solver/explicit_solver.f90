@@ -24,6 +24,7 @@ module explicit_solver
   use run_summary, only: run_summary_t
   use progress_report, only: progress_t, start_progress, report_progress
   use wall_clock, only: phase_timer_t, start_phase, stop_phase
+  use restart_control, only: restart_control_t, write_due_dumps, resume_run
   implicit none
   private
 
@@ -37,37 +38,49 @@ contains
 
   !> Run from t = 0 to the end time (or end cycle). On a run-time error (inverted element,
   !> runaway motion, exploding energy, collapsing time step, a stop signal) the last state is
-  !> written and `error` says what, where and when.
-  subroutine run_explicit(model, state, results, summary, error)
+  !> written and `error` says what, where and when. `restart`: the run's restart dumps
+  !> (restart_control); with `restart%resuming` the run continues from the dump being read.
+  subroutine run_explicit(model, state, results, summary, error, restart)
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(inout) :: state
     type(results_file_t), intent(inout) :: results
     type(run_summary_t), intent(inout) :: summary
     type(error_t), allocatable, intent(out) :: error
+    type(restart_control_t), intent(inout), optional :: restart
     type(history_set_t) :: histories
     type(output_plan_t) :: plan
     type(progress_t) :: progress
     type(phase_timer_t) :: timers(phase_count)
     type(error_t), allocatable :: output_error
     real(wp) :: previous_step, step
-    logical :: finished, wrote_state
+    logical :: finished, wrote_state, resuming, clean
 
     call plan_output(model, histories, plan)
 
-    ! cycle 0: forces and accelerations of the initial state (unless its motion is already
-    ! beyond any physical run, or mass scaling added more than ENDMAS allows)
-    call set_up_run_checks(model, state, error)
-    if (.not. allocated(error)) call check_runaway_motion(model, state, 0.0_wp, error)
-    if (.not. allocated(error)) then
-      call compute_forces(model, state, 0.0_wp, timers)
-      call compute_accelerations(state)
-      call hold_prescribed_accelerations(model, 0.0_wp, state%acceleration, state%free_acceleration)
-      call select_time_step(model, state, is_first=.true.)
-      call update_energy_totals(model, state)
-      state%energy%initial_total = total_energy(state)
-      call check_cycle(model, state, .true., error)
+    resuming = .false.
+    if (present(restart)) resuming = restart%resuming
+    if (resuming) then
+      ! the state, clock, plan and histories at the end of the dump's cycle, before its output
+      call resume_run(restart, state, plan, histories, previous_step, timers, error)
+      if (allocated(error)) return
+      finished = reached_end(model, state)
+    else
+      ! cycle 0: forces and accelerations of the initial state (unless its motion is already
+      ! beyond any physical run, or mass scaling added more than ENDMAS allows)
+      call set_up_run_checks(model, state, error)
+      if (.not. allocated(error)) call check_runaway_motion(model, state, 0.0_wp, error)
+      if (.not. allocated(error)) then
+        call compute_forces(model, state, 0.0_wp, timers)
+        call compute_accelerations(state)
+        call hold_prescribed_accelerations(model, 0.0_wp, state%acceleration, state%free_acceleration)
+        call select_time_step(model, state, is_first=.true.)
+        call update_energy_totals(model, state)
+        state%energy%initial_total = total_energy(state)
+        call check_cycle(model, state, .true., error)
+      end if
+      finished = allocated(error) .or. model%end_time <= 0.0_wp .and. model%end_cycle <= 0
+      previous_step = 0.0_wp
     end if
-    finished = allocated(error) .or. model%end_time <= 0.0_wp .and. model%end_cycle <= 0
     call start_phase(timers(phase_output))
     call write_due_output(model, state, plan, histories, results, finished, wrote_state, output_error)
     call stop_phase(timers(phase_output))
@@ -76,7 +89,6 @@ contains
       if (.not. allocated(error)) call move_alloc(output_error, error)
     end if
     call start_progress(progress, model%end_time, model%end_cycle)
-    previous_step = 0.0_wp
 
     do while (.not. finished)
       step = state%next_time_step
@@ -84,13 +96,17 @@ contains
       if (.not. allocated(error)) then
         call advance_one_cycle(model, state, previous_step, step, timers)
         previous_step = step
-        finished = state%time >= model%end_time*(1.0_wp - 1.0e-12_wp) .or. &
-                   (model%end_cycle > 0 .and. state%cycle >= model%end_cycle)
+        finished = reached_end(model, state)
         call check_cycle(model, state, finished, error)
       end if
-      if (.not. allocated(error)) call check_stop_signal(state, error)
+      clean = .not. allocated(error)
+      if (clean) call check_stop_signal(state, error)
       finished = finished .or. allocated(error)
       call start_phase(timers(phase_output))
+      ! restart dumps: the state of this cycle before its output (none after a run-time error)
+      if (present(restart) .and. clean) &
+        call write_due_dumps(restart, state, plan, histories, previous_step, timers, summary%setup_s, &
+                             results, allocated(error), finished, error)
       call write_due_output(model, state, plan, histories, results, finished, wrote_state, output_error)
       call stop_phase(timers(phase_output))
       if (allocated(output_error)) exit
@@ -111,6 +127,14 @@ contains
     if (plan%distortion%worst_element > 0) &
       summary%worst_corner_jacobian_element = model%solid_ids(plan%distortion%worst_element)
   end subroutine run_explicit
+
+  !> Whether the run has reached ENDTIM (to round-off) or ENDCYC.
+  logical function reached_end(model, state)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(in) :: state
+    reached_end = state%time >= model%end_time*(1.0_wp - 1.0e-12_wp) .or. &
+                  (model%end_cycle > 0 .and. state%cycle >= model%end_cycle)
+  end function reached_end
 
   !> One central-difference cycle from t^n to t^{n+1} = t^n + step: velocities at the half step,
   !> supports, walls and rigid bodies, positions, then the forces and accelerations at t^{n+1}
