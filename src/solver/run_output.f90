@@ -143,6 +143,9 @@ contains
       end if
     end if
     allocate (plan%solid_stress(6, size(model%solid_ids)), plan%solid_plastic_strain(size(model%solid_ids)))
+    ! the solids of rigid parts have no stress: zero, not whatever the memory held
+    plan%solid_stress = 0.0_wp
+    plan%solid_plastic_strain = 0.0_wp
     allocate (plan%shell_stress(6, size(model%shell_ids)), plan%shell_stress_peak(6, size(model%shell_ids)), &
               plan%shell_plastic_strain(size(model%shell_ids)), plan%shell_plastic_strain_peak(size(model%shell_ids)))
     plan%shell_stress = 0.0_wp
