@@ -29,7 +29,7 @@ from deck_writer import (block_mesh, efg_section, fields, node_list_set, nodes_c
                          solids_card, write_deck)
 
 STEEL = fields(1, 7.85e-6, 200.0, 0.3, 0.3, 2.0, 1.0) + "\n" + fields(0.0, 0.0)   # MAT_003 card 1, 2 (MID 1)
-DUMP_EVERY = 100     # cycles between dumps of the matrix decks (300-400 cycles each)
+DUMP_EVERY = 50      # cycles between dumps of the matrix decks (300-400 cycles each)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -112,9 +112,9 @@ def contact_deck(path):
         node_list_set(1, list(range(1, count + 1))),
         node_list_set(2, list(range(count + 1, count + len(slider_nodes) + 1))),
         "*BOUNDARY_SPC_SET\n" + fields(1, 0, 1, 1, 1),
-        "*INITIAL_VELOCITY\n" + fields(2) + "\n" + fields(40.0, 5.0, -10.0),
+        "*INITIAL_VELOCITY\n" + fields(2) + "\n" + fields(40.0, 5.0, -1.0),
         "*DEFINE_CURVE\n" + fields(1) + "\n" + fields(0.0, 1.0, width=20) + "\n" + fields(10.0, 1.0, width=20),
-        "*LOAD_NODE_SET\n" + fields(2, 3, 1, -2.0e-4),
+        "*LOAD_NODE_SET\n" + fields(2, 3, 1, -2.0e-2),
         "*CONTACT_AUTOMATIC_SURFACE_TO_SURFACE_ID\n" + fields(3) + "slide\n" + fields(2, 1, 3, 3) + "\n" +
         fields(0.3, 0.2, 0.0, 0.0, 20.0) + "\n" + fields(1.0),
         nodes_card(np.vstack([base_nodes, slider_nodes])),
@@ -166,7 +166,9 @@ MODELS = {"solids": solids_deck, "shells": shells_deck, "meshfree": meshfree_dec
 # Running and comparing
 
 def solver(*arguments, ncpu=1, timeout=300.0):
-    environment = dict(os.environ, OMP_NUM_THREADS=str(ncpu), CRASHFREE_OVERSUBSCRIBE="1")
+    # passive waiting: on a loaded machine two spinning threads slow these tiny runs a
+    # hundredfold (the results do not depend on it)
+    environment = dict(os.environ, OMP_NUM_THREADS=str(ncpu), CRASHFREE_OVERSUBSCRIBE="1", OMP_WAIT_POLICY="passive")
     return subprocess.run([str(BINARY), *map(str, arguments), f"ncpu={ncpu}"], capture_output=True, text=True,
                           timeout=timeout, env=environment)
 
@@ -239,15 +241,18 @@ def test_restart_reproduces_the_uninterrupted_run(tmp_path, model):
     assert_same({k: v for k, v in reference.items() if k != "run@deck"}, plain_contents, "without dumps")
 
     dumps = sorted(p.name for p in (tmp_path / "one").glob("d3dump*"))
-    assert dumps == [f"d3dump{k:02d}" for k in range(1, len(dumps) + 1)] and len(dumps) >= 3, dumps
+    assert dumps == [f"d3dump{k:02d}" for k in range(1, len(dumps) + 1)] and len(dumps) >= 5, dumps
     assert not list((tmp_path / "one").glob("*.tmp"))
+    # every dump continued on 2 threads (the impacts, slides and spins are caught at several
+    # moments), and the middle one also on the same count and from the 2-thread run on 1
     middle = dumps[len(dumps) // 2]
-    for source, ncpu in (("one", 1), ("one", 2), ("two", 1)):
-        target = copy_run(tmp_path / source, tmp_path / f"restart_{source}_{ncpu}")
-        process = restart(target / middle, ncpu)
+    cases = [("one", dump, 2) for dump in dumps] + [("one", middle, 1), ("two", middle, 1)]
+    for source, dump, ncpu in cases:
+        target = copy_run(tmp_path / source, tmp_path / f"restart_{source}_{dump}_{ncpu}")
+        process = restart(target / dump, ncpu)
         assert process.returncode == 0, process.stdout + process.stderr
-        assert f"continuing from restart dump {target / middle}" in process.stdout
-        what = f"{model}: {middle} of the ncpu={1 if source == 'one' else 2} run continued on ncpu={ncpu}"
+        assert f"continuing from restart dump {target / dump}" in process.stdout
+        what = f"{model}: {dump} of the ncpu={1 if source == 'one' else 2} run continued on ncpu={ncpu}"
         assert_same(reference, contents(target / "results.h5"), what)
         with h5py.File(target / "results.h5", "r") as results:
             assert results["run"].attrs["threads"] == ncpu
