@@ -866,7 +866,7 @@ contains
     allocate (characters(size + 1))
     characters = c_null_char
     call h5tcopy_f(H5T_FORTRAN_S1, memory_type, status)
-    if (status == 0) call h5tset_size_f(memory_type, size, status)
+    if (status == 0) call h5tset_size_f(memory_type, size + 1, status)   ! room for the NUL
     if (status == 0) call h5tset_strpad_f(memory_type, H5T_STR_NULLTERM_F, status)
     pointer = c_loc(characters)
     if (status == 0) call h5aread_f(attribute_id, memory_type, pointer, status)

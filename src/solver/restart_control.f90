@@ -194,8 +194,8 @@ contains
       else
         control%dump_number = control%dump_number + 1
       end if
-      write (text, '(a,es12.5,a,i0)') " at time ", state%time, ", cycle ", state%cycle
-      write (output_unit, '(a)') "restart dump "//name//trim(text)//" ("//reason//")"
+      write (text, '(es12.5,a,i0)') state%time, ", cycle ", state%cycle
+      write (output_unit, '(a)') "restart dump "//name//" at time "//trim(adjustl(text))//" ("//reason//")"
     end function write_dump
   end subroutine write_due_dumps
 
@@ -341,8 +341,8 @@ contains
     call close_restart_store(control%source)
     if (allocated(error)) return
     timers%seconds = seconds
-    write (text, '(a,es12.5,a,i0)') " at time ", state%time, ", cycle ", state%cycle
-    write (output_unit, '(a)') "continuing from restart dump "//control%source%path//trim(text)
+    write (text, '(es12.5,a,i0)') state%time, ", cycle ", state%cycle
+    write (output_unit, '(a)') "continuing from restart dump "//control%source%path//" at time "//trim(adjustl(text))
   end subroutine resume_run
 
   !> A restarted run's wall and set-up time include the earlier runs' up to the dump.

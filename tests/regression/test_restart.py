@@ -35,13 +35,13 @@ DUMP_EVERY = 50      # cycles between dumps of the matrix decks (300-400 cycles 
 # ---------------------------------------------------------------------------------------------
 # Decks: small, a few hundred cycles, each exercising the state of one kind of model
 
-def solids_deck(path):
+def solids_deck(path, cells=5, end_time=0.06):
     """A plastic block (MAT_003 with hardening) thrown at a stationary planar wall, one-point
     elements with hourglass stiffness (IHQ 5, accumulated forces), a history node."""
-    nodes, elements = block_mesh((5, 5, 5), (10.0, 10.0, 10.0), origin=(0.0, 0.0, 0.2), perturbation=0.1)
+    nodes, elements = block_mesh((cells, cells, cells), (10.0, 10.0, 10.0), origin=(0.0, 0.0, 0.2), perturbation=0.1)
     return write_deck(
         path, "*TITLE\nsolids against a wall",
-        "*CONTROL_TERMINATION\n" + fields(0.06),
+        "*CONTROL_TERMINATION\n" + fields(end_time),
         "*CONTROL_HOURGLASS\n" + fields(5, 0.1),
         "*DATABASE_GLSTAT\n" + fields(0.001), "*DATABASE_MATSUM\n" + fields(0.002),
         "*DATABASE_RWFORC\n" + fields(0.0005), "*DATABASE_NODOUT\n" + fields(0.001),
@@ -257,3 +257,189 @@ def test_restart_reproduces_the_uninterrupted_run(tmp_path, model):
         with h5py.File(target / "results.h5", "r") as results:
             assert results["run"].attrs["threads"] == ncpu
         assert_xdmf_lists_the_states(target / "results.xdmf", target / "results.h5")
+
+
+# ---------------------------------------------------------------------------------------------
+# Sense switches
+
+def long_deck(path):
+    """The solids deck with 1,000 elements for 0.5 ms (about 5,000 cycles, a second or two), no
+    periodic dumps: long enough for signals to find it running."""
+    deck = solids_deck(path, cells=10, end_time=0.5)
+    deck.write_text(deck.read_text().replace("*DATABASE_BINARY_D3DUMP\n" + fields(DUMP_EVERY) + "\n", ""))
+    return deck
+
+
+def test_sigusr1_and_sigterm_write_dumps_that_continue_the_run(tmp_path):
+    """SIGUSR1 (sw3) writes d3dump01 and the run goes on; SIGTERM (sw1) writes d3dump02, says
+    where it is and ends with error termination. Both continue to the uninterrupted run's file."""
+    deck = long_deck(tmp_path / "long.k")
+    environment = dict(os.environ, OMP_NUM_THREADS="1", GFORTRAN_UNBUFFERED_PRECONNECTED="y")
+    reference = subprocess.Popen([str(BINARY), f"i={deck}", f"outdir={tmp_path / 'reference'}", "ncpu=1"],
+                                 stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=environment)
+    stopped = tmp_path / "stopped"
+    process = subprocess.Popen([str(BINARY), f"i={deck}", f"outdir={stopped}", "ncpu=1"], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True, env=environment)
+    seen = []
+    for line in process.stdout:           # the progress header: the time loop (and its handlers) runs
+        seen.append(line)
+        if "time step" in line:
+            break
+    process.send_signal(signal.SIGUSR1)
+    for line in process.stdout:
+        seen.append(line)
+        if line.startswith("restart dump"):
+            break
+    process.send_signal(signal.SIGTERM)
+    rest, stderr = process.communicate(timeout=120)
+    stdout = "".join(seen) + rest
+    assert reference.wait(timeout=120) == 0, reference.stderr.read()
+    assert process.returncode == 1, stdout + stderr
+    assert re.search(rf"^restart dump {stopped}/d3dump01 at time \S+, cycle \d+ \(SIGUSR1\)$", stdout, re.M), stdout
+    found = re.search(r"stopped by SIGTERM at time (\S+), cycle (\d+): the results hold the run up to this time; "
+                      rf"restart dump ({stopped}/d3dump02) written \(bin/crashfree r=\S+ continues the run\)", stderr)
+    assert found, stderr
+    with h5py.File(stopped / "d3dump02", "r") as dump:
+        assert dump.attrs["reason"] == b"SIGTERM" and dump.attrs["cycle"] == int(found.group(2))
+    with h5py.File(stopped / "d3dump01", "r") as dump:
+        assert dump.attrs["reason"] == b"SIGUSR1" and 0 < dump.attrs["cycle"] < int(found.group(2))
+    with h5py.File(stopped / "results.h5", "r") as results:
+        assert results["run"].attrs["status"] == "error termination"
+        assert "restart dump" in results["run"].attrs["message"]
+    expected = contents(tmp_path / "reference" / "results.h5")
+    for dump, ncpu in (("d3dump01", 2), ("d3dump02", 1)):
+        target = copy_run(stopped, tmp_path / f"from_{dump}")
+        process = restart(target / dump, ncpu)
+        assert process.returncode == 0, process.stdout + process.stderr
+        assert_same(expected, contents(target / "results.h5"), f"continued from {dump} ({ncpu} thread(s))")
+        assert_xdmf_lists_the_states(target / "results.xdmf", target / "results.h5")
+
+
+# ---------------------------------------------------------------------------------------------
+# Running restart files, names, where a restart finds things
+
+def test_running_restart_files_job_names_and_directories(tmp_path):
+    """*DATABASE_BINARY_RUNRSF with NR = 2 writes NAME.runrsf01 and NAME.runrsf02 in turn beside
+    NAME.d3dump01 ...; a restart run from another directory finds the deck (given relative to
+    the first run's directory), takes the dump's job and directory, or outdir= given."""
+    deck = solids_deck(tmp_path / "solids.k")
+    deck.write_text(deck.read_text().replace("*END", "*DATABASE_BINARY_RUNRSF\n" + fields(80, 2) + "\n*END"))
+    environment = dict(os.environ, OMP_NUM_THREADS="1")
+    process = subprocess.run([str(BINARY), "i=solids.k", "outdir=out", "jobid=crash", "ncpu=1"], cwd=tmp_path,
+                             capture_output=True, text=True, env=environment)
+    assert process.returncode == 0, process.stdout + process.stderr
+    out = tmp_path / "out"
+    names = sorted(p.name for p in out.iterdir())
+    assert names == ["crash.d3dump01", "crash.d3dump02", "crash.d3dump03", "crash.d3dump04", "crash.d3dump05",
+                     "crash.d3dump06", "crash.h5", "crash.lock", "crash.runrsf01", "crash.runrsf02", "crash.xdmf"]
+    cycles = {}
+    for name in ("crash.runrsf01", "crash.runrsf02", "crash.d3dump03"):
+        with h5py.File(out / name, "r") as dump:
+            cycles[name] = dump.attrs["cycle"]
+            assert dump.attrs["job_id"] == b"crash" and dump.attrs["deck"] == b"solids.k"
+    assert cycles == {"crash.runrsf01": 240, "crash.runrsf02": 160, "crash.d3dump03": 150}
+    expected = contents(out / "crash.h5")
+
+    # from another directory: the deck by its recorded absolute path, job and directory the dump's
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    target = copy_run(out, tmp_path / "copy")
+    process = subprocess.run([str(BINARY), f"r={target / 'crash.runrsf02'}", "ncpu=2"], cwd=elsewhere,
+                             capture_output=True, text=True, env=dict(environment, OMP_WAIT_POLICY="passive"))
+    assert process.returncode == 0, process.stdout + process.stderr
+    assert f"{tmp_path / 'solids.k'} on 2 thread(s)" in process.stdout
+    assert_same(expected, contents(target / "crash.h5"), "continued from crash.runrsf02")
+    assert not list(elsewhere.iterdir())
+
+    # outdir= and jobid= given: the results file of that name there is continued
+    moved = tmp_path / "moved"
+    moved.mkdir()
+    shutil.copy(out / "crash.h5", moved / "other.h5")
+    process = restart(out / "crash.d3dump03", 1, f"outdir={moved}", "jobid=other", f"i={deck}")
+    assert process.returncode == 0, process.stdout + process.stderr
+    assert_same(expected, contents(moved / "other.h5"), "continued into outdir=moved jobid=other")
+    assert (moved / "other.d3dump04").exists() and not (out / "crash.d3dump07").exists()
+
+
+# ---------------------------------------------------------------------------------------------
+# Refused restarts and deck errors
+
+def test_refused_restarts_say_why_and_leave_the_results_alone(tmp_path):
+    nodes, elements = block_mesh((3, 3, 3), (6.0, 6.0, 6.0), origin=(0.0, 0.0, 0.1))
+    (tmp_path / "mesh.k").write_text("*KEYWORD\n" + nodes_card(nodes) + "\n" + solids_card(elements) + "\n*END\n")
+    deck = write_deck(tmp_path / "deck.k", "*CONTROL_TERMINATION\n" + fields(0.02),
+                      "*DATABASE_BINARY_D3DUMP\n" + fields(30),
+                      "*PART\nblock\n" + fields(1, 1, 1), "*SECTION_SOLID\n" + fields(1, 1),
+                      "*MAT_PLASTIC_KINEMATIC\n" + STEEL,
+                      "*INITIAL_VELOCITY\n" + fields(0) + "\n" + fields(0.0, 0.0, -50.0),
+                      "*RIGIDWALL_PLANAR\n" + fields(0) + "\n" + fields(0.0, 0.0, 0.0, 0.0, 0.0, 1.0),
+                      "*INCLUDE\nmesh.k")
+    run_fresh(deck, tmp_path / "one")
+    run_fresh(deck, tmp_path / "two")
+    one = tmp_path / "one"
+    original = (one / "results.h5").read_bytes()
+
+    def refused(dump, *extra):
+        process = restart(dump, 1, *extra)
+        assert process.returncode == 2, process.stdout + process.stderr
+        assert (one / "results.h5").read_bytes() == original
+        return process.stderr
+
+    text = deck.read_text()
+    deck.write_text(text.replace(fields(0.0, 0.0, -50.0), fields(0.0, 0.0, -51.0)))
+    message = refused(one / "d3dump02")
+    assert f"deck {deck} is not the one restart dump {one}/d3dump02 was written with: {deck} has changed" in message
+    deck.write_text(text)
+    mesh = (tmp_path / "mesh.k").read_text()
+    (tmp_path / "mesh.k").write_text(mesh + "$ a comment\n")
+    message = refused(one / "d3dump02")
+    assert f"{tmp_path / 'mesh.k'} has changed since" in message
+    (tmp_path / "mesh.k").write_text(mesh)
+
+    damaged = tmp_path / "damaged"
+    damaged.write_bytes((one / "d3dump02").read_bytes()[:5000])
+    assert f"restart dump {damaged} cannot be read" in refused(damaged)
+    assert f"restart file {deck} is not a crashfree restart dump" in refused(deck) or \
+        f"restart dump {deck} cannot be read" in refused(deck)
+    assert f"restart dump {tmp_path / 'none'} does not exist" in refused(tmp_path / "none")
+
+    older = tmp_path / "older"
+    shutil.copy(one / "d3dump02", older)
+    with h5py.File(older, "r+") as dump:
+        del dump.attrs["version"]
+        dump.attrs["version"] = np.bytes_(b"0.0.9")
+    assert re.search(r"restart dump \S+older was written by crashfree 0\.0\.9; this is crashfree \S+, which reads "
+                     r"only its own dumps", refused(older, f"outdir={one}"))
+
+    # the results file: another run's, or none
+    foreign = copy_run(tmp_path / "two", tmp_path / "foreign")
+    shutil.copy(one / "d3dump02", foreign / "d3dump02")
+    process = restart(foreign / "d3dump02", 1)
+    assert process.returncode == 2
+    assert f"the results file {foreign}/results.h5 is not the one of the run that wrote {foreign}/d3dump02" in \
+        process.stderr
+    (foreign / "results.h5").unlink()
+    process = restart(foreign / "d3dump02", 1)
+    assert process.returncode == 2
+    assert f"the results file {foreign}/results.h5 of the interrupted run is missing" in process.stderr
+
+    # and the untouched dump still continues the run
+    process = restart(one / "d3dump02", 1)
+    assert process.returncode == 0, process.stdout + process.stderr
+    assert_same(contents(tmp_path / "two" / "results.h5"), contents(one / "results.h5"), "after the refusals")
+
+
+@pytest.mark.parametrize("keyword,card,field,message", [
+    ("D3DUMP", fields(100, 5), "LCDT", "dump intervals from a curve are not available; give CYCL"),
+    ("D3DUMP", fields(-1), "CYCL", "the number of cycles between dumps must be a whole number >= 0"),
+    ("D3DUMP", fields(12.5), "CYCL", "the number of cycles between dumps must be a whole number >= 0"),
+    ("RUNRSF", fields(100, -2), "NR", "the number of running restart files must be >= 0"),
+])
+def test_dump_keyword_errors(tmp_path, keyword, card, field, message):
+    deck = solids_deck(tmp_path / "solids.k")
+    deck.write_text(deck.read_text().replace("*DATABASE_BINARY_D3DUMP\n" + fields(DUMP_EVERY),
+                                             f"*DATABASE_BINARY_{keyword}\n" + card))
+    process = solver(f"i={deck}", f"outdir={tmp_path}")
+    assert process.returncode == 2
+    assert re.search(rf"solids\.k:\d+: \*DATABASE_BINARY_{keyword}: field {field}: {re.escape(message)}",
+                     process.stderr), process.stderr
