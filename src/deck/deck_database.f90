@@ -81,25 +81,28 @@ contains
   !> of cycles between dumps (0: none but those the sense switches ask for), NR the number of
   !> running restart files written in turn (0: 1). LCDT (dump times from a curve) must be 0.
   !> BEAM, NPLTC and PSETID are D3PLOT's and D3PART's fields, which LS-DYNA does not use for
-  !> dumps either; IOOPT only acts with LCDT. The last keyword of each kind counts.
-  subroutine read_dump_output(deck, block, running, input, log)
+  !> dumps either, and IOOPT only acts with LCDT: read, with a warning when set. The last
+  !> keyword of each kind counts.
+  subroutine read_dump_output(deck, block, running, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
     logical, intent(in) :: running
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    character(len=*), parameter :: unused = "LS-DYNA uses it for D3PLOT and D3PART, not for restart dumps"
     type(card_t) :: card
-    integer :: line, second, unused
+    integer :: line, second
     real(wp) :: cycles
     line = 0
     if (.not. require_card(deck, block, line, standard_widths, card, log, "card 1 (CYCL "// &
                            trim(merge("NR  ", "LCDT", running))//" BEAM NPLTC PSETID)", "CYCL")) return
     call get_real(deck, card, 1, "CYCL", cycles, log)
     call get_integer(deck, card, 2, trim(merge("NR  ", "LCDT", running)), second, log)
-    call get_integer(deck, card, 3, "BEAM", unused, log)
-    call get_integer(deck, card, 4, "NPLTC", unused, log)
-    call get_integer(deck, card, 5, "PSETID", unused, log)
     if (card%failed) return
+    call warn_if_set(deck, card, 3, "BEAM", unused, warnings)
+    call warn_if_set(deck, card, 4, "NPLTC", unused, warnings)
+    call warn_if_set(deck, card, 5, "PSETID", unused, warnings)
     if (cycles < 0.0_wp .or. cycles /= aint(cycles) .or. cycles > 2.0e9_wp) then
       call card_problem(deck, log, card, "CYCL", "the number of cycles between dumps must be "// &
                         "a whole number >= 0 (0: no periodic dumps), found "//real_text(cycles))
@@ -120,10 +123,9 @@ contains
         return
       end if
       input%model%output%dump_cycles = nint(cycles)
-      ! card 2 (IOOPT) only steers LCDT: read, not used
       if (next_line(deck, block, line, .true.)) then
         call open_card(deck, block, line, standard_widths, card, log)
-        call get_integer(deck, card, 1, "IOOPT", second, log)
+        call warn_if_set(deck, card, 1, "IOOPT", "it only acts with LCDT", warnings)
       end if
     end if
   end subroutine read_dump_output

@@ -271,7 +271,7 @@ contains
     case (keyword_glstat, keyword_matsum, keyword_nodout, keyword_rwforc)
       call read_history_output(deck, block, keyword%code, input, log, warnings)
     case (keyword_d3dump, keyword_runrsf)
-      call read_dump_output(deck, block, keyword%code == keyword_runrsf, input, log)
+      call read_dump_output(deck, block, keyword%code == keyword_runrsf, input, log, warnings)
     case (keyword_history_node, keyword_history_node_set)
       call read_history_nodes(deck, block, keyword, keyword%code == keyword_history_node_set, &
                               input, log)

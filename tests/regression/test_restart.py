@@ -443,3 +443,15 @@ def test_dump_keyword_errors(tmp_path, keyword, card, field, message):
     assert process.returncode == 2
     assert re.search(rf"solids\.k:\d+: \*DATABASE_BINARY_{keyword}: field {field}: {re.escape(message)}",
                      process.stderr), process.stderr
+
+
+def test_fields_of_other_binary_databases_are_read_with_a_warning(tmp_path):
+    deck = solids_deck(tmp_path / "solids.k")
+    deck.write_text(deck.read_text().replace("*DATABASE_BINARY_D3DUMP\n" + fields(DUMP_EVERY),
+                                             "*DATABASE_BINARY_D3DUMP\n" + fields(100.0, 0, 1, 0, 3) + "\n" + fields(2)))
+    process = solver(f"i={deck}", f"outdir={tmp_path / 'out'}")
+    assert process.returncode == 0, process.stderr
+    for field in ("BEAM", "PSETID", "IOOPT"):
+        assert re.search(rf"\*DATABASE_BINARY_D3DUMP: field {field}: ignored \(", process.stderr), process.stderr
+    assert "NPLTC" not in process.stderr
+    assert sorted(p.name for p in (tmp_path / "out").glob("d3dump*")) == ["d3dump01", "d3dump02", "d3dump03"]
