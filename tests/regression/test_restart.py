@@ -325,7 +325,7 @@ def test_running_restart_files_job_names_and_directories(tmp_path):
     deck = solids_deck(tmp_path / "solids.k")
     deck.write_text(deck.read_text().replace("*END", "*DATABASE_BINARY_RUNRSF\n" + fields(80, 2) + "\n*END"))
     environment = dict(os.environ, OMP_NUM_THREADS="1")
-    process = subprocess.run([str(BINARY), "i=solids.k", "outdir=out", "jobid=crash", "ncpu=1"], cwd=tmp_path,
+    process = subprocess.run([str(BINARY.resolve()), "i=solids.k", "outdir=out", "jobid=crash", "ncpu=1"], cwd=tmp_path,
                              capture_output=True, text=True, env=environment)
     assert process.returncode == 0, process.stdout + process.stderr
     out = tmp_path / "out"
@@ -344,7 +344,7 @@ def test_running_restart_files_job_names_and_directories(tmp_path):
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()
     target = copy_run(out, tmp_path / "copy")
-    process = subprocess.run([str(BINARY), f"r={target / 'crash.runrsf02'}", "ncpu=2"], cwd=elsewhere,
+    process = subprocess.run([str(BINARY.resolve()), f"r={target / 'crash.runrsf02'}", "ncpu=2"], cwd=elsewhere,
                              capture_output=True, text=True, env=dict(environment, OMP_WAIT_POLICY="passive"))
     assert process.returncode == 0, process.stdout + process.stderr
     assert f"{tmp_path / 'solids.k'} on 2 thread(s)" in process.stdout
