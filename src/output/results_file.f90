@@ -603,8 +603,7 @@ contains
       if (.not. allocated(error)) call cut_histories(results, histories, dump_path, error)
       if (.not. allocated(error)) call write_run_restart(results%file_id, threads, error)
       call flush_file(results%file_id, error)
-      if (allocated(error)) error%message = "results file "//results%h5_path//": "//error%message// &
-                                            system_reason()
+      if (allocated(error)) error%message = "results file "//results%h5_path//": "//error%message
     end if
     if (allocated(error)) then
       call h5fclose_f(results%file_id, ignored)
@@ -631,9 +630,9 @@ contains
       path = "/states/"//state_group_name(k)
       call h5lexists_f(results%file_id, path, exists, status)
       if (status /= 0 .or. .not. exists) then
-        call make_error(error, "it holds "//integer_text(k - 1)//" states, the dump "//dump_path// &
-                        " was written after "//integer_text(results%state_count)//": not the file of that run, "// &
-                        "or one cut short")
+        call make_error(error, "state "//state_group_name(k)//" is missing, and the dump "//dump_path// &
+                        " was written after "//integer_text(results%state_count)//" states: not the file of that "// &
+                        "run, or one cut short")
         return
       end if
       time = -huge(1.0_wp)
