@@ -1,6 +1,7 @@
 !> The explicit run, cycle after cycle: the physics of a cycle (solver/explicit_solver) with,
-!> between cycles, the stop signals, the output that is due (output/run_output) and the
-!> progress line. It starts at cycle 0 for a new run.
+!> between cycles, the stop signals, the restart dumps (output/restart_control), the output
+!> that is due (output/run_output) and the progress line. It starts at cycle 0 for a new run,
+!> at the dump's cycle for a restart.
 module explicit_run
   use kinds, only: wp
   use error_handling, only: error_t, make_error
@@ -11,6 +12,7 @@ module explicit_run
   use run_output, only: write_due_output
   use results_file, only: results_file_t
   use run_summary, only: run_summary_t
+  use restart_control, only: restart_control_t, write_due_dumps, resume_run
   use stop_signals, only: received_stop_signal, progress_line_requested, signal_name
   use progress_report, only: start_progress, report_progress
   use wall_clock, only: start_phase, stop_phase
@@ -24,19 +26,28 @@ contains
   !> Run from the run state's time to the end time (or end cycle): from cycle 0 for a new run.
   !> On a run-time error (inverted element, runaway motion, exploding energy, collapsing time
   !> step, a stop signal) the last state is written and `error` says what, where and when.
-  subroutine run_explicit(model, run, results, summary, error)
+  subroutine run_explicit(model, run, results, summary, error, restart)
     type(model_t), intent(in) :: model
     type(run_state_t), intent(inout) :: run
     type(results_file_t), intent(inout) :: results
     type(run_summary_t), intent(inout) :: summary
     type(error_t), allocatable, intent(out) :: error
+    type(restart_control_t), intent(inout) :: restart   !< the run's dumps; resuming: the dump it continues
     type(error_t), allocatable :: output_error
-    logical :: finished
+    logical :: finished, clean
 
-    ! cycle 0: forces and accelerations of the initial state (unless its motion is already
-    ! beyond any physical run, or mass scaling added more than ENDMAS allows)
-    call start_run(model, run, error)
-    finished = allocated(error) .or. model%end_time <= 0.0_wp .and. model%end_cycle <= 0
+    if (restart%resuming) then
+      ! the run state at the end of the dump's cycle, before its output
+      call resume_run(restart, run, error)
+      if (allocated(error)) return
+      finished = run%state%time >= model%end_time*(1.0_wp - 1.0e-12_wp) .or. &
+                 (model%end_cycle > 0 .and. run%state%cycle >= model%end_cycle)
+    else
+      ! cycle 0: forces and accelerations of the initial state (unless its motion is already
+      ! beyond any physical run, or mass scaling added more than ENDMAS allows)
+      call start_run(model, run, error)
+      finished = allocated(error) .or. model%end_time <= 0.0_wp .and. model%end_cycle <= 0
+    end if
     call check_distortion(model, run, finished)
     call output(model, run, results, finished, output_error)
     if (allocated(output_error)) then
@@ -47,8 +58,12 @@ contains
 
     do while (.not. finished)
       call advance_and_check(model, run, finished, error)
-      if (.not. allocated(error)) call check_stop_signal(run%state, error)
+      clean = .not. allocated(error)
+      if (clean) call check_stop_signal(run%state, error)
       finished = finished .or. allocated(error)
+      ! restart dumps: the run state of this cycle before its output (none after a run-time
+      ! error; a stop signal writes one and says where)
+      if (clean) call write_due_dumps(restart, run, summary%setup_s, results, allocated(error), finished, error)
       call check_distortion(model, run, finished)
       call output(model, run, results, finished, output_error)
       if (allocated(output_error)) exit

@@ -22,6 +22,9 @@ module job
   use progress_report, only: format_duration
   use version, only: crashfree_version
   use stop_signals, only: catch_stop_signals
+  use deck_signature, only: deck_source_t
+  use restart_control, only: restart_control_t, prepare_restart, check_restart_deck, set_up_restart_control, &
+                             continue_restart_results, count_earlier_run
   use, intrinsic :: iso_fortran_env, only: error_unit
   !$ use omp_lib, only: omp_set_num_threads, omp_get_max_threads
   implicit none
@@ -34,6 +37,9 @@ contains
   subroutine run_job(options, exit_status)
     type(run_options_t), intent(in) :: options
     integer, intent(out) :: exit_status
+    type(run_options_t) :: settings
+    type(restart_control_t) :: restart
+    type(deck_source_t), allocatable :: sources(:)
     type(model_t) :: model
     type(run_state_t) :: run
     type(results_file_t) :: results
@@ -45,32 +51,42 @@ contains
 
     started = seconds_now()
     exit_status = 2
-    if (allocated(options%restart_file)) then
-      write (error_unit, '(a)') "crashfree: r=: restarts are not supported yet"
+    ! r=: the deck, output directory and job of the dump unless given
+    settings = options
+    if (allocated(settings%restart_file)) &
+      call prepare_restart(restart, settings%restart_file, settings%deck, settings%output_dir, settings%job_id, error)
+    if (allocated(error)) then
+      write (error_unit, '(a)') "crashfree: "//error%message
       return
     end if
-    summary%threads = select_threads(options%threads)
-    write (*, '(a)') "crashfree "//crashfree_version//": "//options%deck//" on "//trim(count_text(summary%threads))// &
+    summary%threads = select_threads(settings%threads)
+    write (*, '(a)') "crashfree "//crashfree_version//": "//settings%deck//" on "//trim(count_text(summary%threads))// &
       " thread(s)"
 
-    call read_deck(options%deck, model, warnings, error, options%ignore_unknown)
+    call read_deck(settings%deck, model, warnings, error, settings%ignore_unknown, sources)
     if (warnings%count > 0) write (error_unit, '(a)') warnings%text
     if (allocated(error)) then
       write (error_unit, '(a)') error%message
       write (error_unit, '(a)') "crashfree: the deck was rejected; nothing was run"
       return
     end if
-    if (.not. model%implicit_static) call set_up_run_state(model, run, error)
+    if (restart%resuming) call check_restart_deck(restart, settings%deck, sources, error)
+    if (.not. (model%implicit_static .or. allocated(error))) call set_up_run_state(model, run, error)
     if (allocated(error)) then
       write (error_unit, '(a)') "crashfree: "//error%message
       return
     end if
-    call make_directory(options%output_dir, error)
+    call make_directory(settings%output_dir, error)
     if (allocated(error)) then
       write (error_unit, '(a)') "crashfree: "//error%message
       return
     end if
-    call open_results(results, options%output_dir, options%job_id, model, summary%threads, error)
+    if (restart%resuming) then
+      call continue_restart_results(restart, results, settings%output_dir, settings%job_id, model, summary%threads, &
+                                    error)
+    else
+      call open_results(results, settings%output_dir, settings%job_id, model, summary%threads, error)
+    end if
     if (allocated(error)) then
       write (error_unit, '(a)') "crashfree: "//error%message
       return
@@ -89,10 +105,13 @@ contains
       ! while the deck is read and the model set up, they end the process at once: nothing has
       ! been written yet, and a previous results file of the job is still whole)
       call catch_stop_signals()
-      call run_explicit(model, run, results, summary, error)
+      call set_up_restart_control(restart, model, settings%output_dir, settings%job_id, settings%deck, sources, &
+                                  started)
+      call run_explicit(model, run, results, summary, error, restart)
     end if
 
     summary%wall_s = seconds_now() - started
+    if (restart%resuming) call count_earlier_run(restart, summary)
     if (allocated(error)) then
       summary%status = status_error
       summary%message = error%message
@@ -104,7 +123,7 @@ contains
     end if
     call close_results(results, summary, close_error)
     if (allocated(close_error)) exit_status = 1
-    call print_summary(summary, options, model%implicit_static)
+    call print_summary(summary, settings, model%implicit_static)
     if (allocated(error)) write (error_unit, '(a)') "crashfree: error termination: "//error%message
     ! last: what the results file holds after a failed write
     if (allocated(close_error)) write (error_unit, '(a)') "crashfree: "//close_error%message

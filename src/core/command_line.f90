@@ -19,9 +19,9 @@ module command_line
   !> What the user asked for.
   type :: run_options_t
     character(len=:), allocatable :: deck          !< i=
-    character(len=:), allocatable :: output_dir    !< outdir= (default ".")
-    character(len=:), allocatable :: job_id        !< jobid= (default "results")
-    character(len=:), allocatable :: restart_file  !< r=
+    character(len=:), allocatable :: output_dir    !< outdir= (default "."; with r= unset: the dump's)
+    character(len=:), allocatable :: job_id        !< jobid= (default "results"; with r= unset: the dump's)
+    character(len=:), allocatable :: restart_file  !< r= (the deck, when i= is not given, is the dump's)
     integer :: threads = 0                         !< ncpu= (0: OMP_NUM_THREADS, else all cores)
     logical :: ignore_unknown = .false.            !< --ignore-unknown
     logical :: show_help = .false.
@@ -53,8 +53,6 @@ contains
     character(len=:), allocatable :: argument, key, value, note
     logical :: bare_deck
 
-    options%output_dir = "."
-    options%job_id = "results"
     bare_deck = .false.
     do k = 1, size(arguments)
       argument = arguments(k)%text
@@ -110,8 +108,15 @@ contains
         call add_error(options%notes, argument//": ignored ("//note//")")
       end select
     end do
-    if (.not. (options%show_help .or. options%show_version) .and. .not. allocated(options%deck)) then
-      call make_error(error, "command line: no input deck given: use i=DECK.k (see --help)")
+    if (.not. (options%show_help .or. options%show_version) .and. .not. allocated(options%deck) .and. &
+        .not. allocated(options%restart_file)) then
+      call make_error(error, "command line: no input deck given: use i=DECK.k, or r=DUMP to continue a run "// &
+                      "(see --help)")
+    end if
+    ! a restart takes the output directory and job of its dump unless they are given
+    if (.not. allocated(options%restart_file)) then
+      if (.not. allocated(options%output_dir)) options%output_dir = "."
+      if (.not. allocated(options%job_id)) options%job_id = "results"
     end if
   end subroutine parse_command_line
 
@@ -148,7 +153,8 @@ contains
     case ("memory", "memory2")
       note = "crashfree sizes its memory from the model"
     case ("d")
-      note = "crashfree writes no restart dumps"
+      note = "crashfree writes no dump at the end of a run; restart dumps come from *DATABASE_BINARY_D3DUMP, "// &
+             "_RUNRSF and the sense switches (SIGTERM, SIGUSR1)"
     case ("o")
       note = "crashfree prints its run output on standard output"
     case ("g")
@@ -166,18 +172,24 @@ contains
   function usage_text() result(text)
     character(len=:), allocatable :: text
     character(len=*), parameter :: nl = new_line('a')
-    text = "usage: crashfree i=DECK.k [outdir=DIR] [ncpu=N] [jobid=NAME] [r=RESTARTFILE]"//nl// &
+    text = "usage: crashfree i=DECK.k [outdir=DIR] [ncpu=N] [jobid=NAME]"//nl// &
            "                 [--ignore-unknown] [--help] [--version]"//nl// &
-           "       crashfree DECK.k [...]"//nl//nl// &
+           "       crashfree DECK.k [...]"//nl// &
+           "       crashfree r=DUMP [outdir=DIR] [ncpu=N] [jobid=NAME]"//nl//nl// &
            "  i=DECK.k        LS-DYNA style keyword deck to run (or the deck name alone, first)"//nl// &
            "  outdir=DIR      directory for the results (default: the current directory)"//nl// &
            "  ncpu=N          OpenMP threads (default: OMP_NUM_THREADS, else all cores; at most"//nl// &
            "                  the processors available); results are bit-identical for any N"//nl// &
            "  jobid=NAME      name the results NAME.h5 and NAME.xdmf (default: results)"//nl// &
-           "  r=FILE          restart file (not supported yet: rejected)"//nl// &
+           "  r=DUMP          continue the run from a restart dump (DIR/d3dump01, DIR/runrsf, ...): the"//nl// &
+           "                  deck is read again from its recorded path (or i=) and must be unchanged;"//nl// &
+           "                  results go on in the run's DIR/JOBID.h5 (default: the dump's directory"//nl// &
+           "                  and job)"//nl// &
            "  --ignore-unknown  warn about unknown keywords instead of stopping"//nl// &
            "  memory= memory2= d=nodump o= g= ncycle= pfile=   LS-DYNA's: accepted, not used"//nl//nl// &
            "Results: DIR/results.h5 (HDF5, see README) and DIR/results.xdmf for ParaView."//nl// &
+           "Signals: SIGINT/SIGTERM stop after the cycle with a restart dump, SIGUSR1 writes a dump"//nl// &
+           "and goes on, SIGUSR2 prints the progress line."//nl// &
            "Exit status: 0 normal termination, 1 error termination, 2 bad command line or deck."
   end function usage_text
 

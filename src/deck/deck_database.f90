@@ -1,4 +1,5 @@
-!> *DATABASE_ keywords: output intervals and the nodes written to the nodout history.
+!> *DATABASE_ keywords: output intervals, the nodes written to the nodout history, and the
+!> restart dumps (*DATABASE_BINARY_D3DUMP, _RUNRSF).
 module deck_database
   use kinds, only: wp
   use error_handling, only: error_list_t
@@ -14,7 +15,7 @@ module deck_database
   private
 
   public :: read_plot_output, read_glstat_output, read_matsum_output, read_nodout_output, read_rwforc_output
-  public :: read_history_nodes, read_history_node_sets
+  public :: read_history_nodes, read_history_node_sets, read_d3dump_output, read_runrsf_output
 
   integer, parameter :: standard_widths(8) = 10
   !> The history outputs read by read_history_output.
@@ -122,6 +123,80 @@ contains
       input%model%output%rwforc_interval = interval
     end select
   end subroutine read_history_output_card
+
+  !> *DATABASE_BINARY_D3DUMP card 1: CYCL LCDT BEAM NPLTC PSETID (card 2: IOOPT);
+  !> *DATABASE_BINARY_RUNRSF (`running`) card 1: CYCL NR BEAM NPLTC PSETID. CYCL is the number
+  !> of cycles between dumps (0: none but those the sense switches ask for), NR the number of
+  !> running restart files written in turn (0: 1). LCDT (dump times from a curve) must be 0.
+  !> BEAM, NPLTC and PSETID are D3PLOT's and D3PART's fields, which LS-DYNA does not use for
+  !> dumps either, and IOOPT only acts with LCDT: read, with a warning when set. The last
+  !> keyword of each kind counts.
+  subroutine read_d3dump_output(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_dump_output(deck, block, .false., input, log, warnings)
+  end subroutine read_d3dump_output
+
+  subroutine read_runrsf_output(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_dump_output(deck, block, .true., input, log, warnings)
+  end subroutine read_runrsf_output
+
+  subroutine read_dump_output(deck, block, running, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    logical, intent(in) :: running
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    character(len=*), parameter :: unused = "LS-DYNA uses it for D3PLOT and D3PART, not for restart dumps"
+    type(card_t) :: card
+    integer :: line, second
+    real(wp) :: cycles
+    line = 0
+    if (.not. require_card(deck, block, line, standard_widths, card, log, "card 1 (CYCL "// &
+                           trim(merge("NR  ", "LCDT", running))//" BEAM NPLTC PSETID)", "CYCL")) return
+    call get_real(deck, card, 1, "CYCL", cycles, log)
+    call get_integer(deck, card, 2, trim(merge("NR  ", "LCDT", running)), second, log)
+    if (card%failed) return
+    call warn_if_set(deck, card, 3, "BEAM", unused, warnings)
+    call warn_if_set(deck, card, 4, "NPLTC", unused, warnings)
+    call warn_if_set(deck, card, 5, "PSETID", unused, warnings)
+    if (cycles < 0.0_wp .or. cycles /= aint(cycles) .or. cycles > 2.0e9_wp) then
+      call card_problem(deck, log, card, "CYCL", "the number of cycles between dumps must be "// &
+                        "a whole number >= 0 (0: no periodic dumps), found "//real_text(cycles))
+      return
+    end if
+    if (running) then
+      if (second < 0) then
+        call card_problem(deck, log, card, "NR", "the number of running restart files must be "// &
+                          ">= 0 (0: one), found "//integer_text(second))
+        return
+      end if
+      input%model%output%running_restart_cycles = nint(cycles)
+      input%model%output%running_restart_files = max(1, second)
+    else
+      if (second /= 0) then
+        call card_problem(deck, log, card, "LCDT", "dump intervals from a curve are not "// &
+                          "available; give CYCL")
+        return
+      end if
+      input%model%output%dump_cycles = nint(cycles)
+      if (next_line(deck, block, line, .true.)) then
+        call open_card(deck, block, line, standard_widths, card, log)
+        call warn_if_set(deck, card, 1, "IOOPT", "it only acts with LCDT", warnings)
+      end if
+    end if
+  end subroutine read_dump_output
 
   subroutine check_interval(deck, card, interval, interval_curve, log)
     type(deck_t), intent(in) :: deck

@@ -10,7 +10,7 @@
 !>
 !> The rows keep the order in which the names were added: on equal spelling distance the
 !> earlier name is suggested. gfortran cannot hold procedure pointers in a named constant, so
-!> `keyword_table()` builds the table on each call (64 rows; once per deck, and per unknown
+!> `keyword_table()` builds the table on each call (66 rows; once per deck, and per unknown
 !> keyword).
 module deck_keyword_table
   use error_handling, only: error_list_t
@@ -39,7 +39,7 @@ module deck_keyword_table
   use deck_controls, only: read_title, read_termination, read_time_step, read_hourglass_control, &
     read_bulk_viscosity, read_energy_control, read_implicit_general, read_implicit_solution
   use deck_database, only: read_plot_output, read_glstat_output, read_matsum_output, read_nodout_output, &
-    read_rwforc_output, read_history_nodes, read_history_node_sets
+    read_rwforc_output, read_history_nodes, read_history_node_sets, read_d3dump_output, read_runrsf_output
   use deck_rigid_bodies, only: read_rigid_materials, read_rigid_motions, read_nodal_rigid_bodies, &
     read_element_masses
   use deck_contact, only: read_nodes_to_surface_contacts, read_surface_to_surface_contacts, &
@@ -157,6 +157,8 @@ contains
                       reader=read_thick_shell_elements), &
       keyword_entry_t("SECTION_SHELL", options="TITLE", fills=[list_sections, list_none], &
                       reader=read_shell_sections), &
+      keyword_entry_t("DATABASE_BINARY_D3DUMP", reader=read_d3dump_output), &
+      keyword_entry_t("DATABASE_BINARY_RUNRSF", reader=read_runrsf_output), &
       keyword_entry_t("KEYWORD"), keyword_entry_t("INCLUDE"), keyword_entry_t("PARAMETER"), &
       keyword_entry_t("COMMENT"), keyword_entry_t("END"), &
       law_keyword(law_rigid, read_rigid_materials, list_rigid_materials), &

@@ -24,6 +24,7 @@ module deck_reader
                                 suggest_known_keyword, list_capacity
   use deck_input, only: deck_input_t, prepare_input
   use deck_cross_check, only: check_and_build
+  use deck_signature, only: deck_source_t
   implicit none
   private
 
@@ -35,19 +36,21 @@ contains
   !> lists every problem found, one per line, as `file:line: *KEYWORD: field NAME: what is
   !> wrong`; `model` is then not usable. Unknown keywords are errors, or with
   !> `ignore_unknown` warnings in `warnings` (which also lists fields read but not used).
-  subroutine read_deck(path, model, warnings, error, ignore_unknown)
+  !> `sources`: the files read (main deck and includes, in reading order), for a restart's check.
+  subroutine read_deck(path, model, warnings, error, ignore_unknown, sources)
     character(len=*), intent(in) :: path
     type(model_t), intent(out) :: model
     type(error_list_t), intent(out) :: warnings
     type(error_t), allocatable, intent(out) :: error
     logical, intent(in) :: ignore_unknown
+    type(deck_source_t), allocatable, intent(out), optional :: sources(:)
     type(deck_t) :: deck
     type(deck_input_t) :: input
     type(problem_log_t) :: log
     type(keyword_entry_t), allocatable :: table(:)
     type(keyword_t), allocatable :: keywords(:)
     integer, allocatable :: lines(:)
-    integer :: block
+    integer :: block, file
 
     call load_deck(path, deck, log, warnings)
     table = keyword_table()
@@ -65,6 +68,14 @@ contains
     end do
     call check_files_unchanged(deck, log)
     if (.not. log%unreadable) call check_and_build(deck, input, model, log, warnings)
+    if (present(sources)) then
+      allocate (sources(deck%file_count))
+      do file = 1, deck%file_count
+        sources(file)%path = deck%files(file)%path
+        sources(file)%size = deck%files(file)%size
+        sources(file)%modified = deck%files(file)%modified
+      end do
+    end if
     call release_deck(deck)
     if (has_problems(log)) then
       call problems_to_error(log, error)

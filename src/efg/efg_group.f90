@@ -7,6 +7,8 @@ module efg_group
   use kinds, only: wp
   use error_handling, only: error_t, make_error
   use run_summary, only: run_summary_t
+  use text_format, only: integer_text
+  use restart_file, only: restart_store_t, exchange_restart, exchange_restart_count
   use model, only: model_t, formulation_efg, boundary_full_transformation, integration_gauss_conventional
   use nodal_state, only: nodal_state_t
   use element_group, only: element_group_t, element_results_t
@@ -33,6 +35,7 @@ module efg_group
     procedure :: element_results
     procedure :: describe
     procedure :: add_to_summary
+    procedure :: exchange_state
     procedure :: failure_text
     procedure :: to_physical
   end type efg_group_t
@@ -247,14 +250,6 @@ contains
     end do
   end subroutine to_physical
 
-  pure function integer_text(value) result(text)
-    integer, intent(in) :: value
-    character(len=:), allocatable :: text
-    character(len=16) :: buffer
-    write (buffer, '(i0)') value
-    text = trim(buffer)
-  end function integer_text
-
   !> Particles, their dofs and the set-up time of the shape functions as well (set, not added:
   !> called before and after the run).
   subroutine add_to_summary(self, summary)
@@ -271,4 +266,42 @@ contains
     end do
     summary%efg_s = self%timer%seconds
   end subroutine add_to_summary
+
+  !> Each part's point blocks (the geometry, shape functions and gradients are rebuilt).
+  subroutine exchange_state(self, store, path, error)
+    class(efg_group_t), intent(inout) :: self
+    type(restart_store_t), intent(inout) :: store
+    character(len=*), intent(in) :: path
+    type(error_t), allocatable, intent(inout) :: error
+    integer :: k
+    call exchange_restart_count(store, path//"/count", "meshfree parts", size(self%parts), error)
+    do k = 1, size(self%parts)
+      call exchange_meshfree(store, path//"/"//integer_text(k), self%parts(k), error)
+    end do
+    call exchange_restart(store, path//"/seconds", self%timer%seconds, error)
+  end subroutine exchange_state
+
+  !> One meshfree part: each point block's stresses, history, energies and powers, the points'
+  !> W P, and the blocks' last steps (the geometry, shape functions and gradients are rebuilt).
+  subroutine exchange_meshfree(store, path, solver, error)
+    type(restart_store_t), intent(inout) :: store
+    character(len=*), intent(in) :: path
+    type(efg_solver_t), intent(inout) :: solver
+    type(error_t), allocatable, intent(inout) :: error
+    integer :: b
+    character(len=:), allocatable :: block_path
+    call exchange_restart_count(store, path//"/block_count", "integration point blocks in "//path, size(solver%blocks), error)
+    call exchange_restart(store, path//"/point_stress", solver%point_stress, error)
+    call exchange_restart(store, path//"/block_time_step", solver%block_time_step, error)
+    call exchange_restart(store, path//"/block_critical_point", solver%block_critical_point, error)
+    call exchange_restart(store, path//"/block_inverted_point", solver%block_inverted_point, error)
+    do b = 1, size(solver%blocks)
+      block_path = path//"/blocks/"//integer_text(b)
+      call exchange_restart(store, block_path//"/stress", solver%blocks(b)%stress, error)
+      call exchange_restart(store, block_path//"/history", solver%blocks(b)%history, error)
+      call exchange_restart(store, block_path//"/internal_energy", solver%blocks(b)%internal_energy, error)
+      call exchange_restart(store, block_path//"/force_power", solver%blocks(b)%force_power, error)
+      call exchange_restart(store, block_path//"/previous_time_step", solver%blocks(b)%previous_time_step, error)
+    end do
+  end subroutine exchange_meshfree
 end module efg_group

@@ -21,6 +21,8 @@ module element_group
   use nodal_state, only: nodal_state_t
   use wall_clock, only: phase_timer_t
   use run_summary, only: run_summary_t
+  use error_handling, only: error_t
+  use restart_file, only: restart_store_t
   implicit none
   private
 
@@ -72,6 +74,10 @@ module element_group
     procedure(describe_interface), deferred :: describe
     !> Its counts and seconds in the run summary (after the run: the time of its force calls).
     procedure(summary_interface), deferred :: add_to_summary
+    !> Restart dumps: write what its blocks carry from cycle to cycle under `path`, or read it
+    !> back into a group built from the same deck (restart_file's exchange_restart); what the
+    !> set-up derives from the deck is not stored.
+    procedure(exchange_interface), deferred :: exchange_state
     !> Optional: the failure message of `failed_element` (default: "<describe> inverted").
     procedure :: failure_text
     !> Optional: transform a nodal field from solver values to physical ones (meshfree parts).
@@ -148,6 +154,14 @@ module element_group
       integer, intent(in) :: element
       character(len=:), allocatable :: text
     end function describe_interface
+
+    subroutine exchange_interface(self, store, path, error)
+      import :: element_group_t, restart_store_t, error_t
+      class(element_group_t), intent(inout) :: self
+      type(restart_store_t), intent(inout) :: store
+      character(len=*), intent(in) :: path
+      type(error_t), allocatable, intent(inout) :: error
+    end subroutine exchange_interface
 
     subroutine summary_interface(self, summary)
       import :: element_group_t, run_summary_t

@@ -5,6 +5,9 @@ module solid_group
   use gather_list, only: gather_list_t
   use block_colouring, only: colour_blocks_by_nodes
   use model, only: model_t
+  use error_handling, only: error_t
+  use text_format, only: integer_text
+  use restart_file, only: restart_store_t, exchange_restart, exchange_restart_count
   use run_summary, only: run_summary_t
   use nodal_state, only: nodal_state_t
   use element_group, only: element_group_t, element_results_t, distortion_t
@@ -34,6 +37,7 @@ module solid_group
     procedure :: element_results
     procedure :: describe
     procedure :: add_to_summary
+    procedure :: exchange_state
     procedure :: failure_text
     procedure :: most_scaled
     procedure :: check_distortion
@@ -281,4 +285,45 @@ contains
     summary%fe_solids = self%element_count()
     summary%fe_solid_s = self%timer%seconds
   end subroutine add_to_summary
+
+  !> The blocks' steps and critical and inverted elements of the last force call, then each block.
+  subroutine exchange_state(self, store, path, error)
+    class(solid_group_t), intent(inout) :: self
+    type(restart_store_t), intent(inout) :: store
+    character(len=*), intent(in) :: path
+    type(error_t), allocatable, intent(inout) :: error
+    integer :: b
+    call exchange_restart_count(store, path//"/count", "solid blocks", size(self%blocks), error)
+    call exchange_restart(store, path//"/time_step", self%block_time_step, error)
+    call exchange_restart(store, path//"/critical_element", self%block_critical_element, error)
+    call exchange_restart(store, path//"/inverted_element", self%block_inverted_element, error)
+    do b = 1, size(self%blocks)
+      call exchange_solid_block(store, path//"/"//integer_text(b), self%blocks(b), error)
+    end do
+    call exchange_restart(store, path//"/seconds", self%timer%seconds, error)
+  end subroutine exchange_state
+
+  !> One block of solids: stresses, material history, energies and the powers of the last
+  !> forces (for the work of the next step), volumes, bulk viscosity, hourglass forces, the
+  !> last steps.
+  subroutine exchange_solid_block(store, path, block, error)
+    type(restart_store_t), intent(inout) :: store
+    character(len=*), intent(in) :: path
+    type(solid_block_t), intent(inout) :: block
+    type(error_t), allocatable, intent(inout) :: error
+    call exchange_restart_count(store, path//"/element_count", "elements in "//path, block%element_count, error)
+    call exchange_restart(store, path//"/internal_energy", block%internal_energy, error)
+    call exchange_restart(store, path//"/hourglass_energy", block%hourglass_energy, error)
+    call exchange_restart(store, path//"/volume", block%volume, error)
+    call exchange_restart(store, path//"/bulk_viscosity", block%bulk_viscosity, error)
+    call exchange_restart(store, path//"/force_power", block%force_power, error)
+    call exchange_restart(store, path//"/hourglass_power", block%hourglass_power, error)
+    call exchange_restart(store, path//"/previous_time_step", block%previous_time_step, error)
+    call exchange_restart(store, path//"/recent_time_step", block%recent_time_step, error)
+    call exchange_restart(store, path//"/recent_critical_element", block%recent_critical_element, error)
+    call exchange_restart(store, path//"/stress", block%stress, error)
+    call exchange_restart(store, path//"/history", block%history, error)
+    call exchange_restart(store, path//"/point_volume", block%point_volume, error)
+    call exchange_restart(store, path//"/hourglass_force", block%hourglass_force, error)
+  end subroutine exchange_solid_block
 end module solid_group

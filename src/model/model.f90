@@ -296,6 +296,9 @@ module model
     real(wp) :: nodout_interval = 0.0_wp
     real(wp) :: rwforc_interval = 0.0_wp
     real(wp) :: rcforc_interval = 0.0_wp     !< *DATABASE_RCFORC
+    integer :: dump_cycles = 0               !< *DATABASE_BINARY_D3DUMP CYCL (0: no periodic dumps)
+    integer :: running_restart_cycles = 0    !< *DATABASE_BINARY_RUNRSF CYCL (0: none)
+    integer :: running_restart_files = 1     !< *DATABASE_BINARY_RUNRSF NR, written in turn
     integer, allocatable :: history_nodes(:) !< node indices for nodout
   end type output_control_t
 

@@ -46,7 +46,9 @@ module results_file
   use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_null_ptr, c_char, c_null_char, c_bool, &
                                          c_int, c_int64_t
   use hdf5, only: hid_t, hsize_t, h5open_f, h5eset_auto_f, h5dont_atexit_f, &
-                  h5fcreate_f, h5fclose_f, h5fflush_f, H5F_ACC_TRUNC_F, H5F_SCOPE_GLOBAL_F, &
+                  h5fcreate_f, h5fopen_f, h5fclose_f, h5fflush_f, H5F_ACC_TRUNC_F, H5F_ACC_RDWR_F, &
+                  H5F_SCOPE_GLOBAL_F, h5gget_info_f, h5aopen_f, h5aread_f, h5sget_simple_extent_dims_f, &
+                  h5sget_simple_extent_ndims_f, &
                   h5pcreate_f, h5pclose_f, h5pset_file_locking_f, h5pset_chunk_f, &
                   H5P_FILE_ACCESS_F, H5P_DATASET_CREATE_F, H5P_GROUP_CREATE_F, &
                   h5pset_link_phase_change_f, h5pset_link_creation_order_f, H5P_CRT_ORDER_TRACKED_F, &
@@ -58,7 +60,7 @@ module results_file
                   h5dget_space_f, h5acreate_f, h5aclose_f, h5awrite_f, h5aexists_f, &
                   h5adelete_f, h5tcopy_f, h5tclose_f, H5T_STRING, H5T_NATIVE_INTEGER, &
                   H5T_STD_I32LE, H5T_STD_I64LE, H5T_IEEE_F64LE, h5kind_to_type, H5_REAL_KIND, &
-                  H5_INTEGER_KIND, h5oclose_f
+                  H5_INTEGER_KIND, h5oclose_f, h5oopen_f
   use kinds, only: wp, long_int
   use error_handling, only: error_t, make_error
   use version, only: crashfree_version
@@ -74,7 +76,7 @@ module results_file
   implicit none
   private
 
-  public :: results_file_t, open_results, write_state, write_histories, close_results
+  public :: results_file_t, open_results, write_state, write_histories, close_results, continue_results
 
   !> An open results file: the HDF5 handle, the paths, the lock, and what the incremental
   !> writing of the histories and the XDMF file needs.
@@ -90,6 +92,9 @@ module results_file
     character(len=:), allocatable :: xdmf_path    !< DIR/JOBID.xdmf
     character(len=:), allocatable :: h5_name      !< JOBID.h5, as the XDMF refers to it
     type(file_lock_t) :: lock                     !< held on DIR/JOBID.lock while open
+    !> A random number written to /run as `run_id` when the file is created; a restart dump
+    !> records it, and a restart continues only the file of the run that wrote the dump.
+    integer(long_int) :: run_id = 0
     integer :: node_count = 0                     !< n, rows of the nodal datasets
     integer :: solid_count = 0                    !< m, rows of the solid datasets
     integer :: shell_count = 0                    !< k, rows of the shell datasets
@@ -171,6 +176,7 @@ contains
     results%state_count = 0
     results%broken = .false.
     results%failed = .false.
+    results%run_id = new_run_id()
     if (allocated(results%state_times)) deallocate (results%state_times)
     allocate (results%state_times(16))
     if (allocated(results%history_rows)) deallocate (results%history_rows)
@@ -241,7 +247,7 @@ contains
       call make_error(error, space_error%message//" while creating "//results%h5_path)
     else
       call write_mesh(results%file_id, model, error)
-      call write_run_start(results%file_id, model, threads, error)
+      call write_run_start(results%file_id, model, threads, results%run_id, error)
       call create_states_group(results%file_id, error)
       call create_group_path(results%file_id, "/history", error)
       call flush_file(results%file_id, error)
@@ -490,6 +496,320 @@ contains
                       state_range(results%xdmf_state_count)
     end if
   end subroutine close_results
+
+
+  !> Continue the results file `directory/job_id.h5` of an interrupted run from a restart dump.
+  !> `results` comes with the dump's bookkeeping (run_state_dump's exchange_results_progress:
+  !> `run_id`, `state_count`, `state_times`, `history_rows`, `output_bytes`) and `histories`
+  !> with the dump's history series (their groups and columns). The job is locked as by
+  !> `open_results`; the file must be the one of the run that wrote the dump (its `run_id`) and
+  !> hold the states the dump counts, at their times. The states and history rows written after
+  !> the dump are removed, `/run` says "running" again and the XDMF file lists the states kept;
+  !> the continued run then writes on as `open_results` had left it. `dump_path` names the dump
+  !> in messages.
+  subroutine continue_results(results, directory, job_id, model, threads, histories, dump_path, error)
+    type(results_file_t), intent(inout) :: results
+    character(len=*), intent(in) :: directory, job_id
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: threads
+    type(history_set_t), intent(in) :: histories
+    character(len=*), intent(in) :: dump_path
+    type(error_t), allocatable, intent(out) :: error
+    character(len=:), allocatable :: holder
+    integer(hid_t) :: access_list
+    integer(long_int) :: file_run_id
+    integer, allocatable :: grown(:)
+    integer :: status, ignored
+    logical :: exists
+
+    if (results%is_open) then
+      call make_error(error, "results file "//results%h5_path//": already open")
+      return
+    end if
+    results%h5_name = job_id//".h5"
+    results%h5_path = join_path(directory, results%h5_name)
+    results%xdmf_path = join_path(directory, job_id//".xdmf")
+    results%node_count = size(model%node_ids)
+    results%solid_count = size(model%solid_ids)
+    results%shell_count = 0
+    if (allocated(model%shell_ids)) results%shell_count = size(model%shell_ids)
+    results%broken = .false.
+    results%failed = .false.
+    results%xdmf_state_count = 0
+    results%xdmf_writes = 0
+    results%xdmf_seconds = 0.0_wp
+    results%xdmf_bytes = 0
+    results%reserved_bytes = 0
+    results%reserved_end = 0
+    if (.not. allocated(results%history_rows)) allocate (results%history_rows(0))
+    if (size(results%history_rows) < histories%count) then
+      allocate (grown(histories%count))
+      grown = 0
+      grown(1:size(results%history_rows)) = results%history_rows
+      call move_alloc(grown, results%history_rows)
+    end if
+
+    call acquire_file_lock(results%lock, join_path(directory, job_id//".lock"), error, holder)
+    if (allocated(error)) then
+      if (len(holder) > 0) then
+        error%message = "another run (process "//holder//") is writing job '"//job_id// &
+                        "' in the output directory '"//directory_text(directory)// &
+                        "' (lock file "//join_path(directory, job_id//".lock")// &
+                        "); wait for it to end, or give this run another outdir= or jobid="
+      else
+        error%message = "results file "//results%h5_path//": "//error%message
+      end if
+      return
+    end if
+    call h5dont_atexit_f(ignored)
+    call h5open_f(status)
+    call h5eset_auto_f(0, status)
+    inquire (file=results%h5_path, exist=exists)
+    if (.not. exists) then
+      call make_error(error, "the results file "//results%h5_path//" of the interrupted run is missing: "// &
+                      "a restart continues it (the dump "//dump_path//" holds the state of the run, not the "// &
+                      "results written before it); put the file back, or give the outdir= and jobid= of "// &
+                      "the interrupted run")
+      call release_file_lock(results%lock)
+      return
+    end if
+    call clear_system_error()
+    call h5pcreate_f(H5P_FILE_ACCESS_F, access_list, status)
+    if (status == 0) call h5pset_file_locking_f(access_list, .false., .true., status)
+    if (status == 0) status = int(c_h5pset_evict_on_close(int(access_list, c_int64_t), .true._c_bool))
+    if (status == 0) call h5fopen_f(results%h5_path, H5F_ACC_RDWR_F, results%file_id, status, &
+                                    access_prp=access_list)
+    call h5pclose_f(access_list, ignored)
+    if (status /= 0) then
+      call make_error(error, "results file "//results%h5_path//": cannot open it for writing"// &
+                      system_reason()//" (not an HDF5 file, or damaged)")
+      results%file_id = -1
+      call release_file_lock(results%lock)
+      return
+    end if
+
+    file_run_id = 0
+    call read_long_attribute(results%file_id, "/run", "run_id", file_run_id, error)
+    if (.not. allocated(error) .and. file_run_id /= results%run_id) &
+      call make_error(error, "")
+    if (allocated(error)) then
+      error%message = "the results file "//results%h5_path//" is not the one of the run that wrote "// &
+                      dump_path//" (its /run run_id is "//long_text(file_run_id)//", the dump's "// &
+                      long_text(results%run_id)//"): a restart continues the results file of the "// &
+                      "interrupted run; put that file back, or give the outdir= and jobid= of that run"
+    else
+      call check_kept_states(results, dump_path, error)
+      if (.not. allocated(error)) call cut_states(results, error)
+      if (.not. allocated(error)) call cut_histories(results, histories, dump_path, error)
+      if (.not. allocated(error)) call write_run_restart(results%file_id, threads, error)
+      call flush_file(results%file_id, error)
+      if (allocated(error)) error%message = "results file "//results%h5_path//": "//error%message
+    end if
+    if (allocated(error)) then
+      call h5fclose_f(results%file_id, ignored)
+      results%file_id = -1
+      call release_file_lock(results%lock)
+      return
+    end if
+    results%is_open = .true.
+    ! the XDMF file of the interrupted run may list states removed here
+    call write_xdmf_now(results, error)
+  end subroutine continue_results
+
+  !> The states the dump counts are in the file, at the dump's times.
+  subroutine check_kept_states(results, dump_path, error)
+    type(results_file_t), intent(in) :: results
+    character(len=*), intent(in) :: dump_path
+    type(error_t), allocatable, intent(inout) :: error
+    character(len=:), allocatable :: path
+    real(wp) :: time
+    integer :: k
+    logical :: exists
+    integer :: status
+    do k = 1, results%state_count
+      path = "/states/"//state_group_name(k)
+      call h5lexists_f(results%file_id, path, exists, status)
+      if (status /= 0 .or. .not. exists) then
+        call make_error(error, "state "//state_group_name(k)//" is missing, and the dump "//dump_path// &
+                        " was written after "//integer_text(results%state_count)//" states: not the file of that "// &
+                        "run, or one cut short")
+        return
+      end if
+      time = -huge(1.0_wp)
+      call read_real_attribute(results%file_id, path, "time", time, error)
+      if (allocated(error)) return
+      if (time /= results%state_times(k)) then
+        call make_error(error, "state "//state_group_name(k)//" is at time "//real_text(time)//", the dump "// &
+                        dump_path//" has it at "//real_text(results%state_times(k))//": not the file of that run")
+        return
+      end if
+    end do
+  end subroutine check_kept_states
+
+  !> Remove the links of the states after the first `state_count` (written after the dump).
+  subroutine cut_states(results, error)
+    type(results_file_t), intent(in) :: results
+    type(error_t), allocatable, intent(inout) :: error
+    integer(hid_t) :: group_id
+    integer :: storage, links, order, status, ignored, k
+    logical :: exists
+    call h5gopen_f(results%file_id, "/states", group_id, status)
+    if (status == 0) call h5gget_info_f(group_id, storage, links, order, status)
+    if (status /= 0) then
+      call make_error(error, "cannot read the group /states")
+      return
+    end if
+    do k = results%state_count + 1, results%state_count + links
+      call h5lexists_f(group_id, state_group_name(k), exists, status)
+      if (status == 0 .and. exists) call h5ldelete_f(group_id, state_group_name(k), status)
+      if (status /= 0) then
+        call make_error(error, "cannot remove the state "//state_group_name(k)//" written after the dump")
+        exit
+      end if
+    end do
+    call h5gclose_f(group_id, ignored)
+  end subroutine cut_states
+
+  !> Cut every history column to the rows the dump counts (a series with none loses its
+  !> columns: the continued run creates them again).
+  subroutine cut_histories(results, histories, dump_path, error)
+    type(results_file_t), intent(in) :: results
+    type(history_set_t), intent(in) :: histories
+    character(len=*), intent(in) :: dump_path
+    type(error_t), allocatable, intent(inout) :: error
+    integer(hsize_t) :: dims(2), maximum(2)
+    integer(hid_t) :: dataset_id, space_id
+    character(len=:), allocatable :: path
+    integer :: series_index, column, rank, status, ignored, rows
+    logical :: exists
+    do series_index = 1, histories%count
+      associate (series => histories%series(series_index))
+        rows = results%history_rows(series_index)
+        do column = 1, size(series%widths)
+          path = "/history/"//series%group//"/"//trim(series%names(column))
+          call h5lexists_f(results%file_id, "/history/"//series%group, exists, status)
+          if (status == 0 .and. exists) call h5lexists_f(results%file_id, path, exists, status)
+          if (status == 0 .and. exists .and. rows == 0) then
+            call h5ldelete_f(results%file_id, path, status)
+            if (status /= 0) call make_error(error, "cannot remove "//path)
+          else if (status == 0 .and. exists) then
+            call h5dopen_f(results%file_id, path, dataset_id, status)
+            if (status == 0) call h5dget_space_f(dataset_id, space_id, status)
+            if (status == 0) call h5sget_simple_extent_ndims_f(space_id, rank, status)
+            if (status == 0 .and. rank >= 1 .and. rank <= 2) then
+              call h5sget_simple_extent_dims_f(space_id, dims(1:rank), maximum(1:rank), status)
+              if (status >= 0) status = 0
+              call h5sclose_f(space_id, ignored)
+              if (status == 0 .and. dims(rank) < int(rows, hsize_t)) then
+                call make_error(error, path//" holds "//integer_text(int(dims(rank)))//" rows, the dump "// &
+                                dump_path//" was written after "//integer_text(rows))
+              else if (status == 0) then
+                dims(rank) = int(rows, hsize_t)
+                call h5dset_extent_f(dataset_id, dims(1:rank), status)
+              end if
+            else if (status == 0) then
+              status = 1
+            end if
+            call h5dclose_f(dataset_id, ignored)
+            if (status /= 0 .and. .not. allocated(error)) call make_error(error, "cannot cut "//path)
+          else if (rows > 0) then
+            call make_error(error, path//" is missing, the dump "//dump_path//" was written after "// &
+                            integer_text(rows)//" rows of it")
+          end if
+          if (allocated(error)) return
+        end do
+      end associate
+    end do
+  end subroutine cut_histories
+
+  !> `/run` of a continued run: running again, on these threads.
+  subroutine write_run_restart(file_id, threads, error)
+    integer(hid_t), intent(in) :: file_id
+    integer, intent(in) :: threads
+    type(error_t), allocatable, intent(inout) :: error
+    integer(hid_t) :: group_id
+    integer :: status
+    if (allocated(error)) return
+    call h5gopen_f(file_id, "/run", group_id, status)
+    if (status /= 0) then
+      call make_error(error, "cannot open group /run")
+      return
+    end if
+    call write_string_attribute(group_id, "/run", "status", "running", error)
+    call write_string_attribute(group_id, "/run", "message", "", error)
+    call write_integer_attribute(group_id, "/run", "threads", threads, error)
+    call h5gclose_f(group_id, status)
+  end subroutine write_run_restart
+
+  !> A scalar attribute `name` of the object at `path`, read as a 64-bit integer.
+  subroutine read_long_attribute(file_id, path, name, value, error)
+    integer(hid_t), intent(in) :: file_id
+    character(len=*), intent(in) :: path, name
+    integer(long_int), intent(inout) :: value
+    type(error_t), allocatable, intent(inout) :: error
+    integer(long_int), target :: stored
+    call read_attribute(file_id, path, name, h5kind_to_type(long_int, H5_INTEGER_KIND), c_loc(stored), error)
+    if (.not. allocated(error)) value = stored
+  end subroutine read_long_attribute
+
+  !> A scalar attribute `name` of the object at `path`, read as a real.
+  subroutine read_real_attribute(file_id, path, name, value, error)
+    integer(hid_t), intent(in) :: file_id
+    character(len=*), intent(in) :: path, name
+    real(wp), intent(inout) :: value
+    type(error_t), allocatable, intent(inout) :: error
+    real(wp), target :: stored
+    call read_attribute(file_id, path, name, h5kind_to_type(wp, H5_REAL_KIND), c_loc(stored), error)
+    if (.not. allocated(error)) value = stored
+  end subroutine read_real_attribute
+
+  subroutine read_attribute(file_id, path, name, memory_type, buffer, error)
+    integer(hid_t), intent(in) :: file_id
+    character(len=*), intent(in) :: path, name
+    integer(hid_t), intent(in) :: memory_type
+    type(c_ptr), intent(in) :: buffer
+    type(error_t), allocatable, intent(inout) :: error
+    integer(hid_t) :: object_id, attribute_id
+    type(c_ptr) :: pointer
+    integer :: status, ignored
+    logical :: exists
+    if (allocated(error)) return
+    call h5oopen_f(file_id, path, object_id, status)
+    if (status /= 0) then
+      call make_error(error, "cannot open "//path)
+      return
+    end if
+    call h5aexists_f(object_id, name, exists, status)
+    if (status == 0 .and. exists) then
+      call h5aopen_f(object_id, name, attribute_id, status)
+      pointer = buffer
+      if (status == 0) then
+        call h5aread_f(attribute_id, memory_type, pointer, status)
+        call h5aclose_f(attribute_id, ignored)
+      end if
+    else
+      status = 1
+    end if
+    call h5oclose_f(object_id, ignored)
+    if (status /= 0) call make_error(error, "cannot read the attribute "//name//" of "//path)
+  end subroutine read_attribute
+
+  !> A random number that identifies a run (OS entropy through random_seed).
+  function new_run_id() result(id)
+    integer(long_int) :: id
+    real(wp) :: noise(2)
+    call random_seed()
+    call random_number(noise)
+    id = int(noise(1)*2.0_wp**30, long_int)*2_long_int**31 + int(noise(2)*2.0_wp**31, long_int)
+  end function new_run_id
+
+  pure function long_text(value) result(text)
+    integer(long_int), intent(in) :: value
+    character(len=:), allocatable :: text
+    character(len=24) :: buffer
+    write (buffer, '(i0)') value
+    text = trim(buffer)
+  end function long_text
 
   ! ---------------------------------------------------------------------------------------------
   ! Commits, failures and the XDMF schedule.
@@ -940,11 +1260,13 @@ contains
   end subroutine create_states_group
 
   !> `/run` at the start. Every attribute of the contract is there from the start; the status
-  !> is "running" until `close_results`, so a file left by a killed process says so.
-  subroutine write_run_start(file_id, model, threads, error)
+  !> is "running" until `close_results`, so a file left by a killed process says so. The
+  !> extension `run_id` identifies the run for its restarts.
+  subroutine write_run_start(file_id, model, threads, run_id, error)
     integer(hid_t), intent(in) :: file_id
     type(model_t), intent(in) :: model
     integer, intent(in) :: threads
+    integer(long_int), intent(in) :: run_id
     type(error_t), allocatable, intent(inout) :: error
     integer(hid_t) :: group_id
     integer :: status
@@ -963,6 +1285,7 @@ contains
     call write_real_attribute(group_id, "/run", "end_time", 0.0_wp, error)
     call write_integer_attribute(group_id, "/run", "cycles", 0, error)
     call write_integer_attribute(group_id, "/run", "threads", threads, error)
+    call write_long_attribute(group_id, "/run", "run_id", run_id, error)
     call h5gclose_f(group_id, status)
   end subroutine write_run_start
 

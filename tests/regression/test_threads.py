@@ -41,7 +41,7 @@ REPOSITORY = Path(__file__).resolve().parents[2]
 THREAD_COUNTS = (1, 2, 3)
 SUM_CHUNK_SIZE = 4096          # sum_chunk_size of src/core/fixed_order_sum.f90
 # attributes of /run that may differ between thread counts
-RUN_ATTRIBUTES_ALLOWED_TO_DIFFER = {"threads"}
+RUN_ATTRIBUTES_ALLOWED_TO_DIFFER = {"threads", "run_id"}   # run_id: a random identity of each run
 
 DENSITY, MODULUS, POISSON = 7.85e-6, 210.0, 0.3     # kg/mm^3, GPa: mm, ms, kg, kN units
 YIELD, TANGENT = 0.3, 1.0                           # GPa
