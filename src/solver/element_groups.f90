@@ -78,14 +78,24 @@ contains
     type(nodal_state_t), intent(inout) :: nodes
     real(wp), intent(in) :: step          !< the step just taken (0 at the start)
     integer :: node, k
-    !$omp parallel do schedule(static) default(shared) private(node)
-    do node = 1, nodes%count
-      nodes%internal_force(:, node) = 0.0_wp
-      nodes%internal_moment(:, node) = 0.0_wp
-      nodes%shell_normal_sum(:, node) = 0.0_wp
-      nodes%shell_area_sum(node) = 0.0_wp
-    end do
-    !$omp end parallel do
+    ! (the rotational arrays only where some node has rotations: a pass over memory that a model
+    ! of solids would pay every cycle for nothing)
+    if (nodes%rotational) then
+      !$omp parallel do schedule(static) default(shared) private(node)
+      do node = 1, nodes%count
+        nodes%internal_force(:, node) = 0.0_wp
+        nodes%internal_moment(:, node) = 0.0_wp
+        nodes%shell_normal_sum(:, node) = 0.0_wp
+        nodes%shell_area_sum(node) = 0.0_wp
+      end do
+      !$omp end parallel do
+    else
+      !$omp parallel do schedule(static) default(shared) private(node)
+      do node = 1, nodes%count
+        nodes%internal_force(:, node) = 0.0_wp
+      end do
+      !$omp end parallel do
+    end if
     do k = 1, size(groups)
       call start_phase(groups(k)%group%timer)
       call groups(k)%group%add_internal_forces(model, nodes, step)

@@ -137,12 +137,18 @@ contains
       !$omp parallel do schedule(static) default(shared) private(node)
       do node = 1, nodes%count
         nodes%velocity(:, node) = nodes%velocity(:, node) + average_step*nodes%acceleration(:, node)
+      end do
+      !$omp end parallel do
+      ! (no node accelerates its rotations in a model without shells)
+      if (.not. nodes%rotational) return
+      !$omp parallel do schedule(static) default(shared) private(node)
+      do node = 1, nodes%count
         nodes%angular_velocity(:, node) = nodes%angular_velocity(:, node) + &
                                           average_step*nodes%angular_acceleration(:, node)
       end do
       !$omp end parallel do
     end associate
-    if (state%nodes%rotational) call remove_drilling_rates(state, average_step)
+    call remove_drilling_rates(state, average_step)
   end subroutine advance_velocities
 
   !> Shells have no stiffness about their normal, so the nodes' rotation about it (drilling)
