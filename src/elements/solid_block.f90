@@ -117,14 +117,14 @@ contains
     integer, allocatable :: part_solid_count(:), first_of_part(:), ordered_solids(:), next_slot(:)
     integer, allocatable :: spatial_order(:)
     logical, allocatable :: exposed(:)
-    integer :: part, solid, block_count, solid_count, part_count, lane, current, slot, pass, k
+    integer :: part, solid, block_count, solid_count, part_count, lane, current, slot, k
 
     solid_count = 0
     if (allocated(model%solid_part)) solid_count = size(model%solid_part)
     part_count = 0
     if (allocated(model%parts)) part_count = size(model%parts)
 
-    ! Counting sort of the solids by part (stable, so the spatial order is kept within a part).
+    ! Solids per part, and where each part's list starts.
     allocate (part_solid_count(part_count), first_of_part(part_count + 1), next_slot(part_count))
     part_solid_count = 0
     do solid = 1, solid_count
@@ -140,17 +140,15 @@ contains
     if (solid_count > 0) exposed = exposed_elements(model%coordinates, model%solid_nodes)
     ! three shared nodes make a face: a quadrilateral, or the triangle of a degenerate hexahedron
     if (solid_count > 0) spatial_order = spatial_element_order(model%solid_nodes, model%solid_part, &
-                                                              model%parts%formulation == formulation_fe, face_nodes=3)
+                                                              model%parts%formulation == formulation_fe, &
+                                                              face_nodes=3, leading=exposed)
     next_slot = first_of_part(1:part_count)
-    do pass = 1, 2
-      do k = 1, solid_count
-        solid = spatial_order(k)
-        part = model%solid_part(solid)
-        if (model%parts(part)%formulation /= formulation_fe) cycle
-        if (exposed(solid) .neqv. pass == 1) cycle
-        ordered_solids(next_slot(part)) = solid
-        next_slot(part) = next_slot(part) + 1
-      end do
+    do k = 1, solid_count
+      solid = spatial_order(k)
+      part = model%solid_part(solid)
+      if (model%parts(part)%formulation /= formulation_fe) cycle
+      ordered_solids(next_slot(part)) = solid
+      next_slot(part) = next_slot(part) + 1
     end do
 
     block_count = sum((part_solid_count + block_size - 1)/block_size)

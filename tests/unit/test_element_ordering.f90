@@ -10,8 +10,10 @@
 !>   node 3) and for wedges given as degenerate hexahedra;
 !> - a row of hexahedra joined only at edges is ordered through the nodes they share (colours
 !>   as above), and a one-element part is left alone;
-!> - build_solid_blocks keeps the exposed elements first and its blocks compact on the
-!>   renumbered mesh.
+!> - leading elements come first, and the blocks of the ordered renumbered mesh gather fewer
+!>   distinct nodes than the slabs of natural input order;
+!> - build_solid_blocks keeps the exposed elements first and few colours on the renumbered
+!>   mesh.
 program test_element_ordering
   use kinds, only: wp, long_int, block_size
   use gather_list, only: gather_list_t
@@ -30,6 +32,7 @@ program test_element_ordering
   call test_wedges()
   call test_shells()
   call test_parts_and_small_cases()
+  call test_leading_and_compact_blocks()
   call test_disconnected_and_edge_chain()
   call test_solid_blocks()
   call finish_suite(suite)
@@ -249,6 +252,47 @@ contains
     order = spatial_element_order(element_nodes(:, 1:65), [(1, k=1, 65)], [.true.], 3)
     call check(suite, "65 elements: a permutation", is_permutation(order, 65))
   end subroutine test_parts_and_small_cases
+
+  !> Leading elements (here every tenth of the renumbered 20 x 20 x 5 mesh) come first; the
+  !> blocks of the ordered mesh are compact: they gather fewer distinct nodes than the blocks of
+  !> the natural numbering cut in input order (slabs of 3.2 rows).
+  subroutine test_leading_and_compact_blocks()
+    integer, allocatable :: element_nodes(:, :), renumbered(:, :), element_of(:), node_of(:), order(:)
+    logical, allocatable :: leading(:)
+    integer :: n, k, leading_count
+    real(wp) :: natural_nodes, ordered_nodes
+    character(len=80) :: counts
+    call hexahedral_mesh([20, 20, 5], element_nodes)
+    call renumber_mesh(element_nodes, 21*21*6, renumbered, element_of, node_of)
+    n = size(renumbered, 2)
+    leading = [(mod(element_of(k), 10) == 0, k=1, n)]
+    leading_count = count(leading)
+    order = spatial_element_order(renumbered, [(1, k=1, n)], [.true.], 3, leading)
+    call check(suite, "leading: a permutation", is_permutation(order, n))
+    call check(suite, "leading: leading elements first", all(leading(order(1:leading_count))) .and. &
+               .not. any(leading(order(leading_count + 1:))))
+    natural_nodes = mean_block_nodes(element_nodes, [(k, k=1, n)])
+    order = spatial_element_order(renumbered, [(1, k=1, n)], [.true.], 3)
+    ordered_nodes = mean_block_nodes(renumbered, order)
+    write (counts, '(a,f6.1,a,f6.1)') "distinct nodes per block: natural ", natural_nodes, ", ordered ", ordered_nodes
+    write (*, '(a)') "  hexahedra 20x20x5 "//trim(counts)
+    call check(suite, "compact blocks", ordered_nodes < natural_nodes, trim(counts))
+  end subroutine test_leading_and_compact_blocks
+
+  !> Mean number of distinct nodes of the full blocks of block_size consecutive elements of
+  !> `order`.
+  real(wp) function mean_block_nodes(element_nodes, order)
+    integer, intent(in) :: element_nodes(:, :), order(:)
+    logical :: seen(maxval(element_nodes))
+    integer :: block, total
+    total = 0
+    do block = 1, size(order)/block_size
+      seen = .false.
+      seen(reshape(element_nodes(:, order((block - 1)*block_size + 1:block*block_size)), [8*block_size])) = .true.
+      total = total + count(seen)
+    end do
+    mean_block_nodes = real(total, wp)/real(max(1, size(order)/block_size), wp)
+  end function mean_block_nodes
 
   !> 100 separate hexahedra keep their input order; 2,000 hexahedra in a row, each joined to
   !> the next along one edge only (no common face), are ordered through their shared nodes.
