@@ -18,10 +18,12 @@
 !> solids first) are ordered the same way among themselves before the others, and the others'
 !> first piece fills the block the leading ones left unfinished.
 !>
-!> The deck's order is kept when its blocks gather from fewer cache lines of the nodal arrays
-!> than these would (gathered_lines): a deck numbered by a structured mesher has blocks that
-!> sweep through memory, and on the naturally numbered 100 x 100 x 10 bench block compact
-!> pieces took 9% longer with one thread and 12% with two (and 11 colours instead of 6).
+!> The deck's order is kept unless these blocks share nodes with fewer other blocks
+!> (block_conflicts, the graph the colouring works on): a deck numbered by a structured mesher
+!> has slabs or rings for blocks, which meet fewer neighbours than compact pieces in 3D, colour
+!> in fewer colours and sweep through memory. On the naturally numbered 100 x 100 x 10 bench
+!> block compact pieces took 9% longer with one thread and 12% with two (11 colours, not 6);
+!> on the square tube of 6,400 shells 1% and 4% (6 colours, not 4).
 !>
 !> METIS is serial and seeded with a fixed value, so the order depends on the model only, not on
 !> the thread count. A part of at most block_size elements is one block whatever its order and
@@ -101,9 +103,8 @@ contains
 
   !> All elements (columns of `element_nodes`, node indices >= 1), grouped by part in increasing
   !> part index; within a part the `leading` elements (if given) first, then the others; each
-  !> group in a spatially coherent order (module comment; input order where that gathers from
-  !> fewer cache lines) in the parts for which `part_wanted` is true, in input order in the
-  !> others. `face_nodes` is the number of nodes two elements of
+  !> group in a spatially coherent order (module comment; input order where that is as good) in
+  !> the parts for which `part_wanted` is true, in input order in the others. `face_nodes` is the number of nodes two elements of
   !> a face-connected mesh share across a face: 3 for solids (a quadrilateral face, or the
   !> triangle of a wedge or tetrahedron given as a degenerate hexahedron), 2 for shells (an
   !> edge).
@@ -113,10 +114,10 @@ contains
     integer, intent(in) :: face_nodes
     logical, intent(in), optional :: leading(:)
     integer, allocatable :: order(:)
-    integer, allocatable :: first_of_part(:), next_slot(:), local_node(:), line_stamp(:)
+    integer, allocatable :: first_of_part(:), next_slot(:), local_node(:)
     logical, allocatable :: first(:)
     type(signal_mask_t) :: signal_mask
-    integer :: element, part, part_count, pass, stamp
+    integer :: element, part, part_count, pass
 
     allocate (first(size(element_part)))
     first = .false.
@@ -141,36 +142,47 @@ contains
       end do
     end do
 
-    ! work arrays over all nodes and their cache lines, so that each part costs its own size
-    allocate (local_node(max(0, maxval(element_nodes))), line_stamp(0:3*max(0, maxval(element_nodes))/8))
+    ! a work array over all nodes, so that each part costs only its own size
+    allocate (local_node(max(0, maxval(element_nodes))))
     local_node = 0
-    line_stamp = 0
-    stamp = 0
     ! METIS would catch a SIGTERM and carry on (signal_hold)
     call hold_termination_signal(signal_mask)
     do part = 1, part_count
       if (.not. part_wanted(part)) cycle
       if (first_of_part(part + 1) - first_of_part(part) <= block_size) cycle
       associate (elements => order(first_of_part(part):first_of_part(part + 1) - 1))
-        call order_part(element_nodes, face_nodes, first(elements), elements, local_node, line_stamp, stamp)
+        call order_part(element_nodes, face_nodes, first(elements), elements, local_node)
       end associate
     end do
     call release_held_signals(signal_mask)
   end function spatial_element_order
 
   !> Reorder the elements of one part in place (leading ones first, as they come in). `local_node`
-  !> is zero on entry and on return; `line_stamp` and `stamp` are gathered_lines' work.
-  subroutine order_part(element_nodes, face_nodes, leading, elements, local_node, line_stamp, stamp)
+  !> is zero on entry and on return.
+  subroutine order_part(element_nodes, face_nodes, leading, elements, local_node)
     integer, intent(in) :: element_nodes(:, :), face_nodes
     logical, intent(in) :: leading(:)
     integer, intent(inout) :: elements(:)
-    integer, intent(inout) :: local_node(:), line_stamp(0:), stamp
+    integer, intent(inout) :: local_node(:)
     type(graph_t) :: graph, leading_graph, other_graph
     integer(idx_t) :: options(metis_option_count)
-    integer, allocatable :: order(:), members(:), group(:)
-    integer :: status, filled, k, leading_count
+    integer, allocatable :: order(:), members(:), group(:), used_nodes(:)
+    integer :: status, filled, k, corner, node, node_count, leading_count
 
-    call part_dual_graph(element_nodes, face_nodes, elements, local_node, graph)
+    ! the part's nodes numbered from 1 in order of appearance
+    allocate (used_nodes(size(element_nodes, 1)*size(elements)))
+    node_count = 0
+    do k = 1, size(elements)
+      do corner = 1, size(element_nodes, 1)
+        node = element_nodes(corner, elements(k))
+        if (local_node(node) > 0) cycle
+        node_count = node_count + 1
+        used_nodes(node_count) = node
+        local_node(node) = node_count
+      end do
+    end do
+
+    call part_dual_graph(element_nodes, face_nodes, elements, local_node, node_count, graph)
     status = metis_set_default_options(options)
     options(metis_option_seed + 1) = metis_seed
     options(metis_option_numbering + 1) = 0
@@ -189,68 +201,94 @@ contains
     call cut_into_pieces(other_graph, members(leading_count + 1:), block_size - mod(filled, block_size), &
                          options, order, filled)
     ! a deck numbered by a structured mesher may already have better blocks: keep them then
-    if (gathered_lines(element_nodes, elements(order), line_stamp, stamp) < &
-        gathered_lines(element_nodes, elements, line_stamp, stamp)) elements = elements(order)
+    if (block_conflicts(element_nodes, elements(order), local_node, node_count) < &
+        block_conflicts(element_nodes, elements, local_node, node_count)) elements = elements(order)
+    local_node(used_nodes(1:node_count)) = 0
   end subroutine order_part
 
-  !> Distinct 64-byte cache lines of a nodal array of three reals per node (coordinates,
-  !> velocities, forces) that the blocks of block_size consecutive `elements` touch, summed over
-  !> the blocks: the memory traffic of the element step. It is small when each block is compact
-  !> in the mesh and its nodes are close in memory. `line_stamp(line)` is the last block (counted
-  !> by `stamp` over all calls, so that nothing needs clearing) that touched the line.
-  integer function gathered_lines(element_nodes, elements, line_stamp, stamp)
-    integer, intent(in) :: element_nodes(:, :), elements(:)
-    integer, intent(inout) :: line_stamp(0:), stamp
-    integer :: k, corner, line
-    gathered_lines = 0
+  !> Pairs of blocks (of block_size consecutive `elements`) that share a node, each pair counted
+  !> from both sides: the edges of the graph that the colouring works on. Few when each block
+  !> is a compact patch of the mesh; with blocks spread over the part every block meets nearly
+  !> every other. `local_node` numbers the part's `node_count` nodes from 1.
+  integer function block_conflicts(element_nodes, elements, local_node, node_count)
+    integer, intent(in) :: element_nodes(:, :), elements(:), local_node(:), node_count
+    integer, allocatable :: node_offsets(:), node_blocks(:), last_block(:), next_slot(:), met_by(:)
+    integer :: k, corner, node, block, slot, pass, other
+
+    ! node -> the blocks around it (each once), in two passes: count, then fill
+    allocate (node_offsets(node_count + 1), last_block(node_count), next_slot(node_count))
+    node_offsets = 0
+    do pass = 1, 2
+      last_block = 0
+      do k = 1, size(elements)
+        block = (k - 1)/block_size + 1
+        do corner = 1, size(element_nodes, 1)
+          node = local_node(element_nodes(corner, elements(k)))
+          if (last_block(node) == block) cycle
+          last_block(node) = block
+          if (pass == 1) then
+            node_offsets(node + 1) = node_offsets(node + 1) + 1
+          else
+            node_blocks(next_slot(node)) = block
+            next_slot(node) = next_slot(node) + 1
+          end if
+        end do
+      end do
+      if (pass == 2) exit
+      node_offsets(1) = 1
+      do node = 1, node_count
+        node_offsets(node + 1) = node_offsets(node + 1) + node_offsets(node)
+      end do
+      allocate (node_blocks(node_offsets(node_count + 1) - 1))
+      next_slot = node_offsets(1:node_count)
+    end do
+
+    allocate (met_by((size(elements) + block_size - 1)/block_size))
+    met_by = 0
+    block_conflicts = 0
     do k = 1, size(elements)
-      if (mod(k - 1, block_size) == 0) stamp = stamp + 1
+      block = (k - 1)/block_size + 1
       do corner = 1, size(element_nodes, 1)
-        line = 3*(element_nodes(corner, elements(k)) - 1)/8 ! 24 bytes per node, 64 per line
-        if (line_stamp(line) == stamp) cycle
-        line_stamp(line) = stamp
-        gathered_lines = gathered_lines + 1
+        node = local_node(element_nodes(corner, elements(k)))
+        do slot = node_offsets(node), node_offsets(node + 1) - 1
+          other = node_blocks(slot)
+          if (other == block .or. met_by(other) == block) cycle
+          met_by(other) = block
+          block_conflicts = block_conflicts + 1
+        end do
       end do
     end do
-  end function gathered_lines
+  end function block_conflicts
 
   !> The part's dual graph: elements adjacent when they share a face (`face_nodes` nodes), or,
-  !> when no two share a face, when they share a node. Vertices are the positions in `elements`.
-  subroutine part_dual_graph(element_nodes, face_nodes, elements, local_node, graph)
-    integer, intent(in) :: element_nodes(:, :), face_nodes, elements(:)
-    integer, intent(inout) :: local_node(:)
+  !> when no two share a face, when they share a node. Vertices are the positions in `elements`;
+  !> `local_node` numbers the part's `part_node_count` nodes from 1.
+  subroutine part_dual_graph(element_nodes, face_nodes, elements, local_node, part_node_count, graph)
+    integer, intent(in) :: element_nodes(:, :), face_nodes, elements(:), local_node(:), part_node_count
     type(graph_t), intent(out) :: graph
     integer(idx_t), allocatable :: element_offsets(:), part_nodes(:)
-    integer, allocatable :: used_nodes(:)
     integer(idx_t) :: element_count, node_count, shared_nodes
     type(c_ptr) :: metis_offsets, metis_neighbours
     integer(idx_t), pointer :: offsets(:), neighbours(:)
     integer :: k, corner, node, slot, attempt
     integer(c_int) :: status
 
-    ! The part as a METIS mesh: its nodes numbered from 0 in order of appearance, and each
-    ! element's distinct nodes (a node listed twice would count twice among the shared ones).
+    ! The part as a METIS mesh: nodes numbered from 0, each element's distinct nodes (a node
+    ! listed twice would count twice among the shared ones).
     element_count = size(elements)
-    allocate (element_offsets(element_count + 1), part_nodes(size(element_nodes, 1)*element_count), &
-              used_nodes(size(element_nodes, 1)*element_count))
-    node_count = 0
+    node_count = part_node_count
+    allocate (element_offsets(element_count + 1), part_nodes(size(element_nodes, 1)*element_count))
     slot = 0
     element_offsets(1) = 0
     do k = 1, size(elements)
       do corner = 1, size(element_nodes, 1)
         node = element_nodes(corner, elements(k))
         if (any(element_nodes(1:corner - 1, elements(k)) == node)) cycle
-        if (local_node(node) == 0) then
-          node_count = node_count + 1
-          used_nodes(node_count) = node
-          local_node(node) = node_count
-        end if
         slot = slot + 1
         part_nodes(slot) = local_node(node) - 1
       end do
       element_offsets(k + 1) = slot
     end do
-    local_node(used_nodes(1:node_count)) = 0
 
     allocate (graph%offsets(element_count + 1), graph%neighbours(0))
     graph%offsets = 0

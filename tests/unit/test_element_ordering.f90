@@ -8,6 +8,8 @@
 !>   numbered mesh cut in input order (at most twice as many plus three), where input order
 !>   needs many times more; the same for a quadrilateral shell mesh with triangles (node 4 =
 !>   node 3) and for wedges given as degenerate hexahedra;
+!> - a plate numbered through its thickness first keeps its input order (its blocks meet fewer
+!>   others than compact pieces);
 !> - a row of hexahedra joined only at edges is ordered through the nodes they share (colours
 !>   as above), and a one-element part is left alone;
 !> - leading elements come first, and the blocks of the ordered renumbered mesh gather fewer
@@ -172,11 +174,24 @@ contains
     call check(suite, label//": the renumbering alone needs many colours", unordered > 2*natural + 3, trim(counts))
   end subroutine check_colours
 
+  !> The renumbered mesh is ordered. A plate of 4 x 40 x 40 cells numbered through its
+  !> thickness first keeps its order: its blocks are slabs through the thickness (4 x 16 x 1),
+  !> which meet fewer other blocks than compact pieces would.
   subroutine test_renumbered_hexahedra()
-    integer, allocatable :: element_nodes(:, :), renumbered(:, :), element_of(:), node_of(:)
+    integer, allocatable :: element_nodes(:, :), renumbered(:, :), element_of(:), node_of(:), order(:)
+    integer, allocatable :: plate(:, :), identity(:), parts(:)
+    integer :: k
     call hexahedral_mesh([20, 20, 5], element_nodes)
     call renumber_mesh(element_nodes, 21*21*6, renumbered, element_of, node_of)
     call check_colours("hexahedra 20x20x5", element_nodes, renumbered, 3)
+    call hexahedral_mesh([4, 40, 40], plate)
+    allocate (identity(size(plate, 2)), parts(size(plate, 2)))
+    do k = 1, size(plate, 2)
+      identity(k) = k
+    end do
+    parts = 1
+    order = spatial_element_order(plate, parts, [.true.], 3)
+    call check(suite, "plate numbered through its thickness keeps its order", all(order == identity))
   end subroutine test_renumbered_hexahedra
 
   !> Every cell of a 20 x 20 x 4 mesh cut into two wedges, each a hexahedron with nodes 3 = 4
