@@ -15,7 +15,7 @@ PYTHON ?= python3
 
 HDF5_INCLUDE ?= /usr/include/hdf5/serial
 HDF5_LIBDIR ?= /usr/lib/x86_64-linux-gnu/hdf5/serial
-LIBS := -L$(HDF5_LIBDIR) -lhdf5_fortran -lhdf5 -llapack -lblas
+LIBS := -L$(HDF5_LIBDIR) -lhdf5_fortran -lhdf5 -lmetis -llapack -lblas
 
 BUILD ?= build/$(MODE)
 OBJ := $(BUILD)/obj

@@ -7,7 +7,9 @@
 #     dummy ratios): CPU time per cycle relative to the all-FE block;
 #  3. an all-EFG block: nanoseconds per interior particle per cycle and set-up per particle;
 #  4. Belytschko-Tsay shells: the square tube of inputs/tube_crush (6,400 shells, NIP 5, MAT_024,
-#     single-surface contact), its first 5 mm of crush: nanoseconds per shell per cycle.
+#     single-surface contact), its first 5 mm of crush: nanoseconds per shell per cycle;
+#  5. element order: a block of 100 x 100 x 10 hexahedra numbered naturally and at random, ncpu=1
+#     and 2 (tools/bench_ordering.py: solid phase, medians of 3 alternating runs).
 set -euo pipefail
 python=${PYTHON:-python3}
 directory=build/bench
@@ -28,3 +30,5 @@ run "$directory/coupled_19.k" coupled_19 1
 run "$directory/efg_block.k" efg_block 1
 run "$directory/tube.k" tube_shells 1
 "$python" tools/bench_report.py "$directory"
+echo
+"$python" tools/bench_ordering.py --directory "$directory/ordering" | sed -n '/^Solid phase/,$p'

@@ -44,6 +44,7 @@ module shell_block
                                    update_plane_stress_block, plane_stress_plastic_strain
   use element_work, only: add_force_work, smallest_time_step
   use gauss_legendre, only: gauss_legendre_rule
+  use element_ordering, only: spatial_element_order
   implicit none
   private
 
@@ -97,13 +98,14 @@ module shell_block
 
 contains
 
-  !> Group the model's shells into blocks: parts in model order, shells of a part in input
-  !> order, at most block_size per block; only finite element (not rigid) parts.
+  !> Group the model's shells into blocks: parts in model order, shells of a part in its
+  !> spatially coherent order (element_ordering: a block is a compact patch of the mesh whatever
+  !> the deck's numbering), at most block_size per block; only finite element (not rigid) parts.
   subroutine build_shell_blocks(model, blocks)
     type(model_t), intent(in) :: model
     type(shell_block_t), allocatable, intent(out) :: blocks(:)
-    integer, allocatable :: per_part(:), shells_around(:)
-    integer :: part, shell, block_count, lane, current, part_count, shell_count, corner
+    integer, allocatable :: per_part(:), shells_around(:), spatial_order(:)
+    integer :: part, shell, block_count, lane, current, part_count, shell_count, corner, k
 
     shell_count = 0
     if (allocated(model%shell_part)) shell_count = size(model%shell_part)
@@ -125,11 +127,15 @@ contains
     end do
     block_count = sum((per_part + block_size - 1)/block_size)
     allocate (blocks(block_count))
+    ! two shared nodes make a common edge
+    if (shell_count > 0) spatial_order = spatial_element_order(model%shell_nodes, model%shell_part, &
+                                                              model%parts%formulation == formulation_fe, face_nodes=2)
     current = 0
     do part = 1, part_count
       if (per_part(part) == 0) cycle
       lane = block_size
-      do shell = 1, shell_count
+      do k = 1, shell_count
+        shell = spatial_order(k)
         if (model%shell_part(shell) /= part) cycle
         if (lane == block_size) then
           if (current > 0) call finish_block(model, blocks(current))

@@ -46,6 +46,7 @@ module solid_block
                        add_point_gradient_norm, deviatoric_mode_trace_bound
   use element_work, only: add_force_work, smallest_time_step
   use solid_exposure, only: exposed_elements
+  use element_ordering, only: spatial_element_order
   use element_time_step, only: bulk_viscosity_pressure, solid_element_time_steps, eigenvalue_time_steps
   implicit none
   private
@@ -103,8 +104,10 @@ module solid_block
 contains
 
   !> Group the model's solids into blocks: parts in model order; in each part first the solids
-  !> at a corner or edge of the mesh (solid_exposure), then the others, each group in input
-  !> order, at most block_size per block (so that the other blocks skip the eigenvalue bound).
+  !> at a corner or edge of the mesh (solid_exposure), then the others, at most block_size per
+  !> block (so that the other blocks skip the eigenvalue bound). Each group follows the part's
+  !> spatially coherent order (element_ordering), so that a block is a compact patch of the
+  !> mesh whatever the deck's numbering.
   !> Only parts discretised with finite elements (formulation_fe) get blocks; EFG and rigid
   !> parts are handled elsewhere. Sets every field, density = material density, exact reference
   !> volumes, zero stress, energies and history.
@@ -112,15 +115,16 @@ contains
     type(model_t), intent(in) :: model
     type(solid_block_t), allocatable, intent(out) :: blocks(:)
     integer, allocatable :: part_solid_count(:), first_of_part(:), ordered_solids(:), next_slot(:)
+    integer, allocatable :: spatial_order(:)
     logical, allocatable :: exposed(:)
-    integer :: part, solid, block_count, solid_count, part_count, lane, current, slot, pass
+    integer :: part, solid, block_count, solid_count, part_count, lane, current, slot, k
 
     solid_count = 0
     if (allocated(model%solid_part)) solid_count = size(model%solid_part)
     part_count = 0
     if (allocated(model%parts)) part_count = size(model%parts)
 
-    ! Counting sort of the solids by part (stable, so input order is kept within a part).
+    ! Solids per part, and where each part's list starts.
     allocate (part_solid_count(part_count), first_of_part(part_count + 1), next_slot(part_count))
     part_solid_count = 0
     do solid = 1, solid_count
@@ -134,15 +138,17 @@ contains
     allocate (ordered_solids(first_of_part(part_count + 1) - 1))
     allocate (exposed(solid_count))
     if (solid_count > 0) exposed = exposed_elements(model%coordinates, model%solid_nodes)
+    ! three shared nodes make a face: a quadrilateral, or the triangle of a degenerate hexahedron
+    if (solid_count > 0) spatial_order = spatial_element_order(model%solid_nodes, model%solid_part, &
+                                                              model%parts%formulation == formulation_fe, &
+                                                              face_nodes=3, leading=exposed)
     next_slot = first_of_part(1:part_count)
-    do pass = 1, 2
-      do solid = 1, solid_count
-        part = model%solid_part(solid)
-        if (model%parts(part)%formulation /= formulation_fe) cycle
-        if (exposed(solid) .neqv. pass == 1) cycle
-        ordered_solids(next_slot(part)) = solid
-        next_slot(part) = next_slot(part) + 1
-      end do
+    do k = 1, solid_count
+      solid = spatial_order(k)
+      part = model%solid_part(solid)
+      if (model%parts(part)%formulation /= formulation_fe) cycle
+      ordered_solids(next_slot(part)) = solid
+      next_slot(part) = next_slot(part) + 1
     end do
 
     block_count = sum((part_solid_count + block_size - 1)/block_size)

@@ -3,7 +3,7 @@
 !> *MAT_PLASTIC_KINEMATIC under a compressive velocity field (plastic after a few cycles).
 !> Not a unit test (no pass/fail); build it against the release library, e.g.
 !>   gfortran -O3 -march=native -fopenmp -Ibuild/release/mod tests/unit/bench_solid_kernels.f90 \
-!>            build/release/lib/libcrashfree.a -o build/release/bench_solid_kernels
+!>            build/release/lib/libcrashfree.a -lmetis -o build/release/bench_solid_kernels
 program bench_solid_kernels
   use, intrinsic :: iso_fortran_env, only: int64, output_unit
   use kinds, only: wp, block_size
