@@ -8,7 +8,7 @@ module explicit_run
   use model, only: model_t
   use explicit_state, only: explicit_state_t
   use run_state, only: run_state_t, phase_output
-  use explicit_solver, only: start_run, advance_and_check, check_distortion, summarise
+  use explicit_solver, only: start_run, advance_and_check, reached_end, check_distortion, summarise
   use run_output, only: write_due_output
   use results_file, only: results_file_t
   use run_summary, only: run_summary_t
@@ -40,8 +40,7 @@ contains
       ! the run state at the end of the dump's cycle, before its output
       call resume_run(restart, run, error)
       if (allocated(error)) return
-      finished = run%state%time >= model%end_time*(1.0_wp - 1.0e-12_wp) .or. &
-                 (model%end_cycle > 0 .and. run%state%cycle >= model%end_cycle)
+      finished = reached_end(model, run%state)
     else
       ! cycle 0: forces and accelerations of the initial state (unless its motion is already
       ! beyond any physical run, or mass scaling added more than ENDMAS allows)

@@ -43,7 +43,7 @@ module explicit_solver
   implicit none
   private
 
-  public :: start_run, advance_and_check, check_distortion, summarise
+  public :: start_run, advance_and_check, reached_end, check_distortion, summarise
 
 contains
 
@@ -73,10 +73,17 @@ contains
     call check_runaway_motion(model, run%state, 0.5_wp*(run%state%time_step + run%state%next_time_step), error)
     if (allocated(error)) return
     call advance_one_cycle(model, run)
-    finished = run%state%time >= model%end_time*(1.0_wp - 1.0e-12_wp) .or. &
-               (model%end_cycle > 0 .and. run%state%cycle >= model%end_cycle)
+    finished = reached_end(model, run%state)
     call check_state(model, run, finished, error)
   end subroutine advance_and_check
+
+  !> Whether the run has reached ENDTIM (to round-off) or ENDCYC.
+  logical function reached_end(model, state)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(in) :: state
+    reached_end = state%time >= model%end_time*(1.0_wp - 1.0e-12_wp) .or. &
+                  (model%end_cycle > 0 .and. state%cycle >= model%end_cycle)
+  end function reached_end
 
   !> One central-difference cycle from t^n to t^{n+1} = t^n + dt, dt = state%next_time_step.
   subroutine advance_one_cycle(model, run)
