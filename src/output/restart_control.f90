@@ -24,6 +24,7 @@ module restart_control
   use, intrinsic :: iso_c_binding, only: c_char, c_null_char, c_size_t, c_ptr, c_associated
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
   use kinds, only: wp
+  use text_format, only: integer_text
   use error_handling, only: error_t, make_error
   use version, only: crashfree_version
   use model, only: model_t
@@ -500,12 +501,4 @@ contains
     if (blank == 0) return
     path = line(18 + blank:)
   end function file_of
-
-  pure function integer_text(value) result(text)
-    integer, intent(in) :: value
-    character(len=:), allocatable :: text
-    character(len=24) :: buffer
-    write (buffer, '(i0)') value
-    text = trim(buffer)
-  end function integer_text
 end module restart_control

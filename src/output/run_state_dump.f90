@@ -32,6 +32,7 @@
 !> ```
 module run_state_dump
   use kinds, only: wp
+  use text_format, only: integer_text
   use error_handling, only: error_t, make_error
   use explicit_state, only: explicit_state_t, energy_totals_t, run_watch_t
   use run_state, only: run_state_t
@@ -70,15 +71,15 @@ contains
       end do
       call exchange_restart_count(store, "rigid/count", "rigid bodies", size(state%rigid), error)
       do k = 1, size(state%rigid)
-        call exchange_rigid_body(store, "rigid/"//number(k), state%rigid(k), error)
+        call exchange_rigid_body(store, "rigid/"//integer_text(k), state%rigid(k), error)
       end do
       call exchange_restart_count(store, "walls/count", "rigid walls", size(state%walls), error)
       do k = 1, size(state%walls)
-        call exchange_wall(store, "walls/"//number(k), state%walls(k), error)
+        call exchange_wall(store, "walls/"//integer_text(k), state%walls(k), error)
       end do
       call exchange_restart_count(store, "contacts/count", "contacts", size(state%contacts), error)
       do k = 1, size(state%contacts)
-        call exchange_contact(store, "contacts/"//number(k), state%contacts(k), error)
+        call exchange_contact(store, "contacts/"//integer_text(k), state%contacts(k), error)
       end do
       call exchange_energy(store, "energy", state%energy, error)
       call exchange_watch(store, "watch", state%watch, error)
@@ -178,7 +179,7 @@ contains
     call exchange_restart(store, path//"/force", contact%force, error)
     call exchange_restart(store, path//"/impulse", contact%impulse, error)
     do p = 1, contact%pass_count
-      call exchange_contact_pass(store, path//"/passes/"//number(p), contact%passes(p), error)
+      call exchange_contact_pass(store, path//"/passes/"//integer_text(p), contact%passes(p), error)
     end do
   end subroutine exchange_contact
 
@@ -312,7 +313,7 @@ contains
       call write_restart(store, path//"/count", histories%count, error)
       do k = 1, histories%count
         associate (series => histories%series(k))
-          series_path = path//"/"//number(k)
+          series_path = path//"/"//integer_text(k)
           call write_restart(store, series_path//"/group", series%group, error)
           call write_restart(store, series_path//"/names", joined(series%names), error)
           call write_restart(store, series_path//"/widths", series%widths, error)
@@ -327,12 +328,12 @@ contains
     call read_restart(store, path//"/count", stored_count, error)
     if (allocated(error)) return
     if (histories%count /= 0 .and. histories%count /= stored_count) then
-      call make_error(error, "restart dump "//store%path//": it holds "//number(stored_count)// &
-                      " history series, this model has "//number(histories%count))
+      call make_error(error, "restart dump "//store%path//": it holds "//integer_text(stored_count)// &
+                      " history series, this model has "//integer_text(histories%count))
       return
     end if
     do k = 1, stored_count
-      series_path = path//"/"//number(k)
+      series_path = path//"/"//integer_text(k)
       call read_restart(store, series_path//"/group", group, error)
       call read_restart(store, series_path//"/names", names, error)
       call read_restart(store, series_path//"/count", row_count, error)
@@ -344,7 +345,7 @@ contains
       if (k > histories%count) then
         call add_history_series(histories, group, columns, widths, row_count, index)
       else if (histories%series(k)%group /= group .or. size(histories%series(k)%widths) /= size(widths)) then
-        call make_error(error, "restart dump "//store%path//": history series "//number(k)//" is "//group// &
+        call make_error(error, "restart dump "//store%path//": history series "//integer_text(k)//" is "//group// &
                         ", this model's is "//histories%series(k)%group)
         return
       else if (any(histories%series(k)%widths /= widths)) then
@@ -443,12 +444,4 @@ contains
       if (text(k:k) == " ") count_blanks = count_blanks + 1
     end do
   end function count_blanks
-
-  pure function number(value) result(text)
-    integer, intent(in) :: value
-    character(len=:), allocatable :: text
-    character(len=24) :: buffer
-    write (buffer, '(i0)') value
-    text = trim(buffer)
-  end function number
 end module run_state_dump

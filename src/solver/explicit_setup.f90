@@ -3,6 +3,7 @@
 !> (forces and the first step come from the time loop's own cycle 0).
 module explicit_setup
   use kinds, only: wp
+  use text_format, only: integer_text
   use fixed_order_sum, only: chunk_count
   use error_handling, only: error_t, make_error
   use model, only: model_t
@@ -102,8 +103,8 @@ contains
     do k = 1, size(model%loads)
       call note_particle(model%loads(k)%node)
     end do
-    if (count > 0) text = "warning: "//trim(id_text(count))//" constraint(s) or load(s) act on interior "// &
-      "particles of meshfree parts (node "//trim(id_text(model%node_ids(first)))//" first): they act on "// &
+    if (count > 0) text = "warning: "//trim(integer_text(count))//" constraint(s) or load(s) act on interior "// &
+      "particles of meshfree parts (node "//trim(integer_text(model%node_ids(first)))//" first): they act on "// &
       "generalized displacements, not on the nodes' own motion; put them on the parts' surfaces"
     if (model%mass_scaled_time_step /= 0.0_wp) then
       if (len(text) > 0) text = text//new_line('a')
@@ -117,11 +118,4 @@ contains
       if (first == 0) first = node
     end subroutine note_particle
   end function set_up_warnings
-
-  pure function id_text(id) result(text)
-    integer, intent(in) :: id
-    character(len=12) :: text
-    write (text, '(i0)') id
-  end function id_text
-
 end module explicit_setup

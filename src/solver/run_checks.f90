@@ -21,6 +21,7 @@
 module run_checks
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp
+  use text_format, only: integer_text
   use error_handling, only: error_t, make_error
   use model, only: model_t, law_null
   use explicit_state, only: explicit_state_t, energy_totals_t
@@ -464,12 +465,4 @@ contains
     end if
     text = trim(adjustl(buffer))
   end function real_text
-
-  pure function integer_text(value) result(text)
-    integer, intent(in) :: value
-    character(len=:), allocatable :: text
-    character(len=16) :: buffer
-    write (buffer, '(i0)') value
-    text = trim(buffer)
-  end function integer_text
 end module run_checks
