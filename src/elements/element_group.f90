@@ -84,6 +84,9 @@ module element_group
     procedure :: to_physical
     !> Optional: the element whose density mass scaling raised most, and the factor.
     procedure :: most_scaled
+    !> For kinds whose blocks report a step, critical element and failed element each: the
+    !> header from those arrays, in block order.
+    procedure, non_overridable :: header_from_blocks
     !> Optional: the thinnest element (shells; bounds the angular velocities of the run checks).
     procedure :: thinnest
     !> Optional: count the elements folded at a corner, warn when more are (solids).
@@ -178,6 +181,27 @@ contains
     character(len=:), allocatable :: text
     text = self%describe(model, self%failed_element)//" inverted"
   end function failure_text
+
+  !> The smallest block step and the element that sets it (the first block on a tie: the same
+  !> for any thread count), the first failed element, and whether a step was NaN (the ordered
+  !> comparisons skip it).
+  subroutine header_from_blocks(self, block_time_step, block_critical_element, block_failed_element)
+    class(element_group_t), intent(inout) :: self
+    real(wp), intent(in) :: block_time_step(:)
+    integer, intent(in) :: block_critical_element(:), block_failed_element(:)
+    integer :: b
+    self%stable_time_step = huge(1.0_wp)
+    self%critical_element = 0
+    self%failed_element = 0
+    do b = 1, size(block_time_step)
+      if (block_time_step(b) < self%stable_time_step) then
+        self%stable_time_step = block_time_step(b)
+        self%critical_element = block_critical_element(b)
+      end if
+      if (self%failed_element == 0) self%failed_element = block_failed_element(b)
+    end do
+    self%step_not_finite = any(block_time_step /= block_time_step)
+  end subroutine header_from_blocks
 
   subroutine to_physical(self, field, physical)
     class(element_group_t), intent(in) :: self

@@ -6,7 +6,7 @@ module element_work
   implicit none
   private
 
-  public :: add_force_work, smallest_time_step, booked_energy, add_kinetic_energy, scale_block_density
+  public :: add_force_work, smallest_time_step, booked_energy, add_kinetic_energy, scale_block_density, raise_largest_scaling
 
 contains
 
@@ -89,4 +89,22 @@ contains
       density(i) = density(i)*factor
     end do
   end subroutine scale_block_density
+
+  !> The lane whose density mass scaling raised most over the material's, when above `largest`:
+  !> `largest` and `element` (its entry of `elements`) are raised (the mass-scaling report).
+  pure subroutine raise_largest_scaling(nel, density, material_density, elements, largest, element)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: density(block_size), material_density
+    integer, intent(in) :: elements(block_size)
+    real(wp), intent(inout) :: largest
+    integer, intent(inout) :: element
+    integer :: i
+    if (.not. material_density > 0.0_wp) return
+    do i = 1, nel
+      if (density(i)/material_density > largest) then
+        largest = density(i)/material_density
+        element = elements(i)
+      end if
+    end do
+  end subroutine raise_largest_scaling
 end module element_work

@@ -13,7 +13,7 @@ module shell_group
   use run_summary, only: run_summary_t
   use nodal_state, only: nodal_state_t
   use element_group, only: element_group_t, element_results_t
-  use element_work, only: booked_energy, add_kinetic_energy, scale_block_density
+  use element_work, only: booked_energy, add_kinetic_energy, scale_block_density, raise_largest_scaling
   use shell_block, only: shell_block_t, build_shell_blocks, shell_block_masses, shell_block_time_steps, &
                          compute_shell_block, shell_block_element_results
   implicit none
@@ -151,17 +151,7 @@ contains
       end do
       !$omp end parallel do
     end do
-    self%stable_time_step = huge(1.0_wp)
-    self%critical_element = 0
-    self%failed_element = 0
-    do b = 1, size(self%blocks)
-      if (self%block_time_step(b) < self%stable_time_step) then
-        self%stable_time_step = self%block_time_step(b)
-        self%critical_element = self%block_critical_element(b)
-      end if
-      if (self%failed_element == 0) self%failed_element = self%block_degenerate_element(b)
-    end do
-    self%step_not_finite = any(self%block_time_step /= self%block_time_step)
+    call self%header_from_blocks(self%block_time_step, self%block_critical_element, self%block_degenerate_element)
   end subroutine add_internal_forces
 
   !> internal_force and internal_moment of the block's nodes += the shells' nodal forces and
@@ -262,17 +252,12 @@ contains
     type(model_t), intent(in) :: model
     real(wp), intent(inout) :: largest
     integer, intent(inout) :: element
-    real(wp) :: factor
-    integer :: b, lane
+    integer :: b
     do b = 1, size(self%blocks)
-      do lane = 1, self%blocks(b)%element_count
-        if (.not. model%materials(self%blocks(b)%material)%density > 0.0_wp) cycle
-        factor = self%blocks(b)%density(lane)/model%materials(self%blocks(b)%material)%density
-        if (factor > largest) then
-          largest = factor
-          element = self%blocks(b)%elements(lane)
-        end if
-      end do
+      associate (block => self%blocks(b))
+        call raise_largest_scaling(block%element_count, block%density, model%materials(block%material)%density, &
+                                   block%elements, largest, element)
+      end associate
     end do
   end subroutine most_scaled
 

@@ -11,7 +11,7 @@ module solid_group
   use run_summary, only: run_summary_t
   use nodal_state, only: nodal_state_t
   use element_group, only: element_group_t, element_results_t, distortion_t
-  use element_work, only: booked_energy, add_kinetic_energy, scale_block_density
+  use element_work, only: booked_energy, add_kinetic_energy, scale_block_density, raise_largest_scaling
   use solid_block, only: solid_block_t, build_solid_blocks, solid_block_corner_masses, solid_block_time_steps, &
                          compute_solid_block, solid_block_element_results
   use distortion_check, only: check_solid_distortion
@@ -151,18 +151,7 @@ contains
       end do
       !$omp end parallel do
     end do
-    ! the header, in block order (the same element for any thread count)
-    self%stable_time_step = huge(1.0_wp)
-    self%critical_element = 0
-    self%failed_element = 0
-    do b = 1, size(self%blocks)
-      if (self%block_time_step(b) < self%stable_time_step) then
-        self%stable_time_step = self%block_time_step(b)
-        self%critical_element = self%block_critical_element(b)
-      end if
-      if (self%failed_element == 0) self%failed_element = self%block_inverted_element(b)
-    end do
-    self%step_not_finite = any(self%block_time_step /= self%block_time_step)
+    call self%header_from_blocks(self%block_time_step, self%block_critical_element, self%block_inverted_element)
   end subroutine add_internal_forces
 
   subroutine add_energies(self, step_correction, internal, hourglass)
@@ -237,17 +226,12 @@ contains
     type(model_t), intent(in) :: model
     real(wp), intent(inout) :: largest
     integer, intent(inout) :: element
-    real(wp) :: factor
-    integer :: b, lane
+    integer :: b
     do b = 1, size(self%blocks)
-      do lane = 1, self%blocks(b)%element_count
-        if (.not. model%materials(self%blocks(b)%material)%density > 0.0_wp) cycle
-        factor = self%blocks(b)%density(lane)/model%materials(self%blocks(b)%material)%density
-        if (factor > largest) then
-          largest = factor
-          element = self%blocks(b)%elements(lane)
-        end if
-      end do
+      associate (block => self%blocks(b))
+        call raise_largest_scaling(block%element_count, block%density, model%materials(block%material)%density, &
+                                   block%elements, largest, element)
+      end associate
     end do
   end subroutine most_scaled
 
