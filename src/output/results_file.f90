@@ -156,7 +156,6 @@ contains
     integer, intent(in) :: threads              !< OpenMP threads of the run
     type(error_t), allocatable, intent(out) :: error
     type(error_t), allocatable :: space_error
-    character(len=:), allocatable :: holder
     integer(hid_t) :: access_list
     integer :: status, ignored
 
@@ -190,18 +189,8 @@ contains
     results%reserved_end = 0
 
     ! The lock before anything else: a second run must not truncate the first one's file.
-    call acquire_file_lock(results%lock, join_path(directory, job_id//".lock"), error, holder)
-    if (allocated(error)) then
-      if (len(holder) > 0) then
-        error%message = "another run (process "//holder//") is writing job '"//job_id// &
-                        "' in the output directory '"//directory_text(directory)// &
-                        "' (lock file "//join_path(directory, job_id//".lock")// &
-                        "); wait for it to end, or give this run another outdir= or jobid="
-      else
-        error%message = "results file "//results%h5_path//": "//error%message
-      end if
-      return
-    end if
+    call lock_job(results, directory, job_id, error)
+    if (allocated(error)) return
 
     ! Before the library starts (a later call in the same process changes nothing): no exit
     ! handler, see the module comment.
@@ -515,7 +504,6 @@ contains
     type(history_set_t), intent(in) :: histories
     character(len=*), intent(in) :: dump_path
     type(error_t), allocatable, intent(out) :: error
-    character(len=:), allocatable :: holder
     integer(hid_t) :: access_list
     integer(long_int) :: file_run_id
     integer, allocatable :: grown(:)
@@ -549,18 +537,8 @@ contains
       call move_alloc(grown, results%history_rows)
     end if
 
-    call acquire_file_lock(results%lock, join_path(directory, job_id//".lock"), error, holder)
-    if (allocated(error)) then
-      if (len(holder) > 0) then
-        error%message = "another run (process "//holder//") is writing job '"//job_id// &
-                        "' in the output directory '"//directory_text(directory)// &
-                        "' (lock file "//join_path(directory, job_id//".lock")// &
-                        "); wait for it to end, or give this run another outdir= or jobid="
-      else
-        error%message = "results file "//results%h5_path//": "//error%message
-      end if
-      return
-    end if
+    call lock_job(results, directory, job_id, error)
+    if (allocated(error)) return
     call h5dont_atexit_f(ignored)
     call h5open_f(status)
     call h5eset_auto_f(0, status)
@@ -1699,4 +1677,22 @@ contains
     end if
     text = trim(adjustl(buffer))
   end function real_text
+
+  !> The job's lock file DIR/JOBID.lock, or an error naming the run that holds it.
+  subroutine lock_job(results, directory, job_id, error)
+    type(results_file_t), intent(inout) :: results
+    character(len=*), intent(in) :: directory, job_id
+    type(error_t), allocatable, intent(out) :: error
+    character(len=:), allocatable :: holder
+    call acquire_file_lock(results%lock, join_path(directory, job_id//".lock"), error, holder)
+    if (.not. allocated(error)) return
+    if (len(holder) > 0) then
+      error%message = "another run (process "//holder//") is writing job '"//job_id// &
+                      "' in the output directory '"//directory_text(directory)// &
+                      "' (lock file "//join_path(directory, job_id//".lock")// &
+                      "); wait for it to end, or give this run another outdir= or jobid="
+    else
+      error%message = "results file "//results%h5_path//": "//error%message
+    end if
+  end subroutine lock_job
 end module results_file
