@@ -10,7 +10,7 @@
 !>
 !> The rows keep the order in which the names were added: on equal spelling distance the
 !> earlier name is suggested. gfortran cannot hold procedure pointers in a named constant, so
-!> `keyword_table()` builds the table on each call (66 rows; once per deck, and per unknown
+!> `keyword_table()` builds the table on each call (about 100 rows; once per deck, and per unknown
 !> keyword).
 module deck_keyword_table
   use error_handling, only: error_list_t
@@ -37,9 +37,11 @@ module deck_keyword_table
     read_planar_walls, read_cylinder_walls, read_segment_loads, read_segment_set_loads, &
     read_nonuniform_segment_loads
   use deck_controls, only: read_title, read_termination, read_time_step, read_hourglass_control, &
-    read_bulk_viscosity, read_energy_control, read_implicit_general, read_implicit_solution
+    read_bulk_viscosity, read_energy_control, read_implicit_general, read_implicit_solution, &
+    read_unused_control, read_sensor_definition
   use deck_database, only: read_plot_output, read_glstat_output, read_matsum_output, read_nodout_output, &
-    read_rwforc_output, read_history_nodes, read_history_node_sets, read_d3dump_output, read_runrsf_output
+    read_rwforc_output, read_history_nodes, read_history_node_sets, read_d3dump_output, read_runrsf_output, &
+    read_unused_output
   use deck_rigid_bodies, only: read_rigid_materials, read_rigid_motions, read_nodal_rigid_bodies, &
     read_element_masses
   use deck_contact, only: read_nodes_to_surface_contacts, read_surface_to_surface_contacts, &
@@ -94,7 +96,7 @@ contains
       keyword_entry_t("TITLE", reader=read_title), &
       keyword_entry_t("NODE", fills=[list_nodes, list_none], reader=read_nodes), &
       keyword_entry_t("ELEMENT_SOLID", fills=[list_solids, list_none], reader=read_solid_elements), &
-      keyword_entry_t("PART", fills=[list_parts, list_none], reader=read_parts), &
+      keyword_entry_t("PART", options="CONTACT", fills=[list_parts, list_none], reader=read_parts), &
       keyword_entry_t("SECTION_SOLID", options="TITLE", fills=[list_sections, list_none], &
                       reader=read_solid_sections), &
       keyword_entry_t("SECTION_SOLID_EFG", options="TITLE", fills=[list_sections, list_none], &
@@ -107,6 +109,38 @@ contains
       keyword_entry_t("CONTROL_TERMINATION", reader=read_termination), &
       keyword_entry_t("CONTROL_TIMESTEP", reader=read_time_step), &
       keyword_entry_t("CONTROL_ENERGY", reader=read_energy_control), &
+      ! read, not acted upon: LS-DYNA's bookkeeping, display and output files
+      keyword_entry_t("CONTROL_PARALLEL", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_OUTPUT", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_CPU", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_SHELL", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_SOLID", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_ACCURACY", reader=read_unused_control), &
+      keyword_entry_t("DATABASE_EXTENT_BINARY", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_FORMAT", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_BINARY_INTFOR", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_BINARY_D3THDT", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_SPCFORC", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_SLEOUT", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_SECFORC", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_ELOUT", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_BNDOUT", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_NCFORC", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_SWFORC", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_JNTFORC", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_CROSS_SECTION_PLANE", options="ID", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_CROSS_SECTION_SET", options="ID", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_HISTORY_SHELL", options="ID", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_HISTORY_SHELL_SET", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_HISTORY_SOLID", options="ID", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_HISTORY_SOLID_SET", reader=read_unused_output), &
+      keyword_entry_t("SENSOR_DEFINE_NODE", options="SET", reader=read_sensor_definition), &
+      keyword_entry_t("SENSOR_DEFINE_ELEMENT", options="SET", reader=read_sensor_definition), &
+      keyword_entry_t("SENSOR_DEFINE_FORCE", reader=read_sensor_definition), &
+      keyword_entry_t("SENSOR_DEFINE_FUNCTION", reader=read_sensor_definition), &
+      keyword_entry_t("SENSOR_DEFINE_MISC", reader=read_sensor_definition), &
+      keyword_entry_t("SENSOR_DEFINE_CALC-MATH", reader=read_sensor_definition), &
+      keyword_entry_t("SENSOR_DEFINE_ANGLE", reader=read_sensor_definition), &
       keyword_entry_t("SET_NODE_LIST", options="TITLE", fills=[list_node_sets, list_none], entries=per_block, &
                       reader=read_node_set), &
       keyword_entry_t("SET_NODE_LIST_GENERATE", options="TITLE", fills=[list_node_sets, list_none], &

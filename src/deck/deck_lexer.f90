@@ -40,11 +40,16 @@ module deck_lexer
   end type source_file_t
 
   !> One keyword and its data lines (indices into the line table; none when last < first).
+  !> `last_line` is the last line that is not blank; the blank lines after it, up to
+  !> `end_line`, separate it from the next keyword. They are cards only where a definition
+  !> still needs a card (a blank card: all its fields take their defaults), never the start
+  !> of another definition.
   type :: keyword_block_t
     character(len=:), allocatable :: name      !< upper case, without `*` and format suffix
     integer :: keyword_line = 0
     integer :: first_line = 1
     integer :: last_line = 0
+    integer :: end_line = 0                    !< last line, trailing blank lines included
     integer :: format = format_standard
   end type keyword_block_t
 
@@ -670,9 +675,12 @@ contains
     type(open_block_t), intent(inout) :: block
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
+    integer :: end_line
 
-    ! Trailing blank lines only separate keywords; a block of nothing but blank lines keeps
-    ! one, which then reads as a card of defaults.
+    ! Trailing blank lines separate keywords and start no definition; they are kept (end_line)
+    ! for a definition that still needs a card, which is then a blank card of defaults. A
+    ! block of nothing but blank lines keeps one, which reads as a card of defaults.
+    end_line = block%last_line
     do while (block%last_line > block%first_line)
       if (.not. is_blank_line(deck, block%last_line)) exit
       block%last_line = block%last_line - 1
@@ -680,6 +688,7 @@ contains
     select case (block%kind)
     case (block_regular)
       deck%blocks(deck%block_count)%last_line = block%last_line
+      deck%blocks(deck%block_count)%end_line = end_line
     case (block_include)
       call run_includes(deck, file, file_format, chain, block, log, warnings)
     case (block_parameter)
@@ -925,6 +934,7 @@ contains
         larger(k)%keyword_line = deck%blocks(k)%keyword_line
         larger(k)%first_line = deck%blocks(k)%first_line
         larger(k)%last_line = deck%blocks(k)%last_line
+        larger(k)%end_line = deck%blocks(k)%end_line
         larger(k)%format = deck%blocks(k)%format
       end do
       call move_alloc(larger, deck%blocks)
@@ -934,6 +944,7 @@ contains
     deck%blocks(deck%block_count)%keyword_line = block%keyword_line
     deck%blocks(deck%block_count)%first_line = block%first_line
     deck%blocks(deck%block_count)%last_line = block%last_line
+    deck%blocks(deck%block_count)%end_line = block%last_line
     deck%blocks(deck%block_count)%format = block%format
   end subroutine add_block
 
