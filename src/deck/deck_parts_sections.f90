@@ -84,7 +84,7 @@ contains
         if (.not. require_card(deck, block, line, standard_widths, card, log, "the contact "// &
             "card (FS FD DC VC OPTT SFT SSF CPARM8) of *PART_CONTACT", "FS")) exit
         do k = 1, 8
-          call warn_if_set(deck, card, k, contact_names(k), "part-wise contact values are "// &
+          call warn_if_set(deck, card, k, trim(contact_names(k)), "part-wise contact values are "// &
                            "not available; give them on the *CONTACT_ card", warnings)
         end do
       end if
