@@ -1280,7 +1280,8 @@ contains
                  model%parts(1)%bulk_linear == 0.0_wp .and. model%parts(1)%bulk_quadratic == 0.0_wp)
     end associate
     associate (m => model%materials(3))
-      call check(suite, "026: law, MU 0, LCSR, AOPT 0", m%law == law_honeycomb .and. m%viscosity == 0.0_wp &
+      call check(suite, "026: law, MU 0 (the default 0.05), LCSR, AOPT 0", m%law == law_honeycomb .and. &
+                 m%viscosity == 0.05_wp &
                  .and. all(m%curve_ids == [11, 11, 11, 12, 12, 12, 10]) .and. m%axes_option == 0)
     end associate
     associate (m => model%materials(4))
