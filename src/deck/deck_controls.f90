@@ -163,7 +163,8 @@ contains
   end subroutine read_bulk_viscosity
 
   !> *CONTROL_ENERGY: HGEN RWEN SLNTEN RYLEN ...; 1 = not in the energy balance, 2 = in it.
-  !> HGEN and RWEN are used; the others concern features crashfree does not have.
+  !> HGEN and RWEN are used; the others concern features crashfree does not have, or what it
+  !> always does (a warning names each one set).
   subroutine read_energy_control(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
@@ -185,6 +186,15 @@ contains
       "computed) or 2 (in the energy balance), found "//integer_text(wall))
     input%model%hourglass_energy_in_balance = hourglass == 2
     input%model%wall_energy_in_balance = wall /= 1
+    call warn_if_set(deck, card, 3, "SLNTEN", "contact energy is always computed and in the "// &
+                     "energy balance", warnings)
+    call warn_if_set(deck, card, 4, "RYLEN", "no Rayleigh damping, so no damping energy", warnings)
+    call warn_if_set(deck, card, 5, "IRGEN", "no initial reference geometry", warnings)
+    call warn_if_set(deck, card, 6, "MATEN", "matsum always holds each part's internal, "// &
+                     "hourglass and kinetic energy", warnings)
+    call warn_if_set(deck, card, 7, "DRLEN", "no dynamic relaxation", warnings)
+    call warn_if_set(deck, card, 8, "DISEN", "no damping, so no dissipated damping energy", &
+                     warnings)
   end subroutine read_energy_control
 
   !> *CONTROL_IMPLICIT_GENERAL: IMFLAG DT0 IMFORM NSBS IGS CNSTN FORM ZERO_V. IMFLAG 0 (blank)
