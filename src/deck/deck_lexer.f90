@@ -515,7 +515,7 @@ contains
       if (unusual) call check_characters(deck, text(1:last), state, log)
       deck%keyword_lines = deck%keyword_lines + 1
       call open_keyword(deck, deck%lines%count, text(1:last), state%file_format, state%block, &
-                        state%ended, log)
+                        state%ended, log, warnings)
       return
     end if
     if (state%block%kind == block_comment) return
@@ -580,7 +580,7 @@ contains
   end subroutine report_file_totals
 
   !> Start the block of the keyword on line `line`, whose text is `text`.
-  subroutine open_keyword(deck, line, text, file_format, block, ended, log)
+  subroutine open_keyword(deck, line, text, file_format, block, ended, log, warnings)
     type(deck_t), intent(inout) :: deck
     integer, intent(in) :: line
     character(len=*), intent(in) :: text
@@ -588,6 +588,7 @@ contains
     type(open_block_t), intent(out) :: block
     logical, intent(out) :: ended
     type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
     character(len=:), allocatable :: name
     integer :: name_end, suffix_format
 
@@ -615,7 +616,7 @@ contains
     select case (name)
     case ("KEYWORD")
       block%kind = block_ignored
-      call read_keyword_options(deck, line, text(name_end + 1:), file_format, log)
+      call read_keyword_options(deck, line, text(name_end + 1:), file_format, log, warnings)
     case ("INCLUDE")
       block%kind = block_include
     case ("PARAMETER")
@@ -632,17 +633,19 @@ contains
   end subroutine open_keyword
 
   !> `*KEYWORD LONG=Y`, `LONG=S|K|N`, `I10=Y|N`; a memory size (a bare number, MEMORY=...) and
-  !> NCPU=... are accepted and ignored. The setting holds for the rest of this file and for
-  !> the files it includes.
-  subroutine read_keyword_options(deck, line, options, file_format, log)
+  !> NCPU=... are accepted and not used, with one warning naming them. The format setting holds
+  !> for the rest of this file and for the files it includes.
+  subroutine read_keyword_options(deck, line, options, file_format, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: line
     character(len=*), intent(in) :: options
     integer, intent(inout) :: file_format
     type(problem_log_t), intent(inout) :: log
-    character(len=:), allocatable :: rest, token
+    type(error_list_t), intent(inout) :: warnings
+    character(len=:), allocatable :: rest, token, unused
     integer :: token_end, status, memory
 
+    unused = ""
     rest = to_upper(trim_blanks(options))
     do while (len(rest) > 0)
       token_end = scan(rest, " "//achar(9)) - 1
@@ -662,9 +665,14 @@ contains
         if (status /= number_ok .and. verify(token(len(token):), "MGK") /= 0) then
           call report_problem(log, line_location(deck, line)//": *KEYWORD: option '"//token// &
             "' is not understood (LONG=Y|S|K, I10=Y|N or a memory size)")
+        else
+          unused = unused//" "//token
         end if
       end select
     end do
+    if (len(unused) > 0) call add_error(warnings, line_location(deck, line)//": *KEYWORD:"// &
+      unused//": read, not acted upon (memory is sized from the model; threads are set with "// &
+      "ncpu= on the command line, and results are the same for any thread count)")
   end subroutine read_keyword_options
 
   !> Finish the open block: trim trailing blank lines, run *INCLUDE and *PARAMETER.

@@ -278,7 +278,8 @@ def test_shell_elform_zero_is_two(tmp_path):
 def test_bookkeeping_keywords_are_read_and_change_nothing(tmp_path):
     plain = write(tmp_path, "plain", CUBE.format(**WRITTEN_OUT))
     with_bookkeeping = write(tmp_path, "bookkeeping", CUBE.format(**dict(
-        WRITTEN_OUT, extra=BOOKKEEPING, energy="*CONTROL_ENERGY\n         1         2         2         2\n")))
+        WRITTEN_OUT, extra=BOOKKEEPING, energy="*CONTROL_ENERGY\n         1         2         2         2\n"))
+        .replace("*KEYWORD\n", "*KEYWORD 20000000 NCPU=-2\n"))
     first, second = run(plain), run(with_bookkeeping)
     assert first.returncode == 0, first.stderr
     assert second.returncode == 0, second.stderr
@@ -292,6 +293,7 @@ def test_bookkeeping_keywords_are_read_and_change_nothing(tmp_path):
     # the fields a deck sets are named with their values
     assert "fields set, not used: NCPU=2 CONST=1" in text
     assert "THEORY=2" in text
+    assert "deck.k:1: *KEYWORD: 20000000 NCPU=-2: read, not acted upon" in text
     # *CONTROL_ENERGY: HGEN and RWEN act, the flags of what crashfree always does or lacks do not
     assert "*CONTROL_ENERGY: field SLNTEN: ignored (contact energy is always computed" in text
     assert "*CONTROL_ENERGY: field RYLEN: ignored" in text
