@@ -337,6 +337,9 @@ contains
       call note_not_acted_upon(deck, block, [character(len=40) :: "OSU INN PIDOSU IACC EXACC"], &
         "stresses are rotated objectively in every cycle and results do not depend on the "// &
         "node numbering", warnings)
+    else if (index(name, "CONTROL_MPP_") == 1) then
+      call note_not_acted_upon(deck, block, [character(len=1) :: ], "it sets up LS-DYNA's MPP "// &
+        "domain decomposition and files; crashfree runs one process on OpenMP threads", warnings)
     else
       call note_not_acted_upon(deck, block, [character(len=1) :: ], "crashfree has no use "// &
         "for it", warnings)

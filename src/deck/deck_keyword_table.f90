@@ -116,6 +116,14 @@ contains
       keyword_entry_t("CONTROL_SHELL", reader=read_unused_control), &
       keyword_entry_t("CONTROL_SOLID", reader=read_unused_control), &
       keyword_entry_t("CONTROL_ACCURACY", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_MPP_DECOMPOSITION_AUTOMATIC", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_MPP_DECOMPOSITION_METHOD", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_MPP_DECOMPOSITION_NUMPROC", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_MPP_DECOMPOSITION_SHOW", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_MPP_DECOMPOSITION_OUTDECOMP", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_MPP_IO_NOD3DUMP", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_MPP_IO_NODUMP", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_MPP_IO_NOFULL", reader=read_unused_control), &
       keyword_entry_t("DATABASE_EXTENT_BINARY", reader=read_unused_output), &
       keyword_entry_t("DATABASE_FORMAT", reader=read_unused_output), &
       keyword_entry_t("DATABASE_BINARY_INTFOR", reader=read_unused_output), &
@@ -128,6 +136,14 @@ contains
       keyword_entry_t("DATABASE_NCFORC", reader=read_unused_output), &
       keyword_entry_t("DATABASE_SWFORC", reader=read_unused_output), &
       keyword_entry_t("DATABASE_JNTFORC", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_DEFORC", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_RBDOUT", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_SBTOUT", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_NODFOR", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_ABSTAT", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_DEFGEO", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_BINARY_D3PROP", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_NODAL_FORCE_GROUP", reader=read_unused_output), &
       keyword_entry_t("DATABASE_CROSS_SECTION_PLANE", options="ID", reader=read_unused_output), &
       keyword_entry_t("DATABASE_CROSS_SECTION_SET", options="ID", reader=read_unused_output), &
       keyword_entry_t("DATABASE_HISTORY_SHELL", options="ID", reader=read_unused_output), &

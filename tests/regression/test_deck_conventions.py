@@ -117,6 +117,10 @@ $ a blank third card
       0.01
 *DATABASE_HISTORY_SOLID
          1
+*CONTROL_MPP_DECOMPOSITION_AUTOMATIC
+*CONTROL_MPP_IO_NODUMP
+*DATABASE_RBDOUT
+      0.01
 *SENSOR_DEFINE_NODE_SET
          1      NODE         1         2         3
 *SENSOR_DEFINE_FUNCTION
@@ -288,7 +292,8 @@ def test_bookkeeping_keywords_are_read_and_change_nothing(tmp_path):
     for keyword in ["CONTROL_PARALLEL", "CONTROL_OUTPUT", "CONTROL_CPU", "CONTROL_SHELL", "CONTROL_SOLID",
                     "CONTROL_ACCURACY", "DATABASE_EXTENT_BINARY", "DATABASE_FORMAT", "DATABASE_BINARY_INTFOR",
                     "DATABASE_SPCFORC", "DATABASE_SLEOUT", "DATABASE_SECFORC", "DATABASE_HISTORY_SOLID",
-                    "SENSOR_DEFINE_NODE_SET", "SENSOR_DEFINE_FUNCTION"]:
+                    "SENSOR_DEFINE_NODE_SET", "SENSOR_DEFINE_FUNCTION", "CONTROL_MPP_DECOMPOSITION_AUTOMATIC",
+                    "CONTROL_MPP_IO_NODUMP", "DATABASE_RBDOUT"]:
         assert f"*{keyword}: read, not acted upon" in text, keyword
     # the fields a deck sets are named with their values
     assert "fields set, not used: NCPU=2 CONST=1" in text
