@@ -190,7 +190,8 @@ contains
            "                  deck is read again from its recorded path (or i=) and must be unchanged;"//nl// &
            "                  results go on in the run's DIR/JOBID.h5 (default: the dump's directory"//nl// &
            "                  and job)"//nl// &
-           "  --ignore-unknown  warn about unknown keywords instead of stopping"//nl// &
+           "  --ignore-unknown  warn about unknown keywords and skip them instead of stopping (a"//nl// &
+           "                  keyword crashfree reads, with an option it lacks, still stops)"//nl// &
            "  memory= memory2= d=nodump s= o= g= ncycle= pfile=   LS-DYNA's: accepted, not used"//nl//nl// &
            "Results: DIR/results.h5 (HDF5, see README) and DIR/results.xdmf for ParaView."//nl// &
            "Signals: SIGINT/SIGTERM stop after the cycle with a restart dump, SIGUSR1 writes a dump"//nl// &
