@@ -78,7 +78,8 @@ WRITTEN_OUT = dict(
 # The same cards left blank: the last card of a keyword, a keyword of one blank card, blank
 # lines inside and after the *NODE lines, comment lines around them (not cards).
 BLANK = dict(
-    timestep="*CONTROL_TIMESTEP\n\n",
+    # card 1 blank in the middle (card 2, which crashfree does not read, follows)
+    timestep="*CONTROL_TIMESTEP\n\n         0         0         0\n",
     energy="*CONTROL_ENERGY\n$ HGEN and RWEN: defaults\n          \n\n",
     solid_section="         1",
     node_gap="\n$ a comment\n   \n",
@@ -202,10 +203,12 @@ def test_blank_cards_read_as_their_defaults(tmp_path):
 
 def test_a_missing_card_is_still_reported(tmp_path):
     """Only a blank line is a card: a keyword that ends without it still lacks the card."""
-    deck = write(tmp_path, "missing", CUBE.format(**dict(BLANK, generation_card_2="")))
+    text = CUBE.format(**dict(BLANK, generation_card_2=""))
+    deck = write(tmp_path, "missing", text)
+    card_1 = text.splitlines().index("         1         3       0.0       1.0       0.0       0.0") + 1
     result = run(deck)
     assert result.returncode == 2
-    assert "deck.k:43: *INITIAL_VELOCITY_GENERATION: field XC: card 2" in result.stderr
+    assert f"deck.k:{card_1}: *INITIAL_VELOCITY_GENERATION: field XC: card 2" in result.stderr
 
 
 def test_solid_elform_zero_is_one(tmp_path):
