@@ -10,7 +10,7 @@
 !>
 !> The rows keep the order in which the names were added: on equal spelling distance the
 !> earlier name is suggested. gfortran cannot hold procedure pointers in a named constant, so
-!> `keyword_table()` builds the table on each call (66 rows; once per deck, and per unknown
+!> `keyword_table()` builds the table on each call (about 80 rows; once per deck, and per unknown
 !> keyword).
 module deck_keyword_table
   use error_handling, only: error_list_t
@@ -24,14 +24,17 @@ module deck_keyword_table
     list_sections, list_materials, list_hourglasses, list_curves, list_node_sets, list_part_sets, list_spcs, &
     list_motions, list_loads, list_velocities, list_walls, list_segment_sets, list_segment_loads, &
     list_rigid_materials, list_rigid_motions, list_nodal_rigid_bodies, list_element_masses, list_contacts, &
-    list_count
+    list_count, list_boxes, list_frames, list_vectors
   use deck_nodes_elements, only: read_nodes, read_solid_elements, read_shell_elements, read_thick_shell_elements
   use deck_parts_sections, only: read_parts, read_solid_sections, read_efg_sections, read_shell_sections, &
     read_hourglasses
   use deck_materials, only: read_elastic_materials, read_plastic_kinematic_materials, read_honeycomb_materials, &
     read_modified_honeycomb_materials, read_low_density_foam_materials, read_piecewise_linear_materials, &
     read_null_materials
-  use deck_sets_curves, only: read_node_set, read_generated_node_set, read_part_set, read_segment_set, read_curve
+  use deck_sets_curves, only: read_node_set, read_generated_node_set, read_part_set, read_segment_set, read_curve, &
+    read_generated_part_set, read_general_node_set, read_added_node_set, read_added_part_set
+  use deck_boxes_frames, only: read_boxes, read_local_boxes, read_point_frames, read_node_frames, &
+    read_vector_frames, read_vectors
   use deck_loads_bcs, only: read_node_spcs, read_set_spcs, read_node_motions, read_set_motions, read_node_loads, &
     read_set_loads, read_initial_velocities, read_initial_velocity_nodes, read_velocity_generations, &
     read_planar_walls, read_cylinder_walls, read_segment_loads, read_segment_set_loads, &
@@ -150,7 +153,7 @@ contains
       law_keyword(law_honeycomb, read_honeycomb_materials), &
       law_keyword(law_modified_honeycomb, read_modified_honeycomb_materials), &
       law_keyword(law_low_density_foam, read_low_density_foam_materials), &
-      keyword_entry_t("RIGIDWALL_GEOMETRIC_CYLINDER", options="MOTION ID", fills=[list_walls, list_none], &
+      keyword_entry_t("RIGIDWALL_GEOMETRIC_CYLINDER", options="MOTION DISPLAY ID", fills=[list_walls, list_none], &
                       reader=read_cylinder_walls), &
       keyword_entry_t("ELEMENT_SHELL", fills=[list_shells, list_none], reader=read_shell_elements), &
       keyword_entry_t("ELEMENT_SHELL_THICKNESS", fills=[list_shells, list_none], entries=per_two_lines, &
@@ -176,7 +179,28 @@ contains
       keyword_entry_t("CONTROL_CONTACT", reader=read_control_contact), &
       keyword_entry_t("DATABASE_RCFORC", reader=read_rcforc), &
       law_keyword(law_piecewise_linear, read_piecewise_linear_materials), &
-      law_keyword(law_null, read_null_materials)]
+      law_keyword(law_null, read_null_materials), &
+      keyword_entry_t("SET_NODE", options="TITLE", fills=[list_node_sets, list_none], entries=per_block, &
+                      reader=read_node_set), &
+      keyword_entry_t("SET_NODE_GENERAL", options="TITLE", fills=[list_node_sets, list_none], entries=per_block, &
+                      reader=read_general_node_set), &
+      keyword_entry_t("SET_NODE_ADD", options="TITLE", fills=[list_node_sets, list_none], entries=per_block, &
+                      reader=read_added_node_set), &
+      keyword_entry_t("SET_PART", options="TITLE", fills=[list_part_sets, list_none], entries=per_block, &
+                      reader=read_part_set), &
+      keyword_entry_t("SET_PART_LIST_GENERATE", options="TITLE", fills=[list_part_sets, list_none], &
+                      entries=per_block, reader=read_generated_part_set), &
+      keyword_entry_t("SET_PART_ADD", options="TITLE", fills=[list_part_sets, list_none], entries=per_block, &
+                      reader=read_added_part_set), &
+      keyword_entry_t("DEFINE_BOX", options="TITLE", fills=[list_boxes, list_none], reader=read_boxes), &
+      keyword_entry_t("DEFINE_BOX_LOCAL", options="TITLE", fills=[list_boxes, list_none], reader=read_local_boxes), &
+      keyword_entry_t("DEFINE_COORDINATE_SYSTEM", options="TITLE", fills=[list_frames, list_none], &
+                      reader=read_point_frames), &
+      keyword_entry_t("DEFINE_COORDINATE_NODES", options="TITLE", fills=[list_frames, list_none], &
+                      reader=read_node_frames), &
+      keyword_entry_t("DEFINE_COORDINATE_VECTOR", options="TITLE", fills=[list_frames, list_none], &
+                      reader=read_vector_frames), &
+      keyword_entry_t("DEFINE_VECTOR", options="TITLE", fills=[list_vectors, list_none], reader=read_vectors)]
   end function keyword_table
 
   !> The row of material law `law` (a code of law_table): *MAT_<name>, also *MAT_<nnn>, with
