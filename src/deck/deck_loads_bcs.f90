@@ -730,7 +730,6 @@ contains
     type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
     integer :: line, n, segments, k
-    real(wp) :: length
 
     line = 0
     if (.not. has_data(deck, block, log, "card 1 (NSID NSIDEX BOXID BIRTH DEATH)", "NSID")) return

@@ -57,7 +57,8 @@ contains
     call remove_local_components(model, acceleration)
     do k = 1, size(model%motions)
       associate (motion => model%motions(k))
-        if (motion%direction < 1) then
+        if (motion%direction == motion_along_vector .or. &
+            motion%direction == motion_only_along_vector) then
           ! along a vector: the component along it is the prescribed dof
           along = dot_product(acceleration(:, motion%node), motion%vector)
           free_acceleration(k) = along
@@ -159,7 +160,7 @@ contains
       associate (motion => model%motions(k))
         node = motion%node
         direction = motion%direction
-        if (direction < 1) then
+        if (direction == motion_along_vector .or. direction == motion_only_along_vector) then
           call impose_along_vector(model, k, time, dt, average_dt, displacement, acceleration, &
                                    free_acceleration, mass, velocity, support_work)
           cycle
