@@ -77,7 +77,7 @@ module deck_keyword_table
   type :: keyword_entry_t
     character(len=36) :: name = ""       !< without the `*`
     character(len=36) :: alias = ""      !< another name of the same keyword ("" if none)
-    character(len=28) :: options = ""    !< the options it accepts, blank-separated (any order)
+    character(len=36) :: options = ""    !< the options it accepts, blank-separated (any order)
     logical :: one_option = .false.      !< at most one of them (the contacts: _ID or _TITLE)
     !> The input lists its definitions go to (deck_input's list_...), and how many entries a
     !> block can add to them (per_line, per_block, per_two_lines).
@@ -131,7 +131,7 @@ contains
                       reader=read_set_motions), &
       keyword_entry_t("LOAD_NODE_POINT", fills=[list_loads, list_none], reader=read_node_loads), &
       keyword_entry_t("LOAD_NODE_SET", fills=[list_loads, list_none], reader=read_set_loads), &
-      keyword_entry_t("RIGIDWALL_PLANAR", options="FINITE MOVING FORCES ID", fills=[list_walls, list_none], &
+      keyword_entry_t("RIGIDWALL_PLANAR", options="FINITE MOVING FORCES DISPLAY ID", fills=[list_walls, list_none], &
                       reader=read_planar_walls), &
       keyword_entry_t("DATABASE_BINARY_D3PLOT", reader=read_plot_output), &
       keyword_entry_t("DATABASE_GLSTAT", reader=read_glstat_output), &
@@ -280,7 +280,7 @@ contains
     character(len=*), intent(in) :: name
     character(len=:), allocatable, intent(out) :: suggestion, base
     character(len=36), allocatable :: names(:)
-    character(len=28), allocatable :: options(:)
+    character(len=36), allocatable :: options(:)
     call known_names(keyword_table(), names, options)
     call suggest_keyword(name, names, options, suggestion, base)
   end subroutine suggest_known_keyword
@@ -289,7 +289,7 @@ contains
   !> aliases included.
   integer function known_keyword_count()
     character(len=36), allocatable :: names(:)
-    character(len=28), allocatable :: options(:)
+    character(len=36), allocatable :: options(:)
     call known_names(keyword_table(), names, options)
     known_keyword_count = size(names)
   end function known_keyword_count
@@ -300,7 +300,7 @@ contains
     integer, intent(in) :: k
     character(len=:), allocatable, intent(out) :: name, options
     character(len=36), allocatable :: names(:)
-    character(len=28), allocatable :: all_options(:)
+    character(len=36), allocatable :: all_options(:)
     call known_names(keyword_table(), names, all_options)
     name = trim(names(k))
     options = trim(all_options(k))
@@ -310,7 +310,7 @@ contains
   pure subroutine known_names(table, names, options)
     type(keyword_entry_t), intent(in) :: table(:)
     character(len=36), allocatable, intent(out) :: names(:)
-    character(len=28), allocatable, intent(out) :: options(:)
+    character(len=36), allocatable, intent(out) :: options(:)
     integer :: k, n
     allocate (names(size(table) + count(table%alias /= "")), options(size(table) + count(table%alias /= "")))
     n = 0

@@ -668,9 +668,9 @@ contains
       real_text(entry%wall%birth))
   end function read_wall_card_one
 
-  !> *RIGIDWALL_PLANAR(_FINITE)(_MOVING)(_FORCES)(_ID): [RWID heading], card 1 NSID NSIDEX
-  !> BOXID OFFSET BIRTH DEATH RWKSF, card 2 XT YT ZT XH YH ZH FRIC WVEL, then the option cards
-  !> in the order FINITE, MOVING, FORCES.
+  !> *RIGIDWALL_PLANAR(_FINITE)(_MOVING)(_FORCES)(_DISPLAY)(_ID): [RWID heading], card 1 NSID
+  !> NSIDEX BOXID OFFSET BIRTH DEATH RWKSF, card 2 XT YT ZT XH YH ZH FRIC WVEL, then the option
+  !> cards in the order FINITE, MOVING, FORCES, DISPLAY.
   subroutine read_planar_walls(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
@@ -711,6 +711,11 @@ contains
           if (.not. require_card(deck, block, line, standard_widths, card, log, &
                                  "the FORCES card (SOFT SSID N1 N2 N3 N4)", "SOFT")) exit
           call warn_if_set(deck, card, 1, "SOFT", "the wall force is not softened", warnings)
+        end if
+        if (keyword%display) then
+          if (.not. require_card(deck, block, line, standard_widths, card, log, &
+                                 "the DISPLAY card (PID RO E PR)", "PID")) exit
+          call note_display_card(deck, line, warnings)
         end if
       end associate
     end do
@@ -772,12 +777,20 @@ contains
         if (keyword%display) then
           if (.not. require_card(deck, block, line, standard_widths, card, log, &
                                  "the DISPLAY card (PID RO E PR)", "PID")) exit
-          call located_warning(deck, warnings, line, "PID RO E PR", "the DISPLAY card is "// &
-            "read but not used: it only shows the wall in a post-processor")
+          call note_display_card(deck, line, warnings)
         end if
       end associate
     end do
   end subroutine read_cylinder_walls
+
+  !> The DISPLAY card of a wall (PID RO E PR) only shows the wall in a post-processor.
+  subroutine note_display_card(deck, line, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: line
+    type(error_list_t), intent(inout) :: warnings
+    call located_warning(deck, warnings, line, "PID RO E PR", "the DISPLAY card is read but "// &
+                         "not used: it only shows the wall in a post-processor")
+  end subroutine note_display_card
 
   !> The MOTION card of a cylinder, read: a curve, OPT 0 or 1, a direction (normalised here).
   subroutine check_cylinder_motion(deck, card, wall, log)
