@@ -322,3 +322,23 @@ def test_bad_sets_and_frames_are_deck_errors(tmp_path, run_deck, cards, message)
     run = run_deck(write_deck(tmp_path / "bad.k", *block, *frame_cards(), *cards))
     assert run.status == 2, run.stdout
     assert message in run.stdout + run.stderr
+
+
+def test_wall_box_tracks_only_the_nodes_inside(tmp_path, run_deck):
+    """*RIGIDWALL_PLANAR BOXID: the nodes in the box (x <= 1.5) never pass the wall z = -0.5; the
+    others (held back only by the block) go through it."""
+    nodes, _, cards = block_cards(end_time=0.05)
+    deck = write_deck(
+        tmp_path / "wall_box.k", *cards,
+        "*INITIAL_VELOCITY\n" + fields(0) + "\n" + fields(0.0, 0.0, -40.0),
+        "*RIGIDWALL_PLANAR\n" + fields(0, 0, 2) + "\n" + fields(0.0, 0.0, -0.5, 0.0, 0.0, 0.5),
+        "*DEFINE_BOX\n" + fields(2, -1.0, 1.5, -1.0, 4.0, -1.0, 4.0),
+    )
+    run = run_deck(deck)
+    assert run.status == 0, run.stderr
+    with run.open() as results:
+        z = nodes[:, 2] + results["states"][sorted(results["states"].keys())[-1]]["displacement"][:, 2]
+    tracked = nodes[:, 0] <= 1.5
+    print(f"wall box: lowest tracked z {z[tracked].min():.6f}, lowest other z {z[~tracked].min():.6f}")
+    assert z[tracked].min() > -0.5 - 1e-9
+    assert z[~tracked].min() < -0.5 - 0.1
