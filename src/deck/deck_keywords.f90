@@ -22,6 +22,7 @@ module deck_keywords
     logical :: forces = .false.    !< *RIGIDWALL_PLANAR_FORCES
     logical :: motion = .false.    !< *RIGIDWALL_GEOMETRIC_CYLINDER_MOTION
     logical :: contact = .false.   !< *PART_CONTACT: a card of contact values after each part
+    logical :: display = .false.   !< *RIGIDWALL_GEOMETRIC_..._DISPLAY: a display card at the end
   end type keyword_t
 
   !> Longest keyword name a suggestion is looked for (longer ones are no typing slip).
@@ -78,6 +79,9 @@ contains
       case ("CONTACT")
         if (keyword%contact) return
         keyword%contact = .true.
+      case ("DISPLAY")
+        if (keyword%display) return
+        keyword%display = .true.
       end select
     end do
     fits = text(len(text):) /= "_"

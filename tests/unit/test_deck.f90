@@ -795,7 +795,7 @@ contains
       "*RIGIDWALL_PLANAR_MOVING", "0", "0,0,0,0,0,0", "0.0"]), [character(len=120) :: &
       "@:28: *DEFINE_CURVE: field A: abscissa 0.5 is smaller than the previous one, 1.0", &
       "@:30: *BOUNDARY_PRESCRIBED_MOTION_NODE: field DOF: must be 1, 2 or 3 (x, y, z "// &
-      "translation), found 14", &
+      "translation) or 4, -4 (along the vector VID), found 14", &
       "@:31: *BOUNDARY_PRESCRIBED_MOTION_NODE: field DOF: 5 is a rotation", &
       "@:32: *BOUNDARY_PRESCRIBED_MOTION_NODE: field VAD: must be 0 (velocity), 1 "// &
       "(acceleration) or 2 (displacement), found 7", &
@@ -1210,8 +1210,8 @@ contains
       "@:43: *LOAD_SEGMENT_SET: field SSID: segment set id must be > 0, found -1", &
       "@:45: *LOAD_SEGMENT_NONUNIFORM: field DT: death time 0.5 must be later than the arrival "// &
       "time AT = 1.0", &
-      "@:45: *LOAD_SEGMENT_NONUNIFORM: field CID: local coordinate systems are not available; "// &
-      "leave it blank or 0", &
+      "@:45: *LOAD_SEGMENT_NONUNIFORM: field CID: loads in local coordinate systems are not "// &
+      "available; leave it blank or 0", &
       "@:46: *LOAD_SEGMENT_NONUNIFORM: field N6: quadratic segments (mid-side nodes N5-N8) are "// &
       "not available; leave N5-N8 blank, found 11", &
       "@:47: *LOAD_SEGMENT_NONUNIFORM: field P4: the segment is a triangle (N4 = N3), which has "// &
