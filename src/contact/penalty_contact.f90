@@ -38,7 +38,8 @@ module penalty_contact
   implicit none
   private
 
-  public :: contact_state_t, contact_pass_t, set_up_contacts, compute_contact_forces, report_initial_penetrations
+  public :: contact_state_t, contact_pass_t, set_up_contacts, set_up_contact, compute_contact_forces, &
+            report_initial_penetrations
 
   !> Parametric tolerance of the projection (LS-DYNA's MAXPAR default 1.025).
   real(wp), parameter :: parametric_limit = 1.025_wp
@@ -93,6 +94,7 @@ module penalty_contact
   !> One contact during the run.
   type :: contact_state_t
     integer :: pass_count = 0
+    integer, allocatable :: excluded_nodes(:)     !< nodes never checked (interior meshfree particles)
     type(contact_pass_t) :: passes(2)
     real(wp) :: force(3) = 0.0_wp                 !< force on the SURFA side in the last cycle
     real(wp) :: impulse(3) = 0.0_wp               !< since the start of the run
@@ -106,51 +108,98 @@ contains
     logical, intent(in) :: is_particle(:)
     type(contact_state_t), allocatable, intent(out) :: contacts(:)
     type(error_t), allocatable, intent(out) :: error
+    logical, allocatable :: solid_eroded(:), shell_eroded(:)
     integer :: k
-    integer, allocatable :: segments_a(:, :), owners_a(:), segments_b(:, :), owners_b(:), nodes(:)
     if (.not. allocated(model%contacts)) then
       allocate (contacts(0))
       return
     end if
-    allocate (contacts(size(model%contacts)))
+    allocate (contacts(size(model%contacts)), solid_eroded(size(model%solid_part)), &
+              shell_eroded(size(model%shell_part)))
+    solid_eroded = .false.
+    shell_eroded = .false.
     do k = 1, size(model%contacts)
-      associate (contact => model%contacts(k), state => contacts(k))
-        call side_segments(contact%side_a, segments_a, owners_a)
-        if (allocated(error)) return
-        if (contact%kind /= contact_single_surface) then
-          call side_segments(contact%side_b, segments_b, owners_b)
-          if (allocated(error)) return
-        end if
-        select case (contact%kind)
-        case (contact_nodes_to_surface, contact_surface_to_surface)
-          if (contact%side_a%kind == surface_node_set) then
-            nodes = pack(contact%side_a%nodes, .not. is_particle(contact%side_a%nodes))
-          else
-            call surface_node_list(segments_a, is_particle, nodes)
-          end if
-          state%pass_count = 1
-          call build_pass(state%passes(1), nodes, segments_a, owners_a, segments_b, owners_b, contact%scale_b, .false.)
-          state%passes(1)%side_sign = 1.0_wp
-          if (contact%kind == contact_surface_to_surface) then
-            call surface_node_list(segments_b, is_particle, nodes)
-            state%pass_count = 2
-            call build_pass(state%passes(2), nodes, segments_b, owners_b, segments_a, owners_a, contact%scale_a, &
-                            .false.)
-            state%passes(2)%side_sign = -1.0_wp
-          end if
-        case (contact_single_surface)
-          call surface_node_list(segments_a, is_particle, nodes)
-          state%pass_count = 1
-          call build_pass(state%passes(1), nodes, segments_a, owners_a, segments_a, owners_a, contact%scale_a, .true.)
-        end select
-      end associate
+      call set_up_contact(model, is_particle, k, solid_eroded, shell_eroded, contacts(k), error)
+      if (allocated(error)) return
     end do
+  end subroutine set_up_contacts
+
+  !> Build the passes of contact `k` from the model (reference configuration) without the
+  !> elements flagged eroded: their shells and faces leave the surfaces, the faces of the other
+  !> solids of a part that become exterior join them (sides given by parts), and secondary
+  !> nodes with no remaining element are not checked. Also used after erosion
+  !> (contact_erosion), which then carries the pair state over.
+  subroutine set_up_contact(model, is_particle, k, solid_eroded, shell_eroded, state, error)
+    type(model_t), intent(in) :: model
+    logical, intent(in) :: is_particle(:)
+    integer, intent(in) :: k
+    logical, intent(in) :: solid_eroded(:), shell_eroded(:)
+    type(contact_state_t), intent(out) :: state
+    type(error_t), allocatable, intent(out) :: error
+    integer :: n
+    integer, allocatable :: segments_a(:, :), owners_a(:), segments_b(:, :), owners_b(:), nodes(:)
+    logical, allocatable :: node_lost(:)
+    state%excluded_nodes = pack([(n, n=1, size(is_particle))], is_particle)
+    ! nodes that had elements and have none left
+    allocate (node_lost(size(model%node_ids)))
+    node_lost = .false.
+    if (any(solid_eroded) .or. any(shell_eroded)) call find_lost_nodes()
+    associate (contact => model%contacts(k))
+      call side_segments(contact%side_a, segments_a, owners_a)
+      if (allocated(error)) return
+      if (contact%kind /= contact_single_surface) then
+        call side_segments(contact%side_b, segments_b, owners_b)
+        if (allocated(error)) return
+      end if
+      select case (contact%kind)
+      case (contact_nodes_to_surface, contact_surface_to_surface)
+        if (contact%side_a%kind == surface_node_set) then
+          nodes = pack(contact%side_a%nodes, .not. (is_particle(contact%side_a%nodes) .or. &
+                                                    node_lost(contact%side_a%nodes)))
+        else
+          call surface_node_list(segments_a, is_particle, nodes)
+        end if
+        state%pass_count = 1
+        call build_pass(state%passes(1), nodes, segments_a, owners_a, segments_b, owners_b, contact%scale_b, .false.)
+        state%passes(1)%side_sign = 1.0_wp
+        if (contact%kind == contact_surface_to_surface) then
+          call surface_node_list(segments_b, is_particle, nodes)
+          state%pass_count = 2
+          call build_pass(state%passes(2), nodes, segments_b, owners_b, segments_a, owners_a, contact%scale_a, &
+                          .false.)
+          state%passes(2)%side_sign = -1.0_wp
+        end if
+      case (contact_single_surface)
+        call surface_node_list(segments_a, is_particle, nodes)
+        state%pass_count = 1
+        call build_pass(state%passes(1), nodes, segments_a, owners_a, segments_a, owners_a, contact%scale_a, .true.)
+      end select
+    end associate
   contains
+    subroutine find_lost_nodes()
+      logical, allocatable :: had(:), kept(:)
+      integer :: element
+      allocate (had(size(model%node_ids)), kept(size(model%node_ids)))
+      had = .false.
+      kept = .false.
+      do element = 1, size(model%solid_part)
+        had(model%solid_nodes(:, element)) = .true.
+        if (.not. solid_eroded(element)) kept(model%solid_nodes(:, element)) = .true.
+      end do
+      do element = 1, size(model%shell_part)
+        had(model%shell_nodes(:, element)) = .true.
+        if (.not. shell_eroded(element)) kept(model%shell_nodes(:, element)) = .true.
+      end do
+      node_lost = had .and. .not. kept
+    end subroutine find_lost_nodes
+
     !> Segments (outward) and owning solids of one side.
     subroutine side_segments(side, segments, owners)
       type(contact_surface_t), intent(in) :: side
       integer, allocatable, intent(out) :: segments(:, :), owners(:)
       integer :: count, p, s
+      integer, allocatable :: solid_part(:), shell_part(:)
+      logical, allocatable :: keep(:)
       character(len=160) :: text
       count = 0
       select case (side%kind)
@@ -168,11 +217,27 @@ contains
           call make_error(error, trim(text))
           return
         end do
+        ! segments of eroded elements leave (a segment set is the user's list: nothing joins it)
+        allocate (keep(size(owners)))
+        do s = 1, size(owners)
+          if (owners(s) > 0) then
+            keep(s) = .not. solid_eroded(owners(s))
+          else
+            keep(s) = .not. shell_eroded(-owners(s))
+          end if
+        end do
+        if (.not. all(keep)) then
+          owners = pack(owners, keep)
+          segments = reshape(pack(segments, spread(keep, 1, 4)), [4, size(owners)])
+        end if
       case default
+        ! eroded elements are left out of their part: the faces they covered become exterior
+        solid_part = merge(0, model%solid_part, solid_eroded)
+        shell_part = merge(0, model%shell_part, shell_eroded)
         do p = 1, size(side%parts)
-          call append_exterior_faces(model%solid_nodes, model%solid_part, side%parts(p), size(model%node_ids), &
+          call append_exterior_faces(model%solid_nodes, solid_part, side%parts(p), size(model%node_ids), &
                                      segments, owners, count)
-          call append_part_shells(model%shell_nodes, model%shell_part, side%parts(p), segments, owners, count)
+          call append_part_shells(model%shell_nodes, shell_part, side%parts(p), segments, owners, count)
         end do
         if (.not. allocated(segments)) allocate (segments(4, 0), owners(0))
         segments = segments(:, 1:count)
@@ -339,7 +404,7 @@ contains
         shell_thickness = 0.25_wp*sum(model%shell_thickness(:, shell))
       end if
     end function shell_thickness
-  end subroutine set_up_contacts
+  end subroutine set_up_contact
 
   !> Contact forces of every contact at the current configuration (added into
   !> `contact_force`, which is zeroed first) and the contact energy increment: minus the work
@@ -383,7 +448,9 @@ contains
               pass%tangential = 0.0_wp
               cycle
             end if
-            call update_search(pass, coordinates, contact%bucket_interval)
+            ! BSORT of the contact, else NSBCS of *CONTROL_CONTACT, else only when nodes moved
+            call update_search(pass, coordinates, merge(contact%bucket_interval, model%contact_sort_interval, &
+                                                        contact%bucket_interval > 0))
             call pair_forces(contact, pass, step, coordinates, velocity, mass)
             ! serial, in pair order: the same sums for any thread count
             total = 0.0_wp
