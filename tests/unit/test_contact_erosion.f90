@@ -43,6 +43,7 @@ contains
     integer :: i, j, k, e, probe
     real(wp) :: on_top, expected
 
+    allocate (lines(0))
     lines = [character(len=80) :: "*KEYWORD", "*CONTROL_TERMINATION", "1.0", &
                                   "*PART", "block", "1,1,1", "*PART", "probe", "2,1,1", "*SECTION_SOLID", "1,1", &
                                   "*MAT_ELASTIC", "1,1.0e-6,1.0,0.3", "*SET_NODE_LIST", "1", "28", &
@@ -124,6 +125,7 @@ contains
     integer :: corners(4)
     real(wp) :: on_plate, expected
 
+    allocate (lines(0))
     lines = [character(len=80) :: "*KEYWORD", "*CONTROL_TERMINATION", "1.0", &
                                   "*PART", "plate", "1,1,1", "*PART", "probe", "2,2,1", "*SECTION_SHELL", "1,2,1.0,2", &
                                   "0.2,0.2,0.2,0.2", "*SECTION_SOLID", "2,1", "*MAT_ELASTIC", "1,1.0e-6,1.0,0.3", &
