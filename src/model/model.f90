@@ -372,6 +372,7 @@ module model
     type(segment_set_t), allocatable :: segment_sets(:)
     type(contact_t), allocatable :: contacts(:)
     real(wp) :: contact_penalty_scale = 0.1_wp       !< *CONTROL_CONTACT SLSFAC
+    integer :: contact_sort_interval = 0             !< *CONTROL_CONTACT NSBCS (0: sort when nodes moved)
     type(output_control_t) :: output
   end type model_t
 end module model
