@@ -4,6 +4,7 @@
 !> corners with zero Jacobian, which is fine as long as the volume is positive.
 module deck_element_check
   use kinds, only: wp
+  use hex8_geometry, only: tetrahedron_corner_order
   implicit none
   private
 
@@ -25,17 +26,24 @@ contains
 
   !> Check the hexahedron with corner coordinates `x(3, 8)`. `status` is shape_valid,
   !> shape_inside_out (`corner` = the corner with the most negative Jacobian) or shape_flat
-  !> (a collapsed corner and no positive volume).
+  !> (a collapsed corner and no positive volume). A tetrahedron (four distinct corners) is
+  !> checked in the form the elements use, N1 N2 N3 N3 N4 N4 N4 N4 with a positive volume
+  !> (tetrahedron_corner_order): it is flat or valid, never inside out.
   pure subroutine check_hexahedron(corners, status, corner)
     real(wp), intent(in) :: corners(3, 8)
     integer, intent(out) :: status, corner
     real(wp) :: x(3, 8), tolerance, lowest, jacobian, extent, volume
-    integer :: k
+    integer :: k, l, same(8), order(8)
 
+    ! corners at one place stand for one node
+    do k = 1, 8
+      same(k) = findloc([(all(corners(:, l) == corners(:, k)), l=1, 8)], .true., dim=1)
+    end do
+    call tetrahedron_corner_order(same, corners, order)
     ! Work relative to node 1 and in units of the element's size: the tolerances are then
     ! plain numbers and no product can overflow, whatever the units of the deck.
     do k = 1, 8
-      x(:, k) = corners(:, k) - corners(:, 1)
+      x(:, k) = corners(:, order(k)) - corners(:, order(1))
     end do
     extent = maxval(abs(x))
     status = shape_flat
