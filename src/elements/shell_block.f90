@@ -1,4 +1,5 @@
-!> Blocks of Belytschko-Tsay shell elements (*SECTION_SHELL ELFORM 2) and the per-cycle
+!> Blocks of Belytschko-Tsay shell elements (*SECTION_SHELL ELFORM 2; triangles, N4 = N3, as C0
+!> triangles with their own transverse shear, shell_triangle) and the per-cycle
 !> element work on them.
 !>
 !> The element (Belytschko, Lin & Tsay 1984; Hallquist, LS-DYNA Theory Manual, "Belytschko-Tsay

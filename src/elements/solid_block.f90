@@ -331,6 +331,7 @@ contains
         end if
       end do
       call deviatoric_modes(block, material, nel, gram, bx, by, bz, volume, mode_frequency_squared, mode_damping)
+      call clear_tetrahedron_modes(block, nel, mode_frequency_squared, mode_damping)
     else
       call hourglass_shape_vectors(nel, block%hourglass_type, x, y, z, bx, by, bz, volume, gamma, &
                                    hourglass_volume, gradient_norm_squared)
@@ -491,7 +492,8 @@ contains
   !> A tetrahedron has no hourglass modes: every motion of its four nodes is linear. The base
   !> vectors of IHQ 1-3 (not orthogonal to linear fields on a degenerate shape) would still
   !> damp its uniform straining and book that work as hourglass energy; its lanes get none.
-  !> Nor do a tetrahedron's (absent) hourglass modes bound its step.
+  !> Nor do a tetrahedron's (absent) hourglass modes bound its step, nor, under ELFORM 2, its
+  !> (absent) extra deviatoric modes: its gradients are the same at every Gauss point.
   pure subroutine clear_tetrahedron_modes(block, nel, mode_frequency_squared, mode_damping)
     type(solid_block_t), intent(in) :: block
     integer, intent(in) :: nel
@@ -803,6 +805,7 @@ contains
 
     if (bound_wanted) &
       call deviatoric_modes(block, material, nel, gram, bx, by, bz, volume, mode_frequency_squared, mode_damping)
+      call clear_tetrahedron_modes(block, nel, mode_frequency_squared, mode_damping)
     call stable_time_steps(block, material, nel, x, y, z, bx, by, bz, volume, wave_modulus, volumetric_rate, &
                            mode_frequency_squared, mode_damping, element_time_step)
     block%volume(1:nel) = volume(1:nel)

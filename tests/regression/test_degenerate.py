@@ -188,6 +188,8 @@ def test_patch_test_on_tetrahedra_and_wedges(tmp_path, run_deck, kind, element_f
     interior = np.setdiff1d(np.arange(len(nodes)), boundary)
     assert len(interior) == 8
     error = np.abs(final[interior] - velocity[interior]).max() / np.abs(velocity).max()
+    print(f"interior velocity error {error:.2e}, hourglass / internal "
+          f"{abs(energies['hourglass_energy'][-1]) / energies['internal_energy'][-1]:.1e}")
     assert error < 1e-10, f"interior velocity error {error:.3e}"
     assert abs(energies["hourglass_energy"][-1]) <= 1e-10 * energies["internal_energy"][-1]
     assert energies["internal_energy"][-1] > 0.0
@@ -196,8 +198,9 @@ def test_patch_test_on_tetrahedra_and_wedges(tmp_path, run_deck, kind, element_f
 # ---------------------------------------------------------------------------------------------
 # 3. time step
 
+@pytest.mark.parametrize("element_formulation", [1, 2])
 @pytest.mark.parametrize("poisson", [0.0, 0.3, 0.49])
-def test_lone_tetrahedron_step_against_its_critical_step(tmp_path, run_deck, poisson):
+def test_lone_tetrahedron_step_against_its_critical_step(tmp_path, run_deck, poisson, element_formulation):
     x = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.2, 0.9, 0.0], [0.3, 0.2, 0.8]])
     critical, _, _ = lumped_tetrahedron_critical_step(x, poisson)
     deck = write_deck(tmp_path / "tet.k",
@@ -205,7 +208,7 @@ def test_lone_tetrahedron_step_against_its_critical_step(tmp_path, run_deck, poi
                       "*CONTROL_TIMESTEP\n" + fields(0.0, 1.0),
                       "*DATABASE_GLSTAT\n" + fields(1.0e-9),
                       "*PART\nsolid\n" + fields(1, 1, 1),
-                      "*SECTION_SOLID\n" + fields(1, 1),
+                      "*SECTION_SOLID\n" + fields(1, element_formulation),
                       "*MAT_ELASTIC\n" + fields(1, DENSITY, YOUNGS, poisson),
                       nodes_card(x), solids_card([[0, 1, 2, 2, 3, 3, 3, 3]]))
     run = run_deck(deck)
@@ -214,13 +217,15 @@ def test_lone_tetrahedron_step_against_its_critical_step(tmp_path, run_deck, poi
         step = glstat(results)["time_step"][0]
     # at or below the critical step, and the bound is tight (LS-DYNA's rule alone, the
     # smallest altitude over c, is 1.15-1.40 times the critical step of a lone tetrahedron)
+    print(f"step / critical {step / critical:.4f}")
     assert 0.85 * critical <= step <= critical, f"step {step:.5g}, critical {critical:.5g}"
 
 
 def test_tetrahedral_mesh_step_against_the_mesh_critical_step(tmp_path, run_deck):
     """Free 3 x 3 x 3 cube of 162 tetrahedra (irregular): numpy assembles the mesh's stiffness
-    and lumped masses; the first step at TSSFAC 1 is at or below 2 / omega_max and above half of
-    it (the old V / largest face rule was a third of the smallest altitude)."""
+    and lumped masses; the first step at TSSFAC 1 is at or below 2 / omega_max and above 0.45 of
+    it (0.52 measured: the smallest altitude of the flattest tetrahedron sets it, as in LS-DYNA;
+    the old V / largest face rule, a third of the altitude, gave 0.24)."""
     nodes, hexes = block_mesh((3, 3, 3), (1.0, 1.0, 1.0), perturbation=0.2, seed=7)
     nodes = round_to_node_card(nodes)
     elements = tetrahedra(nodes, hexes)
@@ -243,18 +248,23 @@ def test_tetrahedral_mesh_step_against_the_mesh_critical_step(tmp_path, run_deck
     assert run.status == 0, run.stdout + run.stderr
     with run.open() as results:
         step = glstat(results)["time_step"][0]
-    assert 0.5 * critical < step <= critical, f"step {step:.5g}, mesh critical {critical:.5g}"
+    print(f"step / mesh critical {step / critical:.4f}")
+    assert 0.45 * critical < step <= critical, f"step {step:.5g}, mesh critical {critical:.5g}"
 
 
-def test_kicked_tetrahedral_mesh_keeps_its_energy(tmp_path, run_deck):
-    nodes, hexes = block_mesh((3, 3, 3), (1.0, 1.0, 1.0), perturbation=0.2, seed=7)
-    nodes = round_to_node_card(nodes)
+@pytest.mark.parametrize("kind, element_formulation, hourglass_type",
+                         [("tetrahedra", 1, 1), ("tetrahedra", 2, 1), ("wedges", 1, 1), ("wedges", 1, 5),
+                          ("wedges", 2, 1), ("mixed", 1, 4)])
+def test_kicked_degenerate_mesh_keeps_its_energy(tmp_path, run_deck, kind, element_formulation, hourglass_type):
+    """Random nodal velocities on a free irregular mesh, 3,000 cycles at TSSFAC 0.9: stable,
+    the energy balanced; tetrahedra book no hourglass energy."""
+    nodes, elements, _ = degenerate_mesh(kind, (3, 3, 3), (1.0, 1.0, 1.0), seed=7)
     velocity = np.random.default_rng(3).uniform(-1.0, 1.0, nodes.shape)
     deck = write_deck(tmp_path / "kick.k",
                       "*CONTROL_TERMINATION\n" + fields(0.0, 3000),
                       "*CONTROL_TIMESTEP\n" + fields(0.0, 0.9),
                       "*DATABASE_GLSTAT\n" + fields(1.0e-4),
-                      *solid_part(1, 1), nodes_card(nodes), solids_card(tetrahedra(nodes, hexes)),
+                      *solid_part(element_formulation, hourglass_type), nodes_card(nodes), solids_card(elements),
                       initial_velocities(velocity))
     run = run_deck(deck)
     assert run.status == 0, run.stdout + run.stderr
@@ -262,8 +272,11 @@ def test_kicked_tetrahedral_mesh_keeps_its_energy(tmp_path, run_deck):
         assert results["run"].attrs["cycles"] == 3000
         energies = glstat(results)
     total = energies["total_energy"]
+    print(f"energy drift {np.abs(total - total[0]).max() / total[0]:.1e}, "
+          f"hourglass / initial {energies['hourglass_energy'].max() / total[0]:.2e}")
     assert np.abs(total - total[0]).max() < 1e-6 * total[0]
-    assert energies["hourglass_energy"].max() == 0.0
+    if kind == "tetrahedra":
+        assert energies["hourglass_energy"].max() == 0.0
     assert energies["internal_energy"].max() > 0.1 * total[0]
 
 
@@ -294,6 +307,7 @@ def test_wave_front_in_a_tetrahedral_bar(tmp_path, run_deck):
     v0, v1 = velocity[crossing - 1], velocity[crossing]
     arrival = t0 + (speed - v0) * (t1 - t0) / (v1 - v0)
     expected = length / np.sqrt(YOUNGS / DENSITY)
+    print(f"arrival / (L / c) {arrival / expected:.4f}")
     assert abs(arrival - expected) / expected < 0.02, f"arrival {arrival:.6g} ms, L/c {expected:.6g} ms"
 
 
@@ -350,6 +364,7 @@ def test_lone_triangle_step_against_its_critical_step(tmp_path, run_deck):
     assert run.status == 0, run.stdout + run.stderr
     with run.open() as results:
         step = glstat(results)["time_step"][0]
+    print(f"step / critical {step / critical:.4f}")
     assert 0.85 * critical <= step <= critical, f"step {step:.5g}, critical {critical:.5g}"
 
 
@@ -388,6 +403,7 @@ def test_membrane_patch_test_on_a_mixed_quadrilateral_triangle_mesh(tmp_path, ru
         energies = glstat(results)
     interior = np.setdiff1d(np.arange(len(flat)), boundary)
     error = np.abs(final[interior] - velocity[interior]).max() / np.abs(velocity).max()
+    print(f"membrane interior velocity error {error:.2e}")
     assert error < 1e-10, f"interior velocity error {error:.3e}"
     assert abs(energies["hourglass_energy"][-1]) <= 1e-10 * energies["internal_energy"][-1]
     # every element, quadrilateral or triangle, carries the same stress
