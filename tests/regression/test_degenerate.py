@@ -1,19 +1,19 @@
 """Degenerate elements: tetrahedra, wedges and pyramids written as hexahedra with repeated nodes
 (*ELEMENT_SOLID), and triangles written as shells with N4 = N3 or N4 blank (*ELEMENT_SHELL).
 
-1. Mass: a mesh of tetrahedra and wedges carries rho V to 1e-12, each node of a lone
+1. Mass: meshes of tetrahedra, wedges or pyramids carry rho V to 1e-12; each node of a lone
    tetrahedron a quarter of it (the row sum of the consistent mass), whichever of the two
-   tetrahedron forms the deck uses.
-2. Patch test: a linear velocity field on an irregular mixed mesh of tetrahedra and wedges is
-   kept to 1e-10 at the interior nodes, with no hourglass energy (ELFORM 1, IHQ 1 and 4;
-   ELFORM 2).
+   tetrahedron forms the deck uses; a pyramid's apex 1/4 and its base nodes 3/16.
+2. Patch test: a linear velocity field on irregular meshes of tetrahedra, wedges, pyramids and
+   wedges under tetrahedra is kept to 1e-10 at the interior nodes, with no hourglass energy
+   (ELFORM 1 with IHQ 1 (tetrahedra only), 3, 4, 5; ELFORM 2), and no distortion warning.
 3. Time step: a lone tetrahedron's first step at TSSFAC 1 against its exact critical step
    (numpy: the linear tetrahedron with lumped masses V / 4); a tetrahedral mesh's step at or
    below the critical step of the whole mesh and above half of it; a lone triangle's step
    against its exact membrane critical step.
 4. Waves and energy: the elastic bar meshed with tetrahedra carries the wave front at
-   sqrt(E / rho) within 2% (the hexahedron test's tolerance); a kicked tetrahedral mesh keeps
-   its energy and books no hourglass energy.
+   sqrt(E / rho) within 2% (the hexahedron test's tolerance); kicked meshes of each shape
+   (ELFORM 1 and 2) keep their energy; tetrahedra book no hourglass energy.
 5. Shells: the membrane patch test on a mixed quadrilateral / triangle mesh (1e-10); the
    static deflection of a clamped strip of triangles against beam theory and the quadrilateral
    strip within 3%.
@@ -58,6 +58,24 @@ def wedges(hexes):
                      for h in hexes for w in WEDGES], dtype=int)
 
 
+def pyramids(nodes, hexes):
+    """Each hexahedron as six pyramids on its faces with a new apex node at its centre: the
+    nodes with the centres appended, and the pyramids N1 N2 N3 N4 N5 N5 N5 N5 (the base
+    counterclockwise seen from the apex)."""
+    faces = [(0, 1, 2, 3), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
+    centres = np.array([nodes[h].mean(axis=0) for h in hexes])
+    out = []
+    for k, h in enumerate(hexes):
+        apex = len(nodes) + k
+        for face in faces:
+            base = [h[i] for i in face]
+            a, b, d = nodes[base[0]], nodes[base[1]], nodes[base[3]]
+            if np.dot(np.cross(b - a, d - a), centres[k] - a) < 0:
+                base = base[::-1]
+            out.append(base + [apex] * 4)
+    return np.vstack([nodes, centres]), np.array(out, dtype=int)
+
+
 def degenerate_mesh(kind, counts, lengths, seed):
     """Nodes, degenerate elements and boundary nodes of a box with moved interior nodes:
     "tetrahedra", "wedges", or "mixed": wedges in the bottom layer of cells and tetrahedra
@@ -65,6 +83,10 @@ def degenerate_mesh(kind, counts, lengths, seed):
     the same diagonal, so the mesh is conforming)."""
     nodes, hexes = block_mesh(counts, lengths, perturbation=0.2, seed=seed)
     nodes = round_to_node_card(nodes)
+    if kind == "pyramids":
+        boundary = np.flatnonzero(boundary_node_mask(nodes))
+        nodes, elements = pyramids(nodes, hexes)
+        return round_to_node_card(nodes), elements, boundary
     if kind == "tetrahedra":
         elements = tetrahedra(nodes, hexes)
     elif kind == "wedges":
@@ -135,7 +157,26 @@ def test_lone_tetrahedron_lumps_a_quarter_of_its_mass_at_each_node(tmp_path, run
         assert abs(2.0 * kinetic / (DENSITY * volume / 4.0) - 1.0) < 1e-12, f"node {node + 1}"
 
 
-@pytest.mark.parametrize("kind", ["tetrahedra", "wedges"])
+def test_lone_pyramid_lumps_the_row_sums_of_its_mass(tmp_path, run_deck):
+    """A square pyramid: rho V / 4 at the apex, 3 rho V / 16 at each base node."""
+    x = np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 2.0, 0.0], [0.0, 2.0, 0.0], [0.7, 1.2, 1.5]])
+    volume = 4.0 * 1.5 / 3.0
+    for node, share in [(0, 3 / 16), (2, 3 / 16), (4, 1 / 4)]:
+        velocity = np.zeros((5, 3))
+        velocity[node, 2] = 1.0
+        deck = write_deck(tmp_path / f"pyramid_{node}.k",
+                          "*CONTROL_TERMINATION\n" + fields(0.0, 1),
+                          "*DATABASE_GLSTAT\n" + fields(1.0e-9),
+                          *solid_part(), nodes_card(x), solids_card([[0, 1, 2, 3, 4, 4, 4, 4]]),
+                          initial_velocities(velocity))
+        run = run_deck(deck, jobid=f"n{node}")
+        assert run.status == 0, run.stdout + run.stderr
+        with run.open() as results:
+            kinetic = glstat(results)["kinetic_energy"][0]
+        assert abs(2.0 * kinetic / (DENSITY * volume * share) - 1.0) < 1e-12, f"node {node + 1}"
+
+
+@pytest.mark.parametrize("kind", ["tetrahedra", "wedges", "pyramids"])
 def test_mesh_of_tetrahedra_or_wedges_carries_rho_v(tmp_path, run_deck, kind):
     nodes, elements, _ = degenerate_mesh(kind, (3, 3, 3), (1.0, 2.0, 1.5), seed=5)
     velocity = np.tile([1.0, 0.0, 0.0], (len(nodes), 1))
@@ -160,7 +201,8 @@ VELOCITY_GRADIENT = np.array([[0.010, 0.004, -0.002], [0.003, -0.006, 0.005], [-
 # hexahedra): it is tested on tetrahedra only, which have no hourglass modes
 @pytest.mark.parametrize("kind, element_formulation, hourglass_type",
                          [("tetrahedra", 1, 1), ("tetrahedra", 1, 4), ("tetrahedra", 2, 1), ("wedges", 1, 3),
-                          ("wedges", 1, 4), ("wedges", 2, 1), ("mixed", 1, 3), ("mixed", 1, 5), ("mixed", 2, 1)])
+                          ("wedges", 1, 4), ("wedges", 2, 1), ("mixed", 1, 3), ("mixed", 1, 5), ("mixed", 2, 1),
+                          ("pyramids", 1, 3), ("pyramids", 1, 4), ("pyramids", 2, 1)])
 def test_patch_test_on_tetrahedra_and_wedges(tmp_path, run_deck, kind, element_formulation, hourglass_type):
     nodes, elements, boundary = degenerate_mesh(kind, (3, 3, 3), (1.0, 1.0, 1.0), seed=7)
     velocity = nodes @ VELOCITY_GRADIENT.T
@@ -181,12 +223,15 @@ def test_patch_test_on_tetrahedra_and_wedges(tmp_path, run_deck, kind, element_f
                       nodes_card(nodes), solids_card(elements), initial_velocities(velocity), "\n".join(motion))
     run = run_deck(deck)
     assert run.status == 0, run.stdout + run.stderr
+    # the repeated nodes' collapsed corners are not folded corners (distortion check)
+    assert "folded" not in run.stdout
     with run.open() as results:
         assert results["run"].attrs["cycles"] == 100
         final = last_state(results)["velocity"][...]
         energies = glstat(results)
+        assert results["run"].attrs["worst_corner_jacobian_ratio"] > 0.0
     interior = np.setdiff1d(np.arange(len(nodes)), boundary)
-    assert len(interior) == 8
+    assert len(interior) == (8 + 27 if kind == "pyramids" else 8)
     error = np.abs(final[interior] - velocity[interior]).max() / np.abs(velocity).max()
     print(f"interior velocity error {error:.2e}, hourglass / internal "
           f"{abs(energies['hourglass_energy'][-1]) / energies['internal_energy'][-1]:.1e}")
@@ -254,7 +299,7 @@ def test_tetrahedral_mesh_step_against_the_mesh_critical_step(tmp_path, run_deck
 
 @pytest.mark.parametrize("kind, element_formulation, hourglass_type",
                          [("tetrahedra", 1, 1), ("tetrahedra", 2, 1), ("wedges", 1, 1), ("wedges", 1, 5),
-                          ("wedges", 2, 1), ("mixed", 1, 4)])
+                          ("wedges", 2, 1), ("mixed", 1, 4), ("pyramids", 1, 4), ("pyramids", 2, 1)])
 def test_kicked_degenerate_mesh_keeps_its_energy(tmp_path, run_deck, kind, element_formulation, hourglass_type):
     """Random nodal velocities on a free irregular mesh, 3,000 cycles at TSSFAC 0.9: stable,
     the energy balanced; tetrahedra book no hourglass energy."""
