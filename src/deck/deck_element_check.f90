@@ -5,10 +5,11 @@
 module deck_element_check
   use kinds, only: wp
   use hex8_geometry, only: tetrahedron_corner_order
+  use deck_input, only: deck_input_t
   implicit none
   private
 
-  public :: check_hexahedron
+  public :: check_hexahedron, order_tetrahedra
 
   !> Results of `check_hexahedron`.
   integer, parameter, public :: shape_valid = 0, shape_inside_out = 1, shape_flat = 2
@@ -71,6 +72,22 @@ contains
       if (volume <= tolerance) status = shape_flat
     end if
   end subroutine check_hexahedron
+
+  !> Put every tetrahedron of the deck (4 distinct nodes among the 8) in the form N1 N2 N3 N3
+  !> N4 N4 N4 N4 with a positive volume (tetrahedron_corner_order), whichever of LS-DYNA's two
+  !> forms the deck used: the elements, the static analysis, contact and the output then all
+  !> see the tetrahedron itself. Needs resolved node indices.
+  subroutine order_tetrahedra(input)
+    type(deck_input_t), intent(inout) :: input
+    integer :: element, order(8)
+    associate (model => input%model)
+      do element = 1, input%solid_count
+        call tetrahedron_corner_order(model%solid_nodes(:, element), &
+                                      model%coordinates(:, model%solid_nodes(:, element)), order)
+        model%solid_nodes(:, element) = model%solid_nodes(order, element)
+      end do
+    end associate
+  end subroutine order_tetrahedra
 
   !> Volume of the trilinear hexahedron: det J summed over the 2x2x2 Gauss points (exact,
   !> since det J is at most quadratic in each coordinate).

@@ -19,6 +19,11 @@
 !> give the nodal forces and moments as the transposes of the rates above, times the area.
 !> The thickness stays constant, as in LS-DYNA's default (*CONTROL_SHELL ISTUPD = 0).
 !>
+!> A triangle (N4 = N3) is this element collapsed at corner 3, whose membrane and bending rates
+!> are exactly the constant-strain triangle's; its transverse shear comes from its edges
+!> (shell_triangle, against shear locking), it has no hourglass modes and its characteristic
+!> length is 2 A / longest side (docs/shells.md, "Triangles").
+!>
 !> Hourglass control acts on the five modes a single point cannot see: in-plane (x, y),
 !> out-of-plane (z) and the two bending modes, through the vector
 !> gamma = h - (h . x) B1 - (h . y) B2 with h = (1, -1, 1, -1), orthogonal to every linear field
