@@ -462,15 +462,15 @@ contains
     integer, intent(in) :: nodes(8)
     real(wp), intent(in) :: x(3, 8)
     integer, intent(out) :: order(8)
-    integer :: first(4), count, corner
+    integer :: first(4), found, corner
     real(wp) :: a(3), b(3), c(3), triple
     order = [1, 2, 3, 4, 5, 6, 7, 8]
     if (distinct_corner_count(nodes) /= 4) return
-    count = 0
+    found = 0
     do corner = 1, 8
       if (any(nodes(1:corner - 1) == nodes(corner))) cycle
-      count = count + 1
-      first(count) = corner
+      found = found + 1
+      first(found) = corner
     end do
     a = x(:, first(2)) - x(:, first(1))
     b = x(:, first(3)) - x(:, first(1))

@@ -264,10 +264,11 @@ contains
     type(solid_block_t), intent(inout) :: block
     real(wp), intent(in) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
     real(wp) :: corner_volume(block_size, 8), node_volume
-    integer :: i, corner, distinct
+    integer :: i, corner, distinct, lane_nodes(8)
     call hex8_corner_volumes(block%element_count, x, y, z, corner_volume)
     do i = 1, block%element_count
-      distinct = distinct_corner_count(block%nodes(i, :))
+      lane_nodes = block%nodes(i, :)
+      distinct = distinct_corner_count(lane_nodes)
       block%degenerate(i) = distinct < 8
       block%tetrahedron(i) = distinct == 4
       if (.not. block%degenerate(i)) cycle
@@ -489,10 +490,7 @@ contains
     end do
   end function corner_mass_of
 
-  !> A tetrahedron has no hourglass modes: every motion of its four nodes is linear. The base
-  !> vectors of IHQ 1-3 (not orthogonal to linear fields on a degenerate shape) would still
-  !> damp its uniform straining and book that work as hourglass energy; its lanes get none.
-  !> Nor do a tetrahedron's (absent) hourglass modes bound its step, nor, under ELFORM 2, its
+  !> A tetrahedron's (absent) hourglass modes do not bound its step, nor, under ELFORM 2, its
   !> (absent) extra deviatoric modes: its gradients are the same at every Gauss point.
   pure subroutine clear_tetrahedron_modes(block, nel, mode_frequency_squared, mode_damping)
     type(solid_block_t), intent(in) :: block
@@ -507,6 +505,9 @@ contains
     end do
   end subroutine clear_tetrahedron_modes
 
+  !> A tetrahedron has no hourglass modes: every motion of its four nodes is linear. The base
+  !> vectors of IHQ 1-3 (not orthogonal to linear fields on a degenerate shape) would still
+  !> damp its uniform straining and book that work as hourglass energy; its lanes get none.
   pure subroutine clear_tetrahedron_hourglass(block, nel, gamma)
     type(solid_block_t), intent(in) :: block
     integer, intent(in) :: nel
@@ -803,9 +804,10 @@ contains
     call add_force_work(nel, dt, block%previous_time_step, old_power, new_power, block%force_power, &
                         block%internal_energy)
 
-    if (bound_wanted) &
+    if (bound_wanted) then
       call deviatoric_modes(block, material, nel, gram, bx, by, bz, volume, mode_frequency_squared, mode_damping)
       call clear_tetrahedron_modes(block, nel, mode_frequency_squared, mode_damping)
+    end if
     call stable_time_steps(block, material, nel, x, y, z, bx, by, bz, volume, wave_modulus, volumetric_rate, &
                            mode_frequency_squared, mode_damping, element_time_step)
     block%volume(1:nel) = volume(1:nel)

@@ -91,32 +91,32 @@ contains
     real(wp), intent(in) :: coordinates(:, :)
     integer, intent(in) :: element_nodes(8)
     real(wp), intent(inout) :: filled(:)
-    integer :: nodes(8), order(8), neighbour(4), count, corner, k, other, node
+    integer :: nodes(8), order(8), neighbour(4), found, corner, k, other, node
     call tetrahedron_corner_order(element_nodes, coordinates(:, element_nodes), order)
     nodes = element_nodes(order)
     do corner = 1, 8
       node = nodes(corner)
       if (any(nodes(1:corner - 1) == node)) cycle
       ! the distinct neighbours of this node, over all its corners, in corner order
-      count = 0
+      found = 0
       do other = 1, 8
         if (nodes(other) /= node) cycle
         do k = 1, 3
           if (nodes(edge_neighbours(k, other)) == node) cycle
-          if (any(neighbour(1:count) == nodes(edge_neighbours(k, other)))) cycle
-          if (count == 4) then
-            count = 5
+          if (any(neighbour(1:found) == nodes(edge_neighbours(k, other)))) cycle
+          if (found == 4) then
+            found = 5
             exit
           end if
-          count = count + 1
-          neighbour(count) = nodes(edge_neighbours(k, other))
+          found = found + 1
+          neighbour(found) = nodes(edge_neighbours(k, other))
         end do
-        if (count > 4) exit
+        if (found > 4) exit
       end do
-      if (count == 3) then
+      if (found == 3) then
         filled(node) = filled(node) + trihedron_angle(coordinates(:, node), coordinates(:, neighbour(1)), &
                                                       coordinates(:, neighbour(2)), coordinates(:, neighbour(3)))
-      else if (count == 4) then
+      else if (found == 4) then
         ! the apex of a pyramid: neighbours in the order of corners 1-4 go around the base
         filled(node) = filled(node) + trihedron_angle(coordinates(:, node), coordinates(:, neighbour(1)), &
                                                       coordinates(:, neighbour(2)), coordinates(:, neighbour(3))) &
