@@ -154,7 +154,10 @@ def test_lone_tetrahedron_lumps_a_quarter_of_its_mass_at_each_node(tmp_path, run
         assert run.status == 0, run.stdout + run.stderr
         with run.open() as results:
             kinetic = glstat(results)["kinetic_energy"][0]
+            connectivity = results["mesh/solids/connectivity"][0]
         assert abs(2.0 * kinetic / (DENSITY * volume / 4.0) - 1.0) < 1e-12, f"node {node + 1}"
+        # the output shows the tetrahedron itself: N1 N2 N3 N3 N4 N4 N4 N4
+        assert list(connectivity) == [1, 2, 3, 3, 4, 4, 4, 4]
 
 
 def test_lone_pyramid_lumps_the_row_sums_of_its_mass(tmp_path, run_deck):
