@@ -21,6 +21,7 @@ program test_degenerate_solids
   call test_tetrahedron_order()
   call test_masses()
   call test_exposure_of_a_tetrahedral_mesh()
+  call test_exposure_of_a_pyramid_mesh()
   call finish_suite(suite)
 
 contains
@@ -129,6 +130,51 @@ contains
                .not. any(exposed .and. outer_faces < 2) .and. count(outer_faces < 2) == 60)
     call check(suite, "exposure: those with a node on an edge or at a corner are", all(exposed .or. outer_faces < 2))
   end subroutine test_exposure_of_a_tetrahedral_mesh
+
+  !> 3 x 3 x 3 unit cubes, each split into six pyramids on its faces with its centre as their
+  !> apex: the apex of six pyramids is filled (4 pi, two trihedra each), so the pyramids of
+  !> the centre cube are not exposed (all their nodes are inside), while every pyramid with a
+  !> node on an edge or at a corner of the box is.
+  subroutine test_exposure_of_a_pyramid_mesh()
+    integer, parameter :: faces(4, 6) = reshape([1, 4, 3, 2, 5, 6, 7, 8, 1, 2, 6, 5, 2, 3, 7, 6, 3, 4, 8, 7, &
+                                                 4, 1, 5, 8], [4, 6])
+    real(wp) :: coordinates(3, 64 + 27)
+    integer :: connectivity(8, 162), cube(8), i, j, k, face, solid, corner, on_box(162), inside(162)
+    logical, allocatable :: exposed(:)
+    do k = 0, 3
+      do j = 0, 3
+        do i = 0, 3
+          coordinates(:, 1 + i + 4*j + 16*k) = [real(i, wp), real(j, wp), real(k, wp)]
+        end do
+      end do
+    end do
+    solid = 0
+    do k = 0, 2
+      do j = 0, 2
+        do i = 0, 2
+          cube = 1 + [i + 4*j + 16*k, i + 1 + 4*j + 16*k, i + 1 + 4*(j + 1) + 16*k, i + 4*(j + 1) + 16*k, &
+                      i + 4*j + 16*(k + 1), i + 1 + 4*j + 16*(k + 1), i + 1 + 4*(j + 1) + 16*(k + 1), &
+                      i + 4*(j + 1) + 16*(k + 1)]
+          coordinates(:, 65 + i + 3*j + 9*k) = [i + 0.5_wp, j + 0.5_wp, k + 0.5_wp]
+          do face = 1, 6
+            solid = solid + 1
+            ! the base in order around the face (the solid angles do not depend on its sense)
+            connectivity(:, solid) = [cube(faces(:, face)), (65 + i + 3*j + 9*k, corner=1, 4)]
+            on_box(solid) = maxval([(count(coordinates(:, connectivity(corner, solid)) == 0.0_wp .or. &
+                                           coordinates(:, connectivity(corner, solid)) == 3.0_wp), corner=1, 4)])
+            inside(solid) = merge(1, 0, i == 1 .and. j == 1 .and. k == 1)
+          end do
+        end do
+      end do
+    end do
+    exposed = exposed_elements(coordinates, connectivity)
+    call check(suite, "exposure: the pyramids of the centre cube are not exposed", &
+               .not. any(exposed .and. inside == 1))
+    call check(suite, "exposure: pyramids with a node on an edge or at a corner of the box are", &
+               all(exposed .or. on_box < 2))
+    call check(suite, "exposure: pyramids whose nodes are inside or on the box's faces are not", &
+               .not. any(exposed .and. on_box < 2))
+  end subroutine test_exposure_of_a_pyramid_mesh
 
   !> A unit cube's 8 nodes, `count` solids of one elastic part (connectivity left to the caller).
   subroutine cube_model(model, count)
