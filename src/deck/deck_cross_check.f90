@@ -20,7 +20,7 @@ module deck_cross_check
   use deck_boxes_frames, only: resolve_frames, frame_axes, vector_direction, mark_nodes_in_box
   use deck_segments, only: segment_has_no_area
   use deck_id_index, only: id_index_t, build_id_index, find_id, lower_bound
-  use deck_element_check, only: check_hexahedron, shape_inside_out, shape_flat
+  use deck_element_check, only: check_hexahedron, shape_inside_out, shape_flat, order_tetrahedra
   use deck_efg_cards, only: elform_efg
   use deck_material_curves, only: resolve_material_curves, apply_material_bulk_viscosity
   use deck_rigid_bodies, only: build_rigid_bodies
@@ -65,6 +65,7 @@ contains
     call resolve_parts(deck, input, indices, log)
     call check_element_sections(deck, input, log)
     call build_shell_thickness(deck, input, log)
+    if (mesh_resolved) call order_tetrahedra(input)
     call check_static_shells(deck, input, log)
     call resolve_material_curves(deck, input%model, input%material_lines, input%part_lines, log)
     call resolve_frames(deck, input, indices%nodes, log)

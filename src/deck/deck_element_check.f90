@@ -4,10 +4,12 @@
 !> corners with zero Jacobian, which is fine as long as the volume is positive.
 module deck_element_check
   use kinds, only: wp
+  use hex8_geometry, only: tetrahedron_corner_order
+  use deck_input, only: deck_input_t
   implicit none
   private
 
-  public :: check_hexahedron
+  public :: check_hexahedron, order_tetrahedra
 
   !> Results of `check_hexahedron`.
   integer, parameter, public :: shape_valid = 0, shape_inside_out = 1, shape_flat = 2
@@ -25,17 +27,24 @@ contains
 
   !> Check the hexahedron with corner coordinates `x(3, 8)`. `status` is shape_valid,
   !> shape_inside_out (`corner` = the corner with the most negative Jacobian) or shape_flat
-  !> (a collapsed corner and no positive volume).
+  !> (a collapsed corner and no positive volume). A tetrahedron (four distinct corners) is
+  !> checked in the form the elements use, N1 N2 N3 N3 N4 N4 N4 N4 with a positive volume
+  !> (tetrahedron_corner_order): it is flat or valid, never inside out.
   pure subroutine check_hexahedron(corners, status, corner)
     real(wp), intent(in) :: corners(3, 8)
     integer, intent(out) :: status, corner
     real(wp) :: x(3, 8), tolerance, lowest, jacobian, extent, volume
-    integer :: k
+    integer :: k, l, same(8), order(8)
 
+    ! corners at one place stand for one node
+    do k = 1, 8
+      same(k) = findloc([(all(corners(:, l) == corners(:, k)), l=1, 8)], .true., dim=1)
+    end do
+    call tetrahedron_corner_order(same, corners, order)
     ! Work relative to node 1 and in units of the element's size: the tolerances are then
     ! plain numbers and no product can overflow, whatever the units of the deck.
     do k = 1, 8
-      x(:, k) = corners(:, k) - corners(:, 1)
+      x(:, k) = corners(:, order(k)) - corners(:, order(1))
     end do
     extent = maxval(abs(x))
     status = shape_flat
@@ -63,6 +72,22 @@ contains
       if (volume <= tolerance) status = shape_flat
     end if
   end subroutine check_hexahedron
+
+  !> Put every tetrahedron of the deck (4 distinct nodes among the 8) in the form N1 N2 N3 N3
+  !> N4 N4 N4 N4 with a positive volume (tetrahedron_corner_order), whichever of LS-DYNA's two
+  !> forms the deck used: the elements, the static analysis, contact and the output then all
+  !> see the tetrahedron itself. Needs resolved node indices.
+  subroutine order_tetrahedra(input)
+    type(deck_input_t), intent(inout) :: input
+    integer :: element, order(8)
+    associate (model => input%model)
+      do element = 1, input%solid_count
+        call tetrahedron_corner_order(model%solid_nodes(:, element), &
+                                      model%coordinates(:, model%solid_nodes(:, element)), order)
+        model%solid_nodes(:, element) = model%solid_nodes(order, element)
+      end do
+    end associate
+  end subroutine order_tetrahedra
 
   !> Volume of the trilinear hexahedron: det J summed over the 2x2x2 Gauss points (exact,
   !> since det J is at most quadratic in each coordinate).

@@ -18,6 +18,7 @@ module hex8_geometry
   public :: hex8_volume_derivatives, hex8_volume, hex8_velocity_gradient, hex8_largest_face_area
   public :: hex8_gauss_natural_derivatives, hex8_point_derivatives, deformation_increments
   public :: hex8_gradient_invariants, largest_eigenvalue_bounds
+  public :: distinct_corner_count, tetrahedron_corner_order, hex8_corner_volumes
 
   !> Natural coordinates of the eight nodes.
   real(wp), parameter, public :: node_xi(8) = [-1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp]
@@ -220,9 +221,13 @@ contains
   !>   since every eigenvalue of S G is >= 1, lambda_max(S G) <= tr(S G) - 2. It is 0 for a
   !>   parallelepiped (G = S^-1), where the two kinds of modes are orthogonal. Only computed
   !>   `with_overlap` (IHQ 1 has its own, standard_hourglass_overlap).
-  subroutine hex8_gradient_invariants(nel, x, y, z, bx, by, bz, volume, g, trace_g, largest_g, overlap, with_overlap)
+  subroutine hex8_gradient_invariants(nel, x, y, z, bx, by, bz, volume, g, trace_g, largest_g, overlap, with_overlap, &
+                                      corner_weight)
     integer, intent(in) :: nel
     logical, intent(in) :: with_overlap
+    !> corner masses in units of rho V0 / 8 (degenerate elements, solid_block): G then sums
+    !> B_I B_I^T / w_I, the lumped-mass form the eigenvalue bound needs; 1 when absent
+    real(wp), intent(in), optional :: corner_weight(block_size, 8)
     real(wp), intent(in) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
     real(wp), intent(in) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8), volume(block_size)
     real(wp), intent(out) :: g(block_size, 6), trace_g(block_size), largest_g(block_size), overlap(block_size)
@@ -231,14 +236,25 @@ contains
     integer :: node, i
     do i = 1, nel
       g11 = 0.0_wp; g22 = 0.0_wp; g33 = 0.0_wp; g12 = 0.0_wp; g23 = 0.0_wp; g13 = 0.0_wp
-      do node = 1, 8
-        g11 = g11 + bx(i, node)**2
-        g22 = g22 + by(i, node)**2
-        g33 = g33 + bz(i, node)**2
-        g12 = g12 + bx(i, node)*by(i, node)
-        g23 = g23 + by(i, node)*bz(i, node)
-        g13 = g13 + bx(i, node)*bz(i, node)
-      end do
+      if (present(corner_weight)) then
+        do node = 1, 8
+          g11 = g11 + bx(i, node)**2/corner_weight(i, node)
+          g22 = g22 + by(i, node)**2/corner_weight(i, node)
+          g33 = g33 + bz(i, node)**2/corner_weight(i, node)
+          g12 = g12 + bx(i, node)*by(i, node)/corner_weight(i, node)
+          g23 = g23 + by(i, node)*bz(i, node)/corner_weight(i, node)
+          g13 = g13 + bx(i, node)*bz(i, node)/corner_weight(i, node)
+        end do
+      else
+        do node = 1, 8
+          g11 = g11 + bx(i, node)**2
+          g22 = g22 + by(i, node)**2
+          g33 = g33 + bz(i, node)**2
+          g12 = g12 + bx(i, node)*by(i, node)
+          g23 = g23 + by(i, node)*bz(i, node)
+          g13 = g13 + bx(i, node)*bz(i, node)
+        end do
+      end if
       ! b / V, kept finite for a flattened or inverted element (reported by the caller): V^2 is
       ! of the order of |b|^3 for any element of reasonable shape
       scale = 1.0_wp/max(volume(i)**2, 1.0e-12_wp*(g11 + g22 + g33)*sqrt(g11 + g22 + g33), tiny(1.0_wp))
@@ -423,4 +439,70 @@ contains
       spin_increment(i, 3) = (gradient(i, 4) - gradient(i, 2))*half_step
     end do
   end subroutine deformation_increments
+
+  !> Number of distinct nodes among an element's eight: 8 a hexahedron, 6 a wedge
+  !> (pentahedron), 5 a pyramid, 4 a tetrahedron written as a degenerate hexahedron.
+  pure integer function distinct_corner_count(nodes)
+    integer, intent(in) :: nodes(8)
+    integer :: corner
+    distinct_corner_count = 0
+    do corner = 1, 8
+      if (.not. any(nodes(1:corner - 1) == nodes(corner))) distinct_corner_count = distinct_corner_count + 1
+    end do
+  end function distinct_corner_count
+
+  !> A tetrahedron (4 distinct nodes among the 8) may be written N1 N2 N3 N3 N4 N4 N4 N4 or
+  !> N1 N2 N3 N4 N4 N4 N4 N4 (both are in use). Only the first makes the trilinear map the
+  !> tetrahedron itself (the second spans a ruled surface through the four nodes: a
+  !> different volume). `order` lists the corners that give the first form, a b c c d d d d
+  !> with a, b, c, d the corners where the four nodes first appear, b and c swapped if that
+  !> makes the volume positive (a tetrahedron has no other node order to get wrong), from the
+  !> corner coordinates `x(3, 8)`. Any other element gets 1..8.
+  pure subroutine tetrahedron_corner_order(nodes, x, order)
+    integer, intent(in) :: nodes(8)
+    real(wp), intent(in) :: x(3, 8)
+    integer, intent(out) :: order(8)
+    integer :: first(4), found, corner
+    real(wp) :: a(3), b(3), c(3), triple
+    order = [1, 2, 3, 4, 5, 6, 7, 8]
+    if (distinct_corner_count(nodes) /= 4) return
+    found = 0
+    do corner = 1, 8
+      if (any(nodes(1:corner - 1) == nodes(corner))) cycle
+      found = found + 1
+      first(found) = corner
+    end do
+    a = x(:, first(2)) - x(:, first(1))
+    b = x(:, first(3)) - x(:, first(1))
+    c = x(:, first(4)) - x(:, first(1))
+    triple = c(1)*(a(2)*b(3) - a(3)*b(2)) + c(2)*(a(3)*b(1) - a(1)*b(3)) + c(3)*(a(1)*b(2) - a(2)*b(1))
+    if (triple < 0.0_wp) first(2:3) = [first(3), first(2)]
+    order = [first(1), first(2), first(3), first(3), first(4), first(4), first(4), first(4)]
+  end subroutine tetrahedron_corner_order
+
+  !> integral of N_I over each element (corner I of lane i), by the 2x2x2 Gauss rule, exact
+  !> for the trilinear hexahedron (N_I det J is cubic in each natural coordinate). They sum to
+  !> the volume. For a degenerate element the corners of one node together give the row sum of
+  !> its consistent mass over rho: V / 4 at each node of a tetrahedron.
+  subroutine hex8_corner_volumes(nel, x, y, z, corner_volume)
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
+    real(wp), intent(out) :: corner_volume(block_size, 8)
+    real(wp) :: natural(8, 3, 8), dndx(block_size, 8), dndy(block_size, 8), dndz(block_size, 8)
+    real(wp) :: determinant(block_size), shape, g
+    integer :: point, node, i
+    g = 1.0_wp/sqrt(3.0_wp)
+    call hex8_gauss_natural_derivatives(natural)
+    corner_volume(1:nel, :) = 0.0_wp
+    do point = 1, 8
+      call hex8_point_derivatives(nel, natural(:, :, point), x, y, z, dndx, dndy, dndz, determinant)
+      do node = 1, 8
+        shape = 0.125_wp*(1.0_wp + node_xi(node)*g*node_xi(point))*(1.0_wp + node_eta(node)*g*node_eta(point)) &
+                *(1.0_wp + node_zeta(node)*g*node_zeta(point))
+        do i = 1, nel
+          corner_volume(i, node) = corner_volume(i, node) + shape*determinant(i)
+        end do
+      end do
+    end do
+  end subroutine hex8_corner_volumes
 end module hex8_geometry

@@ -17,7 +17,10 @@ module hex8_quality
 contains
 
   !> Smallest corner Jacobian over the largest in magnitude: 1 for a parallelepiped, below 0
-  !> once a corner is inverted, 0 for an element collapsed to nothing.
+  !> once a corner is inverted, 0 for an element collapsed to nothing. A corner with a
+  !> zero edge (a repeated node: a wedge, pyramid or tetrahedron given as a hexahedron) has a
+  !> zero Jacobian by construction and is left out; the other corners of such an element are
+  !> the corners of its own shape.
   pure real(wp) function corner_jacobian_ratio(corners) result(ratio)
     real(wp), intent(in) :: corners(3, 8)
     real(wp) :: a(3), b(3), c(3), jacobian, smallest, largest
@@ -28,6 +31,7 @@ contains
       a = corners(:, corner_edges(1, k)) - corners(:, k)
       b = corners(:, corner_edges(2, k)) - corners(:, k)
       c = corners(:, corner_edges(3, k)) - corners(:, k)
+      if (all(a == 0.0_wp) .or. all(b == 0.0_wp) .or. all(c == 0.0_wp)) cycle
       jacobian = (a(2)*b(3) - a(3)*b(2))*c(1) + (a(3)*b(1) - a(1)*b(3))*c(2) + (a(1)*b(2) - a(2)*b(1))*c(3)
       smallest = min(smallest, jacobian)
       largest = max(largest, abs(jacobian))

@@ -1,4 +1,5 @@
-!> Blocks of Belytschko-Tsay shell elements (*SECTION_SHELL ELFORM 2) and the per-cycle
+!> Blocks of Belytschko-Tsay shell elements (*SECTION_SHELL ELFORM 2; triangles, N4 = N3, as C0
+!> triangles with their own transverse shear, shell_triangle) and the per-cycle
 !> element work on them.
 !>
 !> The element (Belytschko, Lin & Tsay 1984; Hallquist, LS-DYNA Theory Manual, "Belytschko-Tsay
@@ -17,6 +18,11 @@
 !> shear factor SHRF. Resultants N = t sum w_k s_k, M = t sum w_k z_k s_k, Q = t sum w_k s_zk
 !> give the nodal forces and moments as the transposes of the rates above, times the area.
 !> The thickness stays constant, as in LS-DYNA's default (*CONTROL_SHELL ISTUPD = 0).
+!>
+!> A triangle (N4 = N3) is this element collapsed at corner 3, whose membrane and bending rates
+!> are exactly the constant-strain triangle's; its transverse shear comes from its edges
+!> (shell_triangle, against shear locking), it has no hourglass modes and its characteristic
+!> length is 2 A / longest side (docs/shells.md, "Triangles").
 !>
 !> Hourglass control acts on the five modes a single point cannot see: in-plane (x, y),
 !> out-of-plane (z) and the two bending modes, through the vector
@@ -45,6 +51,7 @@ module shell_block
   use element_work, only: add_force_work, smallest_time_step
   use gauss_legendre, only: gauss_legendre_rule
   use element_ordering, only: spatial_element_order
+  use shell_triangle, only: triangle_shear_operator
   implicit none
   private
 
@@ -286,6 +293,7 @@ contains
     call to_local(nel, frame, v, vl)
     call to_local(nel, frame, w, wl)
     call shell_rates(nel, b1, b2, block%centre_weight, vl, wl, membrane, curvature, shear)
+    call triangle_shear_rates(block, nel, xl, yl, vl, wl, shear)
     ! the frame follows side 1-2; the stress must turn with the material (module comment):
     ! half the material spin from the last frame to the mid-step one, where the increments are
     ! added, the other half from there to the end-of-step frame
@@ -318,6 +326,7 @@ contains
     call to_local(nel, frame, w, wl)
     call stress_resultants(block, nel, resultant)
     call resultant_forces(nel, area, b1, b2, block%centre_weight, resultant, local_force)
+    call triangle_shear_forces(block, nel, area, xl, yl, b1, b2, resultant, local_force)
     call hourglass_forces(block, material, nel, dt, area, xl, yl, b1, b2, vl, wl, hourglass_local)
 
     ! global forces, and the work of the last call's and this call's forces
@@ -455,6 +464,55 @@ contains
     end do
   end subroutine shell_rates
 
+  !> The transverse shear rates of the triangle lanes (N4 = N3), from their edges
+  !> (shell_triangle); the quadrilaterals keep those of shell_rates.
+  pure subroutine triangle_shear_rates(block, nel, xl, yl, vl, wl, shear)
+    type(shell_block_t), intent(in) :: block
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: xl(block_size, 4), yl(block_size, 4), vl(block_size, 4, 3), wl(block_size, 4, 3)
+    real(wp), intent(inout) :: shear(block_size, 2)
+    real(wp) :: vz_weight(3, 2), wx_weight(3, 2), wy_weight(3, 2)
+    integer :: i, corner
+    do i = 1, nel
+      if (block%nodes(i, 3) /= block%nodes(i, 4)) cycle
+      call triangle_shear_operator(xl(i, 1:3), yl(i, 1:3), vz_weight, wx_weight, wy_weight)
+      shear(i, :) = 0.0_wp
+      do corner = 1, 3
+        shear(i, :) = shear(i, :) + vz_weight(corner, :)*vl(i, corner, 3) + wx_weight(corner, :)*wl(i, corner, 1) &
+                      + wy_weight(corner, :)*wl(i, corner, 2)
+      end do
+    end do
+  end subroutine triangle_shear_rates
+
+  !> The local forces and moments of the triangle lanes with their edge-based shear: the
+  !> transposes of triangle_shear_rates for the transverse force and of the curvature rates and
+  !> the shear for the moments (what resultant_forces gives the quadrilaterals).
+  pure subroutine triangle_shear_forces(block, nel, area, xl, yl, b1, b2, resultant, local_force)
+    type(shell_block_t), intent(in) :: block
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: area(block_size), xl(block_size, 4), yl(block_size, 4)
+    real(wp), intent(in) :: b1(block_size, 4), b2(block_size, 4), resultant(block_size, 8)
+    real(wp), intent(inout) :: local_force(block_size, 4, 6)
+    real(wp) :: vz_weight(3, 2), wx_weight(3, 2), wy_weight(3, 2)
+    integer :: i, corner
+    do i = 1, nel
+      if (block%nodes(i, 3) /= block%nodes(i, 4)) cycle
+      call triangle_shear_operator(xl(i, 1:3), yl(i, 1:3), vz_weight, wx_weight, wy_weight)
+      do corner = 1, 3
+        local_force(i, corner, 3) = area(i)*(vz_weight(corner, 1)*resultant(i, 7) + vz_weight(corner, 2)*resultant(i, 8))
+        local_force(i, corner, 4) = area(i)*(-b2(i, corner)*resultant(i, 5) - b1(i, corner)*resultant(i, 6) &
+                                             + wx_weight(corner, 1)*resultant(i, 7) + wx_weight(corner, 2)*resultant(i, 8))
+        local_force(i, corner, 5) = area(i)*(b1(i, corner)*resultant(i, 4) + b2(i, corner)*resultant(i, 6) &
+                                             + wy_weight(corner, 1)*resultant(i, 7) + wy_weight(corner, 2)*resultant(i, 8))
+      end do
+      ! corner 4 is node 3 again: its bending moments stay (its gradients complete the
+      ! triangle's), the shear went to corners 1-3
+      local_force(i, 4, 3) = 0.0_wp
+      local_force(i, 4, 4) = area(i)*(-b2(i, 4)*resultant(i, 5) - b1(i, 4)*resultant(i, 6))
+      local_force(i, 4, 5) = area(i)*(b1(i, 4)*resultant(i, 4) + b2(i, 4)*resultant(i, 6))
+    end do
+  end subroutine triangle_shear_forces
+
   !> Resultants per unit length: N_x, N_y, N_xy, M_x, M_y, M_xy, Q_x (zx), Q_y (yz).
   pure subroutine stress_resultants(block, nel, resultant)
     type(shell_block_t), intent(in) :: block
@@ -515,6 +573,9 @@ contains
       hx = dot_product(h, xl(i, :))
       hy = dot_product(h, yl(i, :))
       gamma = h - hx*b1(i, :) - hy*b2(i, :)
+      ! a triangle has no hourglass modes (its three nodes' motions are all linear); gamma is
+      ! zero there up to round-off, which must not give forces or energy
+      if (block%nodes(i, 3) == block%nodes(i, 4)) gamma = 0.0_wp
       rate(1) = dot_product(gamma, vl(i, :, 1))
       rate(2) = dot_product(gamma, vl(i, :, 2))
       rate(3) = dot_product(gamma, vl(i, :, 3))
@@ -570,7 +631,7 @@ contains
         longest = max(longest, norm2(x(i, modulo(corner, 4) + 1, :) - x(i, corner, :)))
       end do
       wave_speed = sqrt(material%youngs_modulus/(block%density(i)*(1.0_wp - material%poissons_ratio**2)))
-      element_time_step(i) = max(area(i), 0.0_wp)/max(longest, tiny(1.0_wp))/wave_speed
+      element_time_step(i) = characteristic_factor(block, i)*max(area(i), 0.0_wp)/max(longest, tiny(1.0_wp))/wave_speed
       out_of_plane = out_of_plane_frequency_squared(block, material, i, area(i), xl(i, :), yl(i, :), b1(i, :), &
                                                     b2(i, :))
       if (out_of_plane > 0.0_wp) element_time_step(i) = min(element_time_step(i), 2.0_wp/sqrt(out_of_plane))
@@ -579,6 +640,14 @@ contains
                                                                           yl(i, :), b1(i, :), b2(i, :)))
     end do
   end subroutine stable_steps
+
+  !> LS-DYNA's characteristic length of a shell is (1 + beta) A / longest side, beta = 0 for a
+  !> quadrilateral and 1 for a triangle (its smallest altitude, 2 A / longest side).
+  pure real(wp) function characteristic_factor(block, i)
+    type(shell_block_t), intent(in) :: block
+    integer, intent(in) :: i
+    characteristic_factor = merge(2.0_wp, 1.0_wp, block%nodes(i, 3) == block%nodes(i, 4))
+  end function characteristic_factor
 
   !> Stable step of lane i's in-plane motion alone (for the exposed lanes): the membrane rule
   !> L / c is the critical step of a mesh, but a free shell's areal mode (u = x, v = y) has
@@ -660,6 +729,7 @@ contains
     real(wp) :: g1(4), g2(4), n(4), gamma(4), mass(4), inertia(4)
     real(wp) :: t, youngs, nu, shear_modulus, plane_lambda, norm_squared
     real(wp) :: s11, s22, s12, rotation, h11, h22, h12, gamma_mass, gamma_inertia, hourglass
+    real(wp) :: vz_weight(3, 2), wx_weight(3, 2), wy_weight(3, 2)
     integer :: corners
     t = block%thickness(i)
     youngs = material%youngs_modulus
@@ -685,6 +755,15 @@ contains
     s22 = sum(g2(1:corners)**2/mass(1:corners))
     s12 = sum(g1(1:corners)*g2(1:corners)/mass(1:corners))
     rotation = sum(n(1:corners)**2/inertia(1:corners))
+    if (corners == 3) then
+      ! the triangle's edge-based shear (shell_triangle): the 2 x 2 form S M^-1 S^T
+      call triangle_shear_operator(xl(1:3), yl(1:3), vz_weight, wx_weight, wy_weight)
+      s11 = sum(vz_weight(:, 1)**2/mass(1:3) + (wx_weight(:, 1)**2 + wy_weight(:, 1)**2)/inertia(1:3))
+      s22 = sum(vz_weight(:, 2)**2/mass(1:3) + (wx_weight(:, 2)**2 + wy_weight(:, 2)**2)/inertia(1:3))
+      s12 = sum(vz_weight(:, 1)*vz_weight(:, 2)/mass(1:3) &
+                + (wx_weight(:, 1)*wx_weight(:, 2) + wy_weight(:, 1)*wy_weight(:, 2))/inertia(1:3))
+      rotation = 0.0_wp
+    end if
     omega2 = block%shear_factor*shear_modulus*t*max(area, 0.0_wp) &
              *(0.5_wp*(s11 + s22) + sqrt(0.25_wp*(s11 - s22)**2 + s12**2) + rotation)
     h11 = sum(g1(1:corners)**2/inertia(1:corners))

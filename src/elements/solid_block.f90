@@ -37,7 +37,8 @@ module solid_block
   use objective_rotation, only: incremental_rotation, rotate_symmetric_tensors
   use hex8_geometry, only: hex8_volume_derivatives, hex8_volume, hex8_velocity_gradient, hex8_largest_face_area, &
                            hex8_gauss_natural_derivatives, hex8_point_derivatives, deformation_increments, &
-                           hex8_gradient_invariants
+                           hex8_gradient_invariants, distinct_corner_count, tetrahedron_corner_order, &
+                           hex8_corner_volumes
   use hex8_one_point, only: one_point_corner_forces, hourglass_shape_vectors, hourglass_viscous_forces, &
                             hourglass_stiffness_forces, one_point_force_powers, previous_hourglass_velocities, &
                             hourglass_power, hourglass_mode_bounds, standard_hourglass_overlap
@@ -74,6 +75,13 @@ module solid_block
     logical :: exposed(block_size) = .false.
     integer :: exposed_count = 0                 !< number of exposed lanes
     integer :: nodes(block_size, 8) = 0          !< node indices of each corner
+    !> Degenerate elements (repeated nodes: wedges, pyramids, tetrahedra; degenerate_lanes).
+    logical :: degenerate(block_size) = .false.
+    !> Tetrahedra among them: no hourglass modes and the characteristic length of a tetrahedron.
+    logical :: tetrahedron(block_size) = .false.
+    !> Corner masses in units of rho V0 / 8: 1 on a hexahedron; on a degenerate element each
+    !> node's row sum of the consistent mass shared equally by its corners (degenerate_lanes).
+    real(wp) :: corner_weight(block_size, 8) = 1.0_wp
     real(wp) :: density(block_size) = 0.0_wp     !< effective density (raised by mass scaling)
     real(wp) :: reference_volume(block_size) = 0.0_wp   !< exact initial volume
     real(wp) :: internal_energy(block_size) = 0.0_wp    !< cumulative, bulk viscosity work included
@@ -117,7 +125,7 @@ contains
     integer, allocatable :: part_solid_count(:), first_of_part(:), ordered_solids(:), next_slot(:)
     integer, allocatable :: spatial_order(:)
     logical, allocatable :: exposed(:)
-    integer :: part, solid, block_count, solid_count, part_count, lane, current, slot, k
+    integer :: part, solid, block_count, solid_count, part_count, lane, current, slot, k, order(8)
 
     solid_count = 0
     if (allocated(model%solid_part)) solid_count = size(model%solid_part)
@@ -166,7 +174,9 @@ contains
         solid = ordered_solids(slot)
         blocks(current)%element_count = lane
         blocks(current)%elements(lane) = solid
-        blocks(current)%nodes(lane, :) = model%solid_nodes(:, solid)
+        call tetrahedron_corner_order(model%solid_nodes(:, solid), model%coordinates(:, model%solid_nodes(:, solid)), &
+                                      order)
+        blocks(current)%nodes(lane, :) = model%solid_nodes(order, solid)
         blocks(current)%exposed(lane) = exposed(solid)
         if (exposed(solid)) blocks(current)%exposed_count = blocks(current)%exposed_count + 1
       end do
@@ -230,6 +240,7 @@ contains
     end do
     call hex8_volume_derivatives(nel, x, y, z, bx, by, bz, block%reference_volume)
     block%volume(1:nel) = block%reference_volume(1:nel)
+    call degenerate_lanes(block, x, y, z)
     if (block%point_count == 1) then
       block%point_volume(1:nel, 1) = block%reference_volume(1:nel)
     else
@@ -241,7 +252,36 @@ contains
     end if
   end subroutine finish_block
 
-  !> Corner masses density * reference volume / 8 (lanes beyond element_count zero).
+  !> Degenerate elements of a filled block (x, y, z its reference coordinates). A hexahedron
+  !> lumps rho V0 / 8 at each corner. With repeated nodes that would give a tetrahedron's
+  !> repeated node 5/8 of its mass: instead each node gets its row sum of the consistent mass,
+  !> rho times the integral of its shape function (hex8_corner_volumes): V / 4 at each node of a
+  !> tetrahedron, V / 6 at each node of a right wedge, V / 4 at a pyramid's apex. The repeated
+  !> corners of a node share its mass equally; the eigenvalue bound on the step (which treats
+  !> the corners as free points) stays a bound, since tying corners together lowers the
+  !> frequencies.
+  subroutine degenerate_lanes(block, x, y, z)
+    type(solid_block_t), intent(inout) :: block
+    real(wp), intent(in) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
+    real(wp) :: corner_volume(block_size, 8), node_volume
+    integer :: i, corner, distinct, lane_nodes(8)
+    call hex8_corner_volumes(block%element_count, x, y, z, corner_volume)
+    do i = 1, block%element_count
+      lane_nodes = block%nodes(i, :)
+      distinct = distinct_corner_count(lane_nodes)
+      block%degenerate(i) = distinct < 8
+      block%tetrahedron(i) = distinct == 4
+      if (.not. block%degenerate(i)) cycle
+      do corner = 1, 8
+        node_volume = sum(corner_volume(i, :), mask=block%nodes(i, :) == block%nodes(i, corner))
+        block%corner_weight(i, corner) = 8.0_wp*node_volume &
+                                         /(count(block%nodes(i, :) == block%nodes(i, corner))*block%reference_volume(i))
+      end do
+    end do
+  end subroutine degenerate_lanes
+
+  !> Corner masses density * reference volume / 8 (a degenerate element: times its corner
+  !> weights, degenerate_lanes); lanes beyond element_count zero.
   subroutine solid_block_corner_masses(block, corner_mass)
     type(solid_block_t), intent(in) :: block
     real(wp), intent(out) :: corner_mass(block_size, 8)
@@ -249,7 +289,8 @@ contains
     nel = block%element_count
     corner_mass = 0.0_wp
     do node = 1, 8
-      corner_mass(1:nel, node) = 0.125_wp*block%density(1:nel)*block%reference_volume(1:nel)
+      corner_mass(1:nel, node) = 0.125_wp*block%density(1:nel)*block%reference_volume(1:nel) &
+                                 *block%corner_weight(1:nel, node)
     end do
   end subroutine solid_block_corner_masses
 
@@ -291,15 +332,18 @@ contains
         end if
       end do
       call deviatoric_modes(block, material, nel, gram, bx, by, bz, volume, mode_frequency_squared, mode_damping)
+      call clear_tetrahedron_modes(block, nel, mode_frequency_squared, mode_damping)
     else
       call hourglass_shape_vectors(nel, block%hourglass_type, x, y, z, bx, by, bz, volume, gamma, &
                                    hourglass_volume, gradient_norm_squared)
+      call clear_tetrahedron_hourglass(block, nel, gamma)
       ! a_h / QM of hourglass_viscous_forces
       viscosity_scale(1:nel) = 0.25_wp*density(1:nel)*sound_speed(1:nel) &
                                *abs(hourglass_volume(1:nel))**(2.0_wp/3.0_wp)
       call hourglass_mode_bounds(nel, block%hourglass_type, block%hourglass_coefficient, wave_modulus, &
                                  viscosity_scale, hourglass_volume, gradient_norm_squared, gamma, &
                                  corner_mass_of(block, nel), mode_frequency_squared, mode_damping)
+      call clear_tetrahedron_modes(block, nel, mode_frequency_squared, mode_damping)
     end if
     call stable_time_steps(block, material, nel, x, y, z, bx, by, bz, volume, wave_modulus, rest, &
                            mode_frequency_squared, mode_damping, element_time_step)
@@ -322,18 +366,29 @@ contains
     real(wp), intent(inout) :: element_time_step(block_size)
     real(wp) :: area(block_size), g(block_size, 6), trace_g(block_size), largest_g(block_size)
     real(wp) :: overlap(block_size), lame_bound, shear_bound, bound_time_step(block_size)
+    real(wp) :: node_bx(block_size, 8), node_by(block_size, 8), node_bz(block_size, 8), node_weight(block_size, 8)
     logical :: standard
     integer :: i
     call hex8_largest_face_area(nel, x, y, z, area)
+    ! a tetrahedron's characteristic length is its smallest altitude, 3 V / largest face (LS-DYNA's
+    ! tetrahedra); the other shapes keep V / largest face
+    do i = 1, nel
+      if (block%tetrahedron(i)) area(i) = area(i)/3.0_wp
+    end do
     call solid_element_time_steps(nel, block%bulk_quadratic, block%bulk_linear, volume, area, wave_modulus, &
                                   block%density, volumetric_rate, element_time_step)
     if (block%exposed_count == 0) return
     standard = block%formulation == formulation_one_point .and. block%hourglass_type == 1
-    call hex8_gradient_invariants(nel, x, y, z, bx, by, bz, volume, g, trace_g, largest_g, overlap, &
-                                  with_overlap=.not. standard)
+    call merged_gradients(block, nel, bx, by, bz, node_bx, node_by, node_bz, node_weight)
+    call hex8_gradient_invariants(nel, x, y, z, node_bx, node_by, node_bz, volume, g, trace_g, largest_g, overlap, &
+                                  with_overlap=.not. standard, corner_weight=node_weight)
     ! IHQ 1's hourglass vectors are the plain base vectors, orthogonal to the strain modes only
     ! on parallelepipeds
     if (standard) call standard_hourglass_overlap(nel, bx, by, bz, volume, g, overlap)
+    ! a degenerate element: no overlap bound (its corners carry unequal masses), the safe 1
+    do i = 1, nel
+      if (block%degenerate(i)) overlap(i) = 1.0_wp
+    end do
     call material_stiffness_bounds(material, lame_bound, shear_bound)
     bound_time_step(1:nel) = element_time_step(1:nel)
     call eigenvalue_time_steps(nel, block%bulk_quadratic, block%bulk_linear, lame_bound, shear_bound, &
@@ -386,14 +441,82 @@ contains
     call material_stiffness_bounds(material, lame_bound, shear_bound_of)
   end function shear_bound_of
 
-  !> Lumped corner mass rho V0 / 8 of lanes 1..nel (the rest zero).
+  !> The volume derivatives and corner weights that the eigenvalue bound of the uniform-strain
+  !> modes takes: a hexahedron's own; on a degenerate element those of its nodes, each node's
+  !> summed over its corners and put at its first corner with the node's whole weight (the
+  !> other corners get zero derivatives and weight 1). Corners of one node move together, so
+  !> this bound is the element's, not that of eight free corners (several times larger on a
+  !> tetrahedron, whose repeated corners have large derivatives of opposite sign).
+  pure subroutine merged_gradients(block, nel, bx, by, bz, node_bx, node_by, node_bz, node_weight)
+    type(solid_block_t), intent(in) :: block
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8)
+    real(wp), intent(out) :: node_bx(block_size, 8), node_by(block_size, 8), node_bz(block_size, 8)
+    real(wp), intent(out) :: node_weight(block_size, 8)
+    integer :: i, corner, other
+    node_bx(1:nel, :) = bx(1:nel, :)
+    node_by(1:nel, :) = by(1:nel, :)
+    node_bz(1:nel, :) = bz(1:nel, :)
+    node_weight(1:nel, :) = block%corner_weight(1:nel, :)
+    do i = 1, nel
+      if (.not. block%degenerate(i)) cycle
+      do corner = 8, 1, -1
+        other = findloc(block%nodes(i, 1:corner), block%nodes(i, corner), dim=1)
+        if (other == corner) cycle
+        node_bx(i, other) = node_bx(i, other) + node_bx(i, corner)
+        node_by(i, other) = node_by(i, other) + node_by(i, corner)
+        node_bz(i, other) = node_bz(i, other) + node_bz(i, corner)
+        node_weight(i, other) = node_weight(i, other) + node_weight(i, corner)
+        node_bx(i, corner) = 0.0_wp
+        node_by(i, corner) = 0.0_wp
+        node_bz(i, corner) = 0.0_wp
+        node_weight(i, corner) = 1.0_wp
+      end do
+    end do
+  end subroutine merged_gradients
+
+  !> Lumped corner mass rho V0 / 8 of lanes 1..nel (the rest zero); for a degenerate element
+  !> its smallest corner mass (the mode bounds that read it take one mass for all corners, and
+  !> a smaller mass only raises them).
   pure function corner_mass_of(block, nel) result(corner_mass)
     type(solid_block_t), intent(in) :: block
     integer, intent(in) :: nel
     real(wp) :: corner_mass(block_size)
+    integer :: i
     corner_mass = 0.0_wp
     corner_mass(1:nel) = 0.125_wp*block%density(1:nel)*block%reference_volume(1:nel)
+    do i = 1, nel
+      if (block%degenerate(i)) corner_mass(i) = corner_mass(i)*minval(block%corner_weight(i, :))
+    end do
   end function corner_mass_of
+
+  !> A tetrahedron's (absent) hourglass modes do not bound its step, nor, under ELFORM 2, its
+  !> (absent) extra deviatoric modes: its gradients are the same at every Gauss point.
+  pure subroutine clear_tetrahedron_modes(block, nel, mode_frequency_squared, mode_damping)
+    type(solid_block_t), intent(in) :: block
+    integer, intent(in) :: nel
+    real(wp), intent(inout) :: mode_frequency_squared(block_size), mode_damping(block_size)
+    integer :: i
+    do i = 1, nel
+      if (block%tetrahedron(i)) then
+        mode_frequency_squared(i) = 0.0_wp
+        mode_damping(i) = 0.0_wp
+      end if
+    end do
+  end subroutine clear_tetrahedron_modes
+
+  !> A tetrahedron has no hourglass modes: every motion of its four nodes is linear. The base
+  !> vectors of IHQ 1-3 (not orthogonal to linear fields on a degenerate shape) would still
+  !> damp its uniform straining and book that work as hourglass energy; its lanes get none.
+  pure subroutine clear_tetrahedron_hourglass(block, nel, gamma)
+    type(solid_block_t), intent(in) :: block
+    integer, intent(in) :: nel
+    real(wp), intent(inout) :: gamma(block_size, 8, 4)
+    integer :: i
+    do i = 1, nel
+      if (block%tetrahedron(i)) gamma(i, :, :) = 0.0_wp
+    end do
+  end subroutine clear_tetrahedron_hourglass
 
   !> One cycle of element work on a block: strain increments from x(n+1) and v(n+1/2), stress
   !> and material state update, energies, corner forces on x(n+1), stable time step.
@@ -527,6 +650,7 @@ contains
     call hourglass_power(nel, block%hourglass_force, old_hourglass_velocity, old_hourglass_power)
     call hourglass_shape_vectors(nel, block%hourglass_type, x, y, z, bx, by, bz, volume, gamma, &
                                  hourglass_volume, gradient_norm_squared)
+    call clear_tetrahedron_hourglass(block, nel, gamma)
     if (block%hourglass_type >= 4) then
       call hourglass_stiffness_forces(nel, block%hourglass_coefficient, dt, wave_modulus, hourglass_volume, &
                                       gradient_norm_squared, rotation, gamma, vx, vy, vz, block%hourglass_force, &
@@ -550,6 +674,7 @@ contains
       call hourglass_mode_bounds(nel, block%hourglass_type, block%hourglass_coefficient, wave_modulus, &
                                  viscosity_scale, hourglass_volume, gradient_norm_squared, gamma, &
                                  corner_mass_of(block, nel), mode_frequency_squared, mode_damping)
+      call clear_tetrahedron_modes(block, nel, mode_frequency_squared, mode_damping)
     end if
     call stable_time_steps(block, material, nel, x, y, z, bx, by, bz, volume, wave_modulus, volumetric_rate, &
                            mode_frequency_squared, mode_damping, element_time_step)
@@ -679,8 +804,10 @@ contains
     call add_force_work(nel, dt, block%previous_time_step, old_power, new_power, block%force_power, &
                         block%internal_energy)
 
-    if (bound_wanted) &
+    if (bound_wanted) then
       call deviatoric_modes(block, material, nel, gram, bx, by, bz, volume, mode_frequency_squared, mode_damping)
+      call clear_tetrahedron_modes(block, nel, mode_frequency_squared, mode_damping)
+    end if
     call stable_time_steps(block, material, nel, x, y, z, bx, by, bz, volume, wave_modulus, volumetric_rate, &
                            mode_frequency_squared, mode_damping, element_time_step)
     block%volume(1:nel) = volume(1:nel)
