@@ -12,7 +12,7 @@ module model
 
   public :: model_t, material_t, section_t, hourglass_t, part_t, node_set_t, part_set_t
   public :: spc_t, prescribed_motion_t, nodal_load_t, segment_load_t, rigid_wall_t, output_control_t
-  public :: rigid_body_t, rigid_motion_t
+  public :: rigid_body_t, rigid_motion_t, spot_weld_t
   public :: segment_set_t, contact_t, contact_surface_t
 
   !> The law codes and what each law can do are in material_laws' law_table. law_null is also
@@ -243,6 +243,20 @@ module model
     real(wp) :: death = 1.0e28_wp
   end type rigid_motion_t
 
+  !> A spot weld held as a small rigid body until it fails: *CONSTRAINED_SPOTWELD (two nodes)
+  !> or *CONSTRAINED_GENERALIZED_WELD_SPOT (a node set). It fails when
+  !> (|fn|/SN)^N + (|fs|/SS)^M >= 1 with the force it transmits (a strength of 0 leaves its
+  !> term out), or at TFAIL; afterwards its nodes move independently.
+  type :: spot_weld_t
+    integer :: id = 0                        !< WID (welds without an id: 1, 2, ... in deck order)
+    integer, allocatable :: nodes(:)         !< node indices
+    real(wp) :: normal_strength = 0.0_wp     !< SN (0: no normal-force term)
+    real(wp) :: shear_strength = 0.0_wp      !< SS (0: no shear-force term)
+    real(wp) :: normal_exponent = 2.0_wp     !< N
+    real(wp) :: shear_exponent = 2.0_wp      !< M
+    real(wp) :: failure_time = 1.0e20_wp     !< TF / TFAIL
+  end type spot_weld_t
+
   !> *SET_SEGMENT, node indices (a triangle repeats node 3); segments with a reported problem
   !> are left out.
   type :: segment_set_t
@@ -337,6 +351,7 @@ module model
     type(rigid_body_t), allocatable :: rigid_bodies(:)
     type(rigid_motion_t), allocatable :: rigid_motions(:)
     real(wp), allocatable :: node_masses(:)          !< *ELEMENT_MASS per node (nodes)
+    type(spot_weld_t), allocatable :: spot_welds(:)  !< *CONSTRAINED_SPOTWELD, _GENERALIZED_WELD_SPOT
     ! controls
     logical :: implicit_static = .false.             !< *CONTROL_IMPLICIT_GENERAL IMFLAG = 1: linear static
     real(wp) :: end_time = 0.0_wp                    !< ENDTIM

@@ -33,6 +33,7 @@ module explicit_solver
   use planar_rigid_walls, only: enforce_planar_walls
   use cylinder_walls, only: enforce_cylinder_walls
   use rigid_bodies, only: advance_rigid_bodies
+  use spot_weld_constraints, only: advance_spot_welds
   use penalty_contact, only: compute_contact_forces, report_initial_penetrations
   use energy_balance, only: measured_energies, total_energy
   use run_checks, only: set_up_run_checks, check_runaway_motion, check_elements, check_time_step, check_energy, &
@@ -231,23 +232,29 @@ contains
   end subroutine enforce_walls
 
   !> Rigid bodies move their nodes (their prescribed motions and constraints do external work);
-  !> shell nodes of a body turn with it. (The moments that deformable shells put on such nodes
-  !> are not passed on to the body: a shell tied to a rigid part transmits forces only.)
+  !> shell nodes of a body turn with it, and the moments that deformable shells put on such
+  !> nodes act on the body (rigid_bodies). Then the spot welds that hold move their nodes as
+  !> small rigid bodies and fail by their forces or time (spot_weld_constraints).
   subroutine move_rigid_bodies(model, state, step, average_step)
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(inout) :: state
     real(wp), intent(in) :: step, average_step
     real(wp) :: work
     integer :: b, k
-    if (size(state%rigid) == 0) return
-    call advance_rigid_bodies(model, state%rigid, state%time, step, average_step, state%nodes%coordinates, &
-                              state%nodes%velocity, work)
-    state%energy%external_work = state%energy%external_work + work
-    do b = 1, size(state%rigid)
-      do k = 1, size(model%rigid_bodies(b)%nodes)
-        state%nodes%angular_velocity(:, model%rigid_bodies(b)%nodes(k)) = state%rigid(b)%angular_velocity
+    if (size(state%rigid) > 0) then
+      call advance_rigid_bodies(model, state%rigid, state%time, step, average_step, state%nodes%coordinates, &
+                                state%nodes%angular_acceleration, state%nodes%rotary_inertia, state%nodes%velocity, work)
+      state%energy%external_work = state%energy%external_work + work
+      do b = 1, size(state%rigid)
+        do k = 1, size(model%rigid_bodies(b)%nodes)
+          state%nodes%angular_velocity(:, model%rigid_bodies(b)%nodes(k)) = state%rigid(b)%angular_velocity
+        end do
       end do
-    end do
+    end if
+    if (size(state%welds) > 0) &
+      call advance_spot_welds(model, state%welds, state%time, step, average_step, state%nodes%coordinates, &
+                              state%nodes%angular_acceleration, state%nodes%rotary_inertia, state%nodes%velocity, &
+                              state%nodes%angular_velocity)
   end subroutine move_rigid_bodies
 
   !> u^{n+1} = u^n + dt v^{n+1/2}; x = X + u; the loads' work over the first half of the step;
