@@ -78,6 +78,11 @@ contains
                              state%nodes%velocity, state%nodes%is_rigid_node, state%rigid, rigid_mass)
     call set_up_spot_welds(model, state%nodes%reference, state%nodes%mass, state%nodes%rotary_inertia, &
                            state%nodes%velocity, state%welds)
+    allocate (state%held_by_weld(state%nodes%count))
+    state%held_by_weld = .false.
+    do b = 1, size(state%welds)
+      state%held_by_weld(model%spot_welds(b)%nodes) = .true.
+    end do
     state%physical_mass = state%physical_mass + rigid_mass
     state%rigid_time_step = huge(1.0_wp)
     do b = 1, size(state%rigid)

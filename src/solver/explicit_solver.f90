@@ -182,6 +182,8 @@ contains
         partial(chunk) = 0.0_wp
         do node = (chunk - 1)*sum_chunk_size + 1, min(chunk*sum_chunk_size, nodes%count)
           if (nodes%rotary_inertia(node) <= 0.0_wp .or. nodes%shell_area_sum(node) <= 0.0_wp) cycle
+          ! a rigid body or weld sets the rotation of its nodes (and takes their moments)
+          if (nodes%is_rigid_node(node) .or. state%held_by_weld(node)) cycle
           length = norm2(nodes%shell_normal_sum(:, node))
           if (length < coplanar*nodes%shell_area_sum(node)) cycle
           ! within the rotations an SPC leaves free (fixed ones stay zero)
@@ -251,10 +253,14 @@ contains
         end do
       end do
     end if
-    if (size(state%welds) > 0) &
-      call advance_spot_welds(model, state%welds, state%time, step, average_step, state%nodes%coordinates, &
-                              state%nodes%angular_acceleration, state%nodes%rotary_inertia, state%nodes%velocity, &
-                              state%nodes%angular_velocity)
+    if (size(state%welds) == 0) return
+    call advance_spot_welds(model, state%welds, state%time, step, average_step, state%nodes%coordinates, &
+                            state%nodes%angular_acceleration, state%nodes%rotary_inertia, state%nodes%velocity, &
+                            state%nodes%angular_velocity)
+    ! the nodes of failed welds are free from the next step
+    do b = 1, size(state%welds)
+      if (state%welds(b)%failed) state%held_by_weld(model%spot_welds(b)%nodes) = .false.
+    end do
   end subroutine move_rigid_bodies
 
   !> u^{n+1} = u^n + dt v^{n+1/2}; x = X + u; the loads' work over the first half of the step;

@@ -58,6 +58,7 @@ module explicit_state
     type(rigid_body_state_t), allocatable :: rigid(:)
     real(wp) :: rigid_time_step = huge(1.0_wp)           !< smallest stable step of the rigid elements
     type(spot_weld_state_t), allocatable :: welds(:)     !< indexed like model%spot_welds
+    logical, allocatable :: held_by_weld(:)              !< (nodes) in a weld that has not failed
     type(wall_state_t), allocatable :: walls(:)          !< indexed like model%walls
     type(contact_state_t), allocatable :: contacts(:)    !< indexed like model%contacts
     ! bookkeeping
