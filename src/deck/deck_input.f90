@@ -23,9 +23,10 @@ module deck_input
     list_node_sets = 9, list_part_sets = 10, list_spcs = 11, list_motions = 12, list_loads = 13, &
     list_velocities = 14, list_walls = 15, list_segment_sets = 16, list_segment_loads = 17, &
     list_rigid_materials = 18, list_rigid_motions = 19, list_nodal_rigid_bodies = 20, &
-    list_element_masses = 21, list_contacts = 22, list_spot_welds = 23
+    list_element_masses = 21, list_contacts = 22, list_spot_welds = 23, &
+    list_rigid_links = 24
   !> Number of lists.
-  integer, parameter, public :: list_count = 23
+  integer, parameter, public :: list_count = 24
 
   !> How an initial velocity was given.
   integer, parameter, public :: velocity_by_set = 1, velocity_by_node = 2, &
@@ -207,6 +208,7 @@ contains
     allocate (input%rigid%nodal(capacity(list_nodal_rigid_bodies)))
     allocate (input%rigid%masses(capacity(list_element_masses)))
     allocate (input%rigid%welds(capacity(list_spot_welds)))
+    allocate (input%rigid%links(capacity(list_rigid_links)))
     allocate (input%contact%entries(capacity(list_contacts)))
   end subroutine prepare_input
 

@@ -24,7 +24,7 @@ module deck_keyword_table
     list_sections, list_materials, list_hourglasses, list_curves, list_node_sets, list_part_sets, list_spcs, &
     list_motions, list_loads, list_velocities, list_walls, list_segment_sets, list_segment_loads, &
     list_rigid_materials, list_rigid_motions, list_nodal_rigid_bodies, list_element_masses, list_contacts, &
-    list_spot_welds, list_count
+    list_spot_welds, list_rigid_links, list_count
   use deck_nodes_elements, only: read_nodes, read_solid_elements, read_shell_elements, read_thick_shell_elements
   use deck_parts_sections, only: read_parts, read_solid_sections, read_efg_sections, read_shell_sections, &
     read_hourglasses
@@ -41,7 +41,8 @@ module deck_keyword_table
   use deck_database, only: read_plot_output, read_glstat_output, read_matsum_output, read_nodout_output, &
     read_rwforc_output, read_history_nodes, read_history_node_sets, read_d3dump_output, read_runrsf_output
   use deck_rigid_bodies, only: read_rigid_materials, read_rigid_motions, read_nodal_rigid_bodies, &
-    read_element_masses, read_spot_welds, read_generalized_spot_welds
+    read_element_masses, read_spot_welds, read_generalized_spot_welds, read_extra_nodes, read_extra_node_sets, &
+    read_rigid_body_merges
   use deck_contact, only: read_nodes_to_surface_contacts, read_surface_to_surface_contacts, &
     read_single_surface_contacts, read_control_contact, read_rcforc
   implicit none
@@ -170,6 +171,10 @@ contains
                       reader=read_spot_welds), &
       keyword_entry_t("CONSTRAINED_GENERALIZED_WELD_SPOT", options="ID", fills=[list_spot_welds, list_none], &
                       reader=read_generalized_spot_welds), &
+      keyword_entry_t("CONSTRAINED_EXTRA_NODES_NODE", fills=[list_rigid_links, list_none], reader=read_extra_nodes), &
+      keyword_entry_t("CONSTRAINED_EXTRA_NODES_SET", fills=[list_rigid_links, list_none], &
+                      reader=read_extra_node_sets), &
+      keyword_entry_t("CONSTRAINED_RIGID_BODIES", fills=[list_rigid_links, list_none], reader=read_rigid_body_merges), &
       keyword_entry_t("ELEMENT_MASS", fills=[list_element_masses, list_none], reader=read_element_masses), &
       keyword_entry_t("CONTACT_AUTOMATIC_NODES_TO_SURFACE", options="ID TITLE", one_option=.true., &
                       fills=[list_contacts, list_none], entries=per_block, reader=read_nodes_to_surface_contacts), &

@@ -9,7 +9,10 @@ module deck_rigid_input
   private
 
   public :: rigid_input_t, rigid_material_input_t, rigid_motion_input_t, nodal_rigid_input_t
-  public :: element_mass_input_t, spot_weld_input_t
+  public :: element_mass_input_t, spot_weld_input_t, rigid_link_input_t
+
+  !> What a rigid_link_input_t adds: a node or a node set to a rigid body, or a rigid part to another.
+  integer, parameter, public :: link_extra_node = 1, link_extra_set = 2, link_merge = 3
 
   !> Card 2 of one *MAT_RIGID: the constraint codes, and the position of the material in
   !> the input's material list.
@@ -56,13 +59,23 @@ module deck_rigid_input
     integer :: line = 0              !< the card with the nodes (or the set)
   end type spot_weld_input_t
 
+  !> One *CONSTRAINED_EXTRA_NODES_NODE / _SET line (PID NID / NSID) or *CONSTRAINED_RIGID_BODIES
+  !> line (PIDM PIDS).
+  type :: rigid_link_input_t
+    integer :: kind = 0              !< link_extra_node, link_extra_set, link_merge
+    integer :: body_id = 0           !< PID (PIDM)
+    integer :: other_id = 0          !< NID, NSID or PIDS
+    integer :: line = 0
+  end type rigid_link_input_t
+
   !> All rigid-body input; each list holds `*_count` entries and grows by doubling.
   type :: rigid_input_t
-    integer :: material_count = 0, motion_count = 0, nodal_count = 0, mass_count = 0, weld_count = 0
+    integer :: material_count = 0, motion_count = 0, nodal_count = 0, mass_count = 0, weld_count = 0, link_count = 0
     type(rigid_material_input_t), allocatable :: materials(:)
     type(rigid_motion_input_t), allocatable :: motions(:)
     type(nodal_rigid_input_t), allocatable :: nodal(:)
     type(element_mass_input_t), allocatable :: masses(:)
     type(spot_weld_input_t), allocatable :: welds(:)
+    type(rigid_link_input_t), allocatable :: links(:)
   end type rigid_input_t
 end module deck_rigid_input

@@ -227,6 +227,8 @@ module model
   type :: rigid_body_t
     integer :: id = 0                        !< part id (PID of a nodal rigid body): rbdout/<id>
     integer :: part = 0                      !< part index; 0 for a nodal rigid body
+    integer, allocatable :: merged_parts(:)  !< *CONSTRAINED_RIGID_BODIES: rigid parts merged into it
+    integer, allocatable :: merged_ids(:)    !< their part ids (a prescribed motion may name them)
     integer, allocatable :: nodes(:)         !< node indices, ascending
     logical :: fixed(6) = .false.            !< CMO = 1: x, y, z (CON1), rx, ry, rz (CON2), global axes
   end type rigid_body_t

@@ -94,6 +94,7 @@ contains
     step = run%state%next_time_step
     average_step = 0.5_wp*(run%state%time_step + step)
     call start_phase(run%timers(phase_velocities))
+    call release_failed_weld_nodes(model, run%state)
     call advance_velocities(run%state, average_step)
     call stop_phase(run%timers(phase_velocities))
     call start_phase(run%timers(phase_constraints))
@@ -257,11 +258,18 @@ contains
     call advance_spot_welds(model, state%welds, state%time, step, average_step, state%nodes%coordinates, &
                             state%nodes%angular_acceleration, state%nodes%rotary_inertia, state%nodes%velocity, &
                             state%nodes%angular_velocity)
-    ! the nodes of failed welds are free from the next step
-    do b = 1, size(state%welds)
-      if (state%welds(b)%failed) state%held_by_weld(model%spot_welds(b)%nodes) = .false.
-    end do
   end subroutine move_rigid_bodies
+
+  !> The nodes of failed welds are free (drilling constraint included) from the step after the
+  !> failure; set before the velocity update, so that a run continued from a dump does the same.
+  subroutine release_failed_weld_nodes(model, state)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(inout) :: state
+    integer :: w
+    do w = 1, size(state%welds)
+      if (state%welds(w)%failed) state%held_by_weld(model%spot_welds(w)%nodes) = .false.
+    end do
+  end subroutine release_failed_weld_nodes
 
   !> u^{n+1} = u^n + dt v^{n+1/2}; x = X + u; the loads' work over the first half of the step;
   !> the clock moves to t^{n+1} (the step cut at ENDTIM lands on it exactly).

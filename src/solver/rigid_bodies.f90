@@ -76,20 +76,26 @@ contains
     corner_mass = 0.0_wp
     do b = 1, count
       is_rigid_node(model%rigid_bodies(b)%nodes) = .true.
-      call set_up_body(model, model%rigid_bodies(b)%part, model%rigid_bodies(b)%nodes, reference, mass, &
-                       rotary_inertia, velocity, corner_mass, bodies(b))
+      if (allocated(model%rigid_bodies(b)%merged_parts)) then
+        call set_up_body(model, model%rigid_bodies(b)%part, model%rigid_bodies(b)%nodes, reference, mass, &
+                         rotary_inertia, velocity, corner_mass, bodies(b), model%rigid_bodies(b)%merged_parts)
+      else
+        call set_up_body(model, model%rigid_bodies(b)%part, model%rigid_bodies(b)%nodes, reference, mass, &
+                         rotary_inertia, velocity, corner_mass, bodies(b))
+      end if
       rigid_mass = rigid_mass + bodies(b)%rigid_element_mass
     end do
   end subroutine set_up_rigid_bodies
 
   !> Mass properties and initial motion of one body: the rigid elements of `part` (0: none, a
-  !> nodal rigid body or a weld) and the masses and rotary inertias of `nodes`. The nodes'
+  !> nodal rigid body or a weld) and of `merged_parts` and the masses and rotary inertias of `nodes`. The nodes'
   !> rotary inertias (shell nodes) join the inertia tensor as point inertias, so that the body
   !> takes the moments the shells put on its nodes. A body whose nodes lie on a line (two
   !> nodes without rotary inertia) has no inertia about that line: a small isotropic term
   !> (1e-6 of the mean principal inertia) keeps the tensor invertible; forces at nodes on the
   !> line have no moment about it, so the spin it allows stays at round-off level.
-  subroutine set_up_body(model, part, nodes, reference, mass, rotary_inertia, velocity, corner_mass, body)
+  subroutine set_up_body(model, part, nodes, reference, mass, rotary_inertia, velocity, corner_mass, body, &
+                         merged_parts)
     type(model_t), intent(in) :: model
     integer, intent(in) :: part
     integer, intent(in) :: nodes(:)
@@ -99,9 +105,14 @@ contains
     real(wp), intent(inout) :: velocity(:, :)
     real(wp), intent(inout) :: corner_mass(:)     !< scratch (nodes), zero on entry and on return
     type(rigid_body_state_t), intent(inout) :: body
+    integer, intent(in), optional :: merged_parts(:)   !< more rigid parts whose elements it has
     integer :: k, node
     real(wp) :: nodal_inertia
-    call integrate_rigid_elements(model, part, reference, body, corner_mass)
+    if (present(merged_parts)) then
+      call integrate_rigid_elements(model, [part, merged_parts], reference, body, corner_mass)
+    else
+      call integrate_rigid_elements(model, [part], reference, body, corner_mass)
+    end if
     body%rigid_element_mass = body%mass
     call add_point_masses(nodes, reference, mass, body)
     allocate (body%offsets(3, size(nodes)), body%node_mass(size(nodes)), body%node_velocity(3, size(nodes)))
@@ -144,9 +155,9 @@ contains
   !> and (before the nodal masses) the inertia about it; corner masses rho V / 8 for the
   !> hexahedra's nodes and rho t A / 4 for the shells'; the stable step of the elements from E,
   !> PR and RO.
-  subroutine integrate_rigid_elements(model, part, reference, body, corner_mass)
+  subroutine integrate_rigid_elements(model, parts, reference, body, corner_mass)
     type(model_t), intent(in) :: model
-    integer, intent(in) :: part
+    integer, intent(in) :: parts(:)               !< part indices (0: none)
     real(wp), intent(in) :: reference(:, :)
     type(rigid_body_state_t), intent(inout) :: body
     real(wp), intent(inout) :: corner_mass(:)
@@ -157,7 +168,7 @@ contains
     real(wp) :: element_volume, density, wave_modulus, nu, youngs, length
     real(wp) :: xs(block_size, 8), ys(block_size, 8), zs(block_size, 8), area(block_size)
     real(wp) :: first(3), second(3, 3), origin(3)
-    integer :: solid, shell, a, i, j, k, material
+    integer :: solid, shell, a, i, j, k, material, part, p
     logical :: started
 
     body%mass = 0.0_wp
@@ -165,7 +176,9 @@ contains
     second = 0.0_wp
     origin = 0.0_wp
     started = .false.
-    if (part > 0) then
+    do p = 1, size(parts)
+      part = parts(p)
+      if (part <= 0) cycle
       material = model%parts(part)%material
       density = model%materials(material)%density
       youngs = model%materials(material)%youngs_modulus
@@ -236,7 +249,7 @@ contains
           body%time_step = min(body%time_step, length/sqrt(youngs/(density*(1.0_wp - nu*nu))))
         end do
       end if
-    end if
+    end do
     ! kept as moments about `origin` until the nodal masses are added
     body%centre = origin
     body%angular_momentum = first

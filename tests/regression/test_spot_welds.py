@@ -11,7 +11,9 @@
    at TF; a generalized weld on three nodes likewise; after failure the nodes separate; the
    count of failed welds is in swforc. (Shear needs sheets that resist the couple of a
    transverse load: point masses on a two-node link just turn.)
-4. Deck errors.
+4. Two rigid parts merged (*CONSTRAINED_RIGID_BODIES) with extra nodes (*CONSTRAINED_EXTRA_NODES
+   _NODE, _SET) spin as one body: its angular momentum is the analytical one.
+5. Deck errors.
 """
 import numpy as np
 import pytest
@@ -248,6 +250,12 @@ def test_generalized_weld_on_three_nodes_fails_at_its_force(tmp_path, run_deck):
      "local coordinate systems are not available"),
     ([node_list_set(5, [1, 2]), "*CONSTRAINED_NODAL_RIGID_BODY\n" + fields(5, 0, 5),
       "*CONSTRAINED_SPOTWELD\n" + fields(1, 2)], "N1", "belongs to rigid body 5"),
+    (["*CONSTRAINED_RIGID_BODIES\n" + fields(1, 7)], "PIDS", "part 7 is not defined"),
+    (["*CONSTRAINED_RIGID_BODIES\n" + fields(1, 1)], "PIDM", "part 1 is not rigid"),
+    (["*CONSTRAINED_EXTRA_NODES_NODE\n" + fields(4, 1)], "PID", "rigid body 4 is not defined"),
+    ([node_list_set(5, [1, 2]), "*CONSTRAINED_NODAL_RIGID_BODY\n" + fields(5, 0, 5), node_list_set(6, [2, 3]),
+      "*CONSTRAINED_NODAL_RIGID_BODY\n" + fields(6, 0, 6), "*CONSTRAINED_EXTRA_NODES_NODE\n" + fields(6, 1)], "NID",
+     "node 1 belongs to rigid body 5 and to rigid body 6"),
 ])
 def test_weld_deck_errors(tmp_path, run_deck, blocks, field, message):
     deck = weld_deck(tmp_path / "bad.k", "\n".join(blocks))
@@ -255,3 +263,61 @@ def test_weld_deck_errors(tmp_path, run_deck, blocks, field, message):
     assert run.status == 2, run.stdout + run.stderr
     text = run.stdout + run.stderr
     assert f"field {field}" in text and message in text, text
+
+
+def merged_bodies_deck(path):
+    """Rigid cubes (side 10) centred at x = -20 (part 1) and x = +20 (part 2), part 2 merged into
+    part 1 (*CONSTRAINED_RIGID_BODIES); two nodes of 1 g at (0, +-30, 0) join the body as a node
+    set (*CONSTRAINED_EXTRA_NODES_SET) and one at the origin as a node (_NODE). The whole spins
+    at 1 rad/ms about z through the origin, its centre of mass (the extra nodes are given the
+    velocities of that spin: the body starts with the rigid fit of all its nodes' velocities)."""
+    from deck_writer import block_mesh, solids_card
+    cube, hexes = block_mesh((1, 1, 1), (10.0, 10.0, 10.0), origin=(-25.0, -5.0, -5.0))
+    nodes = np.vstack([cube, cube + [40.0, 0.0, 0.0], [[0.0, 30.0, 0.0], [0.0, -30.0, 0.0], [0.0, 0.0, 0.0]]])
+    lines = ["*ELEMENT_SOLID"]
+    for k, (part, offset) in enumerate([(1, 0), (2, 8)]):
+        lines.append(f"{k + 1:8d}{part:8d}" + "".join(f"{c + offset + 1:8d}" for c in hexes[0]))
+    return write_deck(
+        path,
+        "*CONTROL_TERMINATION\n" + fields(20.0),
+        "*DATABASE_GLSTAT\n" + fields(0.5),
+        "*DATABASE_BINARY_D3PLOT\n" + fields(10.0),
+        "*PART\nleft\n" + fields(1, 1, 1),
+        "*PART\nright\n" + fields(2, 1, 2),
+        "*SECTION_SOLID\n" + fields(1, 1),
+        "*MAT_RIGID\n" + fields(1, DENSITY, YOUNGS, POISSON),
+        "*MAT_RIGID\n" + fields(2, DENSITY, YOUNGS, POISSON),
+        nodes_card(nodes),
+        "\n".join(lines),
+        "*ELEMENT_MASS\n" + "\n".join(f"{k:8d}{k:8d}{0.001:16.6e}" for k in (17, 18, 19)),
+        node_list_set(3, [17, 18]),
+        "*CONSTRAINED_RIGID_BODIES\n" + fields(1, 2),
+        "*CONSTRAINED_EXTRA_NODES_SET\n" + fields(1, 3),
+        "*CONSTRAINED_EXTRA_NODES_NODE\n" + fields(1, 19),
+        "*INITIAL_VELOCITY_GENERATION\n" + fields(1, 2, 1.0, 0.0, 0.0, 0.0) + "\n" + fields(0.0, 0.0, 0.0, 0.0, 0.0, 1.0),
+        "*INITIAL_VELOCITY_GENERATION\n" + fields(2, 2, 1.0, 0.0, 0.0, 0.0) + "\n" + fields(0.0, 0.0, 0.0, 0.0, 0.0, 1.0),
+        "*INITIAL_VELOCITY_NODE\n" + fields(17, -30.0, 0.0, 0.0) + "\n" + fields(18, 30.0, 0.0, 0.0),
+    ), nodes
+
+
+def test_merged_rigid_parts_and_extra_nodes_move_as_one_body(tmp_path, run_deck):
+    deck, nodes = merged_bodies_deck(tmp_path / "merged.k")
+    run = run_deck(deck)
+    assert run.status == 0, run.stdout + run.stderr
+    with run.open() as results:
+        assert list(results["history/rbdout"]) == ["1"]
+        momentum = results["history/rbdout/1/angular_momentum"][...]
+        kinetic = results["history/glstat/kinetic_energy"][...]
+        displacement = last_state(results)["displacement"][...]
+    cube = DENSITY * 1000.0
+    inertia = 2.0 * (cube * 200.0 / 12.0 + cube * 20.0**2) + 2.0 * 0.001 * 30.0**2
+    print(f"L_z {momentum[0, 2]:.6e}, analytical {inertia:.6e}")
+    assert momentum[:, 2] == pytest.approx(inertia, rel=1e-9)
+    assert np.abs(momentum[:, :2]).max() < 1e-9 * inertia
+    assert kinetic == pytest.approx(0.5 * inertia, rel=1e-9)
+    # rigid: all distances kept (the extra nodes included), and it turned (20 rad)
+    final = nodes + displacement
+    initial_distances = np.linalg.norm(nodes[:, None] - nodes[None], axis=2)
+    final_distances = np.linalg.norm(final[:, None] - final[None], axis=2)
+    assert np.abs(final_distances - initial_distances).max() < 1e-9 * initial_distances.max()
+    assert np.abs(displacement).max() > 10.0
