@@ -12,7 +12,7 @@ module model
 
   public :: model_t, material_t, section_t, hourglass_t, part_t, node_set_t, part_set_t
   public :: spc_t, prescribed_motion_t, nodal_load_t, segment_load_t, rigid_wall_t, output_control_t
-  public :: rigid_body_t, rigid_motion_t, spot_weld_t
+  public :: rigid_body_t, rigid_motion_t, spot_weld_t, tied_contact_t
   public :: segment_set_t, contact_t, contact_surface_t
 
   !> The law codes and what each law can do are in material_laws' law_table. law_null is also
@@ -304,6 +304,23 @@ module model
     integer :: bucket_interval = 0           !< BSORT (0: automatic)
   end type contact_t
 
+  !> Tied contact kinds (*CONTACT_TIED_..., *CONTACT_SPOTWELD).
+  integer, parameter, public :: tied_nodes_to_surface = 1, tied_surface_to_surface = 2, &
+                                tied_shell_edge_to_surface = 3, tied_spotweld = 4
+
+  !> A tied contact after its set-up search: each tied secondary node, the primary segment it
+  !> was projected on and the shape functions there. Its velocity and acceleration are those
+  !> of the segment at that point; its mass and force go to the segment's nodes.
+  type :: tied_contact_t
+    integer :: id = 0                        !< CID (1, 2, ... in deck order without _ID)
+    integer :: kind = tied_nodes_to_surface
+    logical :: offset = .false.              !< _OFFSET: the node keeps its distance to the segment
+    logical :: rotations = .false.           !< shell edges and spot weld beams: rotations tied too
+    integer, allocatable :: nodes(:)         !< tied secondary nodes
+    integer, allocatable :: segments(:, :)   !< (4, tied) the segment's nodes (a triangle repeats N3)
+    real(wp), allocatable :: weights(:, :)   !< (4, tied) its shape functions at the projection
+  end type tied_contact_t
+
   !> Output intervals and requests (*DATABASE_...). An interval of 0 means "not requested".
   type :: output_control_t
     real(wp) :: state_interval = 0.0_wp      !< *DATABASE_BINARY_D3PLOT DT (or ENDTIM/NPLTC)
@@ -372,6 +389,7 @@ module model
     ! contact
     type(segment_set_t), allocatable :: segment_sets(:)
     type(contact_t), allocatable :: contacts(:)
+    type(tied_contact_t), allocatable :: tied_contacts(:) !< *CONTACT_TIED_..., *CONTACT_SPOTWELD
     real(wp) :: contact_penalty_scale = 0.1_wp       !< *CONTROL_CONTACT SLSFAC
     type(output_control_t) :: output
   end type model_t

@@ -17,6 +17,7 @@ module explicit_setup
   use penalty_contact, only: set_up_contacts
   use rigid_bodies, only: set_up_rigid_bodies, add_node_masses
   use spot_weld_constraints, only: set_up_spot_welds
+  use tied_contact, only: set_up_tied_contacts
   implicit none
   private
 
@@ -83,6 +84,8 @@ contains
     do b = 1, size(state%welds)
       state%held_by_weld(model%spot_welds(b)%nodes) = .true.
     end do
+    call set_up_tied_contacts(model, state%nodes%mass, state%nodes%rotary_inertia, state%nodes%velocity, &
+                              state%nodes%angular_velocity, state%ties)
     state%physical_mass = state%physical_mass + rigid_mass
     state%rigid_time_step = huge(1.0_wp)
     do b = 1, size(state%rigid)

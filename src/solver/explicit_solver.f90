@@ -9,7 +9,8 @@
 !>   internal_forces          every element group, in one call that clears and fills
 !>   contact_forces           penalty contacts
 !>   external_forces          nodal loads at t^{n+1}
-!>   accelerations            a = (f_ext - f_int + f_contact) / m, prescribed motions held
+!>   accelerations            a = (f_ext - f_int + f_contact) / m, prescribed motions held, tied
+!>                            contacts (tied nodes move with their segments)
 !>   next_time_step           TSSFAC times the smallest stable step, cut at ENDTIM
 !>   state checks             runaway motion, failed elements, time step, energy (run_checks)
 !>   output                   whatever the output plan says is due (run_output)
@@ -34,6 +35,7 @@ module explicit_solver
   use cylinder_walls, only: enforce_cylinder_walls
   use rigid_bodies, only: advance_rigid_bodies
   use spot_weld_constraints, only: advance_spot_welds
+  use tied_contact, only: apply_tied_contacts
   use penalty_contact, only: compute_contact_forces, report_initial_penetrations
   use energy_balance, only: measured_energies, total_energy
   use run_checks, only: set_up_run_checks, check_runaway_motion, check_elements, check_time_step, check_energy, &
@@ -342,6 +344,10 @@ contains
       end do
       !$omp end parallel do
       call hold_prescribed_accelerations(model, state%time, nodes%acceleration, state%free_acceleration)
+      ! tied contacts: tied nodes' masses and forces to their segments, their motion from them
+      call apply_tied_contacts(model, state%ties, nodes%mass, nodes%rotary_inertia, nodes%fixed, &
+                               nodes%fixed_rotation, nodes%acceleration, nodes%angular_acceleration, &
+                               nodes%velocity, nodes%angular_velocity)
     end associate
   end subroutine compute_accelerations
 
