@@ -321,3 +321,58 @@ def test_merged_rigid_parts_and_extra_nodes_move_as_one_body(tmp_path, run_deck)
     final_distances = np.linalg.norm(final[:, None] - final[None], axis=2)
     assert np.abs(final_distances - initial_distances).max() < 1e-9 * initial_distances.max()
     assert np.abs(displacement).max() > 10.0
+
+
+def welded_sheets_deck(path):
+    """Two 10 x 10 shell sheets (11 x 11 nodes each) 1 mm apart, every node pair spot-welded
+    (121 welds, advanced in parallel); the sheets are peeled apart at x = 0 by a load ramp on
+    that edge (up on the upper sheet, down on the lower one): the welds there fail by force,
+    then the peel runs across the sheets."""
+    lower, shells = plate_mesh((10, 10), (50.0, 50.0))
+    upper = lower + [0.0, 0.0, 1.0]
+    nodes = np.vstack([lower, upper])
+    n = len(lower)
+    velocity = ["*INITIAL_VELOCITY_NODE"] + [fields(n + k + 1, 0.5, 0.0, 2.0 + 0.02 * lower[k, 0])
+                                             for k in range(n)]
+    welds = ["*CONSTRAINED_SPOTWELD"] + [fields(k + 1, n + k + 1, 0.05, 0.05) for k in range(n)]
+    edge = np.flatnonzero(np.isclose(lower[:, 0], 0.0))
+    loads = ["*LOAD_NODE_POINT"] + [fields(k + 1, 3, 1, -1.0) for k in edge] + \
+        [fields(n + k + 1, 3, 1, 1.0) for k in edge]
+    return write_deck(
+        path,
+        "*CONTROL_TERMINATION\n" + fields(1.0),
+        "*DATABASE_GLSTAT\n" + fields(0.01),
+        "*DATABASE_BINARY_D3PLOT\n" + fields(0.25),
+        "*PART\nsheets\n" + fields(1, 1, 1),
+        "*SECTION_SHELL\n" + fields(1, 2, 1.0, 3) + "\n" + fields(0.8, 0.8, 0.8, 0.8),
+        "*MAT_ELASTIC\n" + fields(1, DENSITY, YOUNGS, POISSON),
+        nodes_card(nodes),
+        shells_card(shells) + "\n" + "\n".join(shells_card(shells + n, first_id=101).splitlines()[1:]),
+        "\n".join(velocity),
+        "\n".join(welds),
+        "*DEFINE_CURVE\n" + fields(1) + "\n" + f"{0.0:20.6e}{0.0:20.6e}\n{1.0:20.6e}{0.2:20.6e}",
+        "\n".join(loads),
+    )
+
+
+def test_many_welds_give_the_same_results_on_one_and_three_threads(tmp_path, run_deck):
+    deck = welded_sheets_deck(tmp_path / "welded.k")
+    runs = [run_deck(deck, ncpu=ncpu, jobid=f"threads{ncpu}") for ncpu in (1, 3)]
+    arrays = []
+    for run in runs:
+        assert run.status == 0, run.stdout + run.stderr
+        with run.open() as results:
+            arrays.append({"displacement": last_state(results)["displacement"][...],
+                           "failed": results["history/swforc/failed_welds"][...],
+                           "kinetic": results["history/glstat/kinetic_energy"][...],
+                           "momentum": results["history/glstat/momentum"][...]})
+    failed = arrays[0]["failed"]
+    print(f"{failed[-1]:.0f} of 121 welds failed")
+    # the edge welds fail when the edge load reaches SN (0.2 t = 0.05 at t = 0.25), the others later
+    assert "spot weld 1 (nodes 1, 122) fails at t =  2.5" in runs[0].stdout
+    assert ((failed > 0) & (failed < 121)).any() and np.all(np.diff(failed) >= 0)
+    for name in arrays[0]:
+        assert np.array_equal(arrays[0][name], arrays[1][name]), name
+    # the welds conserve momentum, failing or not
+    mass = 2 * DENSITY * 50.0 * 50.0 * 0.8
+    assert np.abs(arrays[0]["momentum"] - arrays[0]["momentum"][0]).max() < 1e-12 * mass
