@@ -10,7 +10,7 @@
 !>
 !> The rows keep the order in which the names were added: on equal spelling distance the
 !> earlier name is suggested. gfortran cannot hold procedure pointers in a named constant, so
-!> `keyword_table()` builds the table on each call (66 rows; once per deck, and per unknown
+!> `keyword_table()` builds the table on each call (some 80 rows; once per deck, and per unknown
 !> keyword).
 module deck_keyword_table
   use error_handling, only: error_list_t
