@@ -428,3 +428,23 @@ def test_spot_weld_of_a_lap_joint_fails_in_shear(tmp_path, run_deck):
     assert np.hypot(normal, shear) == pytest.approx(pull, rel=0.05)
     assert shear >= 2.0 and abs(normal) < 0.5 * shear
     assert time == pytest.approx(0.2, rel=0.1)
+
+
+def test_restart_with_welds_reproduces_the_uninterrupted_run(tmp_path):
+    """The peeled sheets with dumps every 100 cycles: continued from a dump written while the
+    peel runs (some welds failed, some holding), the results file is the uninterrupted one."""
+    from test_restart import assert_same, contents, copy_run, restart, run_fresh
+    deck = welded_sheets_deck(tmp_path / "welded.k")
+    deck.write_text(deck.read_text().replace("*PART\n", "*DATABASE_BINARY_D3DUMP\n" + fields(100) + "\n*PART\n", 1))
+    run_fresh(deck, tmp_path / "one", ncpu=1)
+    reference = contents(tmp_path / "one" / "results.h5")
+    dumps = sorted(p.name for p in (tmp_path / "one").glob("d3dump*"))
+    assert len(dumps) >= 6, dumps
+    failed = reference["history/swforc/failed_welds"]
+    assert failed[-1] > 0
+    # dumps 3 to 6: about 0.27 to 0.55 ms, while the peel runs (first failure at 0.25 ms)
+    for dump in dumps[2:6]:
+        target = copy_run(tmp_path / "one", tmp_path / f"restart_{dump}")
+        process = restart(target / dump, 2)
+        assert process.returncode == 0, process.stdout + process.stderr
+        assert_same(reference, contents(target / "results.h5"), f"welds continued from {dump}")
