@@ -6,7 +6,8 @@
 2. Two solid blocks with non-matching meshes tied face to face, the upper one thrown
    sideways and up: linear momentum conserved to round-off, the tied nodes stay on the lower
    block's face, and the lower block is carried along.
-3. Deck errors.
+3. *CONTACT_SPOTWELD carries a lone heavy node (a weld beam's end) with its point of a plate.
+4. Deck errors.
 """
 import numpy as np
 import pytest
@@ -166,3 +167,45 @@ def test_tied_contact_that_ties_nothing_is_reported(tmp_path, run_deck):
     run = run_deck(deck)
     assert run.status == 2
     assert "ties no node" in run.stdout + run.stderr
+
+
+def test_spotweld_contact_carries_a_free_node_with_its_offset(tmp_path, run_deck):
+    """*CONTACT_SPOTWELD ties a lone node with a 5 g mass (as a spot-weld beam's end), 0.5 mm
+    above a 2 x 2 shell plate, to the plate; the plate is thrown along x and z: momentum is
+    conserved and the node moves with its point of the plate (its offset kept)."""
+    plate, shells = plate_mesh((2, 2), (10.0, 10.0))
+    nodes = np.vstack([plate, [[3.0, 4.0, 0.5]]])
+    n = len(plate)
+    velocity = ["*INITIAL_VELOCITY_NODE"] + [fields(k + 1, 1.0, 0.0, 0.5) for k in range(n)]
+    deck = write_deck(
+        tmp_path / "spotweld.k",
+        "*CONTROL_TERMINATION\n" + fields(2.0),
+        "*DATABASE_GLSTAT\n" + fields(0.01),
+        "*DATABASE_BINARY_D3PLOT\n" + fields(1.0),
+        "*PART\nplate\n" + fields(1, 1, 1),
+        "*SECTION_SHELL\n" + fields(1, 2, 1.0, 3) + "\n" + fields(1.0, 1.0, 1.0, 1.0),
+        "*MAT_ELASTIC\n" + fields(1, DENSITY, YOUNGS, POISSON),
+        nodes_card(nodes),
+        shells_card(shells),
+        "*ELEMENT_MASS\n" + f"{1:8d}{n + 1:8d}{0.005:16.6e}",
+        "\n".join(velocity),
+        "*SET_NODE_LIST\n" + fields(7) + "\n" + fields(n + 1),
+        "*CONTACT_SPOTWELD_ID\n" + fields(3, "weld") + "\n" + fields(7, 1, 4, 3),
+    )
+    run = run_deck(deck)
+    assert run.status == 0, run.stdout + run.stderr
+    with run.open() as results:
+        momentum = results["history/glstat/momentum"][...]
+        displacement = last_state(results)["displacement"][...]
+    plate_mass = DENSITY * 100.0 * 1.0
+    # the node starts at rest: the tie shares the plate's momentum with it at the start
+    expected = plate_mass * np.array([1.0, 0.0, 0.5])
+    assert np.abs(momentum - expected).max() < 1e-9 * np.linalg.norm(expected)
+    # it moves with its point of the first shell (corners 1, 4, 5, 2 at x, y = 0 and 5):
+    # xi = 0.2, eta = 0.6, while the heavy node makes the plate bend
+    xi, eta = 0.2, 0.6
+    weights = np.array([(1 - xi) * (1 - eta), (1 + xi) * (1 - eta), (1 + xi) * (1 + eta), (1 - xi) * (1 + eta)]) / 4
+    interpolated = weights @ displacement[[0, 3, 4, 1]]
+    print(f"node {displacement[n]}, its point of the plate {interpolated}")
+    assert np.abs(displacement[n] - interpolated).max() < 1e-9 * np.linalg.norm(interpolated)
+    assert interpolated[0] > 0.05
