@@ -18,7 +18,7 @@ module tied_contact
   implicit none
   private
 
-  public :: set_up_tied_contacts, apply_tied_contacts
+  public :: set_up_tied_contacts, distribute_tied_nodes, follow_segments
 
   !> Work arrays of the ties, allocated once: the shares the segments' nodes receive and the
   !> list of those nodes.
@@ -98,16 +98,16 @@ contains
     end if
   end subroutine set_up_tied_contacts
 
-  !> Tie every tied node to its segment (see the module header): `acceleration` and
-  !> `angular_acceleration` of all nodes on entry (a = f / m), of the tied system on return;
-  !> the tied nodes' velocities follow their segments'.
-  subroutine apply_tied_contacts(model, ties, mass, rotary_inertia, fixed, fixed_rotation, acceleration, &
-                                 angular_acceleration, velocity, angular_velocity)
+  !> The first half of the tie (see the module header): each tied node's mass and force go to
+  !> its segment's nodes, whose accelerations are taken again from the sums (SPC'd dofs stay
+  !> zero). `acceleration` and `angular_acceleration` hold a = f / m of every node on entry.
+  subroutine distribute_tied_nodes(model, ties, mass, rotary_inertia, fixed, fixed_rotation, acceleration, &
+                                   angular_acceleration)
     type(model_t), intent(in) :: model
     type(tied_state_t), intent(inout) :: ties
     real(wp), intent(in) :: mass(:), rotary_inertia(:)
     logical, intent(in) :: fixed(:, :), fixed_rotation(:, :)
-    real(wp), intent(inout) :: acceleration(:, :), angular_acceleration(:, :), velocity(:, :), angular_velocity(:, :)
+    real(wp), intent(inout) :: acceleration(:, :), angular_acceleration(:, :)
     integer :: c, i, j, k, node, primary
     real(wp) :: force(3), moment(3), total
     logical :: rotations
@@ -127,7 +127,7 @@ contains
         do i = 1, size(tie%nodes)
           node = tie%nodes(i)
           force = mass(node)*acceleration(:, node)
-          rotations = ties_rotations(tie%rotations, node, tie%segments(:, i))
+          rotations = ties_rotations(tie%rotations, node, tie%segments(:, i), rotary_inertia)
           if (rotations) moment = rotary_inertia(node)*angular_acceleration(:, node)
           do j = 1, 4
             primary = tie%segments(j, i)
@@ -152,28 +152,38 @@ contains
                                          ties%extra_moment(:, node))/total
       where (fixed_rotation(:, node)) angular_acceleration(:, node) = 0.0_wp
     end do
-    ! the tied nodes follow
+  end subroutine distribute_tied_nodes
+
+  !> The second half: every tied node takes the acceleration and velocity of its point of the
+  !> segment (after the segments' prescribed motions are held), and the rotations where tied.
+  subroutine follow_segments(model, rotary_inertia, acceleration, angular_acceleration, velocity, angular_velocity)
+    type(model_t), intent(in) :: model
+    real(wp), intent(in) :: rotary_inertia(:)
+    real(wp), intent(inout) :: acceleration(:, :), angular_acceleration(:, :), velocity(:, :), angular_velocity(:, :)
+    integer :: c, i, node
+    if (.not. allocated(model%tied_contacts)) return
     do c = 1, size(model%tied_contacts)
       associate (tie => model%tied_contacts(c))
         do i = 1, size(tie%nodes)
           node = tie%nodes(i)
           acceleration(:, node) = matmul(acceleration(:, tie%segments(:, i)), tie%weights(:, i))
           velocity(:, node) = matmul(velocity(:, tie%segments(:, i)), tie%weights(:, i))
-          if (.not. ties_rotations(tie%rotations, node, tie%segments(:, i))) cycle
+          if (.not. ties_rotations(tie%rotations, node, tie%segments(:, i), rotary_inertia)) cycle
           angular_acceleration(:, node) = matmul(angular_acceleration(:, tie%segments(:, i)), tie%weights(:, i))
           angular_velocity(:, node) = matmul(angular_velocity(:, tie%segments(:, i)), tie%weights(:, i))
         end do
       end associate
     end do
-  contains
-    !> Rotations are tied where the tie carries them and the node and all the segment's nodes
-    !> have rotational dofs (rotary inertia): a shell edge on a shell surface, not on solids.
-    pure logical function ties_rotations(wanted, node, segment)
-      logical, intent(in) :: wanted
-      integer, intent(in) :: node, segment(4)
-      ties_rotations = wanted
-      if (.not. wanted) return
-      ties_rotations = rotary_inertia(node) > 0.0_wp .and. all(rotary_inertia(segment) > 0.0_wp)
-    end function ties_rotations
-  end subroutine apply_tied_contacts
+  end subroutine follow_segments
+
+  !> Rotations are tied where the tie carries them and the node and all the segment's nodes
+  !> have rotational dofs (rotary inertia): a shell edge on a shell surface, not on solids.
+  pure logical function ties_rotations(wanted, node, segment, rotary_inertia)
+    logical, intent(in) :: wanted
+    integer, intent(in) :: node, segment(4)
+    real(wp), intent(in) :: rotary_inertia(:)
+    ties_rotations = wanted
+    if (.not. wanted) return
+    ties_rotations = rotary_inertia(node) > 0.0_wp .and. all(rotary_inertia(segment) > 0.0_wp)
+  end function ties_rotations
 end module tied_contact

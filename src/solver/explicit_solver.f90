@@ -35,7 +35,7 @@ module explicit_solver
   use cylinder_walls, only: enforce_cylinder_walls
   use rigid_bodies, only: advance_rigid_bodies
   use spot_weld_constraints, only: advance_spot_welds
-  use tied_contact, only: apply_tied_contacts
+  use tied_contact, only: distribute_tied_nodes, follow_segments
   use penalty_contact, only: compute_contact_forces, report_initial_penetrations
   use energy_balance, only: measured_energies, total_energy
   use run_checks, only: set_up_run_checks, check_runaway_motion, check_elements, check_time_step, check_energy, &
@@ -343,11 +343,13 @@ contains
         where (nodes%fixed_rotation(:, node)) nodes%angular_acceleration(:, node) = 0.0_wp
       end do
       !$omp end parallel do
+      ! tied contacts: the tied nodes' masses and forces to their segments; after the prescribed
+      ! motions are held, the tied nodes move with their points of the segments
+      call distribute_tied_nodes(model, state%ties, nodes%mass, nodes%rotary_inertia, nodes%fixed, &
+                                 nodes%fixed_rotation, nodes%acceleration, nodes%angular_acceleration)
       call hold_prescribed_accelerations(model, state%time, nodes%acceleration, state%free_acceleration)
-      ! tied contacts: tied nodes' masses and forces to their segments, their motion from them
-      call apply_tied_contacts(model, state%ties, nodes%mass, nodes%rotary_inertia, nodes%fixed, &
-                               nodes%fixed_rotation, nodes%acceleration, nodes%angular_acceleration, &
-                               nodes%velocity, nodes%angular_velocity)
+      call follow_segments(model, nodes%rotary_inertia, nodes%acceleration, nodes%angular_acceleration, &
+                           nodes%velocity, nodes%angular_velocity)
     end associate
   end subroutine compute_accelerations
 
