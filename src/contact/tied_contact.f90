@@ -69,7 +69,7 @@ contains
               ties%extra_inertia(tie%segments(j, i)) = ties%extra_inertia(tie%segments(j, i)) + &
                                                        tie%weights(j, i)*rotary_inertia(node)
               ties%extra_moment(:, tie%segments(j, i)) = ties%extra_moment(:, tie%segments(j, i)) + &
-                                                         tie%weights(j, i)*rotary_inertia(node)*angular_velocity(:, node)
+                tie%weights(j, i)*rotary_inertia(node)*angular_velocity(:, node)
             end do
           end do
         end associate

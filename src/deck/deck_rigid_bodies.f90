@@ -646,7 +646,7 @@ contains
             node = added(j)
             if (owner(node) == body) cycle
             if (owner(node) /= 0) then
-              call located_problem(deck, log, link%line, merge("NID ", "NSID", link%kind == link_extra_node), &
+              call located_problem(deck, log, link%line, trim(merge("NID ", "NSID", link%kind == link_extra_node)), &
                 "node "//integer_text(input%model%node_ids(node))//" belongs to rigid body "// &
                 integer_text(bodies(owner(node))%id)//" and to rigid body "//integer_text(bodies(body)%id)// &
                 "; a node joins one rigid body only")
@@ -809,7 +809,7 @@ contains
           if (.not. good) cycle
           do j = 1, count
             if (welds(j)%id == welds(count + 1)%id) then
-              call located_problem(deck, log, given%line, merge("NSID", "N1  ", given%node_set /= 0), "weld "// &
+              call located_problem(deck, log, given%line, trim(merge("NSID", "N1  ", given%node_set /= 0)), "weld "// &
                 integer_text(welds(j)%id)//" is defined twice")
               good = .false.
               exit
@@ -819,13 +819,13 @@ contains
           do j = 1, size(welds(count + 1)%nodes)
             node = welds(count + 1)%nodes(j)
             if (owner(node) > 0) then
-              call located_problem(deck, log, given%line, merge("NSID", "N1  ", given%node_set /= 0), "node "// &
+              call located_problem(deck, log, given%line, trim(merge("NSID", "N1  ", given%node_set /= 0)), "node "// &
                 integer_text(input%model%node_ids(node))//" of weld "//integer_text(welds(count + 1)%id)// &
                 " belongs to rigid body "//integer_text(input%model%rigid_bodies(owner(node))%id)// &
                 "; a weld cannot join a rigid body (add the node to the body instead)")
               good = .false.
             else if (owner(node) < 0) then
-              call located_problem(deck, log, given%line, merge("NSID", "N1  ", given%node_set /= 0), "node "// &
+              call located_problem(deck, log, given%line, trim(merge("NSID", "N1  ", given%node_set /= 0)), "node "// &
                 integer_text(input%model%node_ids(node))//" is in weld "//integer_text(welds(-owner(node))%id)// &
                 " and in weld "//integer_text(welds(count + 1)%id)//"; a node may be in one weld only "// &
                 "(join a stack of sheets with one *CONSTRAINED_GENERALIZED_WELD_SPOT on all its nodes)")

@@ -248,7 +248,8 @@ contains
     integer :: b, k
     if (size(state%rigid) > 0) then
       call advance_rigid_bodies(model, state%rigid, state%time, step, average_step, state%nodes%coordinates, &
-                                state%nodes%angular_acceleration, state%nodes%rotary_inertia, state%nodes%velocity, work)
+                                state%nodes%angular_acceleration, state%nodes%rotary_inertia, state%nodes%velocity, &
+                                work)
       state%energy%external_work = state%energy%external_work + work
       do b = 1, size(state%rigid)
         do k = 1, size(model%rigid_bodies(b)%nodes)

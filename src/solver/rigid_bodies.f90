@@ -417,7 +417,9 @@ contains
     body%impulse = body%impulse + impulse
     previous_velocity = body%velocity
     previous_omega = body%angular_velocity
-    free_velocity = body%velocity + impulse/body%mass
+    ! (a weld of nodes without mass, a beam's before its mass is lumped, has nothing to move)
+    free_velocity = body%velocity
+    if (body%mass > 0.0_wp) free_velocity = body%velocity + impulse/body%mass
     free_momentum = body%angular_momentum + angular_impulse
 
     call kinematic_targets(model, b, body, time, dt, average_dt, held, target, body%held_acceleration)

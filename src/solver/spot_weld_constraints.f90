@@ -127,7 +127,8 @@ contains
         weld%normal_force = -dot_product(force, axis)
         weld%shear_force = norm2(force + weld%normal_force*axis)
         value = 0.0_wp
-        if (given%normal_strength > 0.0_wp) value = (abs(weld%normal_force)/given%normal_strength)**given%normal_exponent
+        if (given%normal_strength > 0.0_wp) &
+          value = (abs(weld%normal_force)/given%normal_strength)**given%normal_exponent
         if (given%shear_strength > 0.0_wp) &
           value = value + (weld%shear_force/given%shear_strength)**given%shear_exponent
         weld%failure_value = value
