@@ -838,6 +838,9 @@ contains
         end associate
       end do
       input%model%spot_welds = welds(1:count)
+      if (input%model%implicit_static .and. input%rigid%weld_count > 0) call located_problem(deck, log, &
+        input%rigid%welds(1)%line, trim(merge("NSID", "N1  ", input%rigid%welds(1)%node_set /= 0)), &
+        "spot welds are not available in the linear static analysis (*CONTROL_IMPLICIT_GENERAL IMFLAG = 1)")
     end subroutine build_spot_welds
 
     subroutine build_rigid_motions()

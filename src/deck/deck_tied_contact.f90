@@ -233,7 +233,9 @@ contains
     do k = 1, input%tied%count
       next_id = max(next_id, input%tied%entries(k)%id)
     end do
-    next_id = max(next_id, size(input%model%contacts))
+    do k = 1, size(input%model%contacts)
+      next_id = max(next_id, input%model%contacts(k)%id)
+    end do
     count = 0
     do k = 1, input%tied%count
       associate (entry => input%tied%entries(k))
@@ -253,6 +255,8 @@ contains
             exit
           end if
         end do
+        if (input%model%implicit_static) call located_problem(deck, log, entry%line, "SURFA", &
+          "tied contacts are not available in the linear static analysis (*CONTROL_IMPLICIT_GENERAL IMFLAG = 1)")
         call secondary_nodes(entry, secondary, good)
         if (good) call primary_segments(entry, segments, owners, good)
         if (.not. good) then
