@@ -25,6 +25,7 @@ module deck_cross_check
   use deck_material_curves, only: resolve_material_curves, apply_material_bulk_viscosity
   use deck_rigid_bodies, only: build_rigid_bodies
   use deck_contact, only: build_contacts
+  use deck_tied_contact, only: build_tied_contacts
   use deck_shell_check, only: check_element_sections, build_shell_thickness, &
                               check_static_shells
   implicit none
@@ -82,6 +83,7 @@ contains
     call build_walls(deck, input, indices, log)
     call build_rigid_bodies(deck, input, log)
     call build_contacts(deck, input, log)
+    call build_tied_contacts(deck, input, log, warnings)
     call build_history_nodes(deck, input, indices, log, warnings)
     call check_mesh(deck, input, mesh_resolved, log)
     call check_controls(deck, input, log)

@@ -6,6 +6,7 @@ module deck_input
   use integer_lists, only: reserve_integers
   use model, only: model_t, rigid_wall_t, segment_load_t
   use deck_rigid_input, only: rigid_input_t
+  use deck_tied_input, only: tied_input_t
   use deck_contact_input, only: contact_input_t
   implicit none
   private
@@ -24,9 +25,10 @@ module deck_input
     list_node_sets = 9, list_part_sets = 10, list_spcs = 11, list_motions = 12, list_loads = 13, &
     list_velocities = 14, list_walls = 15, list_segment_sets = 16, list_segment_loads = 17, &
     list_rigid_materials = 18, list_rigid_motions = 19, list_nodal_rigid_bodies = 20, &
-    list_element_masses = 21, list_contacts = 22, list_boxes = 23, list_frames = 24, list_vectors = 25
+    list_element_masses = 21, list_contacts = 22, list_boxes = 23, list_frames = 24, list_vectors = 25, &
+    list_spot_welds = 26, list_rigid_links = 27, list_tied_contacts = 28
   !> Number of lists.
-  integer, parameter, public :: list_count = 25
+  integer, parameter, public :: list_count = 28
 
   !> How a set's members are given (set_input_t%kind): listed ids (or ranges when `generated`),
   !> *SET_NODE_GENERAL operations, or *SET_..._ADD set ids.
@@ -218,6 +220,7 @@ module deck_input
     type(segment_load_input_t), allocatable :: segment_loads(:)
     type(rigid_input_t) :: rigid           !< *MAT_RIGID, rigid motions, nodal rigid bodies, masses
     type(contact_input_t) :: contact       !< *CONTACT_AUTOMATIC_... definitions
+    type(tied_input_t) :: tied             !< *CONTACT_TIED_..., *CONTACT_SPOTWELD definitions
     !> *DATABASE_HISTORY_NODE(_SET) requests in deck order; a node set id is stored with a
     !> negative field number (-k for field IDk) so that nodes and sets keep their order.
     type(id_list_t) :: history_requests
@@ -273,6 +276,9 @@ contains
     allocate (input%rigid%motions(capacity(list_rigid_motions)))
     allocate (input%rigid%nodal(capacity(list_nodal_rigid_bodies)))
     allocate (input%rigid%masses(capacity(list_element_masses)))
+    allocate (input%rigid%welds(capacity(list_spot_welds)))
+    allocate (input%rigid%links(capacity(list_rigid_links)))
+    allocate (input%tied%entries(capacity(list_tied_contacts)))
     allocate (input%contact%entries(capacity(list_contacts)))
     allocate (input%boxes(capacity(list_boxes)))
     allocate (input%frames(capacity(list_frames)))

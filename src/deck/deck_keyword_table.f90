@@ -24,7 +24,7 @@ module deck_keyword_table
     list_sections, list_materials, list_hourglasses, list_curves, list_node_sets, list_part_sets, list_spcs, &
     list_motions, list_loads, list_velocities, list_walls, list_segment_sets, list_segment_loads, &
     list_rigid_materials, list_rigid_motions, list_nodal_rigid_bodies, list_element_masses, list_contacts, &
-    list_count, list_boxes, list_frames, list_vectors
+    list_count, list_boxes, list_frames, list_vectors, list_spot_welds, list_rigid_links, list_tied_contacts
   use deck_nodes_elements, only: read_nodes, read_solid_elements, read_shell_elements, read_thick_shell_elements
   use deck_parts_sections, only: read_parts, read_solid_sections, read_efg_sections, read_shell_sections, &
     read_hourglasses
@@ -46,7 +46,11 @@ module deck_keyword_table
     read_rwforc_output, read_history_nodes, read_history_node_sets, read_d3dump_output, read_runrsf_output, &
     read_unused_output
   use deck_rigid_bodies, only: read_rigid_materials, read_rigid_motions, read_nodal_rigid_bodies, &
-    read_element_masses
+    read_element_masses, read_spot_welds, read_generalized_spot_welds, read_extra_nodes, read_extra_node_sets, &
+    read_rigid_body_merges
+  use deck_tied_contact, only: read_tied_nodes_to_surface, read_tied_nodes_to_surface_offset, &
+    read_tied_surface_to_surface, read_tied_surface_to_surface_offset, read_tied_shell_edge_to_surface, &
+    read_tied_shell_edge_to_surface_offset, read_spotweld_contacts
   use deck_contact, only: read_nodes_to_surface_contacts, read_surface_to_surface_contacts, &
     read_single_surface_contacts, read_control_contact, read_rcforc
   implicit none
@@ -77,8 +81,8 @@ module deck_keyword_table
 
   !> One keyword.
   type :: keyword_entry_t
-    character(len=36) :: name = ""       !< without the `*`
-    character(len=36) :: alias = ""      !< another name of the same keyword ("" if none)
+    character(len=48) :: name = ""       !< without the `*`
+    character(len=48) :: alias = ""      !< another name of the same keyword ("" if none)
     character(len=36) :: options = ""    !< the options it accepts, blank-separated (any order)
     logical :: one_option = .false.      !< at most one of them (the contacts: _ID or _TITLE)
     !> The input lists its definitions go to (deck_input's list_...), and how many entries a
@@ -219,6 +223,28 @@ contains
                       reader=read_rigid_motions), &
       keyword_entry_t("CONSTRAINED_NODAL_RIGID_BODY", options="TITLE", &
                       fills=[list_nodal_rigid_bodies, list_none], reader=read_nodal_rigid_bodies), &
+      keyword_entry_t("CONSTRAINED_SPOTWELD", options="ID", fills=[list_spot_welds, list_none], &
+                      reader=read_spot_welds), &
+      keyword_entry_t("CONSTRAINED_GENERALIZED_WELD_SPOT", options="ID", fills=[list_spot_welds, list_none], &
+                      reader=read_generalized_spot_welds), &
+      keyword_entry_t("CONSTRAINED_EXTRA_NODES_NODE", fills=[list_rigid_links, list_none], reader=read_extra_nodes), &
+      keyword_entry_t("CONSTRAINED_EXTRA_NODES_SET", fills=[list_rigid_links, list_none], &
+                      reader=read_extra_node_sets), &
+      keyword_entry_t("CONSTRAINED_RIGID_BODIES", fills=[list_rigid_links, list_none], reader=read_rigid_body_merges), &
+      keyword_entry_t("CONTACT_TIED_NODES_TO_SURFACE", options="ID TITLE", one_option=.true., &
+                      fills=[list_tied_contacts, list_none], reader=read_tied_nodes_to_surface), &
+      keyword_entry_t("CONTACT_TIED_NODES_TO_SURFACE_OFFSET", options="ID TITLE", one_option=.true., &
+                      fills=[list_tied_contacts, list_none], reader=read_tied_nodes_to_surface_offset), &
+      keyword_entry_t("CONTACT_TIED_SURFACE_TO_SURFACE", options="ID TITLE", one_option=.true., &
+                      fills=[list_tied_contacts, list_none], reader=read_tied_surface_to_surface), &
+      keyword_entry_t("CONTACT_TIED_SURFACE_TO_SURFACE_OFFSET", options="ID TITLE", one_option=.true., &
+                      fills=[list_tied_contacts, list_none], reader=read_tied_surface_to_surface_offset), &
+      keyword_entry_t("CONTACT_TIED_SHELL_EDGE_TO_SURFACE", options="ID TITLE", one_option=.true., &
+                      fills=[list_tied_contacts, list_none], reader=read_tied_shell_edge_to_surface), &
+      keyword_entry_t("CONTACT_TIED_SHELL_EDGE_TO_SURFACE_OFFSET", options="ID TITLE", one_option=.true., &
+                      fills=[list_tied_contacts, list_none], reader=read_tied_shell_edge_to_surface_offset), &
+      keyword_entry_t("CONTACT_SPOTWELD", options="ID TITLE", one_option=.true., &
+                      fills=[list_tied_contacts, list_none], reader=read_spotweld_contacts), &
       keyword_entry_t("ELEMENT_MASS", fills=[list_element_masses, list_none], reader=read_element_masses), &
       keyword_entry_t("CONTACT_AUTOMATIC_NODES_TO_SURFACE", options="ID TITLE", one_option=.true., &
                       fills=[list_contacts, list_none], entries=per_block, reader=read_nodes_to_surface_contacts), &
@@ -329,7 +355,7 @@ contains
   subroutine suggest_known_keyword(name, suggestion, base)
     character(len=*), intent(in) :: name
     character(len=:), allocatable, intent(out) :: suggestion, base
-    character(len=36), allocatable :: names(:)
+    character(len=48), allocatable :: names(:)
     character(len=36), allocatable :: options(:)
     call known_names(keyword_table(), names, options)
     call suggest_keyword(name, names, options, suggestion, base)
@@ -338,7 +364,7 @@ contains
   !> Number of keyword names crashfree knows (those it reads and those the lexer handles),
   !> aliases included.
   integer function known_keyword_count()
-    character(len=36), allocatable :: names(:)
+    character(len=48), allocatable :: names(:)
     character(len=36), allocatable :: options(:)
     call known_names(keyword_table(), names, options)
     known_keyword_count = size(names)
@@ -349,7 +375,7 @@ contains
   subroutine known_keyword(k, name, options)
     integer, intent(in) :: k
     character(len=:), allocatable, intent(out) :: name, options
-    character(len=36), allocatable :: names(:)
+    character(len=48), allocatable :: names(:)
     character(len=36), allocatable :: all_options(:)
     call known_names(keyword_table(), names, all_options)
     name = trim(names(k))
@@ -359,7 +385,7 @@ contains
   !> Every name and alias of `table` in order, with its row's options.
   pure subroutine known_names(table, names, options)
     type(keyword_entry_t), intent(in) :: table(:)
-    character(len=36), allocatable, intent(out) :: names(:)
+    character(len=48), allocatable, intent(out) :: names(:)
     character(len=36), allocatable, intent(out) :: options(:)
     integer :: k, n
     allocate (names(size(table) + count(table%alias /= "")), options(size(table) + count(table%alias /= "")))

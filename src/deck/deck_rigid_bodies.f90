@@ -9,7 +9,7 @@
 module deck_rigid_bodies
   use kinds, only: wp
   use error_handling, only: error_list_t
-  use model, only: material_t, rigid_body_t, rigid_motion_t, formulation_rigid, motion_velocity, &
+  use model, only: material_t, rigid_body_t, rigid_motion_t, spot_weld_t, formulation_rigid, motion_velocity, &
                    motion_acceleration, motion_displacement
   use material_laws, only: law_rigid
   use deck_problems, only: problem_log_t, report_problem
@@ -22,12 +22,14 @@ module deck_rigid_bodies
   use deck_input, only: deck_input_t
   use deck_materials, only: append_material
   use deck_rigid_input, only: rigid_material_input_t, rigid_motion_input_t, nodal_rigid_input_t, &
-                              element_mass_input_t
+                              element_mass_input_t, spot_weld_input_t, rigid_link_input_t, link_extra_node, &
+                              link_extra_set, link_merge
   implicit none
   private
 
   public :: read_rigid_materials, read_rigid_motions, read_nodal_rigid_bodies, read_element_masses
-  public :: build_rigid_bodies
+  public :: build_rigid_bodies, read_spot_welds, read_generalized_spot_welds
+  public :: read_extra_nodes, read_extra_node_sets, read_rigid_body_merges
 
   integer, parameter :: standard_widths(8) = 10
   integer, parameter :: mass_widths(4) = [8, 8, 16, 8]
@@ -275,13 +277,216 @@ contains
     end do
   end subroutine read_element_masses
 
+  !> *CONSTRAINED_SPOTWELD(_ID): with _ID a card WID before each weld; card 1 N1 N2 SN SS N M TF
+  !> EP. SN or SS 0 leaves that term out of the failure criterion; N and M 0 take 2; TF 0 takes
+  !> 1e20 (never). EP (failure by the plastic strain of the shells) is read but not evaluated.
+  subroutine read_spot_welds(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    type(spot_weld_input_t) :: weld
+    integer :: line, id
+    line = 0
+    do while (next_line(deck, block, line, .true.))
+      id = 0
+      if (keyword%id) then
+        call open_card(deck, block, line, standard_widths, card, log)
+        call get_integer(deck, card, 1, "WID", id, log)
+        if (.not. card%failed .and. id <= 0) call card_problem(deck, log, card, "WID", &
+          "must be a positive weld id, found "//integer_text(id))
+        if (.not. next_line(deck, block, line, .true.)) then
+          call located_problem(deck, log, line, "N1", "card 1 (N1 N2 SN SS N M TF EP) of weld "// &
+                               integer_text(id)//" is missing")
+          return
+        end if
+      end if
+      call open_card(deck, block, line, standard_widths, card, log)
+      weld = spot_weld_input_t(id=id, line=line)
+      call get_integer(deck, card, 1, "N1", weld%node_ids(1), log)
+      call get_integer(deck, card, 2, "N2", weld%node_ids(2), log)
+      call read_weld_strengths(deck, card, 3, weld, log)
+      call get_real(deck, card, 7, "TF", weld%failure_time, log)
+      call warn_if_set(deck, card, 8, "EP", "failure by plastic strain is not evaluated (the weld fails by "// &
+                       "force or at TF only)", warnings)
+      if (card%failed) cycle
+      if (weld%failure_time == 0.0_wp) weld%failure_time = 1.0e20_wp
+      if (any(weld%node_ids <= 0)) then
+        call card_problem(deck, log, card, merge("N1", "N2", weld%node_ids(1) <= 0), &
+                          "a spot weld needs two node ids, found "//integer_text(weld%node_ids(1))//" and "// &
+                          integer_text(weld%node_ids(2)))
+        cycle
+      end if
+      if (weld%node_ids(1) == weld%node_ids(2)) then
+        call card_problem(deck, log, card, "N2", "the weld joins node "//integer_text(weld%node_ids(1))// &
+                          " to itself")
+        cycle
+      end if
+      call append_spot_weld(input, weld)
+    end do
+  end subroutine read_spot_welds
+
+  !> *CONSTRAINED_GENERALIZED_WELD_SPOT(_ID): with _ID a card WID; card 1 NSID CID FILTER WINDOW
+  !> NPR NPRT; card 2 TFAIL EPSF SN SS N M. The node set is held as one rigid body until the
+  !> weld fails. CID (a local system for the failure forces) is refused; FILTER, WINDOW, NPR,
+  !> NPRT (force filtering and printing) and EPSF are read but not used.
+  subroutine read_generalized_spot_welds(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    type(spot_weld_input_t) :: weld
+    integer :: line, id, system
+    line = 0
+    do while (next_line(deck, block, line, .true.))
+      id = 0
+      if (keyword%id) then
+        call open_card(deck, block, line, standard_widths, card, log)
+        call get_integer(deck, card, 1, "WID", id, log)
+        if (.not. card%failed .and. id <= 0) call card_problem(deck, log, card, "WID", &
+          "must be a positive weld id, found "//integer_text(id))
+        if (.not. next_line(deck, block, line, .true.)) then
+          call located_problem(deck, log, line, "NSID", "card 1 (NSID CID FILTER WINDOW NPR NPRT) of weld "// &
+                               integer_text(id)//" is missing")
+          return
+        end if
+      end if
+      call open_card(deck, block, line, standard_widths, card, log)
+      weld = spot_weld_input_t(id=id, line=line)
+      call get_integer(deck, card, 1, "NSID", weld%node_set, log)
+      call get_integer(deck, card, 2, "CID", system, log)
+      if (system /= 0) call card_problem(deck, log, card, "CID", "local coordinate systems are not available "// &
+        "for welds (the failure forces are taken along and across the weld); leave CID blank")
+      call warn_if_set(deck, card, 3, "FILTER", "weld forces are not filtered", warnings)
+      call warn_if_set(deck, card, 4, "WINDOW", "weld forces are not filtered", warnings)
+      call warn_if_set(deck, card, 5, "NPR", "weld forces are not printed to a file", warnings)
+      call warn_if_set(deck, card, 6, "NPRT", "weld forces are not printed to a file", warnings)
+      if (.not. card%failed .and. weld%node_set <= 0) call card_problem(deck, log, card, "NSID", &
+        "must be the id of a node set, found "//integer_text(weld%node_set))
+      if (.not. next_line(deck, block, line, .true.)) then
+        call located_problem(deck, log, line, "TFAIL", "card 2 (TFAIL EPSF SN SS N M) is missing")
+        return
+      end if
+      call open_card(deck, block, line, standard_widths, card, log)
+      call get_real(deck, card, 1, "TFAIL", weld%failure_time, log)
+      call warn_if_set(deck, card, 2, "EPSF", "failure by plastic strain is not evaluated (the weld fails by "// &
+                       "force or at TFAIL only)", warnings)
+      call read_weld_strengths(deck, card, 3, weld, log)
+      if (card%failed) cycle
+      if (weld%node_set <= 0) cycle
+      if (weld%failure_time == 0.0_wp) weld%failure_time = 1.0e20_wp
+      call append_spot_weld(input, weld)
+    end do
+  end subroutine read_generalized_spot_welds
+
+  !> SN SS N M from fields first .. first + 3: strengths not negative, exponents positive (0: 2).
+  subroutine read_weld_strengths(deck, card, first, weld, log)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(inout) :: card
+    integer, intent(in) :: first
+    type(spot_weld_input_t), intent(inout) :: weld
+    type(problem_log_t), intent(inout) :: log
+    call get_real(deck, card, first, "SN", weld%normal_strength, log)
+    call get_real(deck, card, first + 1, "SS", weld%shear_strength, log)
+    call get_real(deck, card, first + 2, "N", weld%normal_exponent, log)
+    call get_real(deck, card, first + 3, "M", weld%shear_exponent, log)
+    if (card%failed) return
+    if (weld%normal_exponent == 0.0_wp) weld%normal_exponent = 2.0_wp
+    if (weld%shear_exponent == 0.0_wp) weld%shear_exponent = 2.0_wp
+    if (.not. weld%normal_strength >= 0.0_wp) call card_problem(deck, log, card, "SN", &
+      "the normal force at failure must not be negative (0: no normal-force failure), found "// &
+      real_text(weld%normal_strength))
+    if (.not. weld%shear_strength >= 0.0_wp) call card_problem(deck, log, card, "SS", &
+      "the shear force at failure must not be negative (0: no shear-force failure), found "// &
+      real_text(weld%shear_strength))
+    if (.not. (weld%normal_exponent > 0.0_wp .and. weld%normal_exponent <= 100.0_wp)) call card_problem(deck, log, &
+      card, "N", "the exponent must lie in (0, 100], found "//real_text(weld%normal_exponent))
+    if (.not. (weld%shear_exponent > 0.0_wp .and. weld%shear_exponent <= 100.0_wp)) call card_problem(deck, log, &
+      card, "M", "the exponent must lie in (0, 100], found "//real_text(weld%shear_exponent))
+  end subroutine read_weld_strengths
+
+  !> *CONSTRAINED_EXTRA_NODES_NODE: PID NID per line; the node joins rigid body PID.
+  subroutine read_extra_nodes(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_links(deck, block, input, log, warnings, link_extra_node, "PID", "NID")
+  end subroutine read_extra_nodes
+
+  !> *CONSTRAINED_EXTRA_NODES_SET: PID NSID IFLAG per line; the set's nodes join rigid body PID.
+  subroutine read_extra_node_sets(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_links(deck, block, input, log, warnings, link_extra_set, "PID", "NSID")
+  end subroutine read_extra_node_sets
+
+  !> *CONSTRAINED_RIGID_BODIES: PIDM PIDS IFLAG per line; rigid part PIDS joins rigid part PIDM.
+  subroutine read_rigid_body_merges(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_links(deck, block, input, log, warnings, link_merge, "PIDM", "PIDS")
+  end subroutine read_rigid_body_merges
+
+  !> Lines of two ids and IFLAG (which only matters for *PART_INERTIA, not available: the
+  !> nodes' masses always join the body).
+  subroutine read_links(deck, block, input, log, warnings, kind, first_name, second_name)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    integer, intent(in) :: kind
+    character(len=*), intent(in) :: first_name, second_name
+    type(card_t) :: card
+    type(rigid_link_input_t) :: link
+    integer :: line
+    line = 0
+    do while (next_line(deck, block, line, .true.))
+      call open_card(deck, block, line, standard_widths, card, log)
+      link = rigid_link_input_t(kind=kind, line=line)
+      call get_integer(deck, card, 1, first_name, link%body_id, log)
+      call get_integer(deck, card, 2, second_name, link%other_id, log)
+      if (kind /= link_extra_node) call warn_if_set(deck, card, 3, "IFLAG", "it matters only with "// &
+        "*PART_INERTIA (not available): the masses of the nodes always join the body", warnings)
+      if (card%failed) cycle
+      if (link%body_id <= 0) then
+        call card_problem(deck, log, card, first_name, "must be the id of a rigid body, found "// &
+                          integer_text(link%body_id))
+        cycle
+      end if
+      if (link%other_id <= 0) then
+        call card_problem(deck, log, card, second_name, "must be a positive id, found "//integer_text(link%other_id))
+        cycle
+      end if
+      input%rigid%link_count = input%rigid%link_count + 1
+      input%rigid%links(input%rigid%link_count) = link
+    end do
+  end subroutine read_links
+
   !> Cross-check: rigid parts, nodal rigid bodies, their constraints and prescribed motions,
   !> and lumped masses. Call after parts, node sets and curves are resolved.
   subroutine build_rigid_bodies(deck, input, log)
     type(deck_t), intent(in) :: deck
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
-    integer, allocatable :: owner(:), body_lines(:)
+    integer, allocatable :: owner(:), body_lines(:), main_part(:)
     type(rigid_body_t), allocatable :: bodies(:)
     integer :: k, part, body_count, node_count
 
@@ -298,21 +503,33 @@ contains
       allocate (bodies(body_count + input%rigid%nodal_count), body_lines(body_count + input%rigid%nodal_count))
       allocate (owner(node_count))
       owner = 0
+      call merge_rigid_parts(main_part)
       body_count = 0
       do part = 1, size(model%parts)
         if (model%parts(part)%formulation /= formulation_rigid) cycle
+        if (main_part(part) /= part) cycle
         body_count = body_count + 1
         bodies(body_count)%id = model%parts(part)%id
         bodies(body_count)%part = part
         body_lines(body_count) = input%part_lines(part)
         call set_constraints(part, bodies(body_count))
         call collect_part_nodes(part, body_count)
+        ! parts merged into it (*CONSTRAINED_RIGID_BODIES): their elements and nodes
+        bodies(body_count)%merged_parts = pack([(k, k=1, size(model%parts))], &
+                                               main_part == part .and. [(k, k=1, size(model%parts))] /= part)
+        bodies(body_count)%merged_ids = [(model%parts(bodies(body_count)%merged_parts(k))%id, &
+                                          k=1, size(bodies(body_count)%merged_parts))]
+        do k = 1, size(bodies(body_count)%merged_parts)
+          call collect_part_nodes(bodies(body_count)%merged_parts(k), body_count)
+        end do
       end do
       do k = 1, input%rigid%nodal_count
         call add_nodal_body(input%rigid%nodal(k))
       end do
+      call add_extra_nodes()
       call move_alloc(bodies, model%rigid_bodies)
       model%rigid_bodies = model%rigid_bodies(1:body_count)
+      call build_spot_welds()
       call build_rigid_motions()
       allocate (model%node_masses(node_count))
       model%node_masses = 0.0_wp
@@ -328,6 +545,122 @@ contains
       is_rigid_part = .false.
       if (material > 0) is_rigid_part = input%model%materials(material)%law == law_rigid
     end function is_rigid_part
+
+    !> *CONSTRAINED_RIGID_BODIES: for every part the rigid part whose body it joins (itself when
+    !> it joins none); chains (C into B, B into A) end at their first main part.
+    subroutine merge_rigid_parts(main)
+      integer, allocatable, intent(out) :: main(:)
+      integer :: k, j, first, second
+      allocate (main(size(input%model%parts)))
+      main = [(j, j=1, size(input%model%parts))]
+      do k = 1, input%rigid%link_count
+        associate (link => input%rigid%links(k))
+          if (link%kind /= link_merge) cycle
+          first = rigid_part(link%body_id, link%line, "PIDM")
+          second = rigid_part(link%other_id, link%line, "PIDS")
+          if (first == 0 .or. second == 0) cycle
+          do while (main(first) /= first)
+            first = main(first)
+          end do
+          do while (main(second) /= second)
+            second = main(second)
+          end do
+          if (first == second) cycle
+          main(second) = first
+        end associate
+      end do
+      ! every part straight to its main part (a chain ends where main(j) = j)
+      do j = 1, size(main)
+        first = j
+        do while (main(first) /= first)
+          first = main(first)
+        end do
+        main(j) = first
+      end do
+    end subroutine merge_rigid_parts
+
+    !> The index of rigid part `id`, or 0 with the problem reported.
+    integer function rigid_part(id, line, field)
+      integer, intent(in) :: id, line
+      character(len=*), intent(in) :: field
+      integer :: j
+      rigid_part = 0
+      do j = 1, size(input%model%parts)
+        if (input%model%parts(j)%id == id) rigid_part = j
+      end do
+      if (rigid_part == 0) then
+        call located_problem(deck, log, line, field, "part "//integer_text(id)//" is not defined")
+      else if (input%model%parts(rigid_part)%formulation /= formulation_rigid) then
+        call located_problem(deck, log, line, field, "part "//integer_text(id)//" is not rigid (its material "// &
+                             "is not *MAT_RIGID)")
+        rigid_part = 0
+      end if
+    end function rigid_part
+
+    !> *CONSTRAINED_EXTRA_NODES_NODE / _SET: the nodes join the rigid body of part PID (or the
+    !> nodal rigid body PID, or the body a merged part PID joined).
+    subroutine add_extra_nodes()
+      type(id_index_t) :: node_index
+      integer :: k, j, body, set, node
+      integer, allocatable :: added(:)
+      logical :: changed(body_count)
+      if (input%rigid%link_count == 0) return
+      call build_id_index(input%model%node_ids, node_index)
+      changed = .false.
+      do k = 1, input%rigid%link_count
+        associate (link => input%rigid%links(k))
+          if (link%kind == link_merge) cycle
+          body = 0
+          do j = 1, body_count
+            if (bodies(j)%id == link%body_id) body = j
+            if (allocated(bodies(j)%merged_ids)) then
+              if (any(bodies(j)%merged_ids == link%body_id)) body = j
+            end if
+          end do
+          if (body == 0) then
+            call located_problem(deck, log, link%line, "PID", "rigid body "//integer_text(link%body_id)// &
+              " is not defined (a *MAT_RIGID part or a *CONSTRAINED_NODAL_RIGID_BODY)")
+            cycle
+          end if
+          if (link%kind == link_extra_node) then
+            node = find_id(node_index, link%other_id)
+            if (node == 0) then
+              call located_problem(deck, log, link%line, "NID", "node "//integer_text(link%other_id)// &
+                                   " is not defined")
+              cycle
+            end if
+            added = [node]
+          else
+            set = 0
+            do j = 1, size(input%model%node_sets)
+              if (input%model%node_sets(j)%id == link%other_id) set = j
+            end do
+            if (set == 0) then
+              call located_problem(deck, log, link%line, "NSID", "node set "//integer_text(link%other_id)// &
+                                   " is not defined")
+              cycle
+            end if
+            added = input%model%node_sets(set)%nodes
+          end if
+          do j = 1, size(added)
+            node = added(j)
+            if (owner(node) == body) cycle
+            if (owner(node) /= 0) then
+              call located_problem(deck, log, link%line, trim(merge("NID ", "NSID", link%kind == link_extra_node)), &
+                "node "//integer_text(input%model%node_ids(node))//" belongs to rigid body "// &
+                integer_text(bodies(owner(node))%id)//" and to rigid body "//integer_text(bodies(body)%id)// &
+                "; a node joins one rigid body only")
+              cycle
+            end if
+            owner(node) = body
+            changed(body) = .true.
+          end do
+        end associate
+      end do
+      do body = 1, body_count
+        if (changed(body)) bodies(body)%nodes = pack([(node, node=1, node_count)], owner == body)
+      end do
+    end subroutine add_extra_nodes
 
     subroutine set_constraints(part, body)
       integer, intent(in) :: part
@@ -382,7 +715,7 @@ contains
       integer, intent(in) :: node, first, second
       call located_problem(deck, log, body_lines(second), "PID", "node "// &
         integer_text(input%model%node_ids(node))//" belongs to rigid body "//integer_text(bodies(first)%id)// &
-        " and to rigid body "//integer_text(bodies(second)%id)//"; merging rigid bodies is not available")
+        " and to rigid body "//integer_text(bodies(second)%id)//"; merge rigid parts with *CONSTRAINED_RIGID_BODIES")
     end subroutine shared_node
 
     subroutine add_nodal_body(given)
@@ -429,6 +762,87 @@ contains
       bodies(body)%nodes = pack([(node, node=1, node_count)], owner == body)
     end subroutine add_nodal_body
 
+    !> Spot welds: nodes resolved, a node in at most one weld or rigid body (a weld sharing a
+    !> node with another would be applied after it and undo part of it), ids unique.
+    subroutine build_spot_welds()
+      type(id_index_t) :: nodes
+      type(spot_weld_t), allocatable :: welds(:)
+      integer :: k, j, count, set, node
+      logical :: good
+      allocate (welds(input%rigid%weld_count))
+      count = 0
+      if (input%rigid%weld_count > 0) call build_id_index(input%model%node_ids, nodes)
+      do k = 1, input%rigid%weld_count
+        associate (given => input%rigid%welds(k))
+          welds(count + 1) = spot_weld_t(id=given%id, normal_strength=given%normal_strength, &
+                                         shear_strength=given%shear_strength, normal_exponent=given%normal_exponent, &
+                                         shear_exponent=given%shear_exponent, failure_time=given%failure_time)
+          if (welds(count + 1)%id == 0) welds(count + 1)%id = k
+          good = .true.
+          if (given%node_set == 0) then
+            allocate (welds(count + 1)%nodes(2))
+            do j = 1, 2
+              welds(count + 1)%nodes(j) = find_id(nodes, given%node_ids(j))
+              if (welds(count + 1)%nodes(j) == 0) then
+                call located_problem(deck, log, given%line, merge("N1", "N2", j == 1), "node "// &
+                                     integer_text(given%node_ids(j))//" is not defined")
+                good = .false.
+              end if
+            end do
+          else
+            set = 0
+            do j = 1, size(input%model%node_sets)
+              if (input%model%node_sets(j)%id == given%node_set) set = j
+            end do
+            if (set == 0) then
+              call located_problem(deck, log, given%line, "NSID", "node set "//integer_text(given%node_set)// &
+                                   " is not defined")
+              cycle
+            end if
+            welds(count + 1)%nodes = input%model%node_sets(set)%nodes
+            if (size(welds(count + 1)%nodes) < 2) then
+              call located_problem(deck, log, given%line, "NSID", "node set "//integer_text(given%node_set)// &
+                                   " has fewer than two nodes: a weld joins at least two")
+              good = .false.
+            end if
+          end if
+          if (.not. good) cycle
+          do j = 1, count
+            if (welds(j)%id == welds(count + 1)%id) then
+              call located_problem(deck, log, given%line, trim(merge("NSID", "N1  ", given%node_set /= 0)), "weld "// &
+                integer_text(welds(j)%id)//" is defined twice")
+              good = .false.
+              exit
+            end if
+          end do
+          if (.not. good) cycle
+          do j = 1, size(welds(count + 1)%nodes)
+            node = welds(count + 1)%nodes(j)
+            if (owner(node) > 0) then
+              call located_problem(deck, log, given%line, trim(merge("NSID", "N1  ", given%node_set /= 0)), "node "// &
+                integer_text(input%model%node_ids(node))//" of weld "//integer_text(welds(count + 1)%id)// &
+                " belongs to rigid body "//integer_text(input%model%rigid_bodies(owner(node))%id)// &
+                "; a weld cannot join a rigid body (add the node to the body instead)")
+              good = .false.
+            else if (owner(node) < 0) then
+              call located_problem(deck, log, given%line, trim(merge("NSID", "N1  ", given%node_set /= 0)), "node "// &
+                integer_text(input%model%node_ids(node))//" is in weld "//integer_text(welds(-owner(node))%id)// &
+                " and in weld "//integer_text(welds(count + 1)%id)//"; a node may be in one weld only "// &
+                "(join a stack of sheets with one *CONSTRAINED_GENERALIZED_WELD_SPOT on all its nodes)")
+              good = .false.
+            end if
+          end do
+          if (.not. good) cycle
+          count = count + 1
+          owner(welds(count)%nodes) = -count
+        end associate
+      end do
+      input%model%spot_welds = welds(1:count)
+      if (input%model%implicit_static .and. input%rigid%weld_count > 0) call located_problem(deck, log, &
+        input%rigid%welds(1)%line, trim(merge("NSID", "N1  ", input%rigid%welds(1)%node_set /= 0)), &
+        "spot welds are not available in the linear static analysis (*CONTROL_IMPLICIT_GENERAL IMFLAG = 1)")
+    end subroutine build_spot_welds
+
     subroutine build_rigid_motions()
       type(rigid_motion_t), allocatable :: motions(:)
       integer :: k, j, body, curve, dof, count, other
@@ -439,6 +853,9 @@ contains
           body = 0
           do j = 1, size(model%rigid_bodies)
             if (model%rigid_bodies(j)%id == given%part_id) body = j
+            if (allocated(model%rigid_bodies(j)%merged_ids)) then
+              if (any(model%rigid_bodies(j)%merged_ids == given%part_id)) body = j
+            end if
           end do
           if (body == 0) then
             if (any([(model%parts(j)%id, j=1, size(model%parts))] == given%part_id)) then
@@ -526,6 +943,13 @@ contains
     input%rigid%nodal_count = input%rigid%nodal_count + 1
     input%rigid%nodal(input%rigid%nodal_count) = entry
   end subroutine append_nodal_body
+
+  subroutine append_spot_weld(input, entry)
+    type(deck_input_t), intent(inout) :: input
+    type(spot_weld_input_t), intent(in) :: entry
+    input%rigid%weld_count = input%rigid%weld_count + 1
+    input%rigid%welds(input%rigid%weld_count) = entry
+  end subroutine append_spot_weld
 
   subroutine append_element_mass(input, entry)
     type(deck_input_t), intent(inout) :: input

@@ -12,7 +12,7 @@ module model
 
   public :: model_t, material_t, section_t, hourglass_t, part_t, node_set_t, part_set_t
   public :: spc_t, prescribed_motion_t, nodal_load_t, segment_load_t, rigid_wall_t, output_control_t
-  public :: rigid_body_t, rigid_motion_t
+  public :: rigid_body_t, rigid_motion_t, spot_weld_t, tied_contact_t
   public :: local_spc_t
   public :: segment_set_t, contact_t, contact_surface_t
 
@@ -242,6 +242,8 @@ module model
   type :: rigid_body_t
     integer :: id = 0                        !< part id (PID of a nodal rigid body): rbdout/<id>
     integer :: part = 0                      !< part index; 0 for a nodal rigid body
+    integer, allocatable :: merged_parts(:)  !< *CONSTRAINED_RIGID_BODIES: rigid parts merged into it
+    integer, allocatable :: merged_ids(:)    !< their part ids (a prescribed motion may name them)
     integer, allocatable :: nodes(:)         !< node indices, ascending
     logical :: fixed(6) = .false.            !< CMO = 1: x, y, z (CON1), rx, ry, rz (CON2), global axes
   end type rigid_body_t
@@ -257,6 +259,20 @@ module model
     real(wp) :: birth = 0.0_wp
     real(wp) :: death = 1.0e28_wp
   end type rigid_motion_t
+
+  !> A spot weld held as a small rigid body until it fails: *CONSTRAINED_SPOTWELD (two nodes)
+  !> or *CONSTRAINED_GENERALIZED_WELD_SPOT (a node set). It fails when
+  !> (|fn|/SN)^N + (|fs|/SS)^M >= 1 with the force it transmits (a strength of 0 leaves its
+  !> term out), or at TFAIL; afterwards its nodes move independently.
+  type :: spot_weld_t
+    integer :: id = 0                        !< WID (welds without an id: 1, 2, ... in deck order)
+    integer, allocatable :: nodes(:)         !< node indices
+    real(wp) :: normal_strength = 0.0_wp     !< SN (0: no normal-force term)
+    real(wp) :: shear_strength = 0.0_wp      !< SS (0: no shear-force term)
+    real(wp) :: normal_exponent = 2.0_wp     !< N
+    real(wp) :: shear_exponent = 2.0_wp      !< M
+    real(wp) :: failure_time = 1.0e20_wp     !< TF / TFAIL
+  end type spot_weld_t
 
   !> *SET_SEGMENT, node indices (a triangle repeats node 3); segments with a reported problem
   !> are left out.
@@ -302,6 +318,23 @@ module model
     real(wp) :: soft_scale = 0.1_wp          !< SOFSCL
     integer :: bucket_interval = 0           !< BSORT (0: automatic)
   end type contact_t
+
+  !> Tied contact kinds (*CONTACT_TIED_..., *CONTACT_SPOTWELD).
+  integer, parameter, public :: tied_nodes_to_surface = 1, tied_surface_to_surface = 2, &
+                                tied_shell_edge_to_surface = 3, tied_spotweld = 4
+
+  !> A tied contact after its set-up search: each tied secondary node, the primary segment it
+  !> was projected on and the shape functions there. Its velocity and acceleration are those
+  !> of the segment at that point; its mass and force go to the segment's nodes.
+  type :: tied_contact_t
+    integer :: id = 0                        !< CID (1, 2, ... in deck order without _ID)
+    integer :: kind = tied_nodes_to_surface
+    logical :: offset = .false.              !< _OFFSET: the node keeps its distance to the segment
+    logical :: rotations = .false.           !< shell edges and spot weld beams: rotations tied too
+    integer, allocatable :: nodes(:)         !< tied secondary nodes
+    integer, allocatable :: segments(:, :)   !< (4, tied) the segment's nodes (a triangle repeats N3)
+    real(wp), allocatable :: weights(:, :)   !< (4, tied) its shape functions at the projection
+  end type tied_contact_t
 
   !> Output intervals and requests (*DATABASE_...). An interval of 0 means "not requested".
   type :: output_control_t
@@ -353,6 +386,7 @@ module model
     type(rigid_body_t), allocatable :: rigid_bodies(:)
     type(rigid_motion_t), allocatable :: rigid_motions(:)
     real(wp), allocatable :: node_masses(:)          !< *ELEMENT_MASS per node (nodes)
+    type(spot_weld_t), allocatable :: spot_welds(:)  !< *CONSTRAINED_SPOTWELD, _GENERALIZED_WELD_SPOT
     ! controls
     logical :: implicit_static = .false.             !< *CONTROL_IMPLICIT_GENERAL IMFLAG = 1: linear static
     real(wp) :: end_time = 0.0_wp                    !< ENDTIM
@@ -371,6 +405,7 @@ module model
     ! contact
     type(segment_set_t), allocatable :: segment_sets(:)
     type(contact_t), allocatable :: contacts(:)
+    type(tied_contact_t), allocatable :: tied_contacts(:) !< *CONTACT_TIED_..., *CONTACT_SPOTWELD
     real(wp) :: contact_penalty_scale = 0.1_wp       !< *CONTROL_CONTACT SLSFAC
     integer :: contact_sort_interval = 0             !< *CONTROL_CONTACT NSBCS (0: sort when nodes moved)
     type(output_control_t) :: output

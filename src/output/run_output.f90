@@ -12,6 +12,7 @@ module run_output
   use energy_balance, only: measured_energies, part_energies, total_energy, energy_ratio
   use results_file, only: results_file_t, write_state
   use rigid_bodies, only: rigid_body_history_row
+  use spot_weld_constraints, only: failed_weld_count
   implicit none
   private
 
@@ -44,6 +45,8 @@ contains
         energy%kinetic, energy%internal, energy%hourglass, energy%contact, &
         energy%external_work, total_energy(energy), energy%rigid_wall, energy_ratio(energy), &
         state%added_mass, energy%momentum])
+      if (plan%weld_series > 0) call append_history_row(histories%series(plan%weld_series), &
+                                                        [state%time, real(failed_weld_count(state%welds), wp)])
     end if
     if (matsum_due) then
       call part_energies(model, state, size(model%parts), plan%part_kinetic, plan%part_internal, plan%part_hourglass)

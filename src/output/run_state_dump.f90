@@ -73,6 +73,17 @@ contains
       do k = 1, size(state%rigid)
         call exchange_rigid_body(store, "rigid/"//integer_text(k), state%rigid(k), error)
       end do
+      ! spot welds: each its rigid motion and whether (when, at what forces) it failed
+      if (size(state%welds) > 0) then
+        call exchange_restart_count(store, "welds/count", "spot welds", size(state%welds), error)
+        do k = 1, size(state%welds)
+          call exchange_rigid_body(store, "welds/"//integer_text(k), state%welds(k)%body, error)
+          call exchange_restart(store, "welds/"//integer_text(k)//"/failed", state%welds(k)%failed, error)
+          call exchange_restart(store, "welds/"//integer_text(k)//"/failure_time", state%welds(k)%failure_time, error)
+          call exchange_restart(store, "welds/"//integer_text(k)//"/normal_force", state%welds(k)%normal_force, error)
+          call exchange_restart(store, "welds/"//integer_text(k)//"/shear_force", state%welds(k)%shear_force, error)
+        end do
+      end if
       call exchange_restart_count(store, "walls/count", "rigid walls", size(state%walls), error)
       do k = 1, size(state%walls)
         call exchange_wall(store, "walls/"//integer_text(k), state%walls(k), error)

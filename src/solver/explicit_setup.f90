@@ -16,6 +16,8 @@ module explicit_setup
   use planar_rigid_walls, only: initialise_wall_states
   use penalty_contact, only: set_up_contacts
   use rigid_bodies, only: set_up_rigid_bodies, add_node_masses
+  use spot_weld_constraints, only: set_up_spot_welds
+  use tied_contact, only: set_up_tied_contacts
   implicit none
   private
 
@@ -73,8 +75,17 @@ contains
     integer :: b
     call add_node_masses(model, state%nodes%mass)
     if (allocated(model%node_masses)) state%physical_mass = state%physical_mass + sum(model%node_masses)
-    call set_up_rigid_bodies(model, state%nodes%reference, state%nodes%mass, state%nodes%velocity, &
-                             state%nodes%is_rigid_node, state%rigid, rigid_mass)
+    call set_up_rigid_bodies(model, state%nodes%reference, state%nodes%mass, state%nodes%rotary_inertia, &
+                             state%nodes%velocity, state%nodes%is_rigid_node, state%rigid, rigid_mass)
+    call set_up_spot_welds(model, state%nodes%reference, state%nodes%mass, state%nodes%rotary_inertia, &
+                           state%nodes%velocity, state%welds)
+    allocate (state%held_by_weld(state%nodes%count))
+    state%held_by_weld = .false.
+    do b = 1, size(state%welds)
+      state%held_by_weld(model%spot_welds(b)%nodes) = .true.
+    end do
+    call set_up_tied_contacts(model, state%nodes%mass, state%nodes%rotary_inertia, state%nodes%velocity, &
+                              state%nodes%angular_velocity, state%ties)
     state%physical_mass = state%physical_mass + rigid_mass
     state%rigid_time_step = huge(1.0_wp)
     do b = 1, size(state%rigid)

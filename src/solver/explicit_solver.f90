@@ -9,7 +9,8 @@
 !>   internal_forces          every element group, in one call that clears and fills
 !>   contact_forces           penalty contacts
 !>   external_forces          nodal loads at t^{n+1}
-!>   accelerations            a = (f_ext - f_int + f_contact) / m, prescribed motions held
+!>   accelerations            a = (f_ext - f_int + f_contact) / m, prescribed motions held, tied
+!>                            contacts (tied nodes move with their segments)
 !>   next_time_step           TSSFAC times the smallest stable step, cut at ENDTIM
 !>   state checks             runaway motion, failed elements, time step, energy (run_checks)
 !>   output                   whatever the output plan says is due (run_output)
@@ -33,6 +34,8 @@ module explicit_solver
   use planar_rigid_walls, only: enforce_planar_walls
   use cylinder_walls, only: enforce_cylinder_walls
   use rigid_bodies, only: advance_rigid_bodies
+  use spot_weld_constraints, only: advance_spot_welds
+  use tied_contact, only: distribute_tied_nodes, follow_segments
   use penalty_contact, only: compute_contact_forces, report_initial_penetrations
   use energy_balance, only: measured_energies, total_energy
   use run_checks, only: set_up_run_checks, check_runaway_motion, check_elements, check_time_step, check_energy, &
@@ -93,6 +96,7 @@ contains
     step = run%state%next_time_step
     average_step = 0.5_wp*(run%state%time_step + step)
     call start_phase(run%timers(phase_velocities))
+    call release_failed_weld_nodes(model, run%state)
     call advance_velocities(run%state, average_step)
     call stop_phase(run%timers(phase_velocities))
     call start_phase(run%timers(phase_constraints))
@@ -181,6 +185,8 @@ contains
         partial(chunk) = 0.0_wp
         do node = (chunk - 1)*sum_chunk_size + 1, min(chunk*sum_chunk_size, nodes%count)
           if (nodes%rotary_inertia(node) <= 0.0_wp .or. nodes%shell_area_sum(node) <= 0.0_wp) cycle
+          ! a rigid body or weld sets the rotation of its nodes (and takes their moments)
+          if (nodes%is_rigid_node(node) .or. state%held_by_weld(node)) cycle
           length = norm2(nodes%shell_normal_sum(:, node))
           if (length < coplanar*nodes%shell_area_sum(node)) cycle
           ! within the rotations an SPC leaves free (fixed ones stay zero)
@@ -231,24 +237,42 @@ contains
   end subroutine enforce_walls
 
   !> Rigid bodies move their nodes (their prescribed motions and constraints do external work);
-  !> shell nodes of a body turn with it. (The moments that deformable shells put on such nodes
-  !> are not passed on to the body: a shell tied to a rigid part transmits forces only.)
+  !> shell nodes of a body turn with it, and the moments that deformable shells put on such
+  !> nodes act on the body (rigid_bodies). Then the spot welds that hold move their nodes as
+  !> small rigid bodies and fail by their forces or time (spot_weld_constraints).
   subroutine move_rigid_bodies(model, state, step, average_step)
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(inout) :: state
     real(wp), intent(in) :: step, average_step
     real(wp) :: work
     integer :: b, k
-    if (size(state%rigid) == 0) return
-    call advance_rigid_bodies(model, state%rigid, state%time, step, average_step, state%nodes%coordinates, &
-                              state%nodes%velocity, work)
-    state%energy%external_work = state%energy%external_work + work
-    do b = 1, size(state%rigid)
-      do k = 1, size(model%rigid_bodies(b)%nodes)
-        state%nodes%angular_velocity(:, model%rigid_bodies(b)%nodes(k)) = state%rigid(b)%angular_velocity
+    if (size(state%rigid) > 0) then
+      call advance_rigid_bodies(model, state%rigid, state%time, step, average_step, state%nodes%coordinates, &
+                                state%nodes%angular_acceleration, state%nodes%rotary_inertia, state%nodes%velocity, &
+                                work)
+      state%energy%external_work = state%energy%external_work + work
+      do b = 1, size(state%rigid)
+        do k = 1, size(model%rigid_bodies(b)%nodes)
+          state%nodes%angular_velocity(:, model%rigid_bodies(b)%nodes(k)) = state%rigid(b)%angular_velocity
+        end do
       end do
-    end do
+    end if
+    if (size(state%welds) == 0) return
+    call advance_spot_welds(model, state%welds, state%time, step, average_step, state%nodes%coordinates, &
+                            state%nodes%angular_acceleration, state%nodes%rotary_inertia, state%nodes%velocity, &
+                            state%nodes%angular_velocity)
   end subroutine move_rigid_bodies
+
+  !> The nodes of failed welds are free (drilling constraint included) from the step after the
+  !> failure; set before the velocity update, so that a run continued from a dump does the same.
+  subroutine release_failed_weld_nodes(model, state)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(inout) :: state
+    integer :: w
+    do w = 1, size(state%welds)
+      if (state%welds(w)%failed) state%held_by_weld(model%spot_welds(w)%nodes) = .false.
+    end do
+  end subroutine release_failed_weld_nodes
 
   !> u^{n+1} = u^n + dt v^{n+1/2}; x = X + u; the loads' work over the first half of the step;
   !> the clock moves to t^{n+1} (the step cut at ENDTIM lands on it exactly).
@@ -320,7 +344,13 @@ contains
         where (nodes%fixed_rotation(:, node)) nodes%angular_acceleration(:, node) = 0.0_wp
       end do
       !$omp end parallel do
+      ! tied contacts: the tied nodes' masses and forces to their segments; after the prescribed
+      ! motions are held, the tied nodes move with their points of the segments
+      call distribute_tied_nodes(model, state%ties, nodes%mass, nodes%rotary_inertia, nodes%fixed, &
+                                 nodes%fixed_rotation, nodes%acceleration, nodes%angular_acceleration)
       call hold_prescribed_accelerations(model, state%time, nodes%acceleration, state%free_acceleration)
+      call follow_segments(model, nodes%rotary_inertia, nodes%acceleration, nodes%angular_acceleration, &
+                           nodes%velocity, nodes%angular_velocity)
     end associate
   end subroutine compute_accelerations
 

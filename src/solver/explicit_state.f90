@@ -8,6 +8,8 @@ module explicit_state
   use nodal_state, only: nodal_state_t
   use element_group, only: group_holder_t
   use rigid_body_state, only: rigid_body_state_t
+  use spot_weld_constraints, only: spot_weld_state_t
+  use tied_contact, only: tied_state_t
   use wall_state, only: wall_state_t
   use penalty_contact, only: contact_state_t
   implicit none
@@ -56,6 +58,9 @@ module explicit_state
     ! rigid bodies (indexed like model%rigid_bodies); their nodes move with them
     type(rigid_body_state_t), allocatable :: rigid(:)
     real(wp) :: rigid_time_step = huge(1.0_wp)           !< smallest stable step of the rigid elements
+    type(spot_weld_state_t), allocatable :: welds(:)     !< indexed like model%spot_welds
+    logical, allocatable :: held_by_weld(:)              !< (nodes) in a weld that has not failed
+    type(tied_state_t) :: ties                           !< work arrays of the tied contacts
     type(wall_state_t), allocatable :: walls(:)          !< indexed like model%walls
     type(contact_state_t), allocatable :: contacts(:)    !< indexed like model%contacts
     ! bookkeeping

@@ -27,6 +27,7 @@ module output_plan
   type :: output_plan_t
     type(output_clock_t) :: states, glstat, matsum, nodout, rwforc, rbdout, rcforc
     integer :: glstat_series = 0
+    integer :: weld_series = 0                   !< swforc: failed spot welds (0: the model has none)
     integer, allocatable :: matsum_series(:)     !< per part
     integer, allocatable :: nodout_series(:)     !< per history node
     integer, allocatable :: rwforc_series(:)     !< per wall
@@ -105,6 +106,11 @@ contains
         call add_history_series(histories, "rwforc/"//trim(label), [character(len=32) :: "time", "force"], &
                                 [1, 3], capacity, plan%rwforc_series(k))
       end do
+    end if
+    ! swforc: how many spot welds have failed, at the glstat interval
+    if (allocated(model%spot_welds)) then
+      if (size(model%spot_welds) > 0) call add_history_series(histories, "swforc", [character(len=32) :: "time", &
+                                        "failed_welds"], [1, 1], expected_rows(model, plan%glstat), plan%weld_series)
     end if
     ! rcforc: every contact, at the *DATABASE_RCFORC interval (else the glstat one)
     allocate (plan%rcforc_series(0))

@@ -34,7 +34,7 @@ module rigid_bodies
   private
 
   public :: set_up_rigid_bodies, advance_rigid_bodies, rigid_body_energy, rigid_body_history_row
-  public :: add_node_masses
+  public :: add_node_masses, set_up_body, advance_body
 
   real(wp), parameter :: identity(3, 3) = reshape([1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, &
                                                    0.0_wp, 0.0_wp, 1.0_wp], [3, 3])
@@ -56,16 +56,17 @@ contains
   !> of a body is the least-squares rigid fit of its nodes' initial velocities: the velocity of
   !> the centre of mass and the rotation about it (exact for the field of a rigid motion, as
   !> *INITIAL_VELOCITY_GENERATION gives); its nodes' velocities are replaced by that field.
-  subroutine set_up_rigid_bodies(model, reference, mass, velocity, is_rigid_node, bodies, rigid_mass)
+  subroutine set_up_rigid_bodies(model, reference, mass, rotary_inertia, velocity, is_rigid_node, bodies, rigid_mass)
     type(model_t), intent(in) :: model
     real(wp), intent(in) :: reference(:, :)
     real(wp), intent(inout) :: mass(:)
+    real(wp), intent(in) :: rotary_inertia(:)     !< of the nodes (shells'); the body carries them
     real(wp), intent(inout) :: velocity(:, :)
     logical, intent(out) :: is_rigid_node(:)
     type(rigid_body_state_t), allocatable, intent(out) :: bodies(:)
     real(wp), intent(out) :: rigid_mass
     real(wp), allocatable :: corner_mass(:)
-    integer :: b, k, node, count
+    integer :: b, count
 
     is_rigid_node = .false.
     rigid_mass = 0.0_wp
@@ -74,37 +75,89 @@ contains
     allocate (bodies(count), corner_mass(size(mass)))
     corner_mass = 0.0_wp
     do b = 1, count
-      associate (body => bodies(b), nodes => model%rigid_bodies(b)%nodes)
-        is_rigid_node(nodes) = .true.
-        call integrate_rigid_elements(model, model%rigid_bodies(b)%part, reference, body, corner_mass)
-        rigid_mass = rigid_mass + body%mass
-        call add_point_masses(nodes, reference, mass, body)
-        allocate (body%offsets(3, size(nodes)), body%node_mass(size(nodes)), body%node_velocity(3, size(nodes)))
-        do k = 1, size(nodes)
-          node = nodes(k)
-          mass(node) = mass(node) + corner_mass(node)
-          body%node_mass(k) = mass(node)
-          body%offsets(:, k) = reference(:, node) - body%centre
-        end do
-        body%initial_centre = body%centre
-        body%inverse_inertia = inverse3(body%inertia)
-        call fit_initial_motion(nodes, body, velocity)
-        do k = 1, size(nodes)
-          body%node_velocity(:, k) = body%velocity + cross(body%angular_velocity, body%offsets(:, k))
-          velocity(:, nodes(k)) = body%node_velocity(:, k)
-        end do
-      end associate
+      is_rigid_node(model%rigid_bodies(b)%nodes) = .true.
+      if (allocated(model%rigid_bodies(b)%merged_parts)) then
+        call set_up_body(model, model%rigid_bodies(b)%part, model%rigid_bodies(b)%nodes, reference, mass, &
+                         rotary_inertia, velocity, corner_mass, bodies(b), model%rigid_bodies(b)%merged_parts)
+      else
+        call set_up_body(model, model%rigid_bodies(b)%part, model%rigid_bodies(b)%nodes, reference, mass, &
+                         rotary_inertia, velocity, corner_mass, bodies(b))
+      end if
+      rigid_mass = rigid_mass + bodies(b)%rigid_element_mass
     end do
   end subroutine set_up_rigid_bodies
+
+  !> Mass properties and initial motion of one body: the rigid elements of `part` (0: none, a
+  !> nodal rigid body or a weld) and of `merged_parts` and the masses and rotary inertias of `nodes`. The nodes'
+  !> rotary inertias (shell nodes) join the inertia tensor as point inertias, so that the body
+  !> takes the moments the shells put on its nodes. A body whose nodes lie on a line (two
+  !> nodes without rotary inertia) has no inertia about that line: a small isotropic term
+  !> (1e-6 of the mean principal inertia) keeps the tensor invertible; forces at nodes on the
+  !> line have no moment about it, so the spin it allows stays at round-off level.
+  subroutine set_up_body(model, part, nodes, reference, mass, rotary_inertia, velocity, corner_mass, body, &
+                         merged_parts)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: part
+    integer, intent(in) :: nodes(:)
+    real(wp), intent(in) :: reference(:, :)
+    real(wp), intent(inout) :: mass(:)
+    real(wp), intent(in) :: rotary_inertia(:)
+    real(wp), intent(inout) :: velocity(:, :)
+    real(wp), intent(inout) :: corner_mass(:)     !< scratch (nodes), zero on entry and on return
+    type(rigid_body_state_t), intent(inout) :: body
+    integer, intent(in), optional :: merged_parts(:)   !< more rigid parts whose elements it has
+    integer :: k, node
+    real(wp) :: nodal_inertia
+    if (present(merged_parts)) then
+      call integrate_rigid_elements(model, [part, merged_parts], reference, body, corner_mass)
+    else
+      call integrate_rigid_elements(model, [part], reference, body, corner_mass)
+    end if
+    body%rigid_element_mass = body%mass
+    call add_point_masses(nodes, reference, mass, body)
+    allocate (body%offsets(3, size(nodes)), body%node_mass(size(nodes)), body%node_velocity(3, size(nodes)))
+    nodal_inertia = 0.0_wp
+    do k = 1, size(nodes)
+      node = nodes(k)
+      mass(node) = mass(node) + corner_mass(node)
+      corner_mass(node) = 0.0_wp
+      body%node_mass(k) = mass(node)
+      body%offsets(:, k) = reference(:, node) - body%centre
+      nodal_inertia = nodal_inertia + rotary_inertia(node)
+    end do
+    body%inertia = body%inertia + nodal_inertia*identity
+    body%inertia = body%inertia + degenerate_inertia(body%inertia)*identity
+    body%initial_centre = body%centre
+    body%inverse_inertia = inverse3(body%inertia)
+    call fit_initial_motion(nodes, body, velocity)
+    do k = 1, size(nodes)
+      body%node_velocity(:, k) = body%velocity + cross(body%angular_velocity, body%offsets(:, k))
+      velocity(:, nodes(k)) = body%node_velocity(:, k)
+    end do
+  end subroutine set_up_body
+
+  !> The isotropic inertia to add to `inertia` so that it can be inverted: none for a tensor
+  !> whose determinant is at least 1e-9 of (trace/3)^3 (principal inertias within a factor of
+  !> about 1e-9 of each other at worst); else 1e-6 of the mean principal inertia. A body of one
+  !> node without rotary inertia (zero tensor) keeps it: it cannot turn.
+  pure real(wp) function degenerate_inertia(inertia)
+    real(wp), intent(in) :: inertia(3, 3)
+    real(wp) :: mean
+    mean = (inertia(1, 1) + inertia(2, 2) + inertia(3, 3))/3.0_wp
+    degenerate_inertia = 0.0_wp
+    if (mean <= 0.0_wp) return
+    if (determinant3(inertia) >= 1.0e-9_wp*mean**3) return
+    degenerate_inertia = 1.0e-6_wp*mean
+  end function degenerate_inertia
 
   !> Mass, first and second moments of the part's hexahedra by 2x2x2 Gauss points and of its
   !> shells by 2x2 points on their mid-surface (thickness terms neglected), the centre of mass
   !> and (before the nodal masses) the inertia about it; corner masses rho V / 8 for the
   !> hexahedra's nodes and rho t A / 4 for the shells'; the stable step of the elements from E,
   !> PR and RO.
-  subroutine integrate_rigid_elements(model, part, reference, body, corner_mass)
+  subroutine integrate_rigid_elements(model, parts, reference, body, corner_mass)
     type(model_t), intent(in) :: model
-    integer, intent(in) :: part
+    integer, intent(in) :: parts(:)               !< part indices (0: none)
     real(wp), intent(in) :: reference(:, :)
     type(rigid_body_state_t), intent(inout) :: body
     real(wp), intent(inout) :: corner_mass(:)
@@ -115,7 +168,7 @@ contains
     real(wp) :: element_volume, density, wave_modulus, nu, youngs, length
     real(wp) :: xs(block_size, 8), ys(block_size, 8), zs(block_size, 8), area(block_size)
     real(wp) :: first(3), second(3, 3), origin(3)
-    integer :: solid, shell, a, i, j, k, material
+    integer :: solid, shell, a, i, j, k, material, part, p
     logical :: started
 
     body%mass = 0.0_wp
@@ -123,7 +176,9 @@ contains
     second = 0.0_wp
     origin = 0.0_wp
     started = .false.
-    if (part > 0) then
+    do p = 1, size(parts)
+      part = parts(p)
+      if (part <= 0) cycle
       material = model%parts(part)%material
       density = model%materials(material)%density
       youngs = model%materials(material)%youngs_modulus
@@ -194,7 +249,7 @@ contains
           body%time_step = min(body%time_step, length/sqrt(youngs/(density*(1.0_wp - nu*nu))))
         end do
       end if
-    end if
+    end do
     ! kept as moments about `origin` until the nodal masses are added
     body%centre = origin
     body%angular_momentum = first
@@ -303,69 +358,101 @@ contains
   !> after the ordinary update and the walls; on return the bodies' nodes hold the velocities
   !> of the rigid motion over the step. `support_work` is the work of the constraints and
   !> prescribed motions (external work).
-  subroutine advance_rigid_bodies(model, bodies, time, dt, average_dt, coordinates, velocity, support_work)
+  subroutine advance_rigid_bodies(model, bodies, time, dt, average_dt, coordinates, angular_acceleration, &
+                                  rotary_inertia, velocity, support_work)
     type(model_t), intent(in) :: model
     type(rigid_body_state_t), intent(inout) :: bodies(:)
     real(wp), intent(in) :: time, dt, average_dt
     real(wp), intent(in) :: coordinates(:, :)   !< x^n
+    real(wp), intent(in) :: angular_acceleration(:, :), rotary_inertia(:)
     real(wp), intent(inout) :: velocity(:, :)
     real(wp), intent(out) :: support_work
+    real(wp) :: work
+    integer :: b
+    support_work = 0.0_wp
+    do b = 1, size(bodies)
+      call advance_body(model, b, model%rigid_bodies(b)%nodes, bodies(b), time, dt, average_dt, coordinates, &
+                        angular_acceleration, rotary_inertia, velocity, work)
+      support_work = support_work + work
+    end do
+  end subroutine advance_rigid_bodies
+
+  !> One step of one body `b` (0: a body with no constraints or prescribed motions, a weld) made
+  !> of `nodes`. The impulse of the model on a node is m (v - v_body) for the translations (the
+  !> forces, walls and supports of this velocity update) and I dt_avg alpha for the rotations of
+  !> shell nodes (their moments; the shells' drilling constraint does not act on a body). With
+  !> `constraint_impulse`, each node's impulse from the body, m (v_rigid - v), is returned: what
+  !> the rigid link had to do (a weld's force).
+  subroutine advance_body(model, b, nodes, body, time, dt, average_dt, coordinates, angular_acceleration, &
+                          rotary_inertia, velocity, support_work, constraint_impulse)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: b
+    integer, intent(in) :: nodes(:)
+    type(rigid_body_state_t), intent(inout) :: body
+    real(wp), intent(in) :: time, dt, average_dt
+    real(wp), intent(in) :: coordinates(:, :)   !< x^n
+    real(wp), intent(in) :: angular_acceleration(:, :), rotary_inertia(:)
+    real(wp), intent(inout) :: velocity(:, :)
+    real(wp), intent(out) :: support_work
+    real(wp), intent(out), optional :: constraint_impulse(:, :)   !< (3, nodes)
     real(wp) :: impulse(3), angular_impulse(3), node_impulse(3), free_velocity(3), free_momentum(3)
     real(wp) :: target(6), new_rotation(3, 3), position(3), previous_velocity(3), previous_omega(3)
     logical :: held(6)
-    integer :: b, k, node, d
+    integer :: k, node, d
 
     support_work = 0.0_wp
-    do b = 1, size(bodies)
-      associate (body => bodies(b), nodes => model%rigid_bodies(b)%nodes)
-        ! impulses the model gave the body's nodes during this velocity update
-        impulse = 0.0_wp
-        angular_impulse = 0.0_wp
-        do k = 1, size(nodes)
-          node = nodes(k)
-          node_impulse = body%node_mass(k)*(velocity(:, node) - body%node_velocity(:, k))
-          impulse = impulse + node_impulse
-          angular_impulse = angular_impulse + cross(coordinates(:, node) - body%centre, node_impulse)
-        end do
-        body%force = impulse/average_dt
-        body%moment = angular_impulse/average_dt
-        body%impulse = body%impulse + impulse
-        previous_velocity = body%velocity
-        previous_omega = body%angular_velocity
-        free_velocity = body%velocity + impulse/body%mass
-        free_momentum = body%angular_momentum + angular_impulse
-
-        call kinematic_targets(model, b, body, time, dt, average_dt, held, target, body%held_acceleration)
-        body%held = held
-        ! translations
-        body%velocity = free_velocity
-        do d = 1, 3
-          if (.not. held(d)) cycle
-          support_work = support_work + 0.5_wp*body%mass*(target(d) - free_velocity(d))*(target(d) + previous_velocity(d))
-          body%velocity(d) = target(d)
-        end do
-        ! rotations
-        if (any(held(4:6))) then
-          call constrained_rotation(body, free_momentum, held(4:6), target(4:6), dt, new_rotation)
-          support_work = support_work + 0.5_wp*dot_product(body%angular_momentum - free_momentum, &
-                                                           previous_omega + body%angular_velocity)
-        else
-          body%angular_momentum = free_momentum
-          call free_rotation(body, dt, new_rotation)
-        end if
-        body%rotation_angle = body%rotation_angle + dt*body%angular_velocity
-        ! new position and the nodes' velocities over the step
-        body%centre = body%centre + dt*body%velocity
-        body%rotation = new_rotation
-        do k = 1, size(nodes)
-          node = nodes(k)
-          position = body%centre + matmul(new_rotation, body%offsets(:, k))
-          body%node_velocity(:, k) = (position - coordinates(:, node))/dt
-          velocity(:, node) = body%node_velocity(:, k)
-        end do
-      end associate
+    ! impulses the model gave the body's nodes during this velocity update
+    impulse = 0.0_wp
+    angular_impulse = 0.0_wp
+    do k = 1, size(nodes)
+      node = nodes(k)
+      node_impulse = body%node_mass(k)*(velocity(:, node) - body%node_velocity(:, k))
+      impulse = impulse + node_impulse
+      angular_impulse = angular_impulse + cross(coordinates(:, node) - body%centre, node_impulse)
+      if (rotary_inertia(node) > 0.0_wp) &
+        angular_impulse = angular_impulse + average_dt*rotary_inertia(node)*angular_acceleration(:, node)
     end do
-  end subroutine advance_rigid_bodies
+    body%force = impulse/average_dt
+    body%moment = angular_impulse/average_dt
+    body%impulse = body%impulse + impulse
+    previous_velocity = body%velocity
+    previous_omega = body%angular_velocity
+    ! (a weld of nodes without mass, a beam's before its mass is lumped, has nothing to move)
+    free_velocity = body%velocity
+    if (body%mass > 0.0_wp) free_velocity = body%velocity + impulse/body%mass
+    free_momentum = body%angular_momentum + angular_impulse
+
+    call kinematic_targets(model, b, body, time, dt, average_dt, held, target, body%held_acceleration)
+    body%held = held
+    ! translations
+    body%velocity = free_velocity
+    do d = 1, 3
+      if (.not. held(d)) cycle
+      support_work = support_work + 0.5_wp*body%mass*(target(d) - free_velocity(d))*(target(d) + previous_velocity(d))
+      body%velocity(d) = target(d)
+    end do
+    ! rotations
+    if (any(held(4:6))) then
+      call constrained_rotation(body, free_momentum, held(4:6), target(4:6), dt, new_rotation)
+      support_work = support_work + 0.5_wp*dot_product(body%angular_momentum - free_momentum, &
+                                                       previous_omega + body%angular_velocity)
+    else
+      body%angular_momentum = free_momentum
+      call free_rotation(body, dt, new_rotation)
+    end if
+    body%rotation_angle = body%rotation_angle + dt*body%angular_velocity
+    ! new position and the nodes' velocities over the step
+    body%centre = body%centre + dt*body%velocity
+    body%rotation = new_rotation
+    do k = 1, size(nodes)
+      node = nodes(k)
+      position = body%centre + matmul(new_rotation, body%offsets(:, k))
+      body%node_velocity(:, k) = (position - coordinates(:, node))/dt
+      if (present(constraint_impulse)) &
+        constraint_impulse(:, k) = body%node_mass(k)*(body%node_velocity(:, k) - velocity(:, node))
+      velocity(:, node) = body%node_velocity(:, k)
+    end do
+  end subroutine advance_body
 
   !> Which dofs (x, y, z, rx, ry, rz) are held this step and at what velocity: CMO constraints
   !> (zero) and active prescribed motions (VAD 0 velocity at mid-step, 2 displacement at the
@@ -380,9 +467,11 @@ contains
     real(wp), intent(out) :: acceleration(6)  !< of the held dofs (VAD = 1), for the integer-step values
     real(wp) :: local_time, value, current(6), position(6)
     integer :: k, d
-    held = model%rigid_bodies(b)%fixed
+    held = .false.
     target = 0.0_wp
     acceleration = 0.0_wp
+    if (b <= 0) return
+    held = model%rigid_bodies(b)%fixed
     if (.not. allocated(model%rigid_motions)) return
     current(1:3) = body%velocity
     current(4:6) = body%angular_velocity

@@ -11,6 +11,7 @@ module rigid_body_state
   !> One rigid body (indexed like model%rigid_bodies).
   type, public :: rigid_body_state_t
     real(wp) :: mass = 0.0_wp                    !< elements' mass plus the nodal masses of its nodes
+    real(wp) :: rigid_element_mass = 0.0_wp      !< the rigid elements' share of it (physical mass)
     real(wp) :: inertia(3, 3) = 0.0_wp           !< about the centre of mass, in body axes (= global at t = 0)
     real(wp) :: inverse_inertia(3, 3) = 0.0_wp
     real(wp) :: initial_centre(3) = 0.0_wp
