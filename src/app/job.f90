@@ -173,7 +173,7 @@ contains
     do k = 1, size(state%groups)
       call state%groups(k)%group%add_to_summary(summary)
     end do
-    summary%fe_elements = summary%fe_solids + summary%fe_shells
+    summary%fe_elements = summary%fe_solids + summary%fe_shells + summary%fe_beams
     summary%dofs_total = 3*size(model%node_ids) + 3*count(state%nodes%rotary_inertia > 0.0_wp)
     write (line, '(a,i0,a,i0,a,i0,a,i0,a)') "model: ", size(model%node_ids), " nodes, ", size(model%solid_ids), &
       " solids, ", size(model%shell_ids), " shells in ", size(model%parts), " parts"

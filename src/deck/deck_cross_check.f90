@@ -21,6 +21,7 @@ module deck_cross_check
   use deck_material_curves, only: resolve_material_curves, apply_material_bulk_viscosity
   use deck_rigid_bodies, only: build_rigid_bodies
   use deck_contact, only: build_contacts
+  use deck_beams, only: resolve_beams
   use deck_shell_check, only: check_element_sections, build_shell_thickness, &
                               check_static_shells
   implicit none
@@ -54,6 +55,7 @@ contains
     call resolve_shells(deck, input, indices, shells_resolved, log)
     mesh_resolved = mesh_resolved .and. shells_resolved
     call resolve_parts(deck, input, indices, log)
+    call resolve_beams(deck, input, indices%nodes, indices%parts, log)
     call check_element_sections(deck, input, log)
     call build_shell_thickness(deck, input, log)
     call check_static_shells(deck, input, log)
@@ -569,6 +571,12 @@ contains
           on_shell(input%model%shell_nodes(node, k)) = .true.
       end do
     end do
+    ! (beam nodes have rotations as shell nodes do)
+    do k = 1, input%beam_count
+      do node = 1, 2
+        if (input%model%beam_nodes(node, k) > 0) on_shell(input%model%beam_nodes(node, k)) = .true.
+      end do
+    end do
     first = 0
     others = 0
     do node = 1, input%node_count
@@ -1037,9 +1045,9 @@ contains
 
     if (input%node_count == 0) call report_problem(log, deck%files(1)%path// &
       ": *NODE: field NID: the deck defines no nodes")
-    if (input%solid_count == 0 .and. input%shell_count == 0) call report_problem(log, &
+    if (input%solid_count == 0 .and. input%shell_count == 0 .and. input%beam_count == 0) call report_problem(log, &
       deck%files(1)%path//": *ELEMENT_SOLID: field EID: the deck defines no elements (no "// &
-      "*ELEMENT_SOLID or *ELEMENT_SHELL)")
+      "*ELEMENT_SOLID, *ELEMENT_SHELL or *ELEMENT_BEAM)")
     if (.not. resolved) return
     associate (model => input%model)
       do element = 1, input%shell_count
