@@ -178,6 +178,10 @@ contains
     write (line, '(a,i0,a,i0,a,i0,a,i0,a)') "model: ", size(model%node_ids), " nodes, ", size(model%solid_ids), &
       " solids, ", size(model%shell_ids), " shells in ", size(model%parts), " parts"
     write (*, '(a)') trim(line)
+    if (summary%fe_beams > 0) then
+      write (line, '(a,i0,a)') "beams: ", summary%fe_beams, " (Hughes-Liu and spot weld beams)"
+      write (*, '(a)') trim(line)
+    end if
     write (line, '(a,es12.5)') "mass: ", state%physical_mass
     write (*, '(a)') trim(line)
     if (summary%dofs_efg > 0) then

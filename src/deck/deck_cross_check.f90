@@ -934,6 +934,12 @@ contains
       if (chosen_part(k)) chosen_node(pack(input%model%shell_nodes(:, element), &
                                            input%model%shell_nodes(:, element) > 0)) = .true.
     end do
+    do element = 1, input%beam_count
+      k = input%model%beam_part(element)
+      if (k == 0) cycle
+      if (chosen_part(k)) chosen_node(pack(input%model%beam_nodes(1:2, element), &
+                                           input%model%beam_nodes(1:2, element) > 0)) = .true.
+    end do
     nodes = pack([(k, k=1, input%node_count)], chosen_node)
     generation_nodes = .true.
   end function generation_nodes

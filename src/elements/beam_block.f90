@@ -258,15 +258,21 @@ contains
     type(material_t), intent(in) :: material
     real(wp), intent(in) :: length(block_size)
     real(wp), intent(out) :: element_time_step(block_size)
-    real(wp) :: nodal_mass(block_size), nodal_inertia(block_size), shear_frequency_squared, axial_step
+    real(wp) :: nodal_mass(block_size), nodal_inertia(block_size), shear_frequency_squared, axial_step, length_now
     integer :: i
     element_time_step = huge(1.0_wp)
     call beam_block_masses(block, nodal_mass, nodal_inertia)
     do i = 1, block%element_count
-      if (block%failed(i)) cycle
-      axial_step = length(i)/sqrt(material%youngs_modulus/block%density(i))
-      shear_frequency_squared = block%shear_factor*beam_shear_modulus(material)*block%area*length(i)* &
-                                (2.0_wp/(length(i)**2*nodal_mass(i)) + 0.5_wp/nodal_inertia(i))
+      ! (a failed beam keeps the step of its length at the start, or longer: a model whose
+      ! welds have all failed goes on with the step they had)
+      if (block%failed(i)) then
+        length_now = max(length(i), block%reference_length(i))
+      else
+        length_now = length(i)
+      end if
+      axial_step = length_now/sqrt(material%youngs_modulus/block%density(i))
+      shear_frequency_squared = block%shear_factor*beam_shear_modulus(material)*block%area*length_now* &
+                                (2.0_wp/(length_now**2*nodal_mass(i)) + 0.5_wp/nodal_inertia(i))
       element_time_step(i) = min(axial_step, 2.0_wp/sqrt(shear_frequency_squared))
     end do
   end subroutine lane_time_steps
