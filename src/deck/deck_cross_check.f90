@@ -1053,7 +1053,7 @@ contains
       ": *NODE: field NID: the deck defines no nodes")
     if (input%solid_count == 0 .and. input%shell_count == 0 .and. input%beam_count == 0) call report_problem(log, &
       deck%files(1)%path//": *ELEMENT_SOLID: field EID: the deck defines no elements (no "// &
-      "*ELEMENT_SOLID, *ELEMENT_SHELL or *ELEMENT_BEAM)")
+      "*ELEMENT_SOLID or *ELEMENT_SHELL)")
     if (.not. resolved) return
     associate (model => input%model)
       do element = 1, input%shell_count

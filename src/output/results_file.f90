@@ -1137,7 +1137,7 @@ contains
   ! The groups of the layout. Like every private writer below, each does nothing once `error`
   ! is set, so a sequence of writes reads as a list and stops at the first failure.
 
-  !> `/mesh`: nodes, solids, the (empty) shells, and parts.
+  !> `/mesh`: nodes, solids, the (empty) shells, parts, and the beams of a model that has some.
   subroutine write_mesh(file_id, model, error)
     integer(hid_t), intent(in) :: file_id
     type(model_t), intent(in) :: model
@@ -1213,7 +1213,31 @@ contains
     call write_integer_dataset_1d(file_id, "", "/mesh/parts/ids", part_ids, error)
     call write_string_dataset(file_id, "/mesh/parts/formulation", formulations, error)
     call write_integer_dataset_1d(file_id, "", "/mesh/parts/material_ids", material_ids, error)
+    if (allocated(model%beam_ids)) then
+      if (size(model%beam_ids) > 0) call write_beam_mesh()
+    end if
   contains
+    !> `/mesh/beams` (a model with beams): ids, part ids, the node ids N1 N2 (`connectivity`),
+    !> their 0-based rows (`connectivity_index`) and the orientation node N3 (0: none).
+    subroutine write_beam_mesh()
+      integer, allocatable :: beam_part_ids(:), beam_connectivity(:, :), orientation(:)
+      integer :: beam
+      allocate (beam_part_ids(size(model%beam_ids)), beam_connectivity(2, size(model%beam_ids)), &
+                orientation(size(model%beam_ids)))
+      do beam = 1, size(model%beam_ids)
+        beam_part_ids(beam) = model%parts(model%beam_part(beam))%id
+        beam_connectivity(:, beam) = model%node_ids(model%beam_nodes(1:2, beam))
+        orientation(beam) = 0
+        if (model%beam_nodes(3, beam) > 0) orientation(beam) = model%node_ids(model%beam_nodes(3, beam))
+      end do
+      call create_group_path(file_id, "/mesh/beams", error)
+      call write_integer_dataset_1d(file_id, "", "/mesh/beams/ids", model%beam_ids, error)
+      call write_integer_dataset_1d(file_id, "", "/mesh/beams/part_ids", beam_part_ids, error)
+      call write_integer_dataset_2d(file_id, "", "/mesh/beams/connectivity", beam_connectivity, error)
+      call write_integer_dataset_2d(file_id, "", "/mesh/beams/connectivity_index", model%beam_nodes(1:2, :) - 1, &
+                                    error)
+      call write_integer_dataset_1d(file_id, "", "/mesh/beams/orientation_node", orientation, error)
+    end subroutine write_beam_mesh
     !> 0-based node rows of the shells (as connectivity_index of the solids, for the XDMF file).
     function shell_connectivity_index() result(rows)
       integer, allocatable :: rows(:, :)
