@@ -5,13 +5,13 @@ module deck_beams
   use kinds, only: wp
   use error_handling, only: error_list_t
   use model, only: section_beam, cross_section_rectangular, cross_section_tubular
-  use material_laws, only: law_spotweld
+  use material_laws, only: law_spotweld, law_plastic_kinematic
   use deck_problems, only: problem_log_t
   use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t, line_location
   use deck_keywords, only: keyword_t
   use deck_fields, only: card_t, open_card, next_line, require_card, next_definition, get_integer, get_real, &
-                         card_problem, warn_if_set, card_is_empty, located_problem
+                         card_problem, warn_if_set, card_is_empty, located_problem, located_warning
   use deck_input, only: deck_input_t
   use deck_id_index, only: id_index_t, build_id_index, find_id
   use deck_materials, only: append_material
@@ -272,11 +272,14 @@ contains
   !> The beams: ids unique, part and nodes (N3 too) resolved to indices, the part's section a
   !> *SECTION_BEAM, a length > 0 and N3 off the axis. `node_index` and `part_index` are the
   !> cross-check's indices. Runs before the constraints are built (rotations of beam nodes).
-  subroutine resolve_beams(deck, input, node_index, part_index, log)
+  !> A *MAT_PLASTIC_KINEMATIC on beams with kinematic hardening (BETA < 1) or rate effects
+  !> (SRC, SRP) gets a warning: beam points harden isotropically, without rate effects.
+  subroutine resolve_beams(deck, input, node_index, part_index, log, warnings)
     type(deck_t), intent(in) :: deck
     type(deck_input_t), intent(inout) :: input
     type(id_index_t), intent(in) :: node_index, part_index
     type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
     type(id_index_t) :: beam_index
     integer :: beam, k, index, first, section
     logical :: resolved
@@ -349,6 +352,33 @@ contains
               integer_text(model%beam_ids(beam))//" lies on the beam's axis: it cannot orient the section")
         end if
       end do
+      call warn_beam_plasticity(deck, input, warnings)
     end associate
   end subroutine resolve_beams
+
+  !> The warning of resolve_beams, once per material.
+  subroutine warn_beam_plasticity(deck, input, warnings)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(in) :: input
+    type(error_list_t), intent(inout) :: warnings
+    logical, allocatable :: on_beams(:)
+    integer :: beam, material
+    allocate (on_beams(input%material_count))
+    on_beams = .false.
+    do beam = 1, input%beam_count
+      if (input%model%beam_part(beam) <= 0) cycle
+      material = input%model%parts(input%model%beam_part(beam))%material
+      if (material > 0) on_beams(material) = .true.
+    end do
+    do material = 1, input%material_count
+      if (.not. on_beams(material)) cycle
+      associate (law => input%model%materials(material))
+        if (law%law /= law_plastic_kinematic) cycle
+        if (law%hardening_beta < 1.0_wp) call located_warning(deck, warnings, input%material_lines(material), &
+          "BETA", "beams harden isotropically (as BETA = 1): kinematic hardening is not available on beams")
+        if (law%rate_c > 0.0_wp .or. law%rate_p > 0.0_wp) call located_warning(deck, warnings, &
+          input%material_lines(material), "SRC", "strain-rate effects are not applied on beams")
+      end associate
+    end do
+  end subroutine warn_beam_plasticity
 end module deck_beams

@@ -55,7 +55,7 @@ contains
     call resolve_shells(deck, input, indices, shells_resolved, log)
     mesh_resolved = mesh_resolved .and. shells_resolved
     call resolve_parts(deck, input, indices, log)
-    call resolve_beams(deck, input, indices%nodes, indices%parts, log)
+    call resolve_beams(deck, input, indices%nodes, indices%parts, log, warnings)
     call check_element_sections(deck, input, log)
     call build_shell_thickness(deck, input, log)
     call check_static_shells(deck, input, log)
