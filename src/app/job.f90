@@ -216,7 +216,7 @@ contains
       "  solids", summary%fe_solid_s, "  shells", summary%fe_shell_s, "  meshfree", summary%efg_s, "  contact", &
       summary%contact_s, "  output", summary%output_s, "  other", &
       max(0.0_wp, summary%wall_s - summary%setup_s - summary%fe_solid_s - summary%fe_shell_s - summary%efg_s - &
-          summary%contact_s - summary%output_s)
+          summary%contact_s - summary%output_s - summary%fe_beam_s)
     write (*, '(a)') trim(line)
     if (.not. static .and. summary%cycles > 0 .and. summary%fe_solids > 0) then
       per_element = 1.0e9_wp*summary%fe_solid_s/(real(summary%cycles, wp)*real(summary%fe_solids, wp))
@@ -226,6 +226,12 @@ contains
     if (.not. static .and. summary%cycles > 0 .and. summary%fe_shells > 0) then
       per_element = 1.0e9_wp*summary%fe_shell_s/(real(summary%cycles, wp)*real(summary%fe_shells, wp))
       write (line, '(a,f0.1,a)') "  shell elements: ", per_element, " ns per element per cycle"
+      write (*, '(a)') trim(line)
+    end if
+    if (.not. static .and. summary%cycles > 0 .and. summary%fe_beams > 0) then
+      per_element = 1.0e9_wp*summary%fe_beam_s/(real(summary%cycles, wp)*real(summary%fe_beams, wp))
+      write (line, '(a,f0.1,a,i0,a)') "  beam elements: ", per_element, " ns per element per cycle; ", &
+        summary%failed_beams, " failed"
       write (*, '(a)') trim(line)
     end if
     if (.not. static .and. summary%cycles > 0 .and. summary%efg_particles > 0) then

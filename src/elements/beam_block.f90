@@ -196,8 +196,9 @@ contains
       call beam_section_points(section, block%point_count, block%point_position, block%point_weight)
     end associate
     block%area = sum(block%point_weight(1:block%point_count))
-    block%polar_inertia = sum(block%point_weight(1:block%point_count)*(block%point_position(1:block%point_count, 1)**2 &
-                                                                      + block%point_position(1:block%point_count, 2)**2))
+    associate (points => block%point_position(1:block%point_count, :))
+      block%polar_inertia = sum(block%point_weight(1:block%point_count)*(points(:, 1)**2 + points(:, 2)**2))
+    end associate
     block%density = model%materials(block%material)%density
     allocate (block%stress(block_size, 3, block%point_count), block%plastic_strain(block_size, block%point_count))
     block%stress = 0.0_wp

@@ -1,7 +1,7 @@
 !> The beams (Hughes-Liu, spot weld beams) as an element group (element_group): the blocks of
 !> beam_block, their colouring, nodal masses and rotary inertias, and the per-block results of
 !> the last force call. Failed welds are masked in their blocks (beam_block_t%failed: no stress,
-!> no force); the count of failed beams is in the summary's log line through `failed_beams`.
+!> no force from the cycle they fail in); `failed_beams` counts them (run summary, /timing).
 module beam_group
   use kinds, only: wp, block_size
   use gather_list, only: gather_list_t
@@ -287,8 +287,8 @@ contains
     call exchange_restart(store, path//"/seconds", self%timer%seconds, error)
   end subroutine exchange_state
 
-  !> One block of beams: what it carries from cycle to cycle (the density too: mass scaling is
-  !> derived from the deck again, but a restart must not depend on it).
+  !> One block of beams: what it carries from cycle to cycle (the density and section come from
+  !> the deck and its mass scaling again).
   subroutine exchange_beam_block(store, path, block, error)
     type(restart_store_t), intent(inout) :: store
     character(len=*), intent(in) :: path
