@@ -4,8 +4,8 @@
 module deck_beams
   use kinds, only: wp
   use error_handling, only: error_list_t
-  use model, only: section_beam, cross_section_rectangular, cross_section_tubular
-  use material_laws, only: law_spotweld, law_plastic_kinematic
+  use model, only: section_beam, cross_section_rectangular, cross_section_tubular, beam_resultant_formulation
+  use material_laws, only: law_spotweld, law_plastic_kinematic, law_elastic
   use deck_problems, only: problem_log_t
   use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t, line_location
@@ -147,10 +147,11 @@ contains
           if (section%id <= 0) call card_problem(deck, log, card, "SECID", "section id must be > 0, found "// &
                                                  integer_text(section%id))
           if (section%element_formulation == 0) section%element_formulation = 1
-          if (section%element_formulation /= 1 .and. section%element_formulation /= 9) &
+          if (all(section%element_formulation /= [1, beam_resultant_formulation, 9])) &
             call card_problem(deck, log, card, "ELFORM", "beam formulation "// &
               integer_text(section%element_formulation)//" is not available; crashfree has ELFORM 1 "// &
-              "(Hughes-Liu with cross-section integration, 0 or blank) and 9 (spot weld beam)")
+              "(Hughes-Liu with cross-section integration, 0 or blank), 2 (resultant beam, elastic) and 9 "// &
+              "(spot weld beam)")
           if (section%shear_factor < 0.0_wp) call card_problem(deck, log, card, "SHRF", "shear factor must "// &
             "be > 0 (0 or blank: 1.0; 5/6 is usual for a rectangle), found "//real_text(section%shear_factor))
           if (section%beam_rule == 0) section%beam_rule = 2
@@ -161,7 +162,8 @@ contains
           else if (section%beam_rule > 5) then
             call card_problem(deck, log, card, "QR/IRID", "must be 1-5 (0 or blank: 2), found "// &
                               integer_text(section%beam_rule))
-          else if (section%beam_rule == 1 .and. section%cross_section == cross_section_rectangular) then
+          else if (section%beam_rule == 1 .and. section%cross_section == cross_section_rectangular .and. &
+                   section%element_formulation /= beam_resultant_formulation) then
             call card_problem(deck, log, card, "QR/IRID", "one point on a rectangular section gives the "// &
               "beam no bending stiffness; use 2 (2 x 2 Gauss, the default) or more")
           end if
@@ -175,6 +177,12 @@ contains
         if (section%shear_factor == 0.0_wp) section%shear_factor = 1.0_wp
         call warn_if_set(deck, card, 6, "SCOOR", "the beam's frame is always at its mid-length", warnings)
         call warn_if_set(deck, card, 8, "NAUPD", "the section's sizes do not change", warnings)
+        if (section%element_formulation == beam_resultant_formulation) then
+          if (.not. require_card(deck, block, line, standard_widths, card, log, "card 2 (A ISS ITT J SA IST) "// &
+                                 "of section "//integer_text(section%id), "A")) exit
+          call read_resultant_card(deck, card, section%beam_properties, log)
+          cycle
+        end if
         if (.not. require_card(deck, block, line, standard_widths, card, log, "card 2 (TS1 TS2 TT1 TT2 "// &
                                "NSLOC NTLOC) of section "//integer_text(section%id), "TS1")) exit
         do k = 1, 4
@@ -201,6 +209,36 @@ contains
       end associate
     end do
   end subroutine read_beam_sections
+
+  !> Card 2 of ELFORM 2: A ISS ITT J SA IST; A, ISS, ITT > 0, J and SA >= 0 (0: ISS + ITT, A),
+  !> IST (product of inertia) must be 0.
+  subroutine read_resultant_card(deck, card, properties, log)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(inout) :: card
+    real(wp), intent(out) :: properties(5)
+    type(problem_log_t), intent(inout) :: log
+    character(len=3), parameter :: names(5) = ["A  ", "ISS", "ITT", "J  ", "SA "]
+    real(wp) :: product_of_inertia
+    integer :: k
+    do k = 1, 5
+      call get_real(deck, card, k, trim(names(k)), properties(k), log)
+    end do
+    call get_real(deck, card, 6, "IST", product_of_inertia, log)
+    if (card%failed) return
+    do k = 1, 3
+      if (.not. properties(k) > 0.0_wp) call card_problem(deck, log, card, trim(names(k)), "must be > 0, found "// &
+                                                          real_text(properties(k)))
+    end do
+    do k = 4, 5
+      if (properties(k) < 0.0_wp) call card_problem(deck, log, card, trim(names(k)), "must be >= 0 (0: "// &
+        trim(merge("ISS + ITT", "A        ", k == 4))//"), found "//real_text(properties(k)))
+    end do
+    if (product_of_inertia /= 0.0_wp) call card_problem(deck, log, card, "IST", "a product of inertia "// &
+      "(unsymmetric section) is not available; the section's axes s, t must be principal (0 or blank), found "// &
+      real_text(product_of_inertia))
+    if (properties(4) == 0.0_wp) properties(4) = properties(2) + properties(3)
+    if (properties(5) == 0.0_wp) properties(5) = properties(1)
+  end subroutine read_resultant_card
 
   !> *MAT_SPOTWELD (*MAT_100): C1 MID RO E PR SIGY ET DT TFAIL; C2 EFAIL NRR NRS NRT MRR MSS MTT
   !> NF. DT (a mass-scaling step for the welds) and NF (force filtering) are read and not used.
@@ -281,7 +319,8 @@ contains
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
     type(id_index_t) :: beam_index
-    integer :: beam, k, index, first, section
+    integer :: beam, k, index, first, section, material
+    logical, allocatable :: reported_resultant_part(:)
     logical :: resolved
     real(wp) :: axis(3), toward(3), length
     character(len=2), parameter :: node_names(3) = ["N1", "N2", "N3"]
@@ -292,6 +331,8 @@ contains
       model%beam_nodes = model%beam_nodes(:, 1:input%beam_count)
       input%beam_lines = input%beam_lines(1:input%beam_count)
       call build_id_index(model%beam_ids, beam_index)
+      allocate (reported_resultant_part(input%part_count))
+      reported_resultant_part = .false.
       first = 1
       do k = 2, size(beam_index%ids)
         if (beam_index%ids(k) /= beam_index%ids(k - 1)) then
@@ -329,11 +370,21 @@ contains
         end do
         if (model%beam_part(beam) > 0) then
           section = model%parts(model%beam_part(beam))%section
+          material = model%parts(model%beam_part(beam))%material
           if (section > 0) then
-            if (model%sections(section)%kind /= section_beam) call located_problem(deck, log, &
-              input%beam_lines(beam), "PID", "part "//integer_text(model%parts(model%beam_part(beam))%id)// &
-              " of beam "//integer_text(model%beam_ids(beam))//" has section "// &
-              integer_text(model%sections(section)%id)//", which is not a *SECTION_BEAM; beams need one")
+            if (model%sections(section)%kind /= section_beam) then
+              call located_problem(deck, log, input%beam_lines(beam), "PID", "part "// &
+                integer_text(model%parts(model%beam_part(beam))%id)//" of beam "// &
+                integer_text(model%beam_ids(beam))//" has section "//integer_text(model%sections(section)%id)// &
+                ", which is not a *SECTION_BEAM; beams need one")
+            else if (model%sections(section)%element_formulation == beam_resultant_formulation .and. material > 0 &
+                     .and. .not. reported_resultant_part(model%beam_part(beam))) then
+              reported_resultant_part(model%beam_part(beam)) = .true.
+              if (model%materials(material)%law /= law_elastic) call located_problem(deck, log, &
+                input%part_lines(model%beam_part(beam)), "MID", "part "// &
+                integer_text(model%parts(model%beam_part(beam))%id)//": the resultant beam (ELFORM 2) is "// &
+                "elastic and takes *MAT_ELASTIC only; use ELFORM 1 (integrated section) for plasticity and welds")
+            end if
           end if
         end if
         if (.not. resolved) cycle

@@ -27,11 +27,16 @@
 !>   w_shear^2 = SHRF G A L (2 / (L^2 m) + 1 / (2 J)),  m, J the nodal mass and rotary inertia
 !> (the bending and torsion modes are slower with this J).
 !>
+!> ELFORM 2 (LS-DYNA's Belytschko-Schwer resultant beam; Belytschko, Schwer & Klein 1977) is the
+!> same corotational element with elastic resultants as its state instead of section points:
+!> N += E A e dt, Q += SHRF G SA g dt, T += G J k1 dt, M_s += E ISS k2 dt, M_t += E ITT k3 dt
+!> (*MAT_ELASTIC only; the deck refuses other laws on it).
+!>
 !> A failed beam (material_spotweld: *MAT_SPOTWELD's criteria) keeps zero stress and adds no
 !> force or moment from the cycle in which it failed; `failed` is the mask.
 module beam_block
   use kinds, only: wp, block_size
-  use model, only: model_t, material_t, section_t, formulation_fe, section_beam, cross_section_tubular
+  use model, only: model_t, material_t, section_t, formulation_fe, cross_section_tubular, beam_resultant_formulation
   use gauss_legendre, only: gauss_legendre_rule
   use element_work, only: add_force_work, smallest_time_step
   use beam_point_plasticity, only: update_beam_point, beam_shear_modulus
@@ -53,7 +58,11 @@ module beam_block
     integer :: part = 0                          !< index into model%parts
     integer :: material = 0                      !< index into model%materials
     integer :: point_count = 0                   !< section points
-    real(wp) :: shear_factor = 1.0_wp            !< SHRF
+    real(wp) :: shear_factor = 1.0_wp            !< SHRF (resultant beams: SHRF SA / A)
+    !> ELFORM 2: the resultants are the state (no section points); stiffness per unit strain
+    !> rate of N, Q_s, Q_t, T, M_s, M_t: E A, G SHRF SA, G SHRF SA, G J, E ISS, E ITT.
+    logical :: resultant_beam = .false.
+    real(wp) :: resultant_stiffness(6) = 0.0_wp
     real(wp) :: point_position(max_beam_points, 2) = 0.0_wp !< (s, t) of each section point
     real(wp) :: point_weight(max_beam_points) = 0.0_wp      !< its area
     real(wp) :: area = 0.0_wp                    !< sum of the weights
@@ -191,13 +200,28 @@ contains
     type(beam_block_t), intent(inout) :: block
     block%part = part
     block%material = model%parts(part)%material
-    associate (section => model%sections(model%parts(part)%section))
+    associate (section => model%sections(model%parts(part)%section), &
+               material => model%materials(model%parts(part)%material))
       block%shear_factor = section%shear_factor
-      call beam_section_points(section, block%point_count, block%point_position, block%point_weight)
-    end associate
-    block%area = sum(block%point_weight(1:block%point_count))
-    associate (points => block%point_position(1:block%point_count, :))
-      block%polar_inertia = sum(block%point_weight(1:block%point_count)*(points(:, 1)**2 + points(:, 2)**2))
+      if (section%element_formulation == beam_resultant_formulation) then
+        ! A ISS ITT J SA
+        block%resultant_beam = .true.
+        block%point_count = 0
+        block%area = section%beam_properties(1)
+        block%polar_inertia = section%beam_properties(2) + section%beam_properties(3)
+        block%shear_factor = section%shear_factor*section%beam_properties(5)/section%beam_properties(1)
+        block%resultant_stiffness = [material%youngs_modulus*section%beam_properties(1), &
+          beam_shear_modulus(material)*section%shear_factor*section%beam_properties(5), &
+          beam_shear_modulus(material)*section%shear_factor*section%beam_properties(5), &
+          beam_shear_modulus(material)*section%beam_properties(4), &
+          material%youngs_modulus*section%beam_properties(2), material%youngs_modulus*section%beam_properties(3)]
+      else
+        call beam_section_points(section, block%point_count, block%point_position, block%point_weight)
+        block%area = sum(block%point_weight(1:block%point_count))
+        associate (points => block%point_position(1:block%point_count, :))
+          block%polar_inertia = sum(block%point_weight(1:block%point_count)*(points(:, 1)**2 + points(:, 2)**2))
+        end associate
+      end if
     end associate
     block%density = model%materials(block%material)%density
     allocate (block%stress(block_size, 3, block%point_count), block%plastic_strain(block_size, block%point_count))
@@ -357,6 +381,11 @@ contains
       shear(1) = dot_product(dv, mid_frame(2, :))/mid_length - dot_product(mean_w, mid_frame(3, :))
       shear(2) = dot_product(dv, mid_frame(3, :))/mid_length + dot_product(mean_w, mid_frame(2, :))
       r = 0.0_wp
+      if (block%resultant_beam) then
+        ! elastic resultants, updated in the corotational frame
+        r = block%resultant(i, :) + dt*block%resultant_stiffness*[axial, shear(1), shear(2), twist, curvature(1), &
+                                                                  curvature(2)]
+      end if
       do point = 1, block%point_count
         s = block%point_position(point, 1)
         t = block%point_position(point, 2)

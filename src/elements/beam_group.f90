@@ -224,7 +224,8 @@ contains
         do lane = 1, block%element_count
           beam = block%elements(lane)
           results%beam_resultant(:, beam) = block%resultant(lane, :)
-          results%beam_plastic_strain(beam) = maxval(block%plastic_strain(lane, :))
+          results%beam_plastic_strain(beam) = 0.0_wp
+          if (block%point_count > 0) results%beam_plastic_strain(beam) = maxval(block%plastic_strain(lane, :))
           results%beam_failed(beam) = merge(1.0_wp, 0.0_wp, block%failed(lane))
         end do
       end associate

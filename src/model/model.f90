@@ -98,6 +98,8 @@ module model
   !> Beam cross-section types (CST): rectangular, tubular (a solid circle when the wall is as
   !> thick as the radius).
   integer, parameter, public :: cross_section_rectangular = 0, cross_section_tubular = 1
+  !> *SECTION_BEAM ELFORM of the resultant beam (section by A ISS ITT J SA).
+  integer, parameter, public :: beam_resultant_formulation = 2
 
   !> One section: solid (*SECTION_SOLID, *SECTION_SOLID_EFG) or shell (*SECTION_SHELL).
   type :: section_t
@@ -122,6 +124,8 @@ module model
     integer :: cross_section = cross_section_rectangular !< CST: 0 rectangular, 1 tubular
     integer :: beam_rule = 2               !< QR/IRID: Gauss points per section direction (1-5)
     real(wp) :: beam_size(4) = 0.0_wp      !< TS1 TS2 TT1 TT2 (TS2, TT2 default TS1, TT1)
+    !> ELFORM 2 (resultant beam): A ISS ITT J SA (J 0: ISS + ITT; SA 0: A)
+    real(wp) :: beam_properties(5) = 0.0_wp
   end type section_t
 
   !> One hourglass / bulk-viscosity definition (*HOURGLASS).

@@ -60,14 +60,17 @@ CANTILEVER_ELEMENTS, CANTILEVER_LENGTH, CANTILEVER_SIDE, TIP_LOAD = 10, 100.0, 1
 SHEAR_FACTOR = 5.0 / 6.0
 
 
-def cantilever_deck(path, end_time=26.0, rise_time=18.0):
+def cantilever_deck(path, end_time=26.0, rise_time=18.0, formulation=1):
     """A 100 mm steel beam of 10 x 10 mm section (2 x 2 Gauss points, SHRF 5/6), ten elements
     along x, clamped at x = 0 (all six dofs); the tip load along z rises as a half cosine over
-    18 ms, fifteen periods of the first bending mode (1.2 ms), and is then held."""
+    18 ms, fifteen periods of the first bending mode (1.2 ms), and is then held. With
+    `formulation` 2 the same section as a resultant beam: A, ISS = ITT = s^4/12, J blank."""
     n = CANTILEVER_ELEMENTS
     nodes = np.zeros((n + 2, 3))
     nodes[:n + 1, 0] = np.linspace(0.0, CANTILEVER_LENGTH, n + 1)
     nodes[n + 1] = [0.0, 10.0, 0.0]               # orientation node: s along y, t along z
+    side = CANTILEVER_SIDE
+    section_card = fields(*[side] * 4) if formulation == 1 else fields(side ** 2, side ** 4 / 12, side ** 4 / 12)
     return write_deck(
         path, "*TITLE\ncantilever",
         "*CONTROL_TERMINATION\n" + fields(end_time),
@@ -76,7 +79,7 @@ def cantilever_deck(path, end_time=26.0, rise_time=18.0):
         "*DATABASE_NODOUT\n" + fields(0.01),
         "*DATABASE_HISTORY_NODE\n" + fields(n + 1),
         "*PART\ncantilever\n" + fields(1, 1, 1),
-        "*SECTION_BEAM\n" + fields(1, 1, SHEAR_FACTOR, 2, 0) + "\n" + fields(*[CANTILEVER_SIDE] * 4),
+        "*SECTION_BEAM\n" + fields(1, formulation, SHEAR_FACTOR, 2, 0) + "\n" + section_card,
         "*MAT_ELASTIC\n" + fields(1, DENSITY, YOUNGS, POISSON),
         nodes_card(nodes),
         beams_card([(k + 1, k + 2) for k in range(n)], orientation=n + 2),
@@ -85,7 +88,8 @@ def cantilever_deck(path, end_time=26.0, rise_time=18.0):
         "*LOAD_NODE_POINT\n" + fields(n + 1, 3, 1, TIP_LOAD))
 
 
-def test_cantilever_tip_deflection_matches_timoshenko(tmp_path, run_deck):
+@pytest.mark.parametrize("formulation", [1, 2])
+def test_cantilever_tip_deflection_matches_timoshenko(tmp_path, run_deck, formulation):
     """Static tip deflection of a cantilever: Timoshenko's P L^3 / (3 E I) + P L / (k G A).
 
     The element has one point along its length (no shear locking); on n elements it is exact
@@ -95,8 +99,9 @@ def test_cantilever_tip_deflection_matches_timoshenko(tmp_path, run_deck):
     8 ms (6.7 periods) is the static deflection within 1e-4 (the ringing left by the smooth ramp
     is a few 1e-5 of it). Tolerances: 2e-4 against the element's exact answer (the tip rotation,
     2.9e-3 rad, adds geometric effects of order 1e-5), 0.4% against the continuum. The root
-    element's resultants: shear P, moment P (L - l/2) at its mid-length point, within 0.5%."""
-    run = run_deck(cantilever_deck(tmp_path / "cantilever.k"))
+    element's resultants: shear P, moment P (L - l/2) at its mid-length point, within 0.5%.
+    The resultant beam (ELFORM 2) has the same kinematics and the same answer."""
+    run = run_deck(cantilever_deck(tmp_path / "cantilever.k", formulation=formulation))
     assert run.status == 0, run.stdout + run.stderr
     n, length, side = CANTILEVER_ELEMENTS, CANTILEVER_LENGTH, CANTILEVER_SIDE
     inertia, area = side ** 4 / 12.0, side ** 2
@@ -175,12 +180,18 @@ TUBE_ELEMENTS, TUBE_LENGTH, TUBE_DIAMETER, TUBE_WALL = 10, 100.0, 20.0, 2.0
 ARM, ARM_FORCE, ARM_SIDE = 20.0, 0.5, 20.0
 
 
-def tube_deck(path, end_time=4.5, rise_time=3.0):
+def tube_deck(path, end_time=4.5, rise_time=3.0, formulation=1):
     """A tube (CST 1, QR 2: 8 angles x 2 radii) along x, clamped at x = 0; at the free end two
     arms (part 2: one beam each, 20 x 20 mm, same steel) reach to y = +-20 and are pushed along
     +-z with forces F: a torque 2 a F about x, raised as a half cosine over 3 ms (25 torsion
-    periods), then held."""
+    periods), then held. With `formulation` 2 the tube is a resultant beam with its A, I and J."""
     n = TUBE_ELEMENTS
+    outer, inner = TUBE_DIAMETER / 2.0, TUBE_DIAMETER / 2.0 - TUBE_WALL
+    polar = np.pi / 2.0 * (outer ** 4 - inner ** 4)
+    if formulation == 1:
+        tube_section = fields(1, 1, 1.0, 2, 1) + "\n" + fields(TUBE_DIAMETER, TUBE_DIAMETER, TUBE_WALL, TUBE_WALL)
+    else:
+        tube_section = fields(1, 2, 1.0) + "\n" + fields(np.pi * (outer ** 2 - inner ** 2), polar / 2, polar / 2, polar)
     nodes = np.zeros((n + 3, 3))
     nodes[:n + 1, 0] = np.linspace(0.0, TUBE_LENGTH, n + 1)
     nodes[n + 1] = [TUBE_LENGTH, ARM, 0.0]
@@ -192,7 +203,7 @@ def tube_deck(path, end_time=4.5, rise_time=3.0):
         "*DATABASE_NODOUT\n" + fields(0.01),
         "*DATABASE_HISTORY_NODE\n" + fields(first_arm, second_arm),
         "*PART\ntube\n" + fields(1, 1, 1),
-        "*SECTION_BEAM\n" + fields(1, 1, 1.0, 2, 1) + "\n" + fields(TUBE_DIAMETER, TUBE_DIAMETER, TUBE_WALL, TUBE_WALL),
+        "*SECTION_BEAM\n" + tube_section,
         "*PART\narms\n" + fields(2, 2, 1),
         "*SECTION_BEAM\n" + fields(2, 1, SHEAR_FACTOR, 2, 0) + "\n" + fields(*[ARM_SIDE] * 4),
         "*MAT_ELASTIC\n" + fields(1, DENSITY, YOUNGS, POISSON),
@@ -204,13 +215,14 @@ def tube_deck(path, end_time=4.5, rise_time=3.0):
         "*LOAD_NODE_POINT\n" + fields(first_arm, 3, 1, ARM_FORCE) + "\n" + fields(second_arm, 3, 1, -ARM_FORCE))
 
 
-def test_tube_twist_matches_saint_venant(tmp_path, run_deck):
+@pytest.mark.parametrize("formulation", [1, 2])
+def test_tube_twist_matches_saint_venant(tmp_path, run_deck, formulation):
     """Twist of a thick tube: T L / (G J), J = pi/2 (r_o^4 - r_i^4) (the section's points,
     Gauss in the radius, integrate J exactly). The twist is read from the arms' ends: their
     difference along z over 2 a, less each arm's own bending, F a^3 / (4 E I) + F a / (k G A)
     for one element (1.4% of the end's motion). Mean over the last 1.5 ms (12 periods) after
-    the ramp; tolerance 0.5%."""
-    run = run_deck(tube_deck(tmp_path / "tube.k"))
+    the ramp; tolerance 0.5%. The resultant beam (ELFORM 2) given that J: the same."""
+    run = run_deck(tube_deck(tmp_path / "tube.k", formulation=formulation))
     assert run.status == 0, run.stdout + run.stderr
     outer, inner = TUBE_DIAMETER / 2.0, TUBE_DIAMETER / 2.0 - TUBE_WALL
     polar = np.pi / 2.0 * (outer ** 4 - inner ** 4)
@@ -426,8 +438,8 @@ def test_restart_of_beams_reproduces_the_uninterrupted_run(tmp_path):
 # g. refused input
 
 @pytest.mark.parametrize("old, new, fragments", [
-    (fields(1, 1, SHEAR_FACTOR, 2, 0), fields(1, 2, SHEAR_FACTOR, 2, 0),
-     ["*SECTION_BEAM: field ELFORM", "beam formulation 2 is not available"]),
+    (fields(1, 1, SHEAR_FACTOR, 2, 0), fields(1, 3, SHEAR_FACTOR, 2, 0),
+     ["*SECTION_BEAM: field ELFORM", "beam formulation 3 is not available"]),
     (fields(1, 1, SHEAR_FACTOR, 2, 0), fields(1, 1, SHEAR_FACTOR, -3, 0),
      ["field QR/IRID", "user integration rules"]),
     (fields(1, 1, SHEAR_FACTOR, 2, 0), fields(1, 1, SHEAR_FACTOR, 2, 2),
@@ -548,3 +560,22 @@ def test_weld_on_shell_nodes_carries_the_plates_and_fails_at_nrr(tmp_path, run_d
     assert force[before].max() <= WELD_NRR and force[before].max() > 0.9 * WELD_NRR, force[before].max()
     assert np.all(force[~before] == 0.0)
     assert np.abs(deflection[~before]).max() < 1.5 * deflection[before].max()
+
+
+def test_resultant_beam_refuses_plasticity_and_unsymmetric_sections(tmp_path, run_deck):
+    """ELFORM 2 is elastic: *MAT_PLASTIC_KINEMATIC on it is an error at the part; a product of
+    inertia IST is an error at the section card."""
+    deck = cantilever_deck(tmp_path / "resultant.k", end_time=0.01, formulation=2)
+    text = deck.read_text()
+    elastic = "*MAT_ELASTIC\n" + fields(1, DENSITY, YOUNGS, POISSON)
+    deck.write_text(text.replace(elastic, "*MAT_PLASTIC_KINEMATIC\n" + fields(1, DENSITY, YOUNGS, POISSON, 0.3) +
+                                 "\n" + fields(0.0, 0.0)))
+    run = run_deck(deck)
+    assert run.status == 2 and "*PART: field MID" in run.stderr and "takes *MAT_ELASTIC only" in run.stderr, \
+        run.stderr
+    side = CANTILEVER_SIDE
+    section = fields(side ** 2, side ** 4 / 12, side ** 4 / 12)
+    assert section in text
+    deck.write_text(text.replace(section, fields(side ** 2, side ** 4 / 12, side ** 4 / 12, 0.0, 0.0, 5.0)))
+    run = run_deck(deck)
+    assert run.status == 2 and "field IST" in run.stderr and "product of inertia" in run.stderr, run.stderr
