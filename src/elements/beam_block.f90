@@ -163,7 +163,8 @@ contains
     type(model_t), intent(in) :: model
     type(beam_block_t), allocatable, intent(out) :: blocks(:)
     integer, allocatable :: per_part(:)
-    integer :: part, beam, block_count, lane, current, beam_count
+    integer :: part, beam, block_count, lane, current, beam_count, axis
+    real(wp) :: frame(3, 3)
     beam_count = 0
     if (allocated(model%beam_part)) beam_count = size(model%beam_part)
     allocate (per_part(size(model%parts)))
@@ -189,7 +190,10 @@ contains
         blocks(current)%element_count = lane
         blocks(current)%elements(lane) = beam
         blocks(current)%nodes(lane, :) = model%beam_nodes(1:2, beam)
-        call initial_frame(model, beam, blocks(current)%frame(lane, :, :), blocks(current)%reference_length(lane))
+        call initial_frame(model, beam, frame, blocks(current)%reference_length(lane))
+        do axis = 1, 3
+          blocks(current)%frame(lane, axis, :) = frame(:, axis)
+        end do
       end do
     end do
   end subroutine build_beam_blocks
@@ -229,6 +233,7 @@ contains
     block%plastic_strain = 0.0_wp
   end subroutine start_block
 
+  !> The frame at the start, axes as columns (frame(:, a) = a_a).
   subroutine initial_frame(model, beam, frame, length)
     type(model_t), intent(in) :: model
     integer, intent(in) :: beam
@@ -236,16 +241,16 @@ contains
     real(wp) :: axis(3), toward(3)
     axis = model%coordinates(:, model%beam_nodes(2, beam)) - model%coordinates(:, model%beam_nodes(1, beam))
     length = norm2(axis)
-    frame(1, :) = axis/length
+    frame(:, 1) = axis/length
     if (model%beam_nodes(3, beam) > 0) then
       toward = model%coordinates(:, model%beam_nodes(3, beam)) - model%coordinates(:, model%beam_nodes(1, beam))
-    else if (abs(frame(1, 3)) < 0.866_wp) then
+    else if (abs(frame(3, 1)) < 0.866_wp) then
       toward = [0.0_wp, 0.0_wp, 1.0_wp]
     else
       toward = [1.0_wp, 0.0_wp, 0.0_wp]
     end if
-    frame(2, :) = normal_part(toward, frame(1, :))
-    frame(3, :) = cross(frame(1, :), frame(2, :))
+    frame(:, 2) = normal_part(toward, frame(:, 1))
+    frame(:, 3) = cross(frame(:, 1), frame(:, 2))
   end subroutine initial_frame
 
   !> The unit vector along the part of `vector` normal to the unit vector `axis`.
@@ -331,7 +336,7 @@ contains
     real(wp), intent(out) :: critical_time_step
     integer, intent(out) :: critical_element, degenerate_element
     real(wp) :: x(3, 2), v(3, 2), w(3, 2), mid_axis(3), end_axis(3), mid_frame(3, 3), end_frame(3, 3)
-    real(wp) :: mid_length, end_length(block_size), spin, dv(3), dw(3), mean_w(3)
+    real(wp) :: mid_length, end_length(block_size), spin, dv(3), dw(3), mean_w(3), previous(3), point_stress(3)
     real(wp) :: axial, twist, curvature(2), shear(2), increment(3), s, t, r(6)
     real(wp) :: old_power(block_size), new_power(block_size), element_time_step(block_size)
     integer :: nel, i, node, point
@@ -363,23 +368,28 @@ contains
       ! the frame: a1 along the axis, a2 carried from the last frame and turned by the mean
       ! spin about the axis, half a step to the mid-step frame and half to the end
       mean_w = 0.5_wp*(w(:, 1) + w(:, 2))
-      mid_frame(1, :) = mid_axis/mid_length
-      spin = 0.5_wp*dt*dot_product(mean_w, mid_frame(1, :))
-      call turned_frame(block%frame(i, 2, :), mid_frame(1, :), spin, mid_frame)
-      end_frame(1, :) = end_axis/end_length(i)
-      call turned_frame(mid_frame(2, :), end_frame(1, :), spin, end_frame)
-      block%frame(i, :, :) = end_frame
+      ! (local frames hold the axes as columns)
+      mid_frame(:, 1) = mid_axis/mid_length
+      spin = 0.5_wp*dt*dot_product(mean_w, mid_frame(:, 1))
+      previous = block%frame(i, 2, :)
+      call turned_frame(previous, spin, mid_frame)
+      end_frame(:, 1) = end_axis/end_length(i)
+      previous = mid_frame(:, 2)
+      call turned_frame(previous, spin, end_frame)
+      do node = 1, 3
+        block%frame(i, node, :) = end_frame(:, node)
+      end do
       if (block%failed(i)) cycle
 
       ! rates on the mid-step frame, point updates
       dv = v(:, 2) - v(:, 1)
       dw = w(:, 2) - w(:, 1)
-      axial = dot_product(dv, mid_frame(1, :))/mid_length
-      twist = dot_product(dw, mid_frame(1, :))/mid_length
-      curvature(1) = dot_product(dw, mid_frame(2, :))/mid_length
-      curvature(2) = dot_product(dw, mid_frame(3, :))/mid_length
-      shear(1) = dot_product(dv, mid_frame(2, :))/mid_length - dot_product(mean_w, mid_frame(3, :))
-      shear(2) = dot_product(dv, mid_frame(3, :))/mid_length + dot_product(mean_w, mid_frame(2, :))
+      axial = dot_product(dv, mid_frame(:, 1))/mid_length
+      twist = dot_product(dw, mid_frame(:, 1))/mid_length
+      curvature(1) = dot_product(dw, mid_frame(:, 2))/mid_length
+      curvature(2) = dot_product(dw, mid_frame(:, 3))/mid_length
+      shear(1) = dot_product(dv, mid_frame(:, 2))/mid_length - dot_product(mean_w, mid_frame(:, 3))
+      shear(2) = dot_product(dv, mid_frame(:, 3))/mid_length + dot_product(mean_w, mid_frame(:, 2))
       r = 0.0_wp
       if (block%resultant_beam) then
         ! elastic resultants, updated in the corotational frame
@@ -392,9 +402,10 @@ contains
         increment(1) = dt*(axial - s*curvature(2) + t*curvature(1))
         increment(2) = dt*(shear(1) - t*twist)
         increment(3) = dt*(shear(2) + s*twist)
-        call update_beam_point(material, block%shear_factor, increment, block%stress(i, :, point), &
-                               block%plastic_strain(i, point))
-        associate (stress => block%stress(i, :, point), area => block%point_weight(point))
+        point_stress = block%stress(i, :, point)
+        call update_beam_point(material, block%shear_factor, increment, point_stress, block%plastic_strain(i, point))
+        block%stress(i, :, point) = point_stress
+        associate (stress => point_stress, area => block%point_weight(point))
           r(1) = r(1) + area*stress(1)
           r(2) = r(2) + area*stress(2)
           r(3) = r(3) + area*stress(3)
@@ -412,7 +423,7 @@ contains
       end if
 
       ! forces and moments on the end-of-step frame: the transposes of the rates times L
-      associate (a1 => end_frame(1, :), a2 => end_frame(2, :), a3 => end_frame(3, :), length => end_length(i))
+      associate (a1 => end_frame(:, 1), a2 => end_frame(:, 2), a3 => end_frame(:, 3), length => end_length(i))
         nodal_force(i, 2, 1:3) = r(1)*a1 + r(2)*a2 + r(3)*a3
         nodal_force(i, 1, 1:3) = -nodal_force(i, 2, 1:3)
         nodal_force(i, 2, 4:6) = r(4)*a1 + r(5)*a2 + r(6)*a3
@@ -433,14 +444,14 @@ contains
     call smallest_time_step(nel, element_time_step, block%elements, critical_time_step, critical_element)
   end subroutine compute_beam_block
 
-  !> frame(2, :) = `previous` made normal to the unit axis frame(1, :) (already set) and turned
-  !> about it by `angle`; frame(3, :) = a1 x a2.
-  pure subroutine turned_frame(previous, axis, angle, frame)
-    real(wp), intent(in) :: previous(3), axis(3), angle
+  !> frame(:, 2) = `previous` made normal to the unit axis frame(:, 1) (already set) and turned
+  !> about it by `angle`; frame(:, 3) = a1 x a2.
+  pure subroutine turned_frame(previous, angle, frame)
+    real(wp), intent(in) :: previous(3), angle
     real(wp), intent(inout) :: frame(3, 3)
     real(wp) :: second(3)
-    second = normal_part(previous, axis)
-    frame(2, :) = cos(angle)*second + sin(angle)*cross(axis, second)
-    frame(3, :) = cross(axis, frame(2, :))
+    second = normal_part(previous, frame(:, 1))
+    frame(:, 2) = cos(angle)*second + sin(angle)*cross(frame(:, 1), second)
+    frame(:, 3) = cross(frame(:, 1), frame(:, 2))
   end subroutine turned_frame
 end module beam_block
