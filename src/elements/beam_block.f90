@@ -1,4 +1,4 @@
-!> Blocks of beam elements (*SECTION_BEAM ELFORM 1 Hughes-Liu, 9 spot weld beam) and the
+!> Blocks of beam elements (*SECTION_BEAM ELFORM 1 Hughes-Liu, 2 resultant beam, 9 spot weld beam)
 !> per-cycle element work on them.
 !>
 !> The element (Hughes & Liu 1981, part I, specialised to a beam as in LS-DYNA's Theory Manual,
