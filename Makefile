@@ -114,6 +114,7 @@ test: deps
 bench: deps
 	@$(MAKE) --no-print-directory all
 	@bash tools/bench.sh
+	@bash tools/bench_contact.sh
 
 # Verification studies: write the decks, run every case (NCPU threads each, default 1), then
 # write docs/verification.md and its plots (also when a case failed; the exit status says so).

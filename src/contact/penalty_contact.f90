@@ -4,11 +4,15 @@
 !> sections on the standard penalty formulation and the soft constraint formulation).
 !>
 !> Each contact is done in one or two passes; a pass checks the secondary nodes against the
-!> primary segments. The neighbour search is a bucket sort: the segments, with their bounding
-!> boxes grown by a margin, are sorted into a uniform grid, and every secondary node keeps the
-!> segments of its cell whose box holds it. The lists stay valid until some node of the pass
-!> has moved half the margin since they were built (or BSORT cycles have passed), then they are
-!> rebuilt: cost linear in the surface size. Arrays grow only at rebuilds.
+!> primary segments. The neighbour search is a bucket sort (LS-DYNA Theory Manual, "Contact
+!> Searching", bucket sort): the segments, with their bounding boxes grown by a margin, are
+!> sorted into a uniform grid, and every secondary node keeps the segments of its cell whose box
+!> holds it. The lists stay valid until some node of the pass has moved half the margin since
+!> they were built (or BSORT / NSBCS cycles have passed), then they are rebuilt. Meshes mix
+!> sizes (a 700 mm panel next to 30 mm rails): the margin and the cell are sized by the median
+!> segment, not the largest, and a large segment is entered in every cell its box covers, so a
+!> node's candidates are the segments that are really near it and a rebuild costs time linear in
+!> the surface size whatever the spread of sizes. Arrays grow only at rebuilds.
 !>
 !> Penetration is measured from the closest point of the (bilinear) segment to the node along
 !> the segment normal at that point. Normal force `k d` with LS-DYNA's stiffness for solid
@@ -34,7 +38,8 @@ module penalty_contact
   implicit none
   private
 
-  public :: contact_state_t, contact_pass_t, set_up_contacts, compute_contact_forces, report_initial_penetrations
+  public :: contact_state_t, contact_pass_t, set_up_contacts, set_up_contact, compute_contact_forces, &
+            report_initial_penetrations
 
   !> Parametric tolerance of the projection (LS-DYNA's MAXPAR default 1.025).
   real(wp), parameter :: parametric_limit = 1.025_wp
@@ -71,7 +76,8 @@ module penalty_contact
     ! bucket search
     integer, allocatable :: tracked(:)            !< every node of the pass
     real(wp), allocatable :: tracked_at_build(:, :)
-    real(wp) :: margin = 0.0_wp
+    real(wp) :: margin = 0.0_wp                   !< half the median segment size: motion allowed between rebuilds
+    real(wp) :: cell_size = 0.0_wp                !< median grown box of a segment: the bucket edge
     integer :: cycles_since_build = 0
     logical :: built = .false.
     integer, allocatable :: candidate_first(:), candidates(:)
@@ -88,6 +94,7 @@ module penalty_contact
   !> One contact during the run.
   type :: contact_state_t
     integer :: pass_count = 0
+    integer, allocatable :: excluded_nodes(:)     !< nodes never checked (interior meshfree particles)
     type(contact_pass_t) :: passes(2)
     real(wp) :: force(3) = 0.0_wp                 !< force on the SURFA side in the last cycle
     real(wp) :: impulse(3) = 0.0_wp               !< since the start of the run
@@ -101,51 +108,98 @@ contains
     logical, intent(in) :: is_particle(:)
     type(contact_state_t), allocatable, intent(out) :: contacts(:)
     type(error_t), allocatable, intent(out) :: error
+    logical, allocatable :: solid_eroded(:), shell_eroded(:)
     integer :: k
-    integer, allocatable :: segments_a(:, :), owners_a(:), segments_b(:, :), owners_b(:), nodes(:)
     if (.not. allocated(model%contacts)) then
       allocate (contacts(0))
       return
     end if
-    allocate (contacts(size(model%contacts)))
+    allocate (contacts(size(model%contacts)), solid_eroded(size(model%solid_part)), &
+              shell_eroded(size(model%shell_part)))
+    solid_eroded = .false.
+    shell_eroded = .false.
     do k = 1, size(model%contacts)
-      associate (contact => model%contacts(k), state => contacts(k))
-        call side_segments(contact%side_a, segments_a, owners_a)
-        if (allocated(error)) return
-        if (contact%kind /= contact_single_surface) then
-          call side_segments(contact%side_b, segments_b, owners_b)
-          if (allocated(error)) return
-        end if
-        select case (contact%kind)
-        case (contact_nodes_to_surface, contact_surface_to_surface)
-          if (contact%side_a%kind == surface_node_set) then
-            nodes = pack(contact%side_a%nodes, .not. is_particle(contact%side_a%nodes))
-          else
-            call surface_node_list(segments_a, is_particle, nodes)
-          end if
-          state%pass_count = 1
-          call build_pass(state%passes(1), nodes, segments_a, owners_a, segments_b, owners_b, contact%scale_b, .false.)
-          state%passes(1)%side_sign = 1.0_wp
-          if (contact%kind == contact_surface_to_surface) then
-            call surface_node_list(segments_b, is_particle, nodes)
-            state%pass_count = 2
-            call build_pass(state%passes(2), nodes, segments_b, owners_b, segments_a, owners_a, contact%scale_a, &
-                            .false.)
-            state%passes(2)%side_sign = -1.0_wp
-          end if
-        case (contact_single_surface)
-          call surface_node_list(segments_a, is_particle, nodes)
-          state%pass_count = 1
-          call build_pass(state%passes(1), nodes, segments_a, owners_a, segments_a, owners_a, contact%scale_a, .true.)
-        end select
-      end associate
+      call set_up_contact(model, is_particle, k, solid_eroded, shell_eroded, contacts(k), error)
+      if (allocated(error)) return
     end do
+  end subroutine set_up_contacts
+
+  !> Build the passes of contact `k` from the model (reference configuration) without the
+  !> elements flagged eroded: their shells and faces leave the surfaces, the faces of the other
+  !> solids of a part that become exterior join them (sides given by parts), and secondary
+  !> nodes with no remaining element are not checked. Also used after erosion
+  !> (contact_erosion), which then carries the pair state over.
+  subroutine set_up_contact(model, is_particle, k, solid_eroded, shell_eroded, state, error)
+    type(model_t), intent(in) :: model
+    logical, intent(in) :: is_particle(:)
+    integer, intent(in) :: k
+    logical, intent(in) :: solid_eroded(:), shell_eroded(:)
+    type(contact_state_t), intent(out) :: state
+    type(error_t), allocatable, intent(out) :: error
+    integer :: n
+    integer, allocatable :: segments_a(:, :), owners_a(:), segments_b(:, :), owners_b(:), nodes(:)
+    logical, allocatable :: node_lost(:)
+    state%excluded_nodes = pack([(n, n=1, size(is_particle))], is_particle)
+    ! nodes that had elements and have none left
+    allocate (node_lost(size(model%node_ids)))
+    node_lost = .false.
+    if (any(solid_eroded) .or. any(shell_eroded)) call find_lost_nodes()
+    associate (contact => model%contacts(k))
+      call side_segments(contact%side_a, segments_a, owners_a)
+      if (allocated(error)) return
+      if (contact%kind /= contact_single_surface) then
+        call side_segments(contact%side_b, segments_b, owners_b)
+        if (allocated(error)) return
+      end if
+      select case (contact%kind)
+      case (contact_nodes_to_surface, contact_surface_to_surface)
+        if (contact%side_a%kind == surface_node_set) then
+          nodes = pack(contact%side_a%nodes, .not. (is_particle(contact%side_a%nodes) .or. &
+                                                    node_lost(contact%side_a%nodes)))
+        else
+          call surface_node_list(segments_a, is_particle, nodes)
+        end if
+        state%pass_count = 1
+        call build_pass(state%passes(1), nodes, segments_a, owners_a, segments_b, owners_b, contact%scale_b, .false.)
+        state%passes(1)%side_sign = 1.0_wp
+        if (contact%kind == contact_surface_to_surface) then
+          call surface_node_list(segments_b, is_particle, nodes)
+          state%pass_count = 2
+          call build_pass(state%passes(2), nodes, segments_b, owners_b, segments_a, owners_a, contact%scale_a, &
+                          .false.)
+          state%passes(2)%side_sign = -1.0_wp
+        end if
+      case (contact_single_surface)
+        call surface_node_list(segments_a, is_particle, nodes)
+        state%pass_count = 1
+        call build_pass(state%passes(1), nodes, segments_a, owners_a, segments_a, owners_a, contact%scale_a, .true.)
+      end select
+    end associate
   contains
+    subroutine find_lost_nodes()
+      logical, allocatable :: had(:), kept(:)
+      integer :: element
+      allocate (had(size(model%node_ids)), kept(size(model%node_ids)))
+      had = .false.
+      kept = .false.
+      do element = 1, size(model%solid_part)
+        had(model%solid_nodes(:, element)) = .true.
+        if (.not. solid_eroded(element)) kept(model%solid_nodes(:, element)) = .true.
+      end do
+      do element = 1, size(model%shell_part)
+        had(model%shell_nodes(:, element)) = .true.
+        if (.not. shell_eroded(element)) kept(model%shell_nodes(:, element)) = .true.
+      end do
+      node_lost = had .and. .not. kept
+    end subroutine find_lost_nodes
+
     !> Segments (outward) and owning solids of one side.
     subroutine side_segments(side, segments, owners)
       type(contact_surface_t), intent(in) :: side
       integer, allocatable, intent(out) :: segments(:, :), owners(:)
       integer :: count, p, s
+      integer, allocatable :: solid_part(:), shell_part(:)
+      logical, allocatable :: keep(:)
       character(len=160) :: text
       count = 0
       select case (side%kind)
@@ -163,11 +217,27 @@ contains
           call make_error(error, trim(text))
           return
         end do
+        ! segments of eroded elements leave (a segment set is the user's list: nothing joins it)
+        allocate (keep(size(owners)))
+        do s = 1, size(owners)
+          if (owners(s) > 0) then
+            keep(s) = .not. solid_eroded(owners(s))
+          else
+            keep(s) = .not. shell_eroded(-owners(s))
+          end if
+        end do
+        if (.not. all(keep)) then
+          owners = pack(owners, keep)
+          segments = reshape(pack(segments, spread(keep, 1, 4)), [4, size(owners)])
+        end if
       case default
+        ! eroded elements are left out of their part: the faces they covered become exterior
+        solid_part = merge(0, model%solid_part, solid_eroded)
+        shell_part = merge(0, model%shell_part, shell_eroded)
         do p = 1, size(side%parts)
-          call append_exterior_faces(model%solid_nodes, model%solid_part, side%parts(p), size(model%node_ids), &
+          call append_exterior_faces(model%solid_nodes, solid_part, side%parts(p), size(model%node_ids), &
                                      segments, owners, count)
-          call append_part_shells(model%shell_nodes, model%shell_part, side%parts(p), segments, owners, count)
+          call append_part_shells(model%shell_nodes, shell_part, side%parts(p), segments, owners, count)
         end do
         if (.not. allocated(segments)) allocate (segments(4, 0), owners(0))
         segments = segments(:, 1:count)
@@ -187,7 +257,8 @@ contains
       logical, intent(in) :: single
       integer :: s, j, n, position
       integer, allocatable :: slot(:), fill(:)
-      real(wp) :: bulk, volume, normal(3), longest
+      real(wp) :: bulk, volume, normal(3)
+      real(wp), allocatable :: segment_size(:)
       logical, allocatable :: used(:)
       pass%single = single
       pass%node_count = size(secondary_nodes)
@@ -195,8 +266,7 @@ contains
       pass%nodes = secondary_nodes
       pass%segments = primary
       allocate (pass%stiffness(pass%segment_count), pass%depth(pass%segment_count), pass%area(pass%segment_count), &
-                pass%segment_offset(pass%segment_count))
-      longest = 0.0_wp
+                pass%segment_offset(pass%segment_count), segment_size(pass%segment_count))
       do s = 1, pass%segment_count
         associate (x => model%coordinates(:, primary(:, s)), owner => owners(s))
           associate (material => model%materials(model%parts(owner_part(owner))%material))
@@ -214,12 +284,16 @@ contains
             pass%segment_offset(s) = 0.5_wp*shell_thickness(-owner)
             pass%depth(s) = pass%segment_offset(s)
           end if
+          segment_size(s) = 0.0_wp
           do j = 1, 4
-            longest = max(longest, norm2(x(:, mod(j, 4) + 1) - x(:, j)))
+            segment_size(s) = max(segment_size(s), norm2(x(:, mod(j, 4) + 1) - x(:, j)))
           end do
         end associate
       end do
-      pass%margin = 0.5_wp*longest
+      ! the margin is the motion allowed between rebuilds: half the median segment, not the
+      ! largest (half a 700 mm panel would give every node of a fine mesh nearby hundreds of
+      ! candidates to test every cycle)
+      pass%margin = 0.5_wp*median(segment_size)
       ! node normals: sum of the area vectors of the secondary solid faces at each node; a node
       ! of a (two-sided) shell has none, and its offset is half its thickest shell
       allocate (slot(size(model%node_ids)))
@@ -257,6 +331,11 @@ contains
       end do
       deallocate (used)
       if (pass%node_count > 0) pass%largest_node_offset = maxval(pass%node_offset)
+      ! bucket edge: the median grown box, so that a typical box spans one or two cells
+      do s = 1, pass%segment_count
+        segment_size(s) = segment_size(s) + 2.0_wp*(pass%margin + pass%depth(s) + pass%largest_node_offset)
+      end do
+      pass%cell_size = median(segment_size)
       if (single) then
         ! node -> own segments (CSR)
         allocate (pass%own_first(pass%node_count + 1))
@@ -325,7 +404,7 @@ contains
         shell_thickness = 0.25_wp*sum(model%shell_thickness(:, shell))
       end if
     end function shell_thickness
-  end subroutine set_up_contacts
+  end subroutine set_up_contact
 
   !> Contact forces of every contact at the current configuration (added into
   !> `contact_force`, which is zeroed first) and the contact energy increment: minus the work
@@ -369,7 +448,9 @@ contains
               pass%tangential = 0.0_wp
               cycle
             end if
-            call update_search(pass, coordinates, contact%bucket_interval)
+            ! BSORT of the contact, else NSBCS of *CONTROL_CONTACT, else only when nodes moved
+            call update_search(pass, coordinates, merge(contact%bucket_interval, model%contact_sort_interval, &
+                                                        contact%bucket_interval > 0))
             call pair_forces(contact, pass, step, coordinates, velocity, mass)
             ! serial, in pair order: the same sums for any thread count
             total = 0.0_wp
@@ -470,12 +551,15 @@ contains
     call build_candidates(pass, coordinates)
   end subroutine update_search
 
-  !> Bucket sort: segment boxes (grown by the margin and the contact depth) into a uniform
-  !> grid of about as many cells as segments, then each node's candidates from its cell.
+  !> Bucket sort: segment boxes (grown by the margin, the contact depth and the parametric
+  !> tolerance) into a uniform grid with cells of the median box (at most about two cells per
+  !> segment), each segment in every cell its box covers; then each node's candidates from its
+  !> cell. A node within reach of a segment now (pair_forces' test) was within its grown box at
+  !> the build, as long as no node has moved half the margin since.
   subroutine build_candidates(pass, coordinates)
     type(contact_pass_t), intent(inout) :: pass
     real(wp), intent(in) :: coordinates(:, :)
-    real(wp) :: low(3), high(3), cell, extent(3)
+    real(wp) :: low(3), high(3), cell, extent(3), grow
     integer :: dims(3), s, i, c, total, lo(3), hi(3), ix, iy, iz, cell_count, own
     integer, allocatable :: counts(:)
     pass%built = .true.
@@ -488,24 +572,29 @@ contains
       pass%candidate_first = 1
       return
     end if
-    cell = 0.0_wp
     do s = 1, pass%segment_count
       associate (x => coordinates(:, pass%segments(:, s)))
-        pass%box(1:3, s) = minval(x, dim=2) - (pass%margin + pass%depth(s) + pass%largest_node_offset)
-        pass%box(4:6, s) = maxval(x, dim=2) + (pass%margin + pass%depth(s) + pass%largest_node_offset)
+        pass%box(1:3, s) = minval(x, dim=2)
+        pass%box(4:6, s) = maxval(x, dim=2)
       end associate
-      cell = max(cell, maxval(pass%box(4:6, s) - pass%box(1:3, s)))
+      ! pair_forces reaches the node offset, the depth and the parametric tolerance of the
+      ! segment's current extent (which may grow by the margin before the next build)
+      grow = pass%margin + pass%depth(s) + pass%largest_node_offset + &
+             (parametric_limit - 1.0_wp)*(maxval(pass%box(4:6, s) - pass%box(1:3, s)) + pass%margin)
+      pass%box(1:3, s) = pass%box(1:3, s) - grow
+      pass%box(4:6, s) = pass%box(4:6, s) + grow
     end do
     low = minval(pass%box(1:3, :), dim=2)
     high = maxval(pass%box(4:6, :), dim=2)
     extent = high - low
+    cell = max(pass%cell_size, tiny(1.0_wp))
     do
       dims = max(1, ceiling(extent/cell))
       if (real(dims(1), wp)*dims(2)*dims(3) <= 2.0_wp*pass%segment_count + 8.0_wp) exit
       cell = 1.26_wp*cell
     end do
     cell_count = dims(1)*dims(2)*dims(3)
-    ! segments into cells (each box spans at most two cells per direction)
+    ! segments into cells (a large segment into every cell its box covers)
     if (size(pass%cell_first) < cell_count + 1) then
       deallocate (pass%cell_first)
       allocate (pass%cell_first(cell_count + 1))
@@ -851,6 +940,49 @@ contains
                     (1.0_wp - s)*corners(:, 4))
     end subroutine bilinear
   end subroutine project_on_segment
+
+  !> Median of `values` (the upper one of an even count; 0 for none), by quickselect on a
+  !> copy: linear time on average, used at set-up only.
+  pure real(wp) function median(values)
+    real(wp), intent(in) :: values(:)
+    real(wp), allocatable :: work(:)
+    real(wp) :: pivot, swap
+    integer :: left, right, i, j, target
+    median = 0.0_wp
+    if (size(values) == 0) return
+    work = values
+    target = size(work)/2 + 1
+    left = 1
+    right = size(work)
+    do while (left < right)
+      pivot = work((left + right)/2)
+      i = left
+      j = right
+      do while (i <= j)
+        do while (work(i) < pivot)
+          i = i + 1
+        end do
+        do while (work(j) > pivot)
+          j = j - 1
+        end do
+        if (i <= j) then
+          swap = work(i)
+          work(i) = work(j)
+          work(j) = swap
+          i = i + 1
+          j = j - 1
+        end if
+      end do
+      if (target <= j) then
+        right = j
+      else if (target >= i) then
+        left = i
+      else
+        exit
+      end if
+    end do
+    median = work(target)
+  end function median
 
   pure function cross(a, b) result(c)
     real(wp), intent(in) :: a(3), b(3)

@@ -1,8 +1,9 @@
 !> The command line in the style LS-DYNA users know: `crashfree i=deck.k ncpu=2 ...`.
 !>
-!> LS-DYNA's own arguments that have no meaning here (memory=, d=nodump, o=, ...) are accepted
-!> and listed as notes, so that a command line copied from an LS-DYNA job runs; a bare deck
-!> name as the first argument (`crashfree deck.k`) is the deck, as LS-DYNA takes it.
+!> LS-DYNA's own arguments that have no meaning here (memory=, d=nodump, s=, o=, ...) are
+!> accepted and listed as notes, so that a command line copied from an LS-DYNA job runs; a bare
+!> deck name as the first argument (`crashfree deck.k`) is the deck, as LS-DYNA takes it (also
+!> with a note, so that a mistyped key is not silently taken for a deck).
 module command_line
   use error_handling, only: error_t, error_list_t, make_error, add_error
   implicit none
@@ -73,6 +74,8 @@ contains
         if (argument(1:1) /= "-") then
           options%deck = argument
           bare_deck = .true.
+          call add_error(options%notes, argument//": read as the input deck (i="//argument// &
+                         "), as LS-DYNA takes a first argument without '='")
           cycle
         end if
       end if
@@ -152,6 +155,8 @@ contains
     select case (key)
     case ("memory", "memory2")
       note = "crashfree sizes its memory from the model"
+    case ("s")
+      note = "LS-DYNA's interface segment save file; crashfree writes none"
     case ("d")
       note = "crashfree writes no dump at the end of a run; restart dumps come from *DATABASE_BINARY_D3DUMP, "// &
              "_RUNRSF and the sense switches (SIGTERM, SIGUSR1)"
@@ -185,8 +190,9 @@ contains
            "                  deck is read again from its recorded path (or i=) and must be unchanged;"//nl// &
            "                  results go on in the run's DIR/JOBID.h5 (default: the dump's directory"//nl// &
            "                  and job)"//nl// &
-           "  --ignore-unknown  warn about unknown keywords instead of stopping"//nl// &
-           "  memory= memory2= d=nodump o= g= ncycle= pfile=   LS-DYNA's: accepted, not used"//nl//nl// &
+           "  --ignore-unknown  warn about unknown keywords and skip them instead of stopping (a"//nl// &
+           "                  keyword crashfree reads, with an option it lacks, still stops)"//nl// &
+           "  memory= memory2= d=nodump s= o= g= ncycle= pfile=   LS-DYNA's: accepted, not used"//nl//nl// &
            "Results: DIR/results.h5 (HDF5, see README) and DIR/results.xdmf for ParaView."//nl// &
            "Signals: SIGINT/SIGTERM stop after the cycle with a restart dump, SIGUSR1 writes a dump"//nl// &
            "and goes on, SIGUSR2 prints the progress line."//nl// &

@@ -233,7 +233,8 @@ contains
   end function allowed_text
 
   !> *CONTROL_CONTACT card 1: SLSFAC is used; the options that change LS-DYNA's behaviour but
-  !> are not available give warnings. Further cards are read over.
+  !> are not available give warnings. Card 2: NSBCS (bucket sort interval of contacts whose
+  !> BSORT is 0). Further cards are read over.
   subroutine read_control_contact(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
@@ -258,6 +259,16 @@ contains
     if (scale < 0.0_wp) call card_problem(deck, log, card, "SLSFAC", "must be >= 0, found "// &
                                           real_text(scale))
     if (scale > 0.0_wp) input%model%contact_penalty_scale = scale
+    ! card 2: USRSTR USRFRC NSBCS INTERM XPENE SSTHK ECDT TIEDPRJ; only NSBCS is used
+    if (.not. next_line(deck, block, line, .false.)) return
+    call open_card(deck, block, line, standard_widths, card, log)
+    call get_integer(deck, card, 3, "NSBCS", value, log)
+    if (card%failed) return
+    if (value < 0) then
+      call card_problem(deck, log, card, "NSBCS", "must be >= 0 (0: automatic), found "//integer_text(value))
+      return
+    end if
+    input%model%contact_sort_interval = value
   end subroutine read_control_contact
 
   !> *DATABASE_RCFORC: DT BINARY LCUR IOOPT, as the other history databases.

@@ -7,7 +7,8 @@ module deck_controls
   use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t
   use deck_fields, only: card_t, next_line, require_card, get_integer, get_real, &
-                         card_problem, warn_if_set, line_title, located_warning
+                         card_problem, warn_if_set, line_title, located_warning, &
+                         note_not_acted_upon, keyword_label
   use deck_input, only: deck_input_t
   use deck_keywords, only: keyword_t
   implicit none
@@ -15,7 +16,7 @@ module deck_controls
 
   public :: read_title, read_termination, read_time_step, read_hourglass_control
   public :: read_bulk_viscosity, read_energy_control, read_implicit_general
-  public :: read_implicit_solution
+  public :: read_implicit_solution, read_unused_control, read_sensor_definition
 
   integer, parameter :: standard_widths(8) = 10
 
@@ -162,7 +163,8 @@ contains
   end subroutine read_bulk_viscosity
 
   !> *CONTROL_ENERGY: HGEN RWEN SLNTEN RYLEN ...; 1 = not in the energy balance, 2 = in it.
-  !> HGEN and RWEN are used; the others concern features crashfree does not have.
+  !> HGEN and RWEN are used; the others concern features crashfree does not have, or what it
+  !> always does (a warning names each one set).
   subroutine read_energy_control(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
@@ -184,6 +186,15 @@ contains
       "computed) or 2 (in the energy balance), found "//integer_text(wall))
     input%model%hourglass_energy_in_balance = hourglass == 2
     input%model%wall_energy_in_balance = wall /= 1
+    call warn_if_set(deck, card, 3, "SLNTEN", "contact energy is always computed and in the "// &
+                     "energy balance", warnings)
+    call warn_if_set(deck, card, 4, "RYLEN", "no Rayleigh damping, so no damping energy", warnings)
+    call warn_if_set(deck, card, 5, "IRGEN", "no initial reference geometry", warnings)
+    call warn_if_set(deck, card, 6, "MATEN", "matsum always holds each part's internal, "// &
+                     "hourglass and kinetic energy", warnings)
+    call warn_if_set(deck, card, 7, "DRLEN", "no dynamic relaxation", warnings)
+    call warn_if_set(deck, card, 8, "DISEN", "no damping, so no dissipated damping energy", &
+                     warnings)
   end subroutine read_energy_control
 
   !> *CONTROL_IMPLICIT_GENERAL: IMFLAG DT0 IMFORM NSBS IGS CNSTN FORM ZERO_V. IMFLAG 0 (blank)
@@ -282,4 +293,70 @@ contains
     end do
     input%implicit_solution_line = line
   end subroutine read_implicit_solution
+  !> *CONTROL_ keywords a vehicle deck commonly has that only set LS-DYNA's own bookkeeping,
+  !> or options of formulations crashfree does not have: read (every card), not acted upon;
+  !> the warning names the fields the deck sets.
+  subroutine read_unused_control(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    character(len=:), allocatable :: name
+    name = keyword_label(deck, block)
+    if (index(name, "CONTROL_PARALLEL") == 1) then
+      call note_not_acted_upon(deck, block, [character(len=40) :: "NCPU NUMRHS CONST PARA"], &
+        "threads are set with ncpu= on the command line; results are the same for any "// &
+        "thread count, which is what CONST asks for", warnings)
+    else if (index(name, "CONTROL_OUTPUT") == 1) then
+      call note_not_acted_upon(deck, block, [character(len=60) :: &
+        "NPOPT NEECHO NREFUP IACCOP OPIFS IPNINT IKEDIT IFLUSH", &
+        "IPRTF IERODE TET10S8 MSGMAX IPCURV GMDT IP1DBLT EOCS", &
+        "TOLEV NEWLEG FRFREQ MINFO SOLSIG MSGFLG CDETOL"], &
+        "it controls LS-DYNA's printed output files (d3hsp, messag); crashfree reports on "// &
+        "standard output and writes results.h5", warnings)
+    else if (index(name, "CONTROL_CPU") == 1) then
+      call note_not_acted_upon(deck, block, [character(len=40) :: "CPUTIM IGLST"], &
+        "no CPU-time limit; stop a run with SIGTERM, which writes a restart dump", warnings)
+    else if (index(name, "CONTROL_SHELL") == 1) then
+      call note_not_acted_upon(deck, block, [character(len=60) :: &
+        "WRPANG ESORT IRNXX ISTUPD THEORY BWC MITER PROJ", &
+        "ROTASCL INTGRD LAMSHT CSTYP6 THSHEL", &
+        "PSSTUPD SIDT4TU CNTCO ITSFLG IRQUAD W-MODE STRETCH ICRQ", &
+        "NFAIL1 NFAIL4 PSNFAIL KEEPCS DELFR DRCPSID DRCPRM INTPERR"], &
+        "crashfree's shell is the Belytschko-Tsay shell of *SECTION_SHELL ELFORM 2, with "// &
+        "constant thickness and Gauss points through it; the global shell options do not "// &
+        "change it", warnings)
+    else if (index(name, "CONTROL_SOLID") == 1) then
+      call note_not_acted_upon(deck, block, [character(len=60) :: &
+        "ESORT FMATRX NIPTETS SWLOCL PSFAIL T10JTOL ICOH TET13K"], &
+        "solids take their formulation from *SECTION_SOLID ELFORM; degenerate elements are "// &
+        "not sorted into other formulations", warnings)
+    else if (index(name, "CONTROL_ACCURACY") == 1) then
+      call note_not_acted_upon(deck, block, [character(len=40) :: "OSU INN PIDOSU IACC EXACC"], &
+        "stresses are rotated objectively in every cycle and results do not depend on the "// &
+        "node numbering", warnings)
+    else if (index(name, "CONTROL_MPP_") == 1) then
+      call note_not_acted_upon(deck, block, [character(len=1) :: ], "it sets up LS-DYNA's MPP "// &
+        "domain decomposition and files; crashfree runs one process on OpenMP threads", warnings)
+    else
+      call note_not_acted_upon(deck, block, [character(len=1) :: ], "crashfree has no use "// &
+        "for it", warnings)
+    end if
+  end subroutine read_unused_control
+
+  !> *SENSOR_DEFINE_...: read (all of its cards), not acted upon: crashfree reads nothing that
+  !> a sensor could switch (*SENSOR_CONTROL and *SENSOR_SWITCH are not read, and a deck
+  !> holding them is refused as unknown keywords).
+  subroutine read_sensor_definition(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call note_not_acted_upon(deck, block, [character(len=1) :: ], "nothing in the deck uses "// &
+      "the sensor: crashfree reads no keyword that a sensor switches", warnings)
+  end subroutine read_sensor_definition
 end module deck_controls

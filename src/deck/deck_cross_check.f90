@@ -6,14 +6,18 @@ module deck_cross_check
   use error_handling, only: error_list_t, add_error
   use model, only: model_t, spc_t, prescribed_motion_t, nodal_load_t, segment_load_t, &
                    rigid_wall_t, formulation_fe, formulation_efg, boundary_full_transformation, &
-                   integration_gauss_conventional
+                   integration_gauss_conventional, local_spc_t, motion_along_vector, &
+                   motion_only_along_vector
   use deck_problems, only: problem_log_t, report_problem, has_problems
   use deck_numbers, only: digit
   use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t, line_location
   use deck_fields, only: located_problem, located_warning
   use deck_input, only: deck_input_t, set_input_t, velocity_input_t, velocity_by_set, &
-                        velocity_by_node, velocity_generation
+                        velocity_by_node, velocity_generation, set_general, set_added, &
+                        general_all, general_node, general_part, general_box, &
+                        general_remove_node, general_remove_part, general_remove_box
+  use deck_boxes_frames, only: resolve_frames, frame_axes, vector_direction, mark_nodes_in_box
   use deck_segments, only: segment_has_no_area
   use deck_id_index, only: id_index_t, build_id_index, find_id, lower_bound
   use deck_element_check, only: check_hexahedron, shape_inside_out, shape_flat
@@ -36,6 +40,11 @@ module deck_cross_check
   end type deck_indices_t
 
   character(len=1), parameter :: axis_names(3) = ["x", "y", "z"]
+
+  !> The members (node or part indices) of one set while sets of sets are resolved.
+  type :: member_list_t
+    integer, allocatable :: items(:)
+  end type member_list_t
 
 contains
 
@@ -60,6 +69,7 @@ contains
     call build_shell_thickness(deck, input, log)
     call check_static_shells(deck, input, log)
     call resolve_material_curves(deck, input%model, input%material_lines, input%part_lines, log)
+    call resolve_frames(deck, input, indices%nodes, log)
     call resolve_node_sets(deck, input, indices, log)
     call resolve_part_sets(deck, input, indices, log)
     call resolve_segment_sets(deck, input, indices, log)
@@ -68,6 +78,8 @@ contains
     call build_loads(deck, input, indices, log)
     call build_segment_loads(deck, input, indices, log)
     call build_initial_velocities(deck, input, indices, log)
+    call hold_local_initial_velocities(input)
+    call check_static_conditions(deck, input, log)
     call build_walls(deck, input, indices, log)
     call build_rigid_bodies(deck, input, log)
     call build_contacts(deck, input, log)
@@ -325,49 +337,218 @@ contains
     end do
   end subroutine resolve_parts
 
-  !> Node set members (ids or ranges) to node indices, each node once.
+  !> Node set members (ids, ranges or *SET_NODE_GENERAL operations) to node indices, each node
+  !> once; then the sets of sets (*SET_NODE_ADD), whatever their order in the deck.
   subroutine resolve_node_sets(deck, input, indices, log)
     type(deck_t), intent(in) :: deck
     type(deck_input_t), intent(inout) :: input
     type(deck_indices_t), intent(in) :: indices
     type(problem_log_t), intent(inout) :: log
     integer, allocatable :: seen(:), members(:)
+    type(member_list_t), allocatable :: lists(:)
     integer :: set, count
-    allocate (seen(input%node_count), input%model%node_sets(input%node_set_count))
+    allocate (seen(input%node_count), input%model%node_sets(input%node_set_count), &
+              lists(input%node_set_count))
     seen = 0
     do set = 1, input%node_set_count
       associate (given => input%node_sets(set))
-        if (given%generated) then
-          call generate_members(deck, given, indices%nodes, set, seen, members, count, log)
+        input%model%node_sets(set)%id = given%id
+        input%model%node_sets(set)%title = given%title
+        if (given%kind == set_added) cycle
+        if (given%kind == set_general) then
+          call general_members(deck, input, indices, given, members, count, log)
+        else if (given%generated) then
+          call generate_members(deck, given, indices%nodes, "node", set, seen, members, count, log)
         else
           call list_members(deck, given, indices%nodes, "node", set, seen, members, count, log)
         end if
-        input%model%node_sets(set)%id = given%id
-        input%model%node_sets(set)%title = given%title
-        input%model%node_sets(set)%nodes = members(1:count)
+        lists(set)%items = members(1:count)
       end associate
+    end do
+    call resolve_added_sets(deck, input%node_sets(1:input%node_set_count), indices%node_sets, &
+                            input%node_count, "node", lists, log)
+    do set = 1, input%node_set_count
+      input%model%node_sets(set)%nodes = lists(set)%items
     end do
   end subroutine resolve_node_sets
 
-  !> Part set members to part indices, each part once.
+  !> Part set members (ids or ranges) to part indices, each part once; then the sets of sets
+  !> (*SET_PART_ADD).
   subroutine resolve_part_sets(deck, input, indices, log)
     type(deck_t), intent(in) :: deck
     type(deck_input_t), intent(inout) :: input
     type(deck_indices_t), intent(in) :: indices
     type(problem_log_t), intent(inout) :: log
     integer, allocatable :: seen(:), members(:)
+    type(member_list_t), allocatable :: lists(:)
     integer :: set, count
-    allocate (seen(input%part_count), input%model%part_sets(input%part_set_count))
+    allocate (seen(input%part_count), input%model%part_sets(input%part_set_count), &
+              lists(input%part_set_count))
     seen = 0
     do set = 1, input%part_set_count
       associate (given => input%part_sets(set))
-        call list_members(deck, given, indices%parts, "part", set, seen, members, count, log)
         input%model%part_sets(set)%id = given%id
         input%model%part_sets(set)%title = given%title
-        input%model%part_sets(set)%parts = members(1:count)
+        if (given%kind == set_added) cycle
+        if (given%generated) then
+          call generate_members(deck, given, indices%parts, "part", set, seen, members, count, log)
+        else
+          call list_members(deck, given, indices%parts, "part", set, seen, members, count, log)
+        end if
+        lists(set)%items = members(1:count)
       end associate
     end do
+    call resolve_added_sets(deck, input%part_sets(1:input%part_set_count), indices%part_sets, &
+                            input%part_count, "part", lists, log)
+    do set = 1, input%part_set_count
+      input%model%part_sets(set)%parts = lists(set)%items
+    end do
   end subroutine resolve_part_sets
+
+  !> Sets of sets (kind set_added): the union of their sets' members in the order listed, each
+  !> item once. A set is resolved once all its sets are, so the deck order does not matter;
+  !> sets left over form a loop (a set that contains itself) and are reported.
+  subroutine resolve_added_sets(deck, sets, set_index, item_count, noun, lists, log)
+    type(deck_t), intent(in) :: deck
+    type(set_input_t), intent(in) :: sets(:)
+    type(id_index_t), intent(in) :: set_index
+    integer, intent(in) :: item_count
+    character(len=*), intent(in) :: noun
+    type(member_list_t), intent(inout) :: lists(:)
+    type(problem_log_t), intent(inout) :: log
+    logical, allocatable :: done(:)
+    integer, allocatable :: seen(:), members(:)
+    integer :: k, j, position, count, item
+    logical :: progress, ready
+
+    allocate (done(size(sets)), seen(item_count), members(item_count))
+    done = sets%kind /= set_added
+    seen = 0
+    ! undefined sets, reported once
+    do k = 1, size(sets)
+      if (done(k)) cycle
+      do j = 1, sets(k)%members%count
+        if (find_id(set_index, sets(k)%members%ids(j)) == 0) call located_problem(deck, log, &
+          sets(k)%members%lines(j), "DSID"//integer_text(sets(k)%members%fields(j)), noun// &
+          " set "//integer_text(sets(k)%members%ids(j))//" of set "//integer_text(sets(k)%id)// &
+          " is not defined")
+      end do
+    end do
+    progress = .true.
+    do while (progress)
+      progress = .false.
+      do k = 1, size(sets)
+        if (done(k)) cycle
+        ready = .true.
+        do j = 1, sets(k)%members%count
+          position = find_id(set_index, sets(k)%members%ids(j))
+          if (position > 0) ready = ready .and. done(position)
+        end do
+        if (.not. ready) cycle
+        count = 0
+        do j = 1, sets(k)%members%count
+          position = find_id(set_index, sets(k)%members%ids(j))
+          if (position == 0) cycle
+          do item = 1, size(lists(position)%items)
+            if (seen(lists(position)%items(item)) == k) cycle
+            seen(lists(position)%items(item)) = k
+            count = count + 1
+            members(count) = lists(position)%items(item)
+          end do
+        end do
+        lists(k)%items = members(1:count)
+        done(k) = .true.
+        progress = .true.
+      end do
+    end do
+    do k = 1, size(sets)
+      if (done(k)) cycle
+      call located_problem(deck, log, sets(k)%line, "SID", noun//" set "// &
+        integer_text(sets(k)%id)//" contains itself through its sets (a loop of *SET_"// &
+        trim(merge("NODE", "PART", noun == "node"))//"_ADD)")
+      allocate (lists(k)%items(0))
+    end do
+  end subroutine resolve_added_sets
+
+  !> *SET_NODE_GENERAL: the operations in deck order on a mask of the nodes; members in node
+  !> order.
+  subroutine general_members(deck, input, indices, given, members, count, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(in) :: input
+    type(deck_indices_t), intent(in) :: indices
+    type(set_input_t), intent(in) :: given
+    integer, allocatable, intent(out) :: members(:)
+    integer, intent(out) :: count
+    type(problem_log_t), intent(inout) :: log
+    logical, allocatable :: chosen(:)
+    integer :: operation, first, j, position, k
+    logical :: add
+    character(len=:), allocatable :: field
+
+    allocate (chosen(input%node_count))
+    chosen = .false.
+    first = 0
+    do operation = 1, given%operations%count
+      add = given%operations%ids(operation) <= general_box
+      if (given%operations%ids(operation) == general_all) chosen = .true.
+      do j = first + 1, first + given%operations%fields(operation)
+        field = "E"//integer_text(given%members%fields(j) - 1)
+        select case (given%operations%ids(operation))
+        case (general_node, general_remove_node)
+          position = find_id(indices%nodes, given%members%ids(j))
+          if (position == 0) then
+            call located_problem(deck, log, given%members%lines(j), field, "node "// &
+              integer_text(given%members%ids(j))//" of set "//integer_text(given%id)// &
+              " is not defined")
+          else
+            chosen(position) = add
+          end if
+        case (general_part, general_remove_part)
+          position = find_id(indices%parts, given%members%ids(j))
+          if (position == 0) then
+            call located_problem(deck, log, given%members%lines(j), field, "part "// &
+              integer_text(given%members%ids(j))//" of set "//integer_text(given%id)// &
+              " is not defined")
+          else
+            call mark_part_nodes(input, position, add, chosen)
+          end if
+        case (general_box, general_remove_box)
+          if (.not. mark_nodes_in_box(deck, input, given%members%ids(j), &
+                                      given%members%lines(j), field, add, chosen, log)) cycle
+        end select
+      end do
+      first = first + given%operations%fields(operation)
+    end do
+    members = pack([(k, k=1, input%node_count)], chosen)
+    count = size(members)
+  end subroutine general_members
+
+  !> Set `chosen` to `value` on the nodes of the solids, shells and beams of part `part` (an index).
+  subroutine mark_part_nodes(input, part, value, chosen)
+    type(deck_input_t), intent(in) :: input
+    integer, intent(in) :: part
+    logical, intent(in) :: value
+    logical, intent(inout) :: chosen(:)
+    integer :: element, k
+    do element = 1, input%solid_count
+      if (input%model%solid_part(element) /= part) cycle
+      do k = 1, 8
+        if (input%model%solid_nodes(k, element) > 0) chosen(input%model%solid_nodes(k, element)) = value
+      end do
+    end do
+    do element = 1, input%shell_count
+      if (input%model%shell_part(element) /= part) cycle
+      do k = 1, 4
+        if (input%model%shell_nodes(k, element) > 0) chosen(input%model%shell_nodes(k, element)) = value
+      end do
+    end do
+    do element = 1, input%beam_count
+      if (input%model%beam_part(element) /= part) cycle
+      do k = 1, 2
+        if (input%model%beam_nodes(k, element) > 0) chosen(input%model%beam_nodes(k, element)) = value
+      end do
+    end do
+  end subroutine mark_part_nodes
 
   !> Segment set node ids to node indices. A segment with an undefined node or without area
   !> is reported at its line and marked unusable, so that loads on the set skip it.
@@ -451,12 +632,13 @@ contains
     end do
   end subroutine list_members
 
-  !> Ranges of a generated node set: every defined node with an id in a range (LS-DYNA
-  !> numbering may have gaps); a range that holds no node at all is an error.
-  subroutine generate_members(deck, given, index, stamp, seen, members, count, log)
+  !> Ranges of a generated node (`noun` "node") or part set: every defined node (part) with an
+  !> id in a range (LS-DYNA numbering may have gaps); a range that holds none is an error.
+  subroutine generate_members(deck, given, index, noun, stamp, seen, members, count, log)
     type(deck_t), intent(in) :: deck
     type(set_input_t), intent(in) :: given
     type(id_index_t), intent(in) :: index
+    character(len=*), intent(in) :: noun
     integer, intent(in) :: stamp
     integer, intent(inout) :: seen(:)
     integer, allocatable, intent(out) :: members(:)
@@ -478,7 +660,8 @@ contains
         members(count) = index%positions(k)
       end do
       if (found == 0) call located_problem(deck, log, given%members%lines(2*range - 1), &
-        "B"//integer_text((given%members%fields(2*range - 1) + 1)/2)//"BEG", "no node has an "// &
+        trim(merge("B", "P", noun == "node"))//integer_text((given%members%fields(2*range - 1) + 1)/2)// &
+        "BEG", "no "//noun//" has an "// &
         "id in "//integer_text(first)//"-"//integer_text(last)//" (set "// &
         integer_text(given%id)//")")
     end do
@@ -552,8 +735,10 @@ contains
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
     logical, allocatable :: fixed(:, :), on_shell(:)
-    integer, allocatable :: nodes(:)
-    integer :: k, node, constrained, first, others
+    integer, allocatable :: nodes(:), local_count(:)
+    real(wp), allocatable :: local_directions(:, :, :)
+    real(wp) :: axes(3, 3)
+    integer :: k, node, constrained, first, others, j
     character(len=:), allocatable :: more
     ! TC and RC codes: 1 x, 2 y, 3 z, 4 xy, 5 yz, 6 zx, 7 xyz
     logical, parameter :: by_code(3, 0:7) = reshape([.false., .false., .false., &
@@ -597,10 +782,28 @@ contains
         integer_text(input%model%node_ids(first))//", which belongs to no shell ("// &
         no_rotations//")"//more)
     end if
+    ! directions held in local systems (CID), per node: allocated only when a CID is given
+    if (any(input%spcs(1:input%spc_count)%frame_id /= 0)) then
+      allocate (local_count(input%node_count), local_directions(3, 3, input%node_count))
+    else
+      allocate (local_count(0), local_directions(3, 3, 0))
+    end if
+    local_count = 0
     do k = 1, input%spc_count
       associate (spc => input%spcs(k))
         if (.not. target_nodes(deck, input, indices, spc%target, spc%is_set, spc%line, nodes, &
                                log)) cycle
+        if (spc%frame_id /= 0) then
+          ! the reader has refused rotations with a CID
+          if (.not. frame_axes(deck, input, spc%frame_id, spc%line, "CID", axes, log)) cycle
+          do node = 1, size(nodes)
+            do j = 1, 3
+              if (spc%fixed(j)) call add_direction(axes(:, j), local_count(nodes(node)), &
+                                                   local_directions(:, :, nodes(node)))
+            end do
+          end do
+          cycle
+        end if
         do node = 1, size(nodes)
           fixed(1:3, nodes(node)) = fixed(1:3, nodes(node)) .or. spc%fixed
           fixed(4:6, nodes(node)) = fixed(4:6, nodes(node)) .or. spc%fixed_rotation
@@ -624,6 +827,7 @@ contains
     do node = 1, input%node_count
       if (.not. on_shell(node)) fixed(4:6, node) = .false.
     end do
+    call build_local_spcs(fixed, local_count, local_directions, input)
     allocate (input%model%spcs(count(any(fixed, dim=1))))
     constrained = 0
     do node = 1, input%node_count
@@ -634,8 +838,94 @@ contains
     end do
   end subroutine build_constraints
 
+  !> Add unit vector `direction` to the `count` orthonormal `directions` (Gram-Schmidt), unless
+  !> it lies in their span already (relative tolerance 1e-9).
+  pure subroutine add_direction(direction, count, directions)
+    real(wp), intent(in) :: direction(3)
+    integer, intent(inout) :: count
+    real(wp), intent(inout) :: directions(3, 3)
+    real(wp) :: rest(3)
+    integer :: k
+    rest = direction
+    do k = 1, count
+      rest = rest - dot_product(rest, directions(:, k))*directions(:, k)
+    end do
+    if (norm2(rest) <= 1.0e-9_wp .or. count == 3) return
+    count = count + 1
+    directions(:, count) = rest/norm2(rest)
+  end subroutine add_direction
+
+  !> model%local_spcs from the local directions of each node, with the node's global SPC axes
+  !> put first; a node held in three independent directions is simply fixed in x, y and z.
+  subroutine build_local_spcs(fixed, local_count, local_directions, input)
+    logical, intent(inout) :: fixed(:, :)
+    integer, intent(in) :: local_count(:)
+    real(wp), intent(in) :: local_directions(:, :, :)
+    type(deck_input_t), intent(inout) :: input
+    type(local_spc_t), allocatable :: spcs(:)
+    real(wp) :: unit(3, 3)
+    integer :: node, j, held
+    unit = 0.0_wp
+    do j = 1, 3
+      unit(j, j) = 1.0_wp
+    end do
+    allocate (spcs(count(local_count > 0)))
+    held = 0
+    do node = 1, size(local_count)
+      if (local_count(node) == 0) cycle
+      held = held + 1
+      spcs(held) = local_spc_t(node=node)
+      do j = 1, 3
+        if (fixed(j, node)) call add_direction(unit(:, j), spcs(held)%count, spcs(held)%directions)
+      end do
+      do j = 1, local_count(node)
+        call add_direction(local_directions(:, j, node), spcs(held)%count, spcs(held)%directions)
+      end do
+      if (spcs(held)%count == 3) then
+        fixed(1:3, node) = .true.
+        held = held - 1
+      end if
+    end do
+    input%model%local_spcs = spcs(1:held)
+  end subroutine build_local_spcs
+
+  !> Initial velocities have no component along a direction an SPC holds in a local system
+  !> (the global ones are removed when the run is set up).
+  subroutine hold_local_initial_velocities(input)
+    type(deck_input_t), intent(inout) :: input
+    integer :: k, j
+    if (.not. allocated(input%model%local_spcs)) return
+    do k = 1, size(input%model%local_spcs)
+      associate (spc => input%model%local_spcs(k), velocity => input%model%initial_velocity)
+        do j = 1, spc%count
+          velocity(:, spc%node) = velocity(:, spc%node) - &
+            dot_product(velocity(:, spc%node), spc%directions(:, j))*spc%directions(:, j)
+        end do
+      end associate
+    end do
+  end subroutine hold_local_initial_velocities
+
+  !> The linear static analysis takes SPCs and motions along the global axes only.
+  subroutine check_static_conditions(deck, input, log)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(in) :: input
+    type(problem_log_t), intent(inout) :: log
+    integer :: k
+    if (.not. input%model%implicit_static) return
+    do k = 1, input%spc_count
+      if (input%spcs(k)%frame_id /= 0) call located_problem(deck, log, input%spcs(k)%line, "CID", &
+        "a static analysis (*CONTROL_IMPLICIT_GENERAL) takes SPCs along the global axes only; "// &
+        "use CID 0")
+    end do
+    do k = 1, input%motion_count
+      if (input%motions(k)%direction == 4 .or. input%motions(k)%direction == -4) &
+        call located_problem(deck, log, input%motions(k)%line, "DOF", "a static analysis "// &
+        "(*CONTROL_IMPLICIT_GENERAL) takes motions along x, y, z only (DOF 1, 2, 3)")
+    end do
+  end subroutine check_static_conditions
+
   !> One prescribed_motion_t per node and direction; two motions on one node and direction
-  !> contradict each other.
+  !> contradict each other. DOF 4 and -4 act along the vector VID.
   subroutine build_motions(deck, input, indices, log)
     type(deck_t), intent(in) :: deck
     type(deck_input_t), intent(inout) :: input
@@ -644,6 +934,7 @@ contains
     type(prescribed_motion_t), allocatable :: motions(:)
     integer, allocatable :: nodes(:), owner(:, :)
     integer :: k, node, count, curve
+    real(wp) :: direction(3)
 
     allocate (owner(3, input%node_count), motions(0))
     owner = 0
@@ -653,6 +944,19 @@ contains
         curve = find_curve(deck, indices, given%curve_id, given%line, log)
         if (.not. target_nodes(deck, input, indices, given%target, given%is_set, given%line, &
                                nodes, log)) cycle
+        if (given%direction == 4 .or. given%direction == -4) then
+          if (.not. vector_direction(deck, input, given%vector_id, given%line, "VID", direction, &
+                                     log)) cycle
+          call reserve_motions(motions, count + size(nodes))
+          do node = 1, size(nodes)
+            count = count + 1
+            motions(count) = prescribed_motion_t(node=nodes(node), direction=merge( &
+              motion_along_vector, motion_only_along_vector, given%direction == 4), &
+              vector=direction, kind=given%kind, curve=curve, scale=given%scale, &
+              birth=given%birth, death=given%death)
+          end do
+          cycle
+        end if
         if (given%direction < 1 .or. given%direction > 3) cycle
         call reserve_motions(motions, count + size(nodes))
         do node = 1, size(nodes)
@@ -815,10 +1119,25 @@ contains
     type(velocity_input_t), intent(in) :: given
     type(problem_log_t), intent(inout) :: log
     integer, allocatable :: nodes(:), exempt(:)
-    logical, allocatable :: is_exempt(:)
+    logical, allocatable :: is_exempt(:), in_box(:)
+    real(wp) :: axes(3, 3), velocity(3), exempt_velocity(3)
     integer :: k
     if (.not. set_or_all(deck, input, indices, given%target, given%line, "NSID", nodes, log)) &
       return
+    velocity = given%velocity
+    exempt_velocity = given%exempt_velocity
+    if (given%frame_id > 0) then
+      ! ICID: the velocities are components along the system's axes
+      if (.not. frame_axes(deck, input, given%frame_id, given%line, "ICID", axes, log)) return
+      velocity = matmul(axes, velocity)
+      exempt_velocity = matmul(axes, exempt_velocity)
+    end if
+    allocate (in_box(input%node_count))
+    in_box = given%box_id == 0
+    if (given%box_id > 0) then
+      if (.not. mark_nodes_in_box(deck, input, given%box_id, given%line, "BOXID", .true., &
+                                  in_box, log)) return
+    end if
     allocate (is_exempt(input%node_count))
     is_exempt = .false.
     if (given%exempt_set > 0) then
@@ -826,11 +1145,12 @@ contains
                            exempt, log)) return
       is_exempt(exempt) = .true.
       do k = 1, size(exempt)
-        input%model%initial_velocity(:, exempt(k)) = given%exempt_velocity
+        input%model%initial_velocity(:, exempt(k)) = exempt_velocity
       end do
     end if
     do k = 1, size(nodes)
-      if (.not. is_exempt(nodes(k))) input%model%initial_velocity(:, nodes(k)) = given%velocity
+      if (.not. is_exempt(nodes(k)) .and. in_box(nodes(k))) &
+        input%model%initial_velocity(:, nodes(k)) = velocity
     end do
   end subroutine apply_set_velocity
 
@@ -841,9 +1161,15 @@ contains
     type(velocity_input_t), intent(in) :: given
     type(problem_log_t), intent(inout) :: log
     integer, allocatable :: nodes(:)
+    real(wp) :: axes(3, 3)
     if (.not. target_nodes(deck, input, indices, given%target, .false., given%line, nodes, &
                            log)) return
-    input%model%initial_velocity(:, nodes(1)) = given%velocity
+    if (given%frame_id > 0) then
+      if (.not. frame_axes(deck, input, given%frame_id, given%line, "ICID", axes, log)) return
+      input%model%initial_velocity(:, nodes(1)) = matmul(axes, given%velocity)
+    else
+      input%model%initial_velocity(:, nodes(1)) = given%velocity
+    end if
   end subroutine apply_node_velocity
 
   !> V + OMEGA n x (x - c) on the nodes of a part set (STYP 1), a part (2) or a node set (3).
@@ -854,11 +1180,18 @@ contains
     type(velocity_input_t), intent(in) :: given
     type(problem_log_t), intent(inout) :: log
     integer, allocatable :: nodes(:)
-    real(wp) :: centre(3), axis(3), length
+    real(wp) :: centre(3), axis(3), length, velocity(3), axes(3, 3)
     integer :: k, first, second
 
     centre = given%centre
     axis = given%axis
+    velocity = given%velocity
+    if (given%frame_id > 0) then
+      ! ICID: VX VY VZ and NX NY NZ are along the system's axes; XC YC ZC stay global
+      if (.not. frame_axes(deck, input, given%frame_id, given%line, "ICID", axes, log)) return
+      velocity = matmul(axes, velocity)
+      axis = matmul(axes, axis)
+    end if
     if (given%axis_nodes(1) > 0) then
       first = find_id(indices%nodes, given%axis_nodes(1))
       second = find_id(indices%nodes, given%axis_nodes(2))
@@ -881,7 +1214,7 @@ contains
     end if
     if (.not. generation_nodes(deck, input, indices, given, nodes, log)) return
     do k = 1, size(nodes)
-      input%model%initial_velocity(:, nodes(k)) = given%velocity + given%omega* &
+      input%model%initial_velocity(:, nodes(k)) = velocity + given%omega* &
         cross_product(axis, input%model%coordinates(:, nodes(k)) - centre)
     end do
   end subroutine apply_generated_velocity
@@ -953,7 +1286,7 @@ contains
     type(deck_indices_t), intent(in) :: indices
     type(problem_log_t), intent(inout) :: log
     integer, allocatable :: nodes(:), exempt(:)
-    logical, allocatable :: keep(:)
+    logical, allocatable :: keep(:), in_box(:)
     type(id_index_t) :: wall_index
     integer :: k
 
@@ -970,6 +1303,14 @@ contains
           keep(nodes) = .true.
           keep(exempt) = .false.
           nodes = pack(nodes, keep(nodes))
+        end if
+        if (given%box_id > 0) then
+          ! BOXID: only the tracked nodes inside the box (at the start)
+          if (.not. allocated(in_box)) allocate (in_box(input%node_count))
+          in_box = .false.
+          if (.not. mark_nodes_in_box(deck, input, given%box_id, given%line, "BOXID", .true., &
+                                      in_box, log)) cycle
+          nodes = pack(nodes, in_box(nodes))
         end if
         given%wall%nodes = nodes
         ! a moving cylinder's curve (the reader has reported LCID <= 0)

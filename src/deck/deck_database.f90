@@ -9,13 +9,15 @@ module deck_database
   use deck_lexer, only: deck_t
   use deck_keywords, only: keyword_t
   use deck_fields, only: card_t, open_card, next_line, require_card, get_integer, get_real, &
-                         card_problem, warn_if_set, id_heading, line_problem
+                         card_problem, warn_if_set, id_heading, line_problem, &
+                         note_not_acted_upon, keyword_label
   use deck_input, only: deck_input_t, append_id
   implicit none
   private
 
   public :: read_plot_output, read_glstat_output, read_matsum_output, read_nodout_output, read_rwforc_output
   public :: read_history_nodes, read_history_node_sets, read_d3dump_output, read_runrsf_output
+  public :: read_unused_output
 
   integer, parameter :: standard_widths(8) = 10
   !> The history outputs read by read_history_output.
@@ -270,4 +272,33 @@ contains
       end do
     end do
   end subroutine read_history_node_cards
+  !> *DATABASE_ keywords for LS-DYNA output files crashfree does not write (binary extents,
+  !> ASCII files of forces it does not compute, element histories, the binary format): read
+  !> (every card), not acted upon. results.h5 holds the states and the histories crashfree
+  !> writes (docs/keywords.md lists them).
+  subroutine read_unused_output(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    character(len=:), allocatable :: name
+    name = keyword_label(deck, block)
+    if (index(name, "DATABASE_EXTENT_BINARY") == 1) then
+      call note_not_acted_upon(deck, block, [character(len=1) :: ], "it chooses what "// &
+        "LS-DYNA's d3plot holds; results.h5 holds its fixed set of nodal and element results", &
+        warnings)
+    else if (index(name, "DATABASE_FORMAT") == 1) then
+      call note_not_acted_upon(deck, block, [character(len=1) :: ], "results are written to "// &
+        "HDF5 (results.h5)", warnings)
+    else if (index(name, "DATABASE_HISTORY_") == 1) then
+      call note_not_acted_upon(deck, block, [character(len=1) :: ], "no element histories "// &
+        "(elout); every state in results.h5 holds the stresses of all elements", warnings)
+    else
+      call note_not_acted_upon(deck, block, [character(len=1) :: ], "crashfree does not "// &
+        "write this LS-DYNA output file; results.h5 holds the histories listed in "// &
+        "docs/keywords.md", warnings)
+    end if
+  end subroutine read_unused_output
 end module deck_database

@@ -20,7 +20,7 @@ module deck_fields
   public :: card_t, open_card, next_line, require_card, next_definition, get_integer, get_real
   public :: get_text, has_data, card_is_empty
   public :: field_is_blank, card_problem, line_problem, line_title, id_heading, warn_if_set
-  public :: keyword_label, located_problem, located_warning
+  public :: keyword_label, located_problem, located_warning, note_not_acted_upon
 
   !> One data line split into fields, and the block (keyword) it belongs to.
   type :: card_t
@@ -73,9 +73,11 @@ contains
     end do
   end function next_line
 
-  !> Advance to the next card of a definition and split it. When the block ends first, report
-  !> `field FIRST_FIELD: card LABEL is missing` at the last line read (the keyword line when
-  !> no card was read yet) and return false.
+  !> Advance to the next card of a definition and split it. A blank line is a card (its fields
+  !> take their defaults), also one of the blank lines between the block's last data line and
+  !> the next keyword: LS-DYNA reads a card left blank as a card of defaults. When the block
+  !> ends first, report `field FIRST_FIELD: card LABEL is missing` at the last line read (the
+  !> keyword line when no card was read yet) and return false.
   logical function require_card(deck, block, line, widths, card, log, label, first_field)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
@@ -87,6 +89,11 @@ contains
     integer :: previous
     previous = max(line, deck%blocks(block)%keyword_line)
     require_card = next_line(deck, block, line, .false.)
+    if (.not. require_card .and. line < deck%blocks(block)%end_line) then
+      ! a blank line after the last data line, where this definition still needs a card
+      line = line + 1
+      require_card = .true.
+    end if
     if (require_card) then
       call open_card(deck, block, line, widths, card, log)
     else
@@ -137,8 +144,23 @@ contains
       first_field, label//" is missing: the keyword has no cards", unreadable=.true.)
   end function has_data
 
-  !> Integer field `k`; blank gives `default` (0 when absent).
-  subroutine get_integer(deck, card, k, name, value, log, default)
+  !> Integer field `k`; blank gives `default` (0 when absent), and so does 0 with
+  !> `zero_is_default` (LS-DYNA's "EQ.0: default" fields, such as ELFORM).
+  subroutine get_integer(deck, card, k, name, value, log, default, zero_is_default)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(inout) :: card
+    integer, intent(in) :: k
+    character(len=*), intent(in) :: name
+    integer, intent(out) :: value
+    type(problem_log_t), intent(inout) :: log
+    integer, intent(in), optional :: default
+    logical, intent(in), optional :: zero_is_default
+    call read_integer_field(deck, card, k, name, value, log, default)
+    if (.not. present(zero_is_default) .or. .not. present(default)) return
+    if (zero_is_default .and. value == 0) value = default
+  end subroutine get_integer
+
+  subroutine read_integer_field(deck, card, k, name, value, log, default)
     type(deck_t), intent(in) :: deck
     type(card_t), intent(inout) :: card
     integer, intent(in) :: k
@@ -190,7 +212,7 @@ contains
         if (present(default)) value = default
       end if
     end associate
-  end subroutine get_integer
+  end subroutine read_integer_field
 
   !> Real field `k`; blank gives `default` (0 when absent).
   subroutine get_real(deck, card, k, name, value, log, default)
@@ -295,6 +317,50 @@ contains
     call add_error(warnings, line_location(deck, card%line)//": *"// &
       keyword_label(deck, card%block)//": field "//name//": ignored ("//reason//")")
   end subroutine warn_if_set
+
+  !> A keyword read but not acted upon (display or bookkeeping): one warning at its keyword
+  !> line, `*KEYWORD: read, not acted upon (reason)`, naming the fields the deck sets (not
+  !> blank, not zero) with their values. `field_names(c)` names the fields of card c (blank-
+  !> separated, LS-DYNA's names); cards past the last named one are read over, whatever
+  !> their number.
+  subroutine note_not_acted_upon(deck, block, field_names, reason, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    character(len=*), intent(in) :: field_names(:)
+    character(len=*), intent(in) :: reason
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    type(problem_log_t) :: unused_log
+    character(len=:), allocatable :: set_fields, names, name
+    integer :: line, card_index, k, first, last, status, name_end
+    real(wp) :: value
+
+    set_fields = ""
+    line = 0
+    card_index = 0
+    do while (card_index < size(field_names))
+      if (.not. next_line(deck, block, line, .false.)) exit
+      card_index = card_index + 1
+      ! (a tab in fixed columns is no problem here: nothing of the card is used)
+      call open_card(deck, block, line, [10, 10, 10, 10, 10, 10, 10, 10], card, unused_log)
+      names = trim_blanks(field_names(card_index))
+      do k = 1, 8
+        if (len(names) == 0) exit
+        name_end = index(names, " ") - 1
+        if (name_end < 0) name_end = len(names)
+        name = names(:name_end)
+        names = trim_blanks(names(name_end + 1:))
+        call field_bounds(card, k, first, last)
+        if (last < first) cycle
+        call parse_real(card%text(first:last), value, status)
+        if (status == number_ok .and. value == 0.0_wp) cycle
+        set_fields = set_fields//" "//name//"="//card%text(first:last)
+      end do
+    end do
+    if (len(set_fields) > 0) set_fields = "; fields set, not used:"//set_fields
+    call add_error(warnings, line_location(deck, deck%blocks(block)%keyword_line)//": *"// &
+      keyword_label(deck, block)//": read, not acted upon ("//reason//")"//set_fields)
+  end subroutine note_not_acted_upon
 
   !> Report `field NAME: message` for the line of `card`.
   subroutine card_problem(deck, log, card, name, message, unreadable)

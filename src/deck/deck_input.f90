@@ -13,6 +13,7 @@ module deck_input
   public :: id_list_t, set_input_t, spc_input_t, motion_input_t, load_input_t
   public :: velocity_input_t, wall_input_t, segment_set_input_t, segment_load_input_t
   public :: deck_input_t, prepare_input, append_id
+  public :: box_input_t, frame_input_t, vector_input_t
 
   !> The lists of definitions the keyword readers fill, one entry per definition. Each keyword
   !> table row names the lists its definitions go to (deck_keyword_table), and prepare_input
@@ -23,9 +24,19 @@ module deck_input
     list_node_sets = 9, list_part_sets = 10, list_spcs = 11, list_motions = 12, list_loads = 13, &
     list_velocities = 14, list_walls = 15, list_segment_sets = 16, list_segment_loads = 17, &
     list_rigid_materials = 18, list_rigid_motions = 19, list_nodal_rigid_bodies = 20, &
-    list_element_masses = 21, list_contacts = 22, list_beams = 23
+    list_element_masses = 21, list_contacts = 22, list_boxes = 23, list_frames = 24, list_vectors = 25, &
+    list_beams = 26
   !> Number of lists.
-  integer, parameter, public :: list_count = 23
+  integer, parameter, public :: list_count = 26
+
+  !> How a set's members are given (set_input_t%kind): listed ids (or ranges when `generated`),
+  !> *SET_NODE_GENERAL operations, or *SET_..._ADD set ids.
+  integer, parameter, public :: set_listed = 0, set_general = 1, set_added = 2
+  !> *SET_NODE_GENERAL operations (the ids of set_input_t%operations), applied in deck order.
+  integer, parameter, public :: general_all = 1, general_node = 2, general_part = 3, &
+    general_box = 4, general_remove_node = 5, general_remove_part = 6, general_remove_box = 7
+  !> How a coordinate system is given (frame_input_t%kind).
+  integer, parameter, public :: frame_by_points = 1, frame_by_nodes = 2, frame_by_vectors = 3
 
   !> How an initial velocity was given.
   integer, parameter, public :: velocity_by_set = 1, velocity_by_node = 2, &
@@ -37,15 +48,63 @@ module deck_input
     integer, allocatable :: ids(:), lines(:), fields(:)
   end type id_list_t
 
-  !> One *SET_NODE_LIST(_GENERATE) or *SET_PART_LIST. For a generated set `members` holds
-  !> pairs (first id, last id) of the ranges.
+  !> One *SET_NODE(_LIST)(_GENERATE), *SET_NODE_GENERAL, *SET_NODE_ADD, *SET_PART(_LIST)
+  !> (_GENERATE) or *SET_PART_ADD. For a generated set `members` holds pairs (first id, last id)
+  !> of the ranges; for an added set the ids of its sets; for a general set the entity ids of
+  !> every operation, one after another.
   type :: set_input_t
     integer :: id = 0
     character(len=:), allocatable :: title
     integer :: line = 0
     logical :: generated = .false.
+    integer :: kind = set_listed
     type(id_list_t) :: members
+    !> *SET_NODE_GENERAL: one entry per operation line: the operation (general_...) as id, its
+    !> line, and as field the number of entity ids it put into `members`.
+    type(id_list_t) :: operations
   end type set_input_t
+
+  !> *DEFINE_BOX(_LOCAL): the box [minimum, maximum] in its own axes. A local box's axes are the
+  !> columns of `axes` (global components) with origin `origin`; a plain box has the global ones.
+  type :: box_input_t
+    integer :: id = 0
+    character(len=:), allocatable :: title
+    real(wp) :: minimum(3) = 0.0_wp, maximum(3) = 0.0_wp
+    real(wp) :: axes(3, 3) = reshape([1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, &
+                                      0.0_wp, 0.0_wp, 1.0_wp], [3, 3])
+    real(wp) :: origin(3) = 0.0_wp
+    integer :: line = 0
+  end type box_input_t
+
+  !> *DEFINE_COORDINATE_SYSTEM (three points: origin, a point on local x, a point in the local
+  !> x-y plane), _NODES (the same by three node ids, resolved in the cross-check) or _VECTOR
+  !> (local x and a vector in the local x-y plane). The cross-check fills `axes` (columns: unit
+  !> local x, y, z in global components) and `origin`, and sets `usable`.
+  type :: frame_input_t
+    integer :: id = 0
+    character(len=:), allocatable :: title
+    integer :: kind = frame_by_points
+    real(wp) :: points(3, 3) = 0.0_wp      !< origin, x point, plane point (or x and plane vectors)
+    integer :: nodes(3) = 0                !< N1 N2 N3 of _NODES (ids)
+    integer :: origin_node = 0             !< NID of _VECTOR (0: the global origin)
+    logical :: follows_nodes = .false.     !< FLAG = 1 of _NODES (taken at its initial position)
+    real(wp) :: axes(3, 3) = 0.0_wp
+    real(wp) :: origin(3) = 0.0_wp
+    logical :: usable = .false.
+    integer :: line = 0
+  end type frame_input_t
+
+  !> *DEFINE_VECTOR: from tail to head, in the coordinate system `frame_id` (0: global). The
+  !> cross-check fills `direction` (unit, global components) and sets `usable`.
+  type :: vector_input_t
+    integer :: id = 0
+    character(len=:), allocatable :: title
+    real(wp) :: tail(3) = 0.0_wp, head(3) = 0.0_wp
+    integer :: frame_id = 0
+    real(wp) :: direction(3) = 0.0_wp
+    logical :: usable = .false.
+    integer :: line = 0
+  end type vector_input_t
 
   !> *SET_SEGMENT(_TITLE): card 1 as for the other sets (`members` is not used), then the
   !> segments as written: node ids, N4 = N3 for a triangle. The cross-check turns the ids into
@@ -77,6 +136,7 @@ module deck_input
     logical :: is_set = .false.
     logical :: fixed(3) = .false.
     logical :: fixed_rotation(3) = .false.  !< DOFRX DOFRY DOFRZ
+    integer :: frame_id = 0                 !< CID: the DOFs are along its axes (0: global)
     integer :: line = 0
   end type spc_input_t
 
@@ -86,6 +146,7 @@ module deck_input
     logical :: is_set = .false.
     integer :: direction = 0, kind = 0, curve_id = 0
     real(wp) :: scale = 1.0_wp, birth = 0.0_wp, death = 1.0e28_wp
+    integer :: vector_id = 0                !< VID: the direction of DOF 4 and -4
     integer :: line = 0
   end type motion_input_t
 
@@ -104,6 +165,8 @@ module deck_input
     integer :: target = 0             !< NSID, NID or ID (0: all nodes)
     integer :: target_type = 1        !< STYP of _GENERATION: 1 part set, 2 part, 3 node set
     integer :: exempt_set = 0         !< NSIDEX
+    integer :: box_id = 0             !< BOXID: only nodes inside the box (0: no box)
+    integer :: frame_id = 0           !< ICID: velocities (and axis) in this system (0: global)
     real(wp) :: velocity(3) = 0.0_wp
     real(wp) :: exempt_velocity(3) = 0.0_wp
     real(wp) :: omega = 0.0_wp        !< angular velocity about the axis
@@ -118,6 +181,7 @@ module deck_input
   type :: wall_input_t
     type(rigid_wall_t) :: wall
     integer :: node_set = 0, exempt_set = 0
+    integer :: box_id = 0             !< BOXID: only tracked nodes inside the box (0: no box)
     logical :: id_given = .false.
     integer :: line = 0               !< card 1 (NSID)
     integer :: motion_line = 0        !< the MOTION card of a cylinder (LCID)
@@ -132,6 +196,10 @@ module deck_input
     integer :: node_set_count = 0, part_set_count = 0, spc_count = 0, motion_count = 0
     integer :: load_count = 0, velocity_count = 0, wall_count = 0
     integer :: segment_set_count = 0, segment_load_count = 0
+    integer :: box_count = 0, frame_count = 0, vector_count = 0
+    type(box_input_t), allocatable :: boxes(:)
+    type(frame_input_t), allocatable :: frames(:)
+    type(vector_input_t), allocatable :: vectors(:)
     integer, allocatable :: node_lines(:), node_constraints(:)     !< TC code of each node
     integer, allocatable :: node_rotation_constraints(:)           !< RC code of each node
     integer, allocatable :: solid_lines(:), solid_node_lines(:)   !< PID card, node card
@@ -212,6 +280,9 @@ contains
     allocate (input%rigid%nodal(capacity(list_nodal_rigid_bodies)))
     allocate (input%rigid%masses(capacity(list_element_masses)))
     allocate (input%contact%entries(capacity(list_contacts)))
+    allocate (input%boxes(capacity(list_boxes)))
+    allocate (input%frames(capacity(list_frames)))
+    allocate (input%vectors(capacity(list_vectors)))
   end subroutine prepare_input
 
   !> Append one id with its origin (the list grows as needed).

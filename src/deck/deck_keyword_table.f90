@@ -10,7 +10,7 @@
 !>
 !> The rows keep the order in which the names were added: on equal spelling distance the
 !> earlier name is suggested. gfortran cannot hold procedure pointers in a named constant, so
-!> `keyword_table()` builds the table on each call (66 rows; once per deck, and per unknown
+!> `keyword_table()` builds the table on each call (about 100 rows; once per deck, and per unknown
 !> keyword).
 module deck_keyword_table
   use error_handling, only: error_list_t
@@ -24,22 +24,27 @@ module deck_keyword_table
     list_sections, list_materials, list_hourglasses, list_curves, list_node_sets, list_part_sets, list_spcs, &
     list_motions, list_loads, list_velocities, list_walls, list_segment_sets, list_segment_loads, &
     list_rigid_materials, list_rigid_motions, list_nodal_rigid_bodies, list_element_masses, list_contacts, &
-    list_count, list_beams
+    list_count, list_boxes, list_frames, list_vectors, list_beams
   use deck_nodes_elements, only: read_nodes, read_solid_elements, read_shell_elements, read_thick_shell_elements
   use deck_parts_sections, only: read_parts, read_solid_sections, read_efg_sections, read_shell_sections, &
     read_hourglasses
   use deck_materials, only: read_elastic_materials, read_plastic_kinematic_materials, read_honeycomb_materials, &
     read_modified_honeycomb_materials, read_low_density_foam_materials, read_piecewise_linear_materials, &
     read_null_materials
-  use deck_sets_curves, only: read_node_set, read_generated_node_set, read_part_set, read_segment_set, read_curve
+  use deck_sets_curves, only: read_node_set, read_generated_node_set, read_part_set, read_segment_set, read_curve, &
+    read_generated_part_set, read_general_node_set, read_added_node_set, read_added_part_set
+  use deck_boxes_frames, only: read_boxes, read_local_boxes, read_point_frames, read_node_frames, &
+    read_vector_frames, read_vectors
   use deck_loads_bcs, only: read_node_spcs, read_set_spcs, read_node_motions, read_set_motions, read_node_loads, &
     read_set_loads, read_initial_velocities, read_initial_velocity_nodes, read_velocity_generations, &
     read_planar_walls, read_cylinder_walls, read_segment_loads, read_segment_set_loads, &
     read_nonuniform_segment_loads
   use deck_controls, only: read_title, read_termination, read_time_step, read_hourglass_control, &
-    read_bulk_viscosity, read_energy_control, read_implicit_general, read_implicit_solution
+    read_bulk_viscosity, read_energy_control, read_implicit_general, read_implicit_solution, &
+    read_unused_control, read_sensor_definition
   use deck_database, only: read_plot_output, read_glstat_output, read_matsum_output, read_nodout_output, &
-    read_rwforc_output, read_history_nodes, read_history_node_sets, read_d3dump_output, read_runrsf_output
+    read_rwforc_output, read_history_nodes, read_history_node_sets, read_d3dump_output, read_runrsf_output, &
+    read_unused_output
   use deck_rigid_bodies, only: read_rigid_materials, read_rigid_motions, read_nodal_rigid_bodies, &
     read_element_masses
   use deck_beams, only: read_beam_elements, read_beam_elements_with_card, read_beam_sections, &
@@ -76,7 +81,7 @@ module deck_keyword_table
   type :: keyword_entry_t
     character(len=36) :: name = ""       !< without the `*`
     character(len=36) :: alias = ""      !< another name of the same keyword ("" if none)
-    character(len=28) :: options = ""    !< the options it accepts, blank-separated (any order)
+    character(len=36) :: options = ""    !< the options it accepts, blank-separated (any order)
     logical :: one_option = .false.      !< at most one of them (the contacts: _ID or _TITLE)
     !> The input lists its definitions go to (deck_input's list_...), and how many entries a
     !> block can add to them (per_line, per_block, per_two_lines).
@@ -96,7 +101,7 @@ contains
       keyword_entry_t("TITLE", reader=read_title), &
       keyword_entry_t("NODE", fills=[list_nodes, list_none], reader=read_nodes), &
       keyword_entry_t("ELEMENT_SOLID", fills=[list_solids, list_none], reader=read_solid_elements), &
-      keyword_entry_t("PART", fills=[list_parts, list_none], reader=read_parts), &
+      keyword_entry_t("PART", options="CONTACT", fills=[list_parts, list_none], reader=read_parts), &
       keyword_entry_t("SECTION_SOLID", options="TITLE", fills=[list_sections, list_none], &
                       reader=read_solid_sections), &
       keyword_entry_t("SECTION_SOLID_EFG", options="TITLE", fills=[list_sections, list_none], &
@@ -109,6 +114,54 @@ contains
       keyword_entry_t("CONTROL_TERMINATION", reader=read_termination), &
       keyword_entry_t("CONTROL_TIMESTEP", reader=read_time_step), &
       keyword_entry_t("CONTROL_ENERGY", reader=read_energy_control), &
+      ! read, not acted upon: LS-DYNA's bookkeeping, display and output files
+      keyword_entry_t("CONTROL_PARALLEL", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_OUTPUT", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_CPU", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_SHELL", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_SOLID", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_ACCURACY", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_MPP_DECOMPOSITION_AUTOMATIC", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_MPP_DECOMPOSITION_METHOD", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_MPP_DECOMPOSITION_NUMPROC", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_MPP_DECOMPOSITION_SHOW", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_MPP_DECOMPOSITION_OUTDECOMP", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_MPP_IO_NOD3DUMP", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_MPP_IO_NODUMP", reader=read_unused_control), &
+      keyword_entry_t("CONTROL_MPP_IO_NOFULL", reader=read_unused_control), &
+      keyword_entry_t("DATABASE_EXTENT_BINARY", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_FORMAT", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_BINARY_INTFOR", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_BINARY_D3THDT", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_SPCFORC", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_SLEOUT", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_SECFORC", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_ELOUT", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_BNDOUT", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_NCFORC", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_SWFORC", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_JNTFORC", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_DEFORC", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_RBDOUT", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_SBTOUT", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_NODFOR", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_ABSTAT", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_DEFGEO", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_BINARY_D3PROP", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_NODAL_FORCE_GROUP", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_CROSS_SECTION_PLANE", options="ID", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_CROSS_SECTION_SET", options="ID", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_HISTORY_SHELL", options="ID", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_HISTORY_SHELL_SET", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_HISTORY_SOLID", options="ID", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_HISTORY_SOLID_SET", reader=read_unused_output), &
+      keyword_entry_t("SENSOR_DEFINE_NODE", options="SET", reader=read_sensor_definition), &
+      keyword_entry_t("SENSOR_DEFINE_ELEMENT", options="SET", reader=read_sensor_definition), &
+      keyword_entry_t("SENSOR_DEFINE_FORCE", reader=read_sensor_definition), &
+      keyword_entry_t("SENSOR_DEFINE_FUNCTION", reader=read_sensor_definition), &
+      keyword_entry_t("SENSOR_DEFINE_MISC", reader=read_sensor_definition), &
+      keyword_entry_t("SENSOR_DEFINE_CALC-MATH", reader=read_sensor_definition), &
+      keyword_entry_t("SENSOR_DEFINE_ANGLE", reader=read_sensor_definition), &
       keyword_entry_t("SET_NODE_LIST", options="TITLE", fills=[list_node_sets, list_none], entries=per_block, &
                       reader=read_node_set), &
       keyword_entry_t("SET_NODE_LIST_GENERATE", options="TITLE", fills=[list_node_sets, list_none], &
@@ -130,7 +183,7 @@ contains
                       reader=read_set_motions), &
       keyword_entry_t("LOAD_NODE_POINT", fills=[list_loads, list_none], reader=read_node_loads), &
       keyword_entry_t("LOAD_NODE_SET", fills=[list_loads, list_none], reader=read_set_loads), &
-      keyword_entry_t("RIGIDWALL_PLANAR", options="FINITE MOVING FORCES ID", fills=[list_walls, list_none], &
+      keyword_entry_t("RIGIDWALL_PLANAR", options="FINITE MOVING FORCES DISPLAY ID", fills=[list_walls, list_none], &
                       reader=read_planar_walls), &
       keyword_entry_t("DATABASE_BINARY_D3PLOT", reader=read_plot_output), &
       keyword_entry_t("DATABASE_GLSTAT", reader=read_glstat_output), &
@@ -152,7 +205,7 @@ contains
       law_keyword(law_honeycomb, read_honeycomb_materials), &
       law_keyword(law_modified_honeycomb, read_modified_honeycomb_materials), &
       law_keyword(law_low_density_foam, read_low_density_foam_materials), &
-      keyword_entry_t("RIGIDWALL_GEOMETRIC_CYLINDER", options="MOTION ID", fills=[list_walls, list_none], &
+      keyword_entry_t("RIGIDWALL_GEOMETRIC_CYLINDER", options="MOTION DISPLAY ID", fills=[list_walls, list_none], &
                       reader=read_cylinder_walls), &
       keyword_entry_t("ELEMENT_SHELL", fills=[list_shells, list_none], reader=read_shell_elements), &
       keyword_entry_t("ELEMENT_SHELL_THICKNESS", fills=[list_shells, list_none], entries=per_two_lines, &
@@ -186,7 +239,28 @@ contains
       keyword_entry_t("CONTROL_CONTACT", reader=read_control_contact), &
       keyword_entry_t("DATABASE_RCFORC", reader=read_rcforc), &
       law_keyword(law_piecewise_linear, read_piecewise_linear_materials), &
-      law_keyword(law_null, read_null_materials)]
+      law_keyword(law_null, read_null_materials), &
+      keyword_entry_t("SET_NODE", options="TITLE", fills=[list_node_sets, list_none], entries=per_block, &
+                      reader=read_node_set), &
+      keyword_entry_t("SET_NODE_GENERAL", options="TITLE", fills=[list_node_sets, list_none], entries=per_block, &
+                      reader=read_general_node_set), &
+      keyword_entry_t("SET_NODE_ADD", options="TITLE", fills=[list_node_sets, list_none], entries=per_block, &
+                      reader=read_added_node_set), &
+      keyword_entry_t("SET_PART", options="TITLE", fills=[list_part_sets, list_none], entries=per_block, &
+                      reader=read_part_set), &
+      keyword_entry_t("SET_PART_LIST_GENERATE", options="TITLE", fills=[list_part_sets, list_none], &
+                      entries=per_block, reader=read_generated_part_set), &
+      keyword_entry_t("SET_PART_ADD", options="TITLE", fills=[list_part_sets, list_none], entries=per_block, &
+                      reader=read_added_part_set), &
+      keyword_entry_t("DEFINE_BOX", options="TITLE", fills=[list_boxes, list_none], reader=read_boxes), &
+      keyword_entry_t("DEFINE_BOX_LOCAL", options="TITLE", fills=[list_boxes, list_none], reader=read_local_boxes), &
+      keyword_entry_t("DEFINE_COORDINATE_SYSTEM", options="TITLE", fills=[list_frames, list_none], &
+                      reader=read_point_frames), &
+      keyword_entry_t("DEFINE_COORDINATE_NODES", options="TITLE", fills=[list_frames, list_none], &
+                      reader=read_node_frames), &
+      keyword_entry_t("DEFINE_COORDINATE_VECTOR", options="TITLE", fills=[list_frames, list_none], &
+                      reader=read_vector_frames), &
+      keyword_entry_t("DEFINE_VECTOR", options="TITLE", fills=[list_vectors, list_none], reader=read_vectors)]
   end function keyword_table
 
   !> The row of material law `law` (a code of law_table): *MAT_<name>, also *MAT_<nnn>, with
@@ -266,7 +340,7 @@ contains
     character(len=*), intent(in) :: name
     character(len=:), allocatable, intent(out) :: suggestion, base
     character(len=36), allocatable :: names(:)
-    character(len=28), allocatable :: options(:)
+    character(len=36), allocatable :: options(:)
     call known_names(keyword_table(), names, options)
     call suggest_keyword(name, names, options, suggestion, base)
   end subroutine suggest_known_keyword
@@ -275,7 +349,7 @@ contains
   !> aliases included.
   integer function known_keyword_count()
     character(len=36), allocatable :: names(:)
-    character(len=28), allocatable :: options(:)
+    character(len=36), allocatable :: options(:)
     call known_names(keyword_table(), names, options)
     known_keyword_count = size(names)
   end function known_keyword_count
@@ -286,7 +360,7 @@ contains
     integer, intent(in) :: k
     character(len=:), allocatable, intent(out) :: name, options
     character(len=36), allocatable :: names(:)
-    character(len=28), allocatable :: all_options(:)
+    character(len=36), allocatable :: all_options(:)
     call known_names(keyword_table(), names, all_options)
     name = trim(names(k))
     options = trim(all_options(k))
@@ -296,7 +370,7 @@ contains
   pure subroutine known_names(table, names, options)
     type(keyword_entry_t), intent(in) :: table(:)
     character(len=36), allocatable, intent(out) :: names(:)
-    character(len=28), allocatable, intent(out) :: options(:)
+    character(len=36), allocatable, intent(out) :: options(:)
     integer :: k, n
     allocate (names(size(table) + count(table%alias /= "")), options(size(table) + count(table%alias /= "")))
     n = 0

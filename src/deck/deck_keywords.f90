@@ -21,6 +21,8 @@ module deck_keywords
     logical :: moving = .false.    !< *RIGIDWALL_PLANAR_MOVING
     logical :: forces = .false.    !< *RIGIDWALL_PLANAR_FORCES
     logical :: motion = .false.    !< *RIGIDWALL_GEOMETRIC_CYLINDER_MOTION
+    logical :: contact = .false.   !< *PART_CONTACT: a card of contact values after each part
+    logical :: display = .false.   !< *RIGIDWALL_GEOMETRIC_..._DISPLAY: a display card at the end
   end type keyword_t
 
   !> Longest keyword name a suggestion is looked for (longer ones are no typing slip).
@@ -74,6 +76,12 @@ contains
       case ("MOTION")
         if (keyword%motion) return
         keyword%motion = .true.
+      case ("CONTACT")
+        if (keyword%contact) return
+        keyword%contact = .true.
+      case ("DISPLAY")
+        if (keyword%display) return
+        keyword%display = .true.
       end select
     end do
     fits = text(len(text):) /= "_"

@@ -40,11 +40,16 @@ module deck_lexer
   end type source_file_t
 
   !> One keyword and its data lines (indices into the line table; none when last < first).
+  !> `last_line` is the last line that is not blank; the blank lines after it, up to
+  !> `end_line`, separate it from the next keyword. They are cards only where a definition
+  !> still needs a card (a blank card: all its fields take their defaults), never the start
+  !> of another definition.
   type :: keyword_block_t
     character(len=:), allocatable :: name      !< upper case, without `*` and format suffix
     integer :: keyword_line = 0
     integer :: first_line = 1
     integer :: last_line = 0
+    integer :: end_line = 0                    !< last line, trailing blank lines included
     integer :: format = format_standard
   end type keyword_block_t
 
@@ -510,7 +515,7 @@ contains
       if (unusual) call check_characters(deck, text(1:last), state, log)
       deck%keyword_lines = deck%keyword_lines + 1
       call open_keyword(deck, deck%lines%count, text(1:last), state%file_format, state%block, &
-                        state%ended, log)
+                        state%ended, log, warnings)
       return
     end if
     if (state%block%kind == block_comment) return
@@ -575,7 +580,7 @@ contains
   end subroutine report_file_totals
 
   !> Start the block of the keyword on line `line`, whose text is `text`.
-  subroutine open_keyword(deck, line, text, file_format, block, ended, log)
+  subroutine open_keyword(deck, line, text, file_format, block, ended, log, warnings)
     type(deck_t), intent(inout) :: deck
     integer, intent(in) :: line
     character(len=*), intent(in) :: text
@@ -583,6 +588,7 @@ contains
     type(open_block_t), intent(out) :: block
     logical, intent(out) :: ended
     type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
     character(len=:), allocatable :: name
     integer :: name_end, suffix_format
 
@@ -610,7 +616,7 @@ contains
     select case (name)
     case ("KEYWORD")
       block%kind = block_ignored
-      call read_keyword_options(deck, line, text(name_end + 1:), file_format, log)
+      call read_keyword_options(deck, line, text(name_end + 1:), file_format, log, warnings)
     case ("INCLUDE")
       block%kind = block_include
     case ("PARAMETER")
@@ -627,17 +633,19 @@ contains
   end subroutine open_keyword
 
   !> `*KEYWORD LONG=Y`, `LONG=S|K|N`, `I10=Y|N`; a memory size (a bare number, MEMORY=...) and
-  !> NCPU=... are accepted and ignored. The setting holds for the rest of this file and for
-  !> the files it includes.
-  subroutine read_keyword_options(deck, line, options, file_format, log)
+  !> NCPU=... are accepted and not used, with one warning naming them. The format setting holds
+  !> for the rest of this file and for the files it includes.
+  subroutine read_keyword_options(deck, line, options, file_format, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: line
     character(len=*), intent(in) :: options
     integer, intent(inout) :: file_format
     type(problem_log_t), intent(inout) :: log
-    character(len=:), allocatable :: rest, token
+    type(error_list_t), intent(inout) :: warnings
+    character(len=:), allocatable :: rest, token, unused
     integer :: token_end, status, memory
 
+    unused = ""
     rest = to_upper(trim_blanks(options))
     do while (len(rest) > 0)
       token_end = scan(rest, " "//achar(9)) - 1
@@ -657,9 +665,14 @@ contains
         if (status /= number_ok .and. verify(token(len(token):), "MGK") /= 0) then
           call report_problem(log, line_location(deck, line)//": *KEYWORD: option '"//token// &
             "' is not understood (LONG=Y|S|K, I10=Y|N or a memory size)")
+        else
+          unused = unused//" "//token
         end if
       end select
     end do
+    if (len(unused) > 0) call add_error(warnings, line_location(deck, line)//": *KEYWORD:"// &
+      unused//": read, not acted upon (memory is sized from the model; threads are set with "// &
+      "ncpu= on the command line, and results are the same for any thread count)")
   end subroutine read_keyword_options
 
   !> Finish the open block: trim trailing blank lines, run *INCLUDE and *PARAMETER.
@@ -670,9 +683,12 @@ contains
     type(open_block_t), intent(inout) :: block
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
+    integer :: end_line
 
-    ! Trailing blank lines only separate keywords; a block of nothing but blank lines keeps
-    ! one, which then reads as a card of defaults.
+    ! Trailing blank lines separate keywords and start no definition; they are kept (end_line)
+    ! for a definition that still needs a card, which is then a blank card of defaults. A
+    ! block of nothing but blank lines keeps one, which reads as a card of defaults.
+    end_line = block%last_line
     do while (block%last_line > block%first_line)
       if (.not. is_blank_line(deck, block%last_line)) exit
       block%last_line = block%last_line - 1
@@ -680,6 +696,7 @@ contains
     select case (block%kind)
     case (block_regular)
       deck%blocks(deck%block_count)%last_line = block%last_line
+      deck%blocks(deck%block_count)%end_line = end_line
     case (block_include)
       call run_includes(deck, file, file_format, chain, block, log, warnings)
     case (block_parameter)
@@ -925,6 +942,7 @@ contains
         larger(k)%keyword_line = deck%blocks(k)%keyword_line
         larger(k)%first_line = deck%blocks(k)%first_line
         larger(k)%last_line = deck%blocks(k)%last_line
+        larger(k)%end_line = deck%blocks(k)%end_line
         larger(k)%format = deck%blocks(k)%format
       end do
       call move_alloc(larger, deck%blocks)
@@ -934,6 +952,7 @@ contains
     deck%blocks(deck%block_count)%keyword_line = block%keyword_line
     deck%blocks(deck%block_count)%first_line = block%first_line
     deck%blocks(deck%block_count)%last_line = block%last_line
+    deck%blocks(deck%block_count)%end_line = block%last_line
     deck%blocks(deck%block_count)%format = block%format
   end subroutine add_block
 

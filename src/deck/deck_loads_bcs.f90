@@ -28,8 +28,8 @@ module deck_loads_bcs
 
   integer, parameter :: standard_widths(8) = 10
   character(len=*), parameter :: no_rotations = "solid nodes have no rotations"
-  character(len=*), parameter :: no_local_systems = "local coordinate systems are not "// &
-                                                    "available; leave it blank or 0"
+  character(len=*), parameter :: no_local_systems = "loads in local coordinate systems are "// &
+                                                    "not available; leave it blank or 0"
 
 contains
 
@@ -55,8 +55,9 @@ contains
     call read_spc_cards(deck, block, keyword, .true., input, log)
   end subroutine read_set_spcs
 
-  !> *BOUNDARY_SPC_NODE / _SET: NID|NSID CID DOFX DOFY DOFZ DOFRX DOFRY DOFRZ per line. The
-  !> rotations act on shell nodes; the cross-check warns when they name no shell node.
+  !> *BOUNDARY_SPC_NODE / _SET: NID|NSID CID DOFX DOFY DOFZ DOFRX DOFRY DOFRZ per line. With a
+  !> CID the translations are held along the axes of that coordinate system. The rotations act
+  !> on shell nodes (global axes only); the cross-check warns when they name no shell node.
   subroutine read_spc_cards(deck, block, keyword, by_set, input, log)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
@@ -80,7 +81,11 @@ contains
         spc%line = line
         call read_target(deck, card, by_set, spc%target, log)
         call get_integer(deck, card, 2, "CID", system, log)
-        if (system /= 0) call card_problem(deck, log, card, "CID", no_local_systems)
+        if (system < 0) then
+          call card_problem(deck, log, card, "CID", "must be >= 0, found "//integer_text(system))
+        else
+          spc%frame_id = system
+        end if
         do k = 1, 6
           call get_integer(deck, card, k + 2, trim(names(k)), flag, log)
           if (flag /= 0 .and. flag /= 1) then
@@ -92,6 +97,9 @@ contains
         end do
         spc%fixed = fixed(1:3)
         spc%fixed_rotation = fixed(4:6)
+        if (system > 0 .and. any(fixed(4:6))) call card_problem(deck, log, card, "DOFRX", &
+          "rotations held about local axes (CID > 0) are not available; hold rotations with "// &
+          "CID 0 on a separate line")
       end associate
     end do
   end subroutine read_spc_cards
@@ -104,7 +112,7 @@ contains
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
-    call read_motion_cards(deck, block, keyword, .false., input, log)
+    call read_motion_cards(deck, block, keyword, .false., input, log, warnings)
   end subroutine read_node_motions
 
   !> *BOUNDARY_PRESCRIBED_MOTION_SET: see read_motion_cards.
@@ -115,17 +123,19 @@ contains
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
-    call read_motion_cards(deck, block, keyword, .true., input, log)
+    call read_motion_cards(deck, block, keyword, .true., input, log, warnings)
   end subroutine read_set_motions
 
-  !> *BOUNDARY_PRESCRIBED_MOTION_NODE / _SET: NID|NSID DOF VAD LCID SF VID DEATH BIRTH.
-  subroutine read_motion_cards(deck, block, keyword, by_set, input, log)
+  !> *BOUNDARY_PRESCRIBED_MOTION_NODE / _SET: NID|NSID DOF VAD LCID SF VID DEATH BIRTH. DOF 4
+  !> moves the nodes along the vector VID (free across it), DOF -4 along VID only.
+  subroutine read_motion_cards(deck, block, keyword, by_set, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
     type(keyword_t), intent(in) :: keyword
     logical, intent(in) :: by_set
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
     integer :: line, n, vector
 
@@ -150,6 +160,7 @@ contains
         if (motion%death == 0.0_wp) motion%death = 1.0e28_wp
         if (card%failed) cycle
         call check_motion_direction(deck, card, motion%direction, log)
+        motion%vector_id = vector
         select case (motion%kind)
         case (motion_velocity, motion_acceleration, motion_displacement)
         case (3, 4)
@@ -160,8 +171,13 @@ contains
                             "or 2 (displacement), found "//integer_text(motion%kind))
         end select
         call check_curve_given(deck, card, 4, motion%curve_id, log)
-        if (vector /= 0) call card_problem(deck, log, card, "VID", "vectors and local "// &
-          "coordinate systems are not available; use DOF 1, 2 or 3 with VID blank")
+        if (abs(motion%direction) == 4) then
+          if (vector <= 0) call card_problem(deck, log, card, "VID", "DOF "// &
+            integer_text(motion%direction)//" moves along a vector: VID must name a "// &
+            "*DEFINE_VECTOR, found "//integer_text(vector))
+        else
+          call warn_if_set(deck, card, 6, "VID", "used with DOF 4 or -4 only", warnings)
+        end if
         if (motion%death <= motion%birth) call card_problem(deck, log, card, "DEATH", &
           "death time "//real_text(motion%death)//" must be later than the birth time "// &
           real_text(motion%birth))
@@ -169,17 +185,18 @@ contains
     end do
   end subroutine read_motion_cards
 
-  !> DOF of a prescribed motion: 1-3 only, since solid nodes carry no rotations.
+  !> DOF of a prescribed motion: 1-3, or 4 and -4 along a vector; no rotations, since solid
+  !> nodes carry none.
   subroutine check_motion_direction(deck, card, direction, log)
     type(deck_t), intent(in) :: deck
     type(card_t), intent(in) :: card
     integer, intent(in) :: direction
     type(problem_log_t), intent(inout) :: log
     select case (direction)
-    case (1:3)
-    case (4, -4, 8, -8)
-      call card_problem(deck, log, card, "DOF", integer_text(direction)//" (motion along or "// &
-        "about a vector VID) is not available; use DOF 1, 2 or 3 (x, y, z)")
+    case (1:4, -4)
+    case (8, -8)
+      call card_problem(deck, log, card, "DOF", integer_text(direction)//" (rotation about "// &
+        "a vector VID) is not available, since "//no_rotations//"; use DOF 1-4 or -4")
     case (5:7, 9:11, -11:-9)
       call card_problem(deck, log, card, "DOF", integer_text(direction)//" is a rotation, "// &
         "but "//no_rotations//"; use DOF 1, 2 or 3 (x, y, z)")
@@ -187,8 +204,8 @@ contains
       call card_problem(deck, log, card, "DOF", "12 (along segment normals) applies to "// &
         "*BOUNDARY_PRESCRIBED_MOTION_SET_SEGMENT only; use DOF 1, 2 or 3")
     case default
-      call card_problem(deck, log, card, "DOF", "must be 1, 2 or 3 (x, y, z translation), "// &
-                        "found "//integer_text(direction))
+      call card_problem(deck, log, card, "DOF", "must be 1, 2 or 3 (x, y, z translation) or "// &
+                        "4, -4 (along the vector VID), found "//integer_text(direction))
     end select
   end subroutine check_motion_direction
 
@@ -489,9 +506,10 @@ contains
       call get_integer(deck, card, 5, "ICID", system, log)
       call check_set_id(deck, card, 1, "NSID", velocity%target, log)
       call check_set_id(deck, card, 2, "NSIDEX", velocity%exempt_set, log)
-      if (box /= 0) call card_problem(deck, log, card, "BOXID", "boxes (*DEFINE_BOX) are not "// &
-                                      "available; use a node set")
-      if (system /= 0) call card_problem(deck, log, card, "ICID", no_local_systems)
+      call check_set_id(deck, card, 3, "BOXID", box, log)
+      call check_set_id(deck, card, 5, "ICID", system, log)
+      velocity%box_id = max(box, 0)
+      velocity%frame_id = max(system, 0)
       call warn_if_set(deck, card, 4, "IRIGID", "no rigid bodies", warnings)
       if (.not. require_card(deck, block, line, standard_widths, card, log, &
                              "card 2 (VX VY VZ VXR VYR VZR)", "VX")) exit
@@ -527,7 +545,8 @@ contains
       call read_vector(deck, card, 2, ["VX", "VY", "VZ"], velocity%velocity, log)
       call warn_rotations(deck, card, 5, ["VXR", "VYR", "VZR"], warnings)
       call get_integer(deck, card, 8, "ICID", system, log)
-      if (system /= 0) call card_problem(deck, log, card, "ICID", no_local_systems)
+      call check_set_id(deck, card, 8, "ICID", system, log)
+      velocity%frame_id = max(system, 0)
       call add_velocity(input, velocity)
     end do
   end subroutine read_initial_velocity_nodes
@@ -561,7 +580,8 @@ contains
         card, "STYP", "must be 1 (part set), 2 (part) or 3 (node set), found "// &
         integer_text(velocity%target_type))
       call check_set_id(deck, card, 1, "ID", velocity%target, log)
-      if (system /= 0) call card_problem(deck, log, card, "ICID", no_local_systems)
+      call check_set_id(deck, card, 8, "ICID", system, log)
+      velocity%frame_id = max(system, 0)
       call warn_if_set(deck, card, 7, "IVATN", "no rigid bodies or constrained nodes", warnings)
       if (.not. require_card(deck, block, line, standard_widths, card, log, &
                              "card 2 (XC YC ZC NX NY NZ PHASE IRIGID)", "XC")) exit
@@ -641,16 +661,16 @@ contains
     if (entry%wall%death == 0.0_wp) entry%wall%death = 1.0e20_wp
     call check_set_id(deck, card, 1, "NSID", entry%node_set, log)
     call check_set_id(deck, card, 2, "NSIDEX", entry%exempt_set, log)
-    if (box /= 0) call card_problem(deck, log, card, "BOXID", "boxes (*DEFINE_BOX) are "// &
-                                    "not available; use a node set")
+    call check_set_id(deck, card, 3, "BOXID", box, log)
+    entry%box_id = max(box, 0)
     if (entry%wall%death <= entry%wall%birth) call card_problem(deck, log, card, "DEATH", "death "// &
       "time "//real_text(entry%wall%death)//" must be later than the birth time "// &
       real_text(entry%wall%birth))
   end function read_wall_card_one
 
-  !> *RIGIDWALL_PLANAR(_FINITE)(_MOVING)(_FORCES)(_ID): [RWID heading], card 1 NSID NSIDEX
-  !> BOXID OFFSET BIRTH DEATH RWKSF, card 2 XT YT ZT XH YH ZH FRIC WVEL, then the option cards
-  !> in the order FINITE, MOVING, FORCES.
+  !> *RIGIDWALL_PLANAR(_FINITE)(_MOVING)(_FORCES)(_DISPLAY)(_ID): [RWID heading], card 1 NSID
+  !> NSIDEX BOXID OFFSET BIRTH DEATH RWKSF, card 2 XT YT ZT XH YH ZH FRIC WVEL, then the option
+  !> cards in the order FINITE, MOVING, FORCES, DISPLAY.
   subroutine read_planar_walls(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
@@ -692,14 +712,20 @@ contains
                                  "the FORCES card (SOFT SSID N1 N2 N3 N4)", "SOFT")) exit
           call warn_if_set(deck, card, 1, "SOFT", "the wall force is not softened", warnings)
         end if
+        if (keyword%display) then
+          if (.not. require_card(deck, block, line, standard_widths, card, log, &
+                                 "the DISPLAY card (PID RO E PR)", "PID")) exit
+          call note_display_card(deck, line, warnings)
+        end if
       end associate
     end do
   end subroutine read_planar_walls
 
-  !> *RIGIDWALL_GEOMETRIC_CYLINDER(_MOTION)(_ID): [RWID heading], card 1 NSID NSIDEX BOXID
-  !> BIRTH DEATH, card 2 XT YT ZT XH YH ZH FRIC (tail and head of the axis), card 3 RADCYL
-  !> LENCYL NSEGS, then the MOTION card LCID OPT VX VY VZ. Subsections (NSEGS > 0, whose
-  !> VL HEIGHT cards are skipped) and boxes are reported as not available.
+  !> *RIGIDWALL_GEOMETRIC_CYLINDER(_MOTION)(_DISPLAY)(_ID): [RWID heading], card 1 NSID NSIDEX
+  !> BOXID BIRTH DEATH, card 2 XT YT ZT XH YH ZH FRIC (tail and head of the axis), card 3
+  !> RADCYL LENCYL NSEGS, then the MOTION card LCID OPT VX VY VZ and the DISPLAY card PID RO E
+  !> PR (read, and noted as not used: it only shows the wall in a post-processor).
+  !> Subsections (NSEGS > 0, whose VL HEIGHT cards are skipped) are reported as not available.
   subroutine read_cylinder_walls(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
@@ -709,7 +735,6 @@ contains
     type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
     integer :: line, n, segments, k
-    real(wp) :: length
 
     line = 0
     if (.not. has_data(deck, block, log, "card 1 (NSID NSIDEX BOXID BIRTH DEATH)", "NSID")) return
@@ -747,22 +772,45 @@ contains
           call get_integer(deck, card, 1, "LCID", wall%motion_curve_id, log)
           call get_integer(deck, card, 2, "OPT", wall%motion_option, log)
           call read_vector(deck, card, 3, ["VX", "VY", "VZ"], wall%motion_direction, log)
-          if (card%failed) cycle
-          if (wall%motion_curve_id <= 0) call card_problem(deck, log, card, "LCID", "the "// &
-            "motion needs a curve (LCID > 0), found "//integer_text(wall%motion_curve_id))
-          if (wall%motion_option /= 0 .and. wall%motion_option /= 1) call card_problem(deck, log, &
-            card, "OPT", "must be 0 (velocity) or 1 (displacement), found "// &
-            integer_text(wall%motion_option))
-          length = norm2(wall%motion_direction)
-          if (length == 0.0_wp) then
-            call card_problem(deck, log, card, "VX", "the motion direction (VX VY VZ) has zero length")
-          else
-            wall%motion_direction = wall%motion_direction/length
-          end if
+          if (.not. card%failed) call check_cylinder_motion(deck, card, wall, log)
+        end if
+        if (keyword%display) then
+          if (.not. require_card(deck, block, line, standard_widths, card, log, &
+                                 "the DISPLAY card (PID RO E PR)", "PID")) exit
+          call note_display_card(deck, line, warnings)
         end if
       end associate
     end do
   end subroutine read_cylinder_walls
+
+  !> The DISPLAY card of a wall (PID RO E PR) only shows the wall in a post-processor.
+  subroutine note_display_card(deck, line, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: line
+    type(error_list_t), intent(inout) :: warnings
+    call located_warning(deck, warnings, line, "PID RO E PR", "the DISPLAY card is read but "// &
+                         "not used: it only shows the wall in a post-processor")
+  end subroutine note_display_card
+
+  !> The MOTION card of a cylinder, read: a curve, OPT 0 or 1, a direction (normalised here).
+  subroutine check_cylinder_motion(deck, card, wall, log)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(in) :: card
+    type(rigid_wall_t), intent(inout) :: wall
+    type(problem_log_t), intent(inout) :: log
+    real(wp) :: length
+    if (wall%motion_curve_id <= 0) call card_problem(deck, log, card, "LCID", "the "// &
+      "motion needs a curve (LCID > 0), found "//integer_text(wall%motion_curve_id))
+    if (wall%motion_option /= 0 .and. wall%motion_option /= 1) call card_problem(deck, log, &
+      card, "OPT", "must be 0 (velocity) or 1 (displacement), found "// &
+      integer_text(wall%motion_option))
+    length = norm2(wall%motion_direction)
+    if (length == 0.0_wp) then
+      call card_problem(deck, log, card, "VX", "the motion direction (VX VY VZ) has zero length")
+    else
+      wall%motion_direction = wall%motion_direction/length
+    end if
+  end subroutine check_cylinder_motion
 
   !> Card 2: tail (a point of the wall) and head of the normal, friction.
   subroutine read_wall_plane(deck, card, wall, log)

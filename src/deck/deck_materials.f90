@@ -360,6 +360,8 @@ contains
         call get_real(deck, card, 5, "SIGY", material%yield_stress, log)
         call get_real(deck, card, 6, "VF", material%compaction_volume, log)
         call get_real(deck, card, 7, "MU", material%viscosity, log, default=0.05_wp)
+        ! LS-DYNA reads 0 as the default, as for a blank field
+        if (material%viscosity == 0.0_wp) material%viscosity = 0.05_wp
         call get_real(deck, card, 8, "BULK", value, log)
         if (.not. card%failed) then
           if (material%yield_stress < 0.0_wp) call card_problem(deck, log, card, "SIGY", "yield stress of the "// &
@@ -522,6 +524,8 @@ contains
           if (curve <= 0) call card_problem(deck, log, card, "LCID", "a loading curve id > 0 is required, "// &
                                             "found "//integer_text(curve))
           if (material%tension_cutoff == 0.0_wp) material%tension_cutoff = 1.0e20_wp
+          ! LS-DYNA reads 0 as the default (1: no hysteresis), as for a blank field
+          if (material%hysteretic_unloading == 0.0_wp) material%hysteretic_unloading = 1.0_wp
           if (material%tension_cutoff < 0.0_wp) call card_problem(deck, log, card, "TC", "tension cut-off "// &
             "must be > 0 (blank or 0: 1e20), found "//real_text(material%tension_cutoff))
           if (material%hysteretic_unloading < 0.0_wp .or. material%hysteretic_unloading > 1.0_wp) &

@@ -23,7 +23,10 @@ module deck_parts_sections
 
 contains
 
-  !> *PART: a heading line, then PID SECID MID EOSID HGID GRAV ADPOPT TMID; repeated.
+  !> *PART: a heading line, then PID SECID MID EOSID HGID GRAV ADPOPT TMID; repeated. With
+  !> _CONTACT a third card FS FD DC VC OPTT SFT SSF CPARM8 follows, which is read over (a
+  !> warning names the fields set): its values act only through contacts that take friction
+  !> and thickness per part, which crashfree's contacts do not.
   subroutine read_parts(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
@@ -32,8 +35,11 @@ contains
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
-    integer :: line, n, equation_of_state, adaptivity
+    integer :: line, n, equation_of_state, adaptivity, k
+    logical :: stepped
     character(len=:), allocatable :: title
+    character(len=6), parameter :: contact_names(8) = ["FS    ", "FD    ", "DC    ", "VC    ", &
+                                                       "OPTT  ", "SFT   ", "SSF   ", "CPARM8"]
 
     line = 0
     if (.not. has_data(deck, block, log, "the heading line and the data card", "PID")) return
@@ -53,7 +59,11 @@ contains
         call get_integer(deck, card, 4, "EOSID", equation_of_state, log)
         call get_integer(deck, card, 5, "HGID", part%hourglass_id, log)
         call get_integer(deck, card, 7, "ADPOPT", adaptivity, log)
-        if (card%failed) cycle
+        if (card%failed) then
+          ! step over the contact card, which is not the next part's heading line
+          if (keyword%contact) stepped = next_line(deck, block, line, .false.)
+          cycle
+        end if
         if (part%id <= 0) call card_problem(deck, log, card, "PID", "part id must be > 0, "// &
                                             "found "//integer_text(part%id))
         if (part%section_id < 0) call card_problem(deck, log, card, "SECID", &
@@ -70,6 +80,14 @@ contains
       end associate
       call warn_if_set(deck, card, 6, "GRAV", "*LOAD_DENSITY_DEPTH is not read", warnings)
       call warn_if_set(deck, card, 8, "TMID", "no thermal analysis", warnings)
+      if (keyword%contact) then
+        if (.not. require_card(deck, block, line, standard_widths, card, log, "the contact "// &
+            "card (FS FD DC VC OPTT SFT SSF CPARM8) of *PART_CONTACT", "FS")) exit
+        do k = 1, 8
+          call warn_if_set(deck, card, k, trim(contact_names(k)), "part-wise contact values are "// &
+                           "not available; give them on the *CONTACT_ card", warnings)
+        end do
+      end if
     end do
   end subroutine read_parts
 
@@ -97,7 +115,7 @@ contains
 
   !> *SECTION_SOLID and *SECTION_SOLID_EFG (with _TITLE: a title line before card 1).
   !>
-  !> Card 1 is SECID ELFORM AET. ELFORM 1 and 2 are finite elements; ELFORM 41 is the meshfree
+  !> Card 1 is SECID ELFORM AET. ELFORM 1 (0 or blank) and 2 are finite elements; 41 is the meshfree
   !> (EFG) solid and is followed by the EFG card (DX DY DZ ISPLINE IDILA IEBT IDIM TOLDEF), as
   !> is ELFORM 42, which is rejected. Where the cards of one section end:
   !> * *SECTION_SOLID repeats its sections until the next keyword: card 1, plus the EFG card
@@ -117,7 +135,7 @@ contains
     type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
     integer :: line, n, id, formulation
-    logical :: follows_efg_card
+    logical :: follows_efg_card, defaulted
     character(len=:), allocatable :: title
 
     line = 0
@@ -133,6 +151,9 @@ contains
         cycle
       end if
       call get_integer(deck, card, 2, "ELFORM", formulation, log, default=1)
+      ! LS-DYNA: ELFORM 0 (or blank) is the default, 1
+      defaulted = formulation == 0 .or. field_is_blank(card, 2)
+      if (formulation == 0) formulation = 1
       n = input%section_count + 1
       input%section_count = n
       input%section_lines(n) = line
@@ -143,8 +164,7 @@ contains
       if (.not. card%failed) then
         if (id <= 0) call card_problem(deck, log, card, "SECID", "section id must be > 0, "// &
                                        "found "//integer_text(id))
-        call check_solid_formulation(deck, log, card, formulation, field_is_blank(card, &
-                                     2), meshfree_keyword)
+        call check_solid_formulation(deck, log, card, formulation, defaulted, meshfree_keyword)
       end if
       call warn_if_set(deck, card, 3, "AET", "ambient elements are not available", warnings)
       follows_efg_card = meshfree_keyword .or. formulation == elform_efg .or. &
@@ -164,7 +184,7 @@ contains
   !> *SECTION_SHELL (with _TITLE: a title line before each section). Sections repeat until the
   !> next keyword; each is two cards:
   !> card 1 SECID ELFORM SHRF NIP PROPT QR/IRID ICOMP SETYP, card 2 T1 T2 T3 T4 NLOC MAREA IDOF
-  !> EDGSET. Only what the Belytschko-Tsay shell models is accepted: ELFORM 2, Gauss
+  !> EDGSET. Only what the Belytschko-Tsay shell models is accepted: ELFORM 2 (0 or blank: 2), Gauss
   !> integration through the thickness (QR/IRID 0) with 1-10 points, no composite angles
   !> (ICOMP 0), the mid surface as reference (NLOC 0) and no non-structural mass (MAREA 0,
   !> rejected rather than ignored since it would change the mass). T2-T4 blank or 0 take T1,
@@ -193,7 +213,8 @@ contains
         section%kind = section_shell
         section%title = title
         call get_integer(deck, card, 1, "SECID", section%id, log)
-        call get_integer(deck, card, 2, "ELFORM", section%element_formulation, log, default=2)
+        call get_integer(deck, card, 2, "ELFORM", section%element_formulation, log, default=2, &
+                         zero_is_default=.true.)
         call get_real(deck, card, 3, "SHRF", section%shear_factor, log)
         call get_integer(deck, card, 4, "NIP", section%integration_points, log)
         call get_integer(deck, card, 6, "QR/IRID", rule, log)
@@ -264,7 +285,7 @@ contains
     type(problem_log_t), intent(inout) :: log
     type(card_t), intent(in) :: card
     integer, intent(in) :: formulation
-    logical, intent(in) :: blank             !< ELFORM was blank (LS-DYNA's default, 1)
+    logical, intent(in) :: blank             !< ELFORM was blank or 0 (LS-DYNA's default, 1)
     logical, intent(in) :: meshfree_keyword
     character(len=:), allocatable :: reason
     if (meshfree_keyword) then
@@ -274,7 +295,7 @@ contains
         reason = "; adaptive EFG (ELFORM 42) is not available"
       case (1, 2)
         reason = " (a finite element formulation: use *SECTION_SOLID)"
-        if (blank) reason = " (the field is blank, which means 1)"
+        if (blank) reason = " (the field is blank or 0, which means 1)"
       case default
         reason = ""
       end select

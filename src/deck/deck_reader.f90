@@ -97,12 +97,21 @@ contains
     integer :: data_lines
     where = line_location(deck, deck%blocks(block)%keyword_line)//": *"//deck%blocks(block)%name
     data_lines = deck%blocks(block)%last_line - deck%blocks(block)%first_line + 1
+    name = deck%blocks(block)%name
+    base = known_base(name, table)
+    if (ignore_unknown .and. len(base) > 0) then
+      ! a keyword crashfree reads, with an option it does not have: skipping it would drop
+      ! definitions the deck relies on (a part, a load, an include)
+      call report_problem(log, where//": crashfree reads *"//base//", but not with the "// &
+        "option "//name(len(base) + 2:)//"; --ignore-unknown skips only keywords crashfree "// &
+        "does not read at all, so remove the option or the keyword", unreadable=.true.)
+      return
+    end if
     if (ignore_unknown) then
       call add_error(warnings, printable(where)//": unknown keyword skipped ("// &
                      integer_text(data_lines)//" data lines not read)")
       return
     end if
-    name = deck%blocks(block)%name
     call suggest_known_keyword(name, suggestion, base)
     ! the options may not all go together (*CONTACT_..._ID_TITLE): then the name alone
     if (len(suggestion) > 0) then
@@ -119,4 +128,27 @@ contains
     call report_problem(log, where//": unknown keyword"//hint//"; crashfree reads the "// &
       "keywords listed in docs/keywords.md (--ignore-unknown skips the others)", unreadable=.true.)
   end subroutine report_unknown
+
+  !> The longest keyword name (or alias) of `table` that `name` extends by options
+  !> (`name` = BASE_OPTIONS), "" when none.
+  function known_base(name, table) result(base)
+    character(len=*), intent(in) :: name
+    type(keyword_entry_t), intent(in) :: table(:)
+    character(len=:), allocatable :: base
+    character(len=:), allocatable :: candidate
+    integer :: k, which
+    base = ""
+    do k = 1, size(table)
+      do which = 1, 2
+        if (which == 1) then
+          candidate = trim(table(k)%name)
+        else
+          candidate = trim(table(k)%alias)
+        end if
+        if (len(candidate) == 0 .or. len(candidate) <= len(base)) cycle
+        if (len(name) <= len(candidate) + 1) cycle
+        if (name(:len(candidate) + 1) == candidate//"_") base = candidate
+      end do
+    end do
+  end function known_base
 end module deck_reader

@@ -1,4 +1,6 @@
-!> *SET_NODE_LIST, *SET_NODE_LIST_GENERATE, *SET_PART_LIST, *SET_SEGMENT and *DEFINE_CURVE.
+!> *SET_NODE(_LIST), *SET_NODE_LIST_GENERATE, *SET_NODE_GENERAL, *SET_NODE_ADD, *SET_PART(_LIST),
+!> *SET_PART_LIST_GENERATE, *SET_PART_ADD, *SET_SEGMENT and *DEFINE_CURVE. Sets are kept as
+!> written; the cross-check resolves them (sets of sets in any order of the deck).
 module deck_sets_curves
   use kinds, only: wp
   use error_handling, only: error_list_t
@@ -9,12 +11,15 @@ module deck_sets_curves
   use deck_keywords, only: keyword_t
   use deck_fields, only: card_t, open_card, next_line, next_definition, get_integer, get_real, &
                          get_text, card_problem, warn_if_set
-  use deck_input, only: deck_input_t, set_input_t, append_id
+  use deck_input, only: deck_input_t, set_input_t, append_id, set_general, set_added, &
+                        general_all, general_node, general_part, general_box, &
+                        general_remove_node, general_remove_part, general_remove_box
   use deck_segments, only: read_segment_nodes
   implicit none
   private
 
   public :: read_node_set, read_generated_node_set, read_part_set, read_segment_set, read_curve
+  public :: read_generated_part_set, read_general_node_set, read_added_node_set, read_added_part_set
 
   integer, parameter :: standard_widths(8) = 10
   !> *DEFINE_CURVE points: abscissa and ordinate, 20 columns each.
@@ -61,7 +66,7 @@ contains
       set%generated = generated
       if (.not. read_set_header(deck, block, keyword, line, set, log, warnings)) return
       if (generated) then
-        call read_ranges(deck, block, line, set, log)
+        call read_ranges(deck, block, line, set, log, "B")
       else
         call read_members(deck, block, line, "NID", set, log)
       end if
@@ -84,6 +89,124 @@ contains
       call read_members(deck, block, line, "PID", set, log)
     end associate
   end subroutine read_part_set
+
+  !> *SET_PART_LIST_GENERATE: SID card, then up to four ranges P1BEG P1END ... per line; a
+  !> range takes every defined part with an id in it.
+  subroutine read_generated_part_set(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    integer :: line
+    line = 0
+    input%part_set_count = input%part_set_count + 1
+    associate (set => input%part_sets(input%part_set_count))
+      set%generated = .true.
+      if (.not. read_set_header(deck, block, keyword, line, set, log, warnings)) return
+      call read_ranges(deck, block, line, set, log, "P")
+    end associate
+  end subroutine read_generated_part_set
+
+  !> *SET_NODE_ADD: SID card, then node set ids 8 per line (sets of sets may nest, in any
+  !> order of the deck).
+  subroutine read_added_node_set(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    integer :: line
+    line = 0
+    input%node_set_count = input%node_set_count + 1
+    associate (set => input%node_sets(input%node_set_count))
+      set%kind = set_added
+      if (.not. read_set_header(deck, block, keyword, line, set, log, warnings)) return
+      call read_members(deck, block, line, "DSID", set, log)
+    end associate
+  end subroutine read_added_node_set
+
+  !> *SET_PART_ADD: SID card, then part set ids 8 per line.
+  subroutine read_added_part_set(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    integer :: line
+    line = 0
+    input%part_set_count = input%part_set_count + 1
+    associate (set => input%part_sets(input%part_set_count))
+      set%kind = set_added
+      if (.not. read_set_header(deck, block, keyword, line, set, log, warnings)) return
+      call read_members(deck, block, line, "DSID", set, log)
+    end associate
+  end subroutine read_added_part_set
+
+  !> *SET_NODE_GENERAL: SID card, then one operation per line: OPTION E1 ... E7. ALL takes
+  !> every node; NODE the nodes E1-E7; PART the nodes of the elements of parts E1-E7; BOX the
+  !> nodes inside boxes E1-E7; DNODE, DPART and DBOX remove those again. The operations apply
+  !> in deck order.
+  subroutine read_general_node_set(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    character(len=:), allocatable :: option
+    integer :: line, k, id, operation, added
+
+    line = 0
+    input%node_set_count = input%node_set_count + 1
+    associate (set => input%node_sets(input%node_set_count))
+      set%kind = set_general
+      if (.not. read_set_header(deck, block, keyword, line, set, log, warnings)) return
+      do while (next_line(deck, block, line, .true.))
+        call open_card(deck, block, line, standard_widths, card, log)
+        call get_text(deck, card, 1, "OPTION", option, log)
+        select case (to_upper(option))
+        case ("ALL")
+          operation = general_all
+        case ("NODE")
+          operation = general_node
+        case ("PART")
+          operation = general_part
+        case ("BOX")
+          operation = general_box
+        case ("DNODE")
+          operation = general_remove_node
+        case ("DPART")
+          operation = general_remove_part
+        case ("DBOX")
+          operation = general_remove_box
+        case default
+          call card_problem(deck, log, card, "OPTION", """"//option//""" is not available; "// &
+                            "use ALL, NODE, PART, BOX, DNODE, DPART or DBOX")
+          cycle
+        end select
+        added = 0
+        do k = 2, 8
+          call get_integer(deck, card, k, "E"//digit(k - 1), id, log)
+          if (id < 0) then
+            call card_problem(deck, log, card, "E"//digit(k - 1), "id must be > 0 (blank or "// &
+                              "0 entries are skipped), found "//integer_text(id))
+          else if (id > 0 .and. operation == general_all) then
+            call card_problem(deck, log, card, "E"//digit(k - 1), "ALL takes no ids, found "// &
+                              integer_text(id))
+          else if (id > 0) then
+            call append_id(set%members, id, line, k)
+            added = added + 1
+          end if
+        end do
+        call append_id(set%operations, operation, line, added)
+      end do
+    end associate
+  end subroutine read_general_node_set
 
   !> *SET_SEGMENT: SID card, then one segment per line: N1 N2 N3 N4 A1 A2 A3 A4. N4 blank or
   !> 0 (or equal to N3) is a triangle; the attributes A1-A4 are not used.
@@ -170,13 +293,15 @@ contains
     end do
   end subroutine read_members
 
-  !> Ranges B1BEG B1END ... B4BEG B4END; a range takes every defined node with an id in it.
-  subroutine read_ranges(deck, block, line, set, log)
+  !> Ranges B1BEG B1END ... B4BEG B4END (`letter` B; P for parts: P1BEG ...); a range takes
+  !> every defined node (part) with an id in it.
+  subroutine read_ranges(deck, block, line, set, log, letter)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
     integer, intent(inout) :: line
     type(set_input_t), intent(inout) :: set
     type(problem_log_t), intent(inout) :: log
+    character(len=1), intent(in) :: letter
     type(card_t) :: card
     integer :: k, first, last
     character(len=5) :: first_name, last_name
@@ -184,8 +309,8 @@ contains
     do while (next_line(deck, block, line, .true.))
       call open_card(deck, block, line, standard_widths, card, log)
       do k = 1, 4
-        first_name = "B"//digit(k)//"BEG"
-        last_name = "B"//digit(k)//"END"
+        first_name = letter//digit(k)//"BEG"
+        last_name = letter//digit(k)//"END"
         call get_integer(deck, card, 2*k - 1, first_name, first, log)
         call get_integer(deck, card, 2*k, last_name, last, log)
         if (first == 0 .and. last == 0) cycle

@@ -1,5 +1,5 @@
-!> Blocks of beam elements (*SECTION_BEAM ELFORM 1 Hughes-Liu, 2 resultant beam, 9 spot weld beam)
-!> per-cycle element work on them.
+!> Blocks of beam elements (*SECTION_BEAM ELFORM 1 Hughes-Liu, 2 resultant beam, 9 spot weld beam) and
+!> the per-cycle element work on them.
 !>
 !> The element (Hughes & Liu 1981, part I, specialised to a beam as in LS-DYNA's Theory Manual,
 !> "Hughes-Liu beam") is a two-node beam with Timoshenko kinematics, one integration point at

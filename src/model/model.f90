@@ -13,6 +13,7 @@ module model
   public :: model_t, material_t, section_t, hourglass_t, part_t, node_set_t, part_set_t
   public :: spc_t, prescribed_motion_t, nodal_load_t, segment_load_t, rigid_wall_t, output_control_t
   public :: rigid_body_t, rigid_motion_t
+  public :: local_spc_t
   public :: segment_set_t, contact_t, contact_surface_t
 
   !> The law codes and what each law can do are in material_laws' law_table. law_null is also
@@ -174,10 +175,24 @@ module model
     logical :: fixed_rotation(3) = .false.  !< rotations about x, y, z (act on shell nodes only)
   end type spc_t
 
+  !> One node constrained along directions other than the global axes (*BOUNDARY_SPC with a
+  !> CID): its velocity keeps no component along `directions(:, 1:count)` (orthonormal, global
+  !> components; the node's global SPC directions are among them).
+  type :: local_spc_t
+    integer :: node = 0
+    integer :: count = 0
+    real(wp) :: directions(3, 3) = 0.0_wp
+  end type local_spc_t
+
+  !> Prescribed-motion directions beyond x, y, z (1, 2, 3): along `vector`, free across it
+  !> (LS-DYNA's DOF 4), or along `vector` and held across it (DOF -4).
+  integer, parameter, public :: motion_along_vector = 4, motion_only_along_vector = -4
+
   !> One prescribed motion of one node and one translational direction.
   type :: prescribed_motion_t
     integer :: node = 0
-    integer :: direction = 0                 !< 1, 2, 3
+    integer :: direction = 0                 !< 1, 2, 3, motion_along_vector, motion_only_along_vector
+    real(wp) :: vector(3) = 0.0_wp           !< unit direction of the last two (VID)
     integer :: kind = motion_velocity        !< VAD
     integer :: curve = 0                     !< index into model%curves
     real(wp) :: scale = 1.0_wp               !< SF
@@ -352,6 +367,7 @@ module model
     type(part_set_t), allocatable :: part_sets(:)
     ! boundary conditions and loads
     type(spc_t), allocatable :: spcs(:)
+    type(local_spc_t), allocatable :: local_spcs(:)  !< SPCs in local systems (CID)
     type(prescribed_motion_t), allocatable :: motions(:)
     type(nodal_load_t), allocatable :: loads(:)
     type(segment_load_t), allocatable :: segment_loads(:)
@@ -379,6 +395,7 @@ module model
     type(segment_set_t), allocatable :: segment_sets(:)
     type(contact_t), allocatable :: contacts(:)
     real(wp) :: contact_penalty_scale = 0.1_wp       !< *CONTROL_CONTACT SLSFAC
+    integer :: contact_sort_interval = 0             !< *CONTROL_CONTACT NSBCS (0: sort when nodes moved)
     type(output_control_t) :: output
   end type model_t
 end module model

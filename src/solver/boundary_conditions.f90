@@ -8,7 +8,8 @@
 module boundary_conditions
   use kinds, only: wp
   use curves, only: curve_value
-  use model, only: model_t, motion_velocity, motion_acceleration, motion_displacement
+  use model, only: model_t, motion_velocity, motion_acceleration, motion_displacement, &
+                   motion_along_vector, motion_only_along_vector
   implicit none
   private
 
@@ -44,15 +45,34 @@ contains
   !> one (VAD = 1) or zero (velocity and displacement are imposed on the half-step velocities),
   !> so that integer-step velocities, kinetic energy and output show the prescribed motion. The
   !> acceleration the forces would have given each prescribed dof is kept in
-  !> `free_acceleration`: the support's reaction does the work between the two.
+  !> `free_acceleration`: the support's reaction does the work between the two. Nodes held in
+  !> local directions (SPCs with a CID) lose their acceleration along those directions first.
   subroutine hold_prescribed_accelerations(model, time, acceleration, free_acceleration)
     type(model_t), intent(in) :: model
     real(wp), intent(in) :: time
     real(wp), intent(inout) :: acceleration(:, :)
     real(wp), intent(out) :: free_acceleration(:)
     integer :: k
+    real(wp) :: along, value
+    call remove_local_components(model, acceleration)
     do k = 1, size(model%motions)
       associate (motion => model%motions(k))
+        if (motion%direction == motion_along_vector .or. &
+            motion%direction == motion_only_along_vector) then
+          ! along a vector: the component along it is the prescribed dof
+          along = dot_product(acceleration(:, motion%node), motion%vector)
+          free_acceleration(k) = along
+          if (time < motion%birth .or. time > motion%death) cycle
+          value = 0.0_wp
+          if (motion%kind == motion_acceleration) value = &
+            motion%scale*curve_value(model%curves(motion%curve), time - motion%birth)
+          if (motion%direction == motion_only_along_vector) then
+            acceleration(:, motion%node) = value*motion%vector
+          else
+            acceleration(:, motion%node) = acceleration(:, motion%node) + (value - along)*motion%vector
+          end if
+          cycle
+        end if
         free_acceleration(k) = acceleration(motion%direction, motion%node)
         if (time < motion%birth .or. time > motion%death) cycle
         if (motion%kind == motion_acceleration) then
@@ -64,6 +84,23 @@ contains
       end associate
     end do
   end subroutine hold_prescribed_accelerations
+
+  !> Remove from `vectors` (velocities or accelerations, per node) the components along the
+  !> local SPC directions of each node (orthonormal, so one projection each).
+  pure subroutine remove_local_components(model, vectors)
+    type(model_t), intent(in) :: model
+    real(wp), intent(inout) :: vectors(:, :)
+    integer :: k, j
+    if (.not. allocated(model%local_spcs)) return
+    do k = 1, size(model%local_spcs)
+      associate (spc => model%local_spcs(k))
+        do j = 1, spc%count
+          vectors(:, spc%node) = vectors(:, spc%node) - &
+            dot_product(vectors(:, spc%node), spc%directions(:, j))*spc%directions(:, j)
+        end do
+      end associate
+    end do
+  end subroutine remove_local_components
 
   !> External nodal forces at `time` (overwrites `external_force`).
   subroutine assemble_nodal_loads(model, time, external_force)
@@ -118,10 +155,16 @@ contains
       node = model%spcs(k)%node
       where (fixed(:, node)) velocity(:, node) = 0.0_wp
     end do
+    call remove_local_components(model, velocity)
     do k = 1, size(model%motions)
       associate (motion => model%motions(k))
         node = motion%node
         direction = motion%direction
+        if (direction == motion_along_vector .or. direction == motion_only_along_vector) then
+          call impose_along_vector(model, k, time, dt, average_dt, displacement, acceleration, &
+                                   free_acceleration, mass, velocity, support_work)
+          cycle
+        end if
         select case (motion%kind)
         case (motion_velocity)
           local_time = time + 0.5_wp*dt
@@ -152,4 +195,52 @@ contains
       end associate
     end do
   end subroutine impose_kinematic_conditions
+
+  !> impose_kinematic_conditions for motion `k`, which acts along its unit vector d: the
+  !> velocity component v.d becomes the prescribed one (and, for motion_only_along_vector, the
+  !> components across d vanish). The support's work is booked as for an axis direction.
+  subroutine impose_along_vector(model, k, time, dt, average_dt, displacement, acceleration, &
+                                 free_acceleration, mass, velocity, support_work)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: k
+    real(wp), intent(in) :: time, dt, average_dt
+    real(wp), intent(in) :: displacement(:, :), acceleration(:, :), free_acceleration(:), mass(:)
+    real(wp), intent(inout) :: velocity(:, :)
+    real(wp), intent(inout) :: support_work
+    real(wp) :: local_time, value, target, current, previous(3), free(3)
+    associate (motion => model%motions(k), node => model%motions(k)%node)
+      select case (motion%kind)
+      case (motion_velocity)
+        local_time = time + 0.5_wp*dt
+      case (motion_acceleration)
+        local_time = time
+      case default
+        local_time = time + dt
+      end select
+      if (local_time < motion%birth .or. local_time > motion%death) return
+      value = motion%scale*curve_value(model%curves(motion%curve), local_time - motion%birth)
+      current = dot_product(velocity(:, node), motion%vector)
+      select case (motion%kind)
+      case (motion_velocity)
+        target = value
+      case (motion_acceleration)
+        target = current
+      case default
+        target = (value - dot_product(displacement(:, node), motion%vector))/dt
+      end select
+      previous = velocity(:, node) - average_dt*acceleration(:, node)
+      ! the velocity the forces alone would have given (across d a held node has no velocity
+      ! before or after, so whatever the forces did there does no work)
+      free = velocity(:, node) + average_dt*(free_acceleration(k) - &
+             dot_product(acceleration(:, node), motion%vector))*motion%vector
+      if (motion%direction == motion_only_along_vector) then
+        velocity(:, node) = target*motion%vector
+      else
+        velocity(:, node) = velocity(:, node) + (target - current)*motion%vector
+      end if
+      ! impulse m (v^{n+1/2} - v_free) times the mean of v^{n-1/2} and v^{n+1/2}
+      support_work = support_work + 0.5_wp*mass(node)*dot_product(velocity(:, node) - free, &
+                                                                   velocity(:, node) + previous)
+    end associate
+  end subroutine impose_along_vector
 end module boundary_conditions

@@ -255,3 +255,25 @@ def test_node_arriving_under_a_segment_from_its_edge_is_not_pushed_out(tmp_path,
     assert np.abs(velocity[:, 2]).max() < 1e-9 * speed
     assert np.allclose(velocity[:, 0], speed, rtol=1e-9)
     assert np.abs(contact).max() == 0.0
+
+
+def test_bucket_sort_interval_changes_when_the_search_runs_not_the_forces(tmp_path, run_deck):
+    """NSBCS (*CONTROL_CONTACT card 2) and BSORT only make the search sort more often than the
+    automatic rule (when a node has moved half the search margin), which misses no pair: the
+    head-on impact gives the same histories and states, bit for bit, with a sort every cycle.
+    A negative NSBCS is refused, naming the field."""
+    automatic = run_deck(head_on_deck(tmp_path / "automatic.k", end_time=0.015)[0], jobid="automatic")
+    every_cycle = run_deck(head_on_deck(tmp_path / "every.k", end_time=0.015,
+                                        extra="*CONTROL_CONTACT\n" + fields(0.0) + "\n" + fields(0, 0, 1))[0],
+                           jobid="every")
+    assert automatic.status == 0 and every_cycle.status == 0, automatic.stdout + every_cycle.stdout
+    with automatic.open() as first, every_cycle.open() as second:
+        a, b = datasets(first), datasets(second)
+    compared = [name for name in a if name.startswith(("history/", "states/"))]
+    assert compared and all(name in b for name in compared)
+    for name in compared:
+        assert np.array_equal(a[name], b[name]), f"{name} differs with NSBCS = 1"
+    bad = run_deck(head_on_deck(tmp_path / "bad_nsbcs.k", extra="*CONTROL_CONTACT\n" + fields(0.0) + "\n" +
+                                fields(0, 0, -5))[0], jobid="bad_nsbcs")
+    assert bad.status == 2
+    assert "*CONTROL_CONTACT: field NSBCS: must be >= 0" in bad.stdout + bad.stderr, bad.stdout + bad.stderr
