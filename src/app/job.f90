@@ -173,11 +173,15 @@ contains
     do k = 1, size(state%groups)
       call state%groups(k)%group%add_to_summary(summary)
     end do
-    summary%fe_elements = summary%fe_solids + summary%fe_shells
+    summary%fe_elements = summary%fe_solids + summary%fe_shells + summary%fe_beams
     summary%dofs_total = 3*size(model%node_ids) + 3*count(state%nodes%rotary_inertia > 0.0_wp)
     write (line, '(a,i0,a,i0,a,i0,a,i0,a)') "model: ", size(model%node_ids), " nodes, ", size(model%solid_ids), &
       " solids, ", size(model%shell_ids), " shells in ", size(model%parts), " parts"
     write (*, '(a)') trim(line)
+    if (summary%fe_beams > 0) then
+      write (line, '(a,i0,a)') "beams: ", summary%fe_beams, " (Hughes-Liu and spot weld beams)"
+      write (*, '(a)') trim(line)
+    end if
     write (line, '(a,es12.5)') "mass: ", state%physical_mass
     write (*, '(a)') trim(line)
     if (summary%dofs_efg > 0) then
@@ -212,7 +216,7 @@ contains
       "  solids", summary%fe_solid_s, "  shells", summary%fe_shell_s, "  meshfree", summary%efg_s, "  contact", &
       summary%contact_s, "  output", summary%output_s, "  other", &
       max(0.0_wp, summary%wall_s - summary%setup_s - summary%fe_solid_s - summary%fe_shell_s - summary%efg_s - &
-          summary%contact_s - summary%output_s)
+          summary%contact_s - summary%output_s - summary%fe_beam_s)
     write (*, '(a)') trim(line)
     if (.not. static .and. summary%cycles > 0 .and. summary%fe_solids > 0) then
       per_element = 1.0e9_wp*summary%fe_solid_s/(real(summary%cycles, wp)*real(summary%fe_solids, wp))
@@ -222,6 +226,12 @@ contains
     if (.not. static .and. summary%cycles > 0 .and. summary%fe_shells > 0) then
       per_element = 1.0e9_wp*summary%fe_shell_s/(real(summary%cycles, wp)*real(summary%fe_shells, wp))
       write (line, '(a,f0.1,a)') "  shell elements: ", per_element, " ns per element per cycle"
+      write (*, '(a)') trim(line)
+    end if
+    if (.not. static .and. summary%cycles > 0 .and. summary%fe_beams > 0) then
+      per_element = 1.0e9_wp*summary%fe_beam_s/(real(summary%cycles, wp)*real(summary%fe_beams, wp))
+      write (line, '(a,f0.1,a,i0,a)') "  beam elements: ", per_element, " ns per element per cycle; ", &
+        summary%failed_beams, " failed"
       write (*, '(a)') trim(line)
     end if
     if (.not. static .and. summary%cycles > 0 .and. summary%efg_particles > 0) then

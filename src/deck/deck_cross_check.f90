@@ -26,6 +26,7 @@ module deck_cross_check
   use deck_rigid_bodies, only: build_rigid_bodies
   use deck_contact, only: build_contacts
   use deck_tied_contact, only: build_tied_contacts
+  use deck_beams, only: resolve_beams
   use deck_shell_check, only: check_element_sections, build_shell_thickness, &
                               check_static_shells
   implicit none
@@ -64,6 +65,7 @@ contains
     call resolve_shells(deck, input, indices, shells_resolved, log)
     mesh_resolved = mesh_resolved .and. shells_resolved
     call resolve_parts(deck, input, indices, log)
+    call resolve_beams(deck, input, indices%nodes, indices%parts, log, warnings)
     call check_element_sections(deck, input, log)
     call build_shell_thickness(deck, input, log)
     if (mesh_resolved) call order_tetrahedra(input)
@@ -524,7 +526,7 @@ contains
     count = size(members)
   end subroutine general_members
 
-  !> Set `chosen` to `value` on the nodes of the solids and shells of part `part` (an index).
+  !> Set `chosen` to `value` on the nodes of the solids, shells and beams of part `part` (an index).
   subroutine mark_part_nodes(input, part, value, chosen)
     type(deck_input_t), intent(in) :: input
     integer, intent(in) :: part
@@ -541,6 +543,12 @@ contains
       if (input%model%shell_part(element) /= part) cycle
       do k = 1, 4
         if (input%model%shell_nodes(k, element) > 0) chosen(input%model%shell_nodes(k, element)) = value
+      end do
+    end do
+    do element = 1, input%beam_count
+      if (input%model%beam_part(element) /= part) cycle
+      do k = 1, 2
+        if (input%model%beam_nodes(k, element) > 0) chosen(input%model%beam_nodes(k, element)) = value
       end do
     end do
   end subroutine mark_part_nodes
@@ -749,6 +757,12 @@ contains
       do node = 1, 4
         if (input%model%shell_nodes(node, k) > 0) &
           on_shell(input%model%shell_nodes(node, k)) = .true.
+      end do
+    end do
+    ! (beam nodes have rotations as shell nodes do)
+    do k = 1, input%beam_count
+      do node = 1, 2
+        if (input%model%beam_nodes(node, k) > 0) on_shell(input%model%beam_nodes(node, k)) = .true.
       end do
     end do
     first = 0
@@ -1256,6 +1270,12 @@ contains
       if (chosen_part(k)) chosen_node(pack(input%model%shell_nodes(:, element), &
                                            input%model%shell_nodes(:, element) > 0)) = .true.
     end do
+    do element = 1, input%beam_count
+      k = input%model%beam_part(element)
+      if (k == 0) cycle
+      if (chosen_part(k)) chosen_node(pack(input%model%beam_nodes(1:2, element), &
+                                           input%model%beam_nodes(1:2, element) > 0)) = .true.
+    end do
     nodes = pack([(k, k=1, input%node_count)], chosen_node)
     generation_nodes = .true.
   end function generation_nodes
@@ -1375,7 +1395,7 @@ contains
 
     if (input%node_count == 0) call report_problem(log, deck%files(1)%path// &
       ": *NODE: field NID: the deck defines no nodes")
-    if (input%solid_count == 0 .and. input%shell_count == 0) call report_problem(log, &
+    if (input%solid_count == 0 .and. input%shell_count == 0 .and. input%beam_count == 0) call report_problem(log, &
       deck%files(1)%path//": *ELEMENT_SOLID: field EID: the deck defines no elements (no "// &
       "*ELEMENT_SOLID or *ELEMENT_SHELL)")
     if (.not. resolved) return

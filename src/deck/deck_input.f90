@@ -26,9 +26,9 @@ module deck_input
     list_velocities = 14, list_walls = 15, list_segment_sets = 16, list_segment_loads = 17, &
     list_rigid_materials = 18, list_rigid_motions = 19, list_nodal_rigid_bodies = 20, &
     list_element_masses = 21, list_contacts = 22, list_boxes = 23, list_frames = 24, list_vectors = 25, &
-    list_spot_welds = 26, list_rigid_links = 27, list_tied_contacts = 28
+    list_spot_welds = 26, list_rigid_links = 27, list_tied_contacts = 28, list_beams = 29
   !> Number of lists.
-  integer, parameter, public :: list_count = 28
+  integer, parameter, public :: list_count = 29
 
   !> How a set's members are given (set_input_t%kind): listed ids (or ranges when `generated`),
   !> *SET_NODE_GENERAL operations, or *SET_..._ADD set ids.
@@ -208,6 +208,9 @@ module deck_input
     !> *ELEMENT_SHELL). model%shell_thickness holds THIC1-4 as read (0: the section's).
     integer :: shell_count = 0
     integer, allocatable :: shell_lines(:), shell_thickness_lines(:)
+    !> *ELEMENT_BEAM: the element card of each beam (deck_beams).
+    integer :: beam_count = 0
+    integer, allocatable :: beam_lines(:)
     integer, allocatable :: part_lines(:), section_lines(:), material_lines(:)
     integer, allocatable :: hourglass_lines(:), curve_lines(:)
     type(set_input_t), allocatable :: node_sets(:), part_sets(:)
@@ -253,6 +256,8 @@ contains
     n = capacity(list_shells)
     allocate (input%model%shell_ids(n), input%model%shell_part(n), input%model%shell_nodes(4, n), &
               input%model%shell_thickness(4, n), input%shell_lines(n), input%shell_thickness_lines(n))
+    n = capacity(list_beams)
+    allocate (input%model%beam_ids(n), input%model%beam_part(n), input%model%beam_nodes(3, n), input%beam_lines(n))
     n = capacity(list_parts)
     allocate (input%model%parts(n), input%part_lines(n))
     n = capacity(list_sections)

@@ -16,7 +16,7 @@ module deck_keyword_table
   use error_handling, only: error_list_t
   use material_laws, only: find_law, law_keyword_name, law_number_name, law_elastic, &
                            law_plastic_kinematic, law_honeycomb, law_modified_honeycomb, law_low_density_foam, &
-                           law_rigid, law_piecewise_linear, law_null
+                           law_rigid, law_piecewise_linear, law_null, law_spotweld
   use deck_problems, only: problem_log_t
   use deck_lexer, only: deck_t
   use deck_keywords, only: keyword_t, keyword_unknown, read_options, suggest_keyword
@@ -24,7 +24,7 @@ module deck_keyword_table
     list_sections, list_materials, list_hourglasses, list_curves, list_node_sets, list_part_sets, list_spcs, &
     list_motions, list_loads, list_velocities, list_walls, list_segment_sets, list_segment_loads, &
     list_rigid_materials, list_rigid_motions, list_nodal_rigid_bodies, list_element_masses, list_contacts, &
-    list_count, list_boxes, list_frames, list_vectors, list_spot_welds, list_rigid_links, list_tied_contacts
+    list_count, list_boxes, list_frames, list_vectors, list_spot_welds, list_rigid_links, list_tied_contacts, list_beams
   use deck_nodes_elements, only: read_nodes, read_solid_elements, read_shell_elements, read_thick_shell_elements
   use deck_parts_sections, only: read_parts, read_solid_sections, read_efg_sections, read_shell_sections, &
     read_hourglasses
@@ -51,6 +51,8 @@ module deck_keyword_table
   use deck_tied_contact, only: read_tied_nodes_to_surface, read_tied_nodes_to_surface_offset, &
     read_tied_surface_to_surface, read_tied_surface_to_surface_offset, read_tied_shell_edge_to_surface, &
     read_tied_shell_edge_to_surface_offset, read_spotweld_contacts
+  use deck_beams, only: read_beam_elements, read_beam_elements_with_card, read_beam_sections, &
+    read_spotweld_materials
   use deck_contact, only: read_nodes_to_surface_contacts, read_surface_to_surface_contacts, &
     read_single_surface_contacts, read_control_contact, read_rcforc
   implicit none
@@ -214,6 +216,14 @@ contains
                       reader=read_thick_shell_elements), &
       keyword_entry_t("SECTION_SHELL", options="TITLE", fills=[list_sections, list_none], &
                       reader=read_shell_sections), &
+      keyword_entry_t("ELEMENT_BEAM", fills=[list_beams, list_none], reader=read_beam_elements), &
+      keyword_entry_t("ELEMENT_BEAM_THICKNESS", fills=[list_beams, list_none], entries=per_two_lines, &
+                      reader=read_beam_elements_with_card), &
+      keyword_entry_t("ELEMENT_BEAM_OFFSET", fills=[list_beams, list_none], entries=per_two_lines, &
+                      reader=read_beam_elements_with_card), &
+      keyword_entry_t("SECTION_BEAM", options="TITLE", fills=[list_sections, list_none], &
+                      reader=read_beam_sections), &
+      law_keyword(law_spotweld, read_spotweld_materials), &
       keyword_entry_t("DATABASE_BINARY_D3DUMP", reader=read_d3dump_output), &
       keyword_entry_t("DATABASE_BINARY_RUNRSF", reader=read_runrsf_output), &
       keyword_entry_t("KEYWORD"), keyword_entry_t("INCLUDE"), keyword_entry_t("PARAMETER"), &

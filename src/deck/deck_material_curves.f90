@@ -7,7 +7,7 @@
 !>   that need them (the crushable honeycombs and foam).
 module deck_material_curves
   use kinds, only: wp
-  use model, only: model_t, material_t, section_shell, piecewise_hardening_curve
+  use model, only: model_t, material_t, section_shell, section_beam, piecewise_hardening_curve
   use material_laws, only: law_table, find_law, law_keyword_name, law_curve_field, law_piecewise_linear, &
                            law_null
   use deck_problems, only: problem_log_t
@@ -107,6 +107,12 @@ contains
         law = find_law(material%law)
         if (law == 0) cycle
         formulation = section%element_formulation
+        if (section%kind == section_beam) then
+          if (.not. law_table(law)%beams) call located_problem(deck, log, part_lines(part), "MID", part_name// &
+            " (*"//law_keyword_name(law)//") is not available on beams; beam sections take *MAT_ELASTIC, "// &
+            "*MAT_PLASTIC_KINEMATIC or *MAT_SPOTWELD")
+          cycle
+        end if
         if (section%kind == section_shell) then
           if (.not. law_table(law)%shells) then
             call located_problem(deck, log, part_lines(part), "MID", part_name//" has no shell (plane-stress) "// &

@@ -9,7 +9,7 @@
 !> mesh of a million shells on a solid section gives one line, not a million.
 module deck_shell_check
   use kinds, only: wp
-  use model, only: section_solid, section_shell
+  use model, only: section_solid, section_shell, section_beam
   use deck_problems, only: problem_log_t
   use deck_numbers, only: digit
   use text_format, only: integer_text, real_text
@@ -71,7 +71,12 @@ contains
     do part = 1, input%part_count
       if (first(part) == 0) cycle
       associate (section => input%model%sections(input%model%parts(part)%section))
-        if (wanted == section_solid) then
+        if (section%kind == section_beam) then
+          message = "part "//integer_text(input%model%parts(part)%id)//" of "// &
+            trim(merge("solid element", "shell        ", wanted == section_solid))//" "// &
+            integer_text(ids(first(part)))//" has beam section "//integer_text(section%id)// &
+            " (*SECTION_BEAM); beam sections are for *ELEMENT_BEAM"
+        else if (wanted == section_solid) then
           message = "part "//integer_text(input%model%parts(part)%id)//" of solid element "// &
             integer_text(ids(first(part)))//" has shell section "//integer_text(section%id)// &
             " (*SECTION_SHELL); solid elements need a *SECTION_SOLID or *SECTION_SOLID_EFG "// &

@@ -45,6 +45,10 @@ module element_group
     real(wp), allocatable :: shell_stress(:, :)          !< (6, shells) mid-surface
     real(wp), allocatable :: shell_stress_peak(:, :)     !< (6, shells) the point of largest von Mises
     real(wp), allocatable :: shell_plastic_strain(:), shell_plastic_strain_peak(:)
+    !> (6, beams) N, Q_s, Q_t, T, M_s, M_t in the beam's local axes r, s, t (beam_group)
+    real(wp), allocatable :: beam_resultant(:, :)
+    real(wp), allocatable :: beam_plastic_strain(:)      !< (beams) largest over the section points
+    real(wp), allocatable :: beam_failed(:)              !< (beams) 1 failed (*MAT_SPOTWELD), 0 not
   end type element_results_t
 
   type, abstract :: element_group_t

@@ -27,6 +27,7 @@ module material_laws
   integer, parameter, public :: law_honeycomb = 26            !< *MAT_HONEYCOMB
   integer, parameter, public :: law_modified_honeycomb = 126  !< *MAT_MODIFIED_HONEYCOMB
   integer, parameter, public :: law_low_density_foam = 57     !< *MAT_LOW_DENSITY_FOAM
+  integer, parameter, public :: law_spotweld = 100            !< *MAT_SPOTWELD (beams)
 
   !> History count of a law without a plane-stress kernel (it cannot be used on shell blocks).
   integer, parameter, public :: no_plane_stress_kernel = -1
@@ -40,6 +41,7 @@ module material_laws
     logical :: solids = .false.           !< may be used on hexahedra (ELFORM 1, 2)
     logical :: shells = .false.           !< may be used on shells (ELFORM 2)
     logical :: meshfree = .false.         !< may be used on EFG parts (ELFORM 41)
+    logical :: beams = .false.            !< may be used on beams (*SECTION_BEAM ELFORM 1, 9)
     !> Needs a hexahedron section (ELFORM 1, 2 or 41): the law takes its material axes or its
     !> volume from the hexahedron (EFG points from their background cell).
     logical :: hexahedra_only = .false.
@@ -54,11 +56,11 @@ module material_laws
   end type material_law_t
 
   !> The laws, in the order messages list them.
-  type(material_law_t), parameter :: law_table(8) = [ &
+  type(material_law_t), parameter :: law_table(9) = [ &
     material_law_t(code=law_elastic, name="ELASTIC", solids=.true., shells=.true., meshfree=.true., &
-                   history_count=0, shell_history_count=0), &
+                   beams=.true., history_count=0, shell_history_count=0), &
     material_law_t(code=law_plastic_kinematic, name="PLASTIC_KINEMATIC", solids=.true., shells=.true., &
-                   meshfree=.true., history_count=7, shell_history_count=4), &
+                   meshfree=.true., beams=.true., history_count=7, shell_history_count=4), &
     material_law_t(code=law_piecewise_linear, name="PIECEWISE_LINEAR_PLASTICITY", solids=.true., &
                    shells=.true., meshfree=.true., history_count=1, shell_history_count=1, &
                    curve_fields="LCSS LCSR", curve_card=2), &
@@ -73,7 +75,8 @@ module material_laws
                    hexahedra_only=.true., history_count=23, curve_fields="LCA LCB LCC LCAB LCBC LCCA LCSR", &
                    curve_card=2), &
     material_law_t(code=law_low_density_foam, name="LOW_DENSITY_FOAM", solids=.true., meshfree=.true., &
-                   hexahedra_only=.true., history_count=7, curve_fields="LCID", curve_card=1)]
+                   hexahedra_only=.true., history_count=7, curve_fields="LCID", curve_card=1), &
+    material_law_t(code=law_spotweld, name="SPOTWELD", beams=.true.)]
 
 contains
 

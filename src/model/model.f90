@@ -55,6 +55,11 @@ module model
     ! *MAT_PIECEWISE_LINEAR_PLASTICITY (SIGY, ETAN, FAIL, C, P, VP above; curves in the slots
     ! piecewise_hardening_curve and piecewise_rate_curve)
     real(wp) :: failure_time_step = 0.0_wp  !< TDEL (read and kept; erosion is not modelled)
+    ! *MAT_SPOTWELD (E, PR, SIGY above; ET in tangent_modulus)
+    real(wp) :: failure_time = 0.0_wp       !< TFAIL: the weld fails at this time (0: never)
+    real(wp) :: failure_plastic_strain = 0.0_wp !< EFAIL: plastic strain at failure (0: none)
+    !> NRR NRS NRT MRR MSS MTT: resultants at failure (0: that term is left out)
+    real(wp) :: failure_resultants(6) = 0.0_wp
     ! *MAT_NULL
     real(wp) :: pressure_cutoff = 0.0_wp    !< PC (read and kept)
     ! *MAT_HONEYCOMB, *MAT_MODIFIED_HONEYCOMB (E, PR, SIGY above: the fully compacted material)
@@ -89,6 +94,13 @@ module model
 
   !> Section kinds (section_t%kind).
   integer, parameter, public :: section_solid = 1, section_shell = 2
+  !> *SECTION_BEAM (section_t%kind).
+  integer, parameter, public :: section_beam = 3
+  !> Beam cross-section types (CST): rectangular, tubular (a solid circle when the wall is as
+  !> thick as the radius).
+  integer, parameter, public :: cross_section_rectangular = 0, cross_section_tubular = 1
+  !> *SECTION_BEAM ELFORM of the resultant beam (section by A ISS ITT J SA).
+  integer, parameter, public :: beam_resultant_formulation = 2
 
   !> One section: solid (*SECTION_SOLID, *SECTION_SOLID_EFG) or shell (*SECTION_SHELL).
   type :: section_t
@@ -109,6 +121,12 @@ module model
     real(wp) :: kernel_tolerance = 0.0_wp  !< TOLDEF: 0 Lagrangian kernel (the only one built)
     integer :: boundary_treatment = boundary_coupled        !< IEBT: 3 coupled FE/EFG, 1 full transformation
     integer :: domain_integration = integration_local_boundary !< IDIM: 1 local boundary (SCNI), 2 Gauss 2x2x2
+    ! *SECTION_BEAM (ELFORM 1 Hughes-Liu, 9 spot weld beam; SHRF above, default 1)
+    integer :: cross_section = cross_section_rectangular !< CST: 0 rectangular, 1 tubular
+    integer :: beam_rule = 2               !< QR/IRID: Gauss points per section direction (1-5)
+    real(wp) :: beam_size(4) = 0.0_wp      !< TS1 TS2 TT1 TT2 (TS2, TT2 default TS1, TT1)
+    !> ELFORM 2 (resultant beam): A ISS ITT J SA (J 0: ISS + ITT; SA 0: A)
+    real(wp) :: beam_properties(5) = 0.0_wp
   end type section_t
 
   !> One hourglass / bulk-viscosity definition (*HOURGLASS).
@@ -367,6 +385,11 @@ module model
     integer, allocatable :: shell_part(:)            !< part index of each shell
     integer, allocatable :: shell_nodes(:, :)        !< (4, shells) node indices
     real(wp), allocatable :: shell_thickness(:, :)   !< (4, shells): *ELEMENT_SHELL_THICKNESS, else the section's
+    ! beam elements (*ELEMENT_BEAM)
+    integer, allocatable :: beam_ids(:)
+    integer, allocatable :: beam_part(:)             !< part index of each beam
+    integer, allocatable :: beam_nodes(:, :)         !< (3, beams) node indices N1 N2 and the orientation
+                                                     !< node N3 (0: none)
     ! properties
     type(part_t), allocatable :: parts(:)
     type(section_t), allocatable :: sections(:)

@@ -22,7 +22,10 @@ module run_summary
     real(wp) :: efg_setup_s = 0.0_wp             !< part of setup_s: EFG neighbours, shape functions, gradients
     ! sizes
     integer :: fe_elements = 0, efg_particles = 0, dofs_total = 0, dofs_efg = 0
-    integer :: fe_solids = 0, fe_shells = 0      !< fe_elements = fe_solids + fe_shells
+    integer :: fe_solids = 0, fe_shells = 0      !< fe_elements = fe_solids + fe_shells + fe_beams
+    integer :: fe_beams = 0                      !< beam elements (beam_group)
+    real(wp) :: fe_beam_s = 0.0_wp               !< seconds of the beams' force calls
+    integer :: failed_beams = 0                  !< beams failed by their material (*MAT_SPOTWELD)
     ! FE solids folded inside out at a corner (checked at each state)
     integer :: tangled_solids = 0                !< at the last state
     real(wp) :: worst_corner_jacobian_ratio = 1.0_wp !< smallest corner Jacobian ratio of the run

@@ -262,6 +262,9 @@ contains
   !> Write the next state `/states/NNNNNN` and, when `histories` is given, the history rows
   !> recorded since the previous call, as one commit; then rewrite the XDMF file when its
   !> schedule says so.
+  !> Beam results, when the model has beams: `beam_resultant` (6, beams) N, Q_s, Q_t, T, M_s,
+  !> M_t in each beam's local axes, `beam_plastic_strain` the largest of its section points,
+  !> `beam_failed` 1 for a failed weld.
   !> Shell results (global axes): `shell_stress` the mid-surface stress (mean over the
   !> through-thickness points), `shell_plastic_strain` its mean plastic strain, and, as crashfree
   !> extensions, `shell_stress_peak` / `shell_plastic_strain_peak` at the point with the largest
@@ -272,7 +275,7 @@ contains
   !> keeps the states before it.
   subroutine write_state(results, time, displacement, velocity, solid_stress, &
                          solid_plastic_strain, error, shell_stress, shell_plastic_strain, shell_stress_peak, &
-                         shell_plastic_strain_peak, histories)
+                         shell_plastic_strain_peak, histories, beam_resultant, beam_plastic_strain, beam_failed)
     type(results_file_t), intent(inout) :: results
     real(wp), intent(in) :: time
     ! Contiguous: the solver's whole arrays go to HDF5 without a copy.
@@ -284,6 +287,8 @@ contains
     real(wp), intent(in), contiguous, optional :: shell_stress(:, :), shell_stress_peak(:, :) !< (6, shells)
     real(wp), intent(in), contiguous, optional :: shell_plastic_strain(:), shell_plastic_strain_peak(:) !< (shells)
     type(history_set_t), intent(in), target, optional :: histories !< rows not yet in the file are added
+    real(wp), intent(in), contiguous, optional :: beam_resultant(:, :)   !< (6, beams)
+    real(wp), intent(in), contiguous, optional :: beam_plastic_strain(:), beam_failed(:) !< (beams)
     real(wp) :: no_shell_stress(6, 0), no_shell_strain(0)
     real(wp), allocatable :: grown(:)
     type(error_t), allocatable :: space_error
@@ -355,6 +360,13 @@ contains
       else
         call write_real_dataset_2d(group_id, path, "shell_stress", no_shell_stress, error, objects)
         call write_real_dataset_1d(group_id, path, "shell_plastic_strain", no_shell_strain, error, objects)
+      end if
+      if (present(beam_resultant)) then
+        if (size(beam_resultant, 2) > 0) then
+          call write_real_dataset_2d(group_id, path, "beam_resultant", beam_resultant, error, objects)
+          call write_real_dataset_1d(group_id, path, "beam_plastic_strain", beam_plastic_strain, error, objects)
+          call write_real_dataset_1d(group_id, path, "beam_failed", beam_failed, error, objects)
+        end if
       end if
     end if
     if (present(histories)) call append_histories(results, histories, objects, error)
@@ -1125,7 +1137,7 @@ contains
   ! The groups of the layout. Like every private writer below, each does nothing once `error`
   ! is set, so a sequence of writes reads as a list and stops at the first failure.
 
-  !> `/mesh`: nodes, solids, the (empty) shells, and parts.
+  !> `/mesh`: nodes, solids, the (empty) shells, parts, and the beams of a model that has some.
   subroutine write_mesh(file_id, model, error)
     integer(hid_t), intent(in) :: file_id
     type(model_t), intent(in) :: model
@@ -1201,7 +1213,31 @@ contains
     call write_integer_dataset_1d(file_id, "", "/mesh/parts/ids", part_ids, error)
     call write_string_dataset(file_id, "/mesh/parts/formulation", formulations, error)
     call write_integer_dataset_1d(file_id, "", "/mesh/parts/material_ids", material_ids, error)
+    if (allocated(model%beam_ids)) then
+      if (size(model%beam_ids) > 0) call write_beam_mesh()
+    end if
   contains
+    !> `/mesh/beams` (a model with beams): ids, part ids, the node ids N1 N2 (`connectivity`),
+    !> their 0-based rows (`connectivity_index`) and the orientation node N3 (0: none).
+    subroutine write_beam_mesh()
+      integer, allocatable :: beam_part_ids(:), beam_connectivity(:, :), orientation(:)
+      integer :: beam
+      allocate (beam_part_ids(size(model%beam_ids)), beam_connectivity(2, size(model%beam_ids)), &
+                orientation(size(model%beam_ids)))
+      do beam = 1, size(model%beam_ids)
+        beam_part_ids(beam) = model%parts(model%beam_part(beam))%id
+        beam_connectivity(:, beam) = model%node_ids(model%beam_nodes(1:2, beam))
+        orientation(beam) = 0
+        if (model%beam_nodes(3, beam) > 0) orientation(beam) = model%node_ids(model%beam_nodes(3, beam))
+      end do
+      call create_group_path(file_id, "/mesh/beams", error)
+      call write_integer_dataset_1d(file_id, "", "/mesh/beams/ids", model%beam_ids, error)
+      call write_integer_dataset_1d(file_id, "", "/mesh/beams/part_ids", beam_part_ids, error)
+      call write_integer_dataset_2d(file_id, "", "/mesh/beams/connectivity", beam_connectivity, error)
+      call write_integer_dataset_2d(file_id, "", "/mesh/beams/connectivity_index", model%beam_nodes(1:2, :) - 1, &
+                                    error)
+      call write_integer_dataset_1d(file_id, "", "/mesh/beams/orientation_node", orientation, error)
+    end subroutine write_beam_mesh
     !> 0-based node rows of the shells (as connectivity_index of the solids, for the XDMF file).
     function shell_connectivity_index() result(rows)
       integer, allocatable :: rows(:, :)
@@ -1304,12 +1340,12 @@ contains
     type(results_file_t), intent(in) :: results
     type(run_summary_t), intent(in) :: summary
     type(error_t), allocatable, intent(inout) :: error
-    character(len=*), parameter :: second_names(8) = [character(len=11) :: "wall_s", &
-      "fe_solid_s", "fe_shell_s", "efg_s", "contact_s", "output_s", "setup_s", "efg_setup_s"]
-    character(len=*), parameter :: count_names(8) = [character(len=13) :: "cycles", "threads", &
-      "fe_elements", "efg_particles", "dofs_total", "dofs_efg", "fe_solids", "fe_shells"]
-    real(wp) :: seconds(8)
-    integer :: counts(8), entry, status
+    character(len=*), parameter :: second_names(9) = [character(len=11) :: "wall_s", &
+      "fe_solid_s", "fe_shell_s", "efg_s", "contact_s", "output_s", "setup_s", "efg_setup_s", "fe_beam_s"]
+    character(len=*), parameter :: count_names(10) = [character(len=13) :: "cycles", "threads", &
+      "fe_elements", "efg_particles", "dofs_total", "dofs_efg", "fe_solids", "fe_shells", "fe_beams", "failed_beams"]
+    real(wp) :: seconds(9)
+    integer :: counts(10), entry, status
     integer(hid_t) :: group_id
 
     call create_group_path(results%file_id, "/timing", error)
@@ -1320,9 +1356,10 @@ contains
       return
     end if
     seconds = [summary%wall_s, summary%fe_solid_s, summary%fe_shell_s, summary%efg_s, &
-               summary%contact_s, summary%output_s, summary%setup_s, summary%efg_setup_s]
+               summary%contact_s, summary%output_s, summary%setup_s, summary%efg_setup_s, summary%fe_beam_s]
     counts = [summary%cycles, summary%threads, summary%fe_elements, summary%efg_particles, &
-              summary%dofs_total, summary%dofs_efg, summary%fe_solids, summary%fe_shells]
+              summary%dofs_total, summary%dofs_efg, summary%fe_solids, summary%fe_shells, &
+              summary%fe_beams, summary%failed_beams]
     do entry = 1, size(seconds)
       call write_real_attribute(group_id, "/timing", trim(second_names(entry)), seconds(entry), &
                                 error)

@@ -156,10 +156,15 @@ contains
       if (size(model%shell_ids) > 0) then
         call write_state(results, state%time, plan%node_displacement, plan%node_velocity, fields%solid_stress, &
                          fields%solid_plastic_strain, error, fields%shell_stress, fields%shell_plastic_strain, &
-                         fields%shell_stress_peak, fields%shell_plastic_strain_peak, histories=histories)
+                         fields%shell_stress_peak, fields%shell_plastic_strain_peak, histories=histories, &
+                         beam_resultant=fields%beam_resultant, beam_plastic_strain=fields%beam_plastic_strain, &
+                         beam_failed=fields%beam_failed)
       else
+        ! (beam fields not allocated: a model without beams; the dummies are then absent)
         call write_state(results, state%time, plan%node_displacement, plan%node_velocity, fields%solid_stress, &
-                         fields%solid_plastic_strain, error, histories=histories)
+                         fields%solid_plastic_strain, error, histories=histories, &
+                         beam_resultant=fields%beam_resultant, beam_plastic_strain=fields%beam_plastic_strain, &
+                         beam_failed=fields%beam_failed)
       end if
     end associate
   end subroutine write_current_state

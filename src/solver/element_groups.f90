@@ -2,7 +2,7 @@
 !> (the registration point of a new kind), sets up their masses, computes the internal forces
 !> of all of them and gathers what the engine needs from their headers.
 !>
-!> Order is part of the results: groups are visited solids, shells, meshfree parts, always, so
+!> Order is part of the results: groups are visited solids, shells, meshfree parts, beams, always, so
 !> a node shared by several kinds receives their forces in the same order on every run, and the
 !> smallest stable step goes to the first group on a tie.
 module element_groups
@@ -14,6 +14,7 @@ module element_groups
   use solid_group, only: new_solid_group
   use shell_group, only: new_shell_group
   use efg_group, only: new_efg_group
+  use beam_group, only: new_beam_group
   use wall_clock, only: start_phase, stop_phase
   implicit none
   private
@@ -38,6 +39,8 @@ contains
     call add(group)
     call new_efg_group(model, group, error)
     if (allocated(error)) return
+    call add(group)
+    call new_beam_group(model, group)
     call add(group)
   contains
     subroutine add(group)

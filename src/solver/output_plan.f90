@@ -160,6 +160,13 @@ contains
       results%shell_stress_peak = 0.0_wp
       results%shell_plastic_strain = 0.0_wp
       results%shell_plastic_strain_peak = 0.0_wp
+      if (allocated(model%beam_ids)) then
+        allocate (results%beam_resultant(6, size(model%beam_ids)), results%beam_plastic_strain(size(model%beam_ids)), &
+                  results%beam_failed(size(model%beam_ids)))
+        results%beam_resultant = 0.0_wp
+        results%beam_plastic_strain = 0.0_wp
+        results%beam_failed = 0.0_wp
+      end if
     end associate
     allocate (plan%node_velocity(3, size(model%node_ids)), plan%node_displacement(3, size(model%node_ids)), &
               plan%generalized_velocity(3, size(model%node_ids)), plan%node_acceleration(3, size(model%node_ids)))

@@ -1,0 +1,310 @@
+!> The beams (Hughes-Liu, spot weld beams) as an element group (element_group): the blocks of
+!> beam_block, their colouring, nodal masses and rotary inertias, and the per-block results of
+!> the last force call. Failed welds are masked in their blocks (beam_block_t%failed: no stress,
+!> no force from the cycle they fail in); `failed_beams` counts them (run summary, /timing).
+module beam_group
+  use kinds, only: wp, block_size
+  use gather_list, only: gather_list_t
+  use block_colouring, only: colour_blocks_by_nodes
+  use model, only: model_t
+  use error_handling, only: error_t
+  use text_format, only: integer_text
+  use restart_file, only: restart_store_t, exchange_restart, exchange_restart_count
+  use run_summary, only: run_summary_t
+  use nodal_state, only: nodal_state_t
+  use element_group, only: element_group_t, element_results_t
+  use element_work, only: booked_energy, add_kinetic_energy, scale_block_density, raise_largest_scaling
+  use beam_block, only: beam_block_t, build_beam_blocks, beam_block_masses, beam_block_time_steps, &
+                        compute_beam_block
+  implicit none
+  private
+
+  public :: beam_group_t, new_beam_group, failed_beams
+
+  type, extends(element_group_t) :: beam_group_t
+    type(beam_block_t), allocatable :: blocks(:)
+    real(wp), allocatable :: nodal_mass(:, :)          !< (block_size, blocks), at each of the two nodes
+    real(wp), allocatable :: nodal_inertia(:, :)
+    real(wp), allocatable :: block_time_step(:)
+    integer, allocatable :: block_critical_element(:)
+    integer, allocatable :: block_degenerate_element(:)
+    type(gather_list_t) :: colours
+  contains
+    procedure :: element_count
+    procedure :: scale_masses
+    procedure :: lump_masses
+    procedure :: add_internal_forces
+    procedure :: add_energies
+    procedure :: add_part_energies
+    procedure :: element_results
+    procedure :: describe
+    procedure :: add_to_summary
+    procedure :: exchange_state
+    procedure :: failure_text
+    procedure :: most_scaled
+  end type beam_group_t
+
+contains
+
+  !> A new group of this kind (its constructor for element_groups).
+  subroutine new_beam_group(model, group)
+    type(model_t), intent(in) :: model
+    class(element_group_t), allocatable, intent(out) :: group
+    integer :: count
+    allocate (beam_group_t :: group)
+    select type (group)
+    type is (beam_group_t)
+      group%name = "beam"
+      call build_beam_blocks(model, group%blocks)
+      count = size(group%blocks)
+      allocate (group%nodal_mass(block_size, count), group%nodal_inertia(block_size, count), &
+                group%block_time_step(count), group%block_critical_element(count), &
+                group%block_degenerate_element(count))
+      group%nodal_mass = 0.0_wp
+      group%nodal_inertia = 0.0_wp
+      group%block_time_step = huge(1.0_wp)
+      group%block_critical_element = 0
+      group%block_degenerate_element = 0
+    end select
+  end subroutine new_beam_group
+
+  integer function element_count(self)
+    class(beam_group_t), intent(in) :: self
+    integer :: b
+    element_count = 0
+    do b = 1, size(self%blocks)
+      element_count = element_count + self%blocks(b)%element_count
+    end do
+  end function element_count
+
+  !> The number of failed beams of `group` (0 for a group of another kind).
+  integer function failed_beams(group)
+    class(element_group_t), intent(in) :: group
+    integer :: b
+    failed_beams = 0
+    select type (group)
+    type is (beam_group_t)
+      do b = 1, size(group%blocks)
+        failed_beams = failed_beams + count(group%blocks(b)%failed(1:group%blocks(b)%element_count))
+      end do
+    end select
+  end function failed_beams
+
+  subroutine scale_masses(self, model, nodes, target_step, physical_mass, added_mass)
+    class(beam_group_t), intent(inout) :: self
+    type(model_t), intent(in) :: model
+    type(nodal_state_t), intent(in) :: nodes
+    real(wp), intent(in) :: target_step
+    real(wp), intent(inout) :: physical_mass, added_mass
+    real(wp) :: element_time_step(block_size), volume(block_size)
+    integer :: b, nel
+    element_time_step = huge(1.0_wp)
+    do b = 1, size(self%blocks)
+      associate (beam => self%blocks(b))
+        nel = beam%element_count
+        volume = 0.0_wp
+        volume(1:nel) = beam%area*beam%reference_length(1:nel)
+        if (target_step > 0.0_wp) &
+          call beam_block_time_steps(beam, model%materials(beam%material), nodes%coordinates, element_time_step)
+        call scale_block_density(nel, volume, target_step, element_time_step, beam%density, physical_mass, &
+                                 added_mass)
+      end associate
+    end do
+  end subroutine scale_masses
+
+  !> Colour the blocks, then add the nodal masses and rotary inertias (serially, in block, node
+  !> and lane order).
+  subroutine lump_masses(self, model, nodes)
+    class(beam_group_t), intent(inout) :: self
+    type(model_t), intent(in) :: model
+    type(nodal_state_t), intent(inout) :: nodes
+    integer, allocatable :: block_nodes(:, :, :), counts(:)
+    integer :: b, end, lane, node
+    allocate (block_nodes(block_size, 2, size(self%blocks)), counts(size(self%blocks)))
+    do b = 1, size(self%blocks)
+      block_nodes(:, :, b) = self%blocks(b)%nodes
+      counts(b) = self%blocks(b)%element_count
+    end do
+    call colour_blocks_by_nodes(nodes%count, block_nodes, counts, self%colours)
+    do b = 1, size(self%blocks)
+      call beam_block_masses(self%blocks(b), self%nodal_mass(:, b), self%nodal_inertia(:, b))
+      do end = 1, 2
+        do lane = 1, self%blocks(b)%element_count
+          node = self%blocks(b)%nodes(lane, end)
+          nodes%mass(node) = nodes%mass(node) + self%nodal_mass(lane, b)
+          nodes%rotary_inertia(node) = nodes%rotary_inertia(node) + self%nodal_inertia(lane, b)
+        end do
+      end do
+    end do
+  end subroutine lump_masses
+
+  !> Forces and moments, colour by colour as the shells (shell_group).
+  subroutine add_internal_forces(self, model, nodes, step)
+    class(beam_group_t), intent(inout) :: self
+    type(model_t), intent(in) :: model
+    type(nodal_state_t), intent(inout) :: nodes
+    real(wp), intent(in) :: step
+    real(wp) :: beam_force(block_size, 2, 6)
+    integer :: colour, k, b
+    do colour = 1, size(self%colours%offsets) - 1
+      !$omp parallel do schedule(dynamic, 2) default(shared) private(k, b, beam_force)
+      do k = self%colours%offsets(colour), self%colours%offsets(colour + 1) - 1
+        b = self%colours%corners(k)
+        call compute_beam_block(self%blocks(b), model%materials(self%blocks(b)%material), nodes%coordinates, &
+                                nodes%velocity, nodes%angular_velocity, step, beam_force, self%block_time_step(b), &
+                                self%block_critical_element(b), self%block_degenerate_element(b))
+        call add_beam_forces(self%blocks(b), beam_force, nodes%internal_force, nodes%internal_moment)
+      end do
+      !$omp end parallel do
+    end do
+    call self%header_from_blocks(self%block_time_step, self%block_critical_element, self%block_degenerate_element)
+  end subroutine add_internal_forces
+
+  subroutine add_beam_forces(block, beam_force, internal_force, internal_moment)
+    type(beam_block_t), intent(in) :: block
+    real(wp), intent(in) :: beam_force(block_size, 2, 6)
+    real(wp), intent(inout) :: internal_force(:, :), internal_moment(:, :)
+    integer :: end, lane, node
+    do end = 1, 2
+      do lane = 1, block%element_count
+        node = block%nodes(lane, end)
+        internal_force(:, node) = internal_force(:, node) + beam_force(lane, end, 1:3)
+        internal_moment(:, node) = internal_moment(:, node) + beam_force(lane, end, 4:6)
+      end do
+    end do
+  end subroutine add_beam_forces
+
+  subroutine add_energies(self, step_correction, internal, hourglass)
+    class(beam_group_t), intent(in) :: self
+    real(wp), intent(in) :: step_correction
+    real(wp), intent(inout) :: internal, hourglass
+    integer :: b
+    do b = 1, size(self%blocks)
+      associate (beam => self%blocks(b))
+        internal = internal + booked_energy(beam%internal_energy, beam%force_power, beam%element_count, &
+                                            step_correction)
+      end associate
+    end do
+  end subroutine add_energies
+
+  subroutine add_part_energies(self, nodes, average_step, step_correction, kinetic, internal, hourglass)
+    class(beam_group_t), intent(in) :: self
+    type(nodal_state_t), intent(in) :: nodes
+    real(wp), intent(in) :: average_step, step_correction
+    real(wp), intent(inout) :: kinetic(:), internal(:), hourglass(:)
+    integer :: b, end, lane, node
+    do b = 1, size(self%blocks)
+      associate (beam => self%blocks(b))
+        internal(beam%part) = internal(beam%part) + booked_energy(beam%internal_energy, beam%force_power, &
+          beam%element_count, step_correction)
+        do end = 1, 2
+          do lane = 1, beam%element_count
+            node = beam%nodes(lane, end)
+            call add_kinetic_energy(self%nodal_mass(lane, b), nodes%velocity(:, node), &
+                                    nodes%acceleration(:, node), average_step, kinetic(beam%part), internal(beam%part))
+            call add_kinetic_energy(self%nodal_inertia(lane, b), nodes%angular_velocity(:, node), &
+                                    nodes%angular_acceleration(:, node), average_step, kinetic(beam%part), &
+                                    internal(beam%part))
+          end do
+        end do
+      end associate
+    end do
+  end subroutine add_part_energies
+
+  !> Per beam: the resultants N, Q_s, Q_t, T, M_s, M_t in its local axes, the largest plastic
+  !> strain of its section points, and 1 for a failed beam (0 otherwise).
+  subroutine element_results(self, model, results)
+    class(beam_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    type(element_results_t), intent(inout) :: results
+    integer :: b, lane, beam
+    if (.not. allocated(results%beam_resultant)) return
+    do b = 1, size(self%blocks)
+      associate (block => self%blocks(b))
+        do lane = 1, block%element_count
+          beam = block%elements(lane)
+          results%beam_resultant(:, beam) = block%resultant(lane, :)
+          results%beam_plastic_strain(beam) = 0.0_wp
+          if (block%point_count > 0) results%beam_plastic_strain(beam) = maxval(block%plastic_strain(lane, :))
+          results%beam_failed(beam) = merge(1.0_wp, 0.0_wp, block%failed(lane))
+        end do
+      end associate
+    end do
+  end subroutine element_results
+
+  function describe(self, model, element) result(text)
+    class(beam_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: element
+    character(len=:), allocatable :: text
+    text = "beam element "//integer_text(model%beam_ids(element))//" (part "// &
+           integer_text(model%parts(model%beam_part(element))%id)//")"
+  end function describe
+
+  function failure_text(self, model) result(text)
+    class(beam_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    character(len=:), allocatable :: text
+    text = self%describe(model, self%failed_element)//" has lost its length (its two nodes met)"
+  end function failure_text
+
+  subroutine most_scaled(self, model, largest, element)
+    class(beam_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    real(wp), intent(inout) :: largest
+    integer, intent(inout) :: element
+    integer :: b
+    do b = 1, size(self%blocks)
+      associate (block => self%blocks(b))
+        call raise_largest_scaling(block%element_count, block%density, model%materials(block%material)%density, &
+                                   block%elements, largest, element)
+      end associate
+    end do
+  end subroutine most_scaled
+
+  !> Its element count and the seconds of its force calls.
+  subroutine add_to_summary(self, summary)
+    class(beam_group_t), intent(in) :: self
+    type(run_summary_t), intent(inout) :: summary
+    summary%fe_beams = self%element_count()
+    summary%fe_beam_s = self%timer%seconds
+    summary%failed_beams = failed_beams(self)
+  end subroutine add_to_summary
+
+  !> The blocks' steps and critical and degenerate elements of the last force call, then each block.
+  subroutine exchange_state(self, store, path, error)
+    class(beam_group_t), intent(inout) :: self
+    type(restart_store_t), intent(inout) :: store
+    character(len=*), intent(in) :: path
+    type(error_t), allocatable, intent(inout) :: error
+    integer :: b
+    call exchange_restart_count(store, path//"/count", "beam blocks", size(self%blocks), error)
+    call exchange_restart(store, path//"/time_step", self%block_time_step, error)
+    call exchange_restart(store, path//"/critical_element", self%block_critical_element, error)
+    call exchange_restart(store, path//"/degenerate_element", self%block_degenerate_element, error)
+    do b = 1, size(self%blocks)
+      call exchange_beam_block(store, path//"/"//integer_text(b), self%blocks(b), error)
+    end do
+    call exchange_restart(store, path//"/seconds", self%timer%seconds, error)
+  end subroutine exchange_state
+
+  !> One block of beams: what it carries from cycle to cycle (the density and section come from
+  !> the deck and its mass scaling again).
+  subroutine exchange_beam_block(store, path, block, error)
+    type(restart_store_t), intent(inout) :: store
+    character(len=*), intent(in) :: path
+    type(beam_block_t), intent(inout) :: block
+    type(error_t), allocatable, intent(inout) :: error
+    call exchange_restart_count(store, path//"/element_count", "elements in "//path, block%element_count, error)
+    call exchange_restart(store, path//"/frame", block%frame, error)
+    call exchange_restart(store, path//"/internal_energy", block%internal_energy, error)
+    call exchange_restart(store, path//"/force_power", block%force_power, error)
+    call exchange_restart(store, path//"/previous_time_step", block%previous_time_step, error)
+    call exchange_restart(store, path//"/previous_force", block%previous_force, error)
+    call exchange_restart(store, path//"/resultant", block%resultant, error)
+    call exchange_restart(store, path//"/failed", block%failed, error)
+    call exchange_restart(store, path//"/time", block%time, error)
+    call exchange_restart(store, path//"/stress", block%stress, error)
+    call exchange_restart(store, path//"/plastic_strain", block%plastic_strain, error)
+  end subroutine exchange_beam_block
+end module beam_group
