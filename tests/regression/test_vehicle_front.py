@@ -63,3 +63,11 @@ def test_coarse_vehicle_front(tmp_path, run_deck):
     slack = SPEED * END_TIME / 400
     assert speed[-1] * contact_time - slack <= figures["crush_end"] <= SPEED * contact_time + slack, \
         figures["crush_end"]
+    # the plotting script's command line: three PNG files and the table
+    output = tmp_path / "post"
+    process = subprocess.run([sys.executable, str(REPOSITORY / "postproc" / "vehicle_front.py"), str(run.results),
+                              "-o", str(output)], capture_output=True, text=True)
+    assert process.returncode == 0, process.stderr
+    for name in ("vehicle_force.png", "vehicle_rear_mass.png", "vehicle_energies.png"):
+        assert (output / name).stat().st_size > 1000, name
+    assert "| barrier impulse on the structure |" in (output / "vehicle_front.md").read_text()
