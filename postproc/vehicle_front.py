@@ -21,11 +21,15 @@ Figures in the table:
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 import numpy as np
 
 import crashfree_results as cr
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "inputs" / "vehicle_front"))
+from generate_vehicle import PARTS  # noqa: E402  (the part names of the example)
 
 
 def wall_history(results, wall: str = "1"):
@@ -71,7 +75,13 @@ def summary(results, wall: str = "1", body: str = "200", gap: float = 5.0) -> di
     momentum_change = momentum[-1, 0] - momentum[0, 0]
     internal = glstat["internal_energy"][-1]
     contact = np.nonzero(np.abs(force_x) > 0.0)[0]
+    parts = {}
+    for part in cr.list_history_groups(results):
+        if part.startswith("matsum/"):
+            history = cr.read_history(results, part)
+            parts[int(part.split("/")[1])] = float(np.asarray(history["internal_energy"])[-1])
     return {
+        "part_internal_energy": dict(sorted(parts.items())),
         "time": time, "force": force_x, "force_averaged": averaged,
         "mass_time": mass_time, "velocity": velocity, "crush": crush, "glstat": glstat,
         "end_time": float(time[-1]),
@@ -108,6 +118,12 @@ def table(figures: dict, run: dict, timing: dict) -> list:
              f"| energy ratio | {figures['energy_ratio']:.4f} |",
              f"| hourglass / internal energy | {figures['hourglass_ratio']:.3f} |",
              f"| contact / internal energy | {figures['contact_ratio']:.4f} |"]
+    absorbed = figures["part_internal_energy"]
+    total = sum(absorbed.values())
+    for part, energy in absorbed.items():
+        name = PARTS.get(part, (f"part {part}",))[0]
+        lines.append(f"| internal energy of {name} (part {part}) | {energy:.0f} J "
+                     f"({100 * energy / total if total > 0 else 0:.1f}%) |")
     if timing:
         shells = timing.get("fe_shells", 0)
         cycles = timing["cycles"]

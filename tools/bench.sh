@@ -10,7 +10,7 @@
 #     single-surface contact), its first 5 mm of crush: nanoseconds per shell per cycle;
 #  5. element order: a block of 100 x 100 x 10 hexahedra numbered naturally and at random, ncpu=1
 #     and 2 (tools/bench_ordering.py: solid phase, medians of 3 alternating runs);
-#  6. the vehicle front structure of inputs/vehicle_front (about 10,400 shells of 8-60 mm, one
+#  6. the vehicle front structure of inputs/vehicle_front (about 11,300 shells of 8-60 mm, one
 #     single-surface contact over all parts), its first 3 ms into the wall, ncpu=1: nanoseconds per
 #     shell per cycle for the shells, the contact and the rest (tools/bench_vehicle.py).
 set -euo pipefail

@@ -16,6 +16,9 @@ z up; the floor lies at z = 0):
   rails        hat sections 80 x 100 with 20 mm flanges, x = 215 .. 915, at y = +-450,
                opening inboard, closing plate on the inboard side
   floor panel  z = 0, x = 915 .. 2115, between the rockers
+  rail extensions  closed boxes 80 x 80 just under the floor, x = 915 .. 2115, at y = +-450:
+               they carry the rails' load to the rear mass, as the rails of a real car run on
+               under the floor (without them the whole load would pass through the 1 mm floor)
   rockers      hat sections 100 x 120, x = 915 .. 2115, at y = +-700, opening inboard
 Joints: the hat flanges and their closing plates are joined either by shared nodes along the
 whole flange (--welds merged: a continuous seam; this branch runs it), or by spot welds every
@@ -24,8 +27,8 @@ whole flange (--welds merged: a continuous seam; this branch runs it), or by spo
 *CONSTRAINED_GENERALIZED_WELD_SPOT on two-node sets). The bolted joints (bumper to cans, cans to
 rails, rails to the floor) are *CONSTRAINED_NODAL_RIGID_BODY ties of the end rings. The floor
 and the rockers share nodes along the rockers' closing plates. The rest of the car is a lumped
-mass (*ELEMENT_MASS) spread over the nodes of the rear ends of the floor and the rockers, which
-form one nodal rigid body (id 200: /history/rbdout/200 is the rear mass's motion).
+mass (*ELEMENT_MASS) spread over the nodes of the rear ends of the floor, the rockers and the rail
+extensions, which form one nodal rigid body (id 200: /history/rbdout/200 is the rear mass's motion).
 
 Materials: *MAT_PIECEWISE_LINEAR_PLASTICITY (024) mild steel with its hardening curve (*DEFINE_CURVE,
 true stress against effective plastic strain), Belytschko-Tsay shells with 3 points through
@@ -47,7 +50,7 @@ PARTS = {
     3: ("crush can left", 1.5), 4: ("crush can right", 1.5),
     5: ("rail left", 2.0), 6: ("rail right", 2.0), 7: ("rail closing plates", 1.5),
     8: ("rocker left", 1.5), 9: ("rocker right", 1.5), 10: ("rocker closing plates", 1.2),
-    11: ("floor panel", 1.0),
+    11: ("floor panel", 1.0), 12: ("rail extensions", 2.0),
 }
 REAR_BODY = 200
 
@@ -154,6 +157,7 @@ def build(args):
     rocker_y, rocker_width, rocker_height, rocker_flange = 700.0, 100.0, 120.0, 20.0
     centre_z = rail_height / 2
     ties = []   # (id, node list)
+    extension_rear = []
 
     # bumper beam along y: u along x (the hat opens rearward, +x), v along z
     gap = 0.0 if merged else 0.5 * (thickness[1] + thickness[2])
@@ -193,7 +197,17 @@ def build(args):
         welds += weld_pairs(rail_hat, rail_plate, args.pitch, size["rail"])
         rail_nodes = nodes_of(rail_hat) + nodes_of(rail_plate)
         ties.append((103 + side, ring(mesh, can_nodes, x_rail, 0) + ring(mesh, rail_nodes, x_rail, 0)))
-        ties.append((105 + side, ring(mesh, rail_nodes, x_rail + rail_length, 0)))   # floor nodes added below
+        # rail extension under the floor, its top wall (t_floor + t_extension) / 2 below it
+        below = 0.5 * (thickness[11] + thickness[12])
+        count = divisions(80.0, size["rocker"])
+        box = [(-40.0, -80.0, 40.0, -80.0, count), (40.0, -80.0, 40.0, 0.0, count),
+               (40.0, 0.0, -40.0, 0.0, count), (-40.0, 0.0, -40.0, -80.0, count)]
+        extension = member(mesh, 12, f"extension{side}", (x_body, y, -below), (1, 0, 0), body_length,
+                           size["rocker"], box, (0, 1, 0), (0, 0, 1))
+        extension_nodes = nodes_of(extension)
+        ties.append((105 + side, ring(mesh, rail_nodes, x_rail + rail_length, 0)
+                     + ring(mesh, extension_nodes, x_body, 0)))   # floor nodes added below
+        extension_rear.extend(ring(mesh, extension_nodes, x_rear, 0))
 
         # rocker: hat opening inboard, closing plate inboard; bottom at z = 0
         gap = 0.0 if merged else 0.5 * (thickness[8] + thickness[10])
@@ -215,7 +229,7 @@ def build(args):
                     if abs(mesh.coordinates[n - 1][1] - y) <= rail_width / 2 + size["floor"] / 2]
             ties[number] = (tie_id, tie_nodes + near)
     body_nodes = sorted({n for key, n in mesh.index.items() if key[0] == "body"})
-    rear = ring(mesh, body_nodes, x_rear, 0)
+    rear = ring(mesh, body_nodes, x_rear, 0) + extension_rear
     ties.append((REAR_BODY, rear))
     return mesh, welds, ties, rear
 
@@ -309,7 +323,7 @@ def write_deck(args, mesh, welds, ties, rear):
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--size", choices=sorted(SIZES), default="default",
-                        help="element sizes: default (8-60 mm, about 9,000 shells) or coarse (17-100 mm, about 3,700)")
+                        help="element sizes: default (8-60 mm, about 11,300 shells) or coarse (17-100 mm, about 4,100)")
     parser.add_argument("--welds", choices=("merged", "spotweld", "generalized"), default="merged",
                         help="flange joints: shared nodes (default), *CONSTRAINED_SPOTWELD pairs or "
                              "*CONSTRAINED_GENERALIZED_WELD_SPOT")

@@ -1,4 +1,4 @@
-"""The vehicle front-structure example (inputs/vehicle_front), coarse mesh (3,752 shells), its
+"""The vehicle front-structure example (inputs/vehicle_front), coarse mesh (4,136 shells), its
 first 3 ms at 15 m/s into the rigid wall: the bumper, 5 mm from the wall, reaches it at
 5 / 15 = 0.333 ms and is crushed for the rest of the run.
 
