@@ -150,9 +150,8 @@ def build(args):
     rail_y, rail_width, rail_height, rail_flange = 450.0, 80.0, 100.0, 20.0
     x_bumper, bumper_depth = 5.0, 60.0
     can_length, rail_length, body_length = 150.0, 700.0, 1200.0
-    x_can = x_bumper + bumper_depth
-    x_rail = x_can + can_length
-    x_body = x_rail + rail_length
+    # the body starts where the rails end; with welds the cans and rails start a plate gap later
+    x_body = x_bumper + bumper_depth + can_length + rail_length
     x_rear = x_body + body_length
     rocker_y, rocker_width, rocker_height, rocker_flange = 700.0, 100.0, 120.0, 20.0
     centre_z = rail_height / 2
