@@ -230,6 +230,10 @@ def build(args):
     body_nodes = sorted({n for key, n in mesh.index.items() if key[0] == "body"})
     rear = ring(mesh, body_nodes, x_rear, 0) + extension_rear
     ties.append((REAR_BODY, rear))
+    # a weld at a member's end would join a rigid tie (LS-DYNA and crashfree refuse that): the tie
+    # holds those two nodes together already
+    tied = {n for _, tie_nodes in ties for n in tie_nodes}
+    welds = [(a, b) for a, b in welds if a not in tied and b not in tied]
     return mesh, welds, ties, rear
 
 
