@@ -9,7 +9,10 @@
 #  4. Belytschko-Tsay shells: the square tube of inputs/tube_crush (6,400 shells, NIP 5, MAT_024,
 #     single-surface contact), its first 5 mm of crush: nanoseconds per shell per cycle;
 #  5. element order: a block of 100 x 100 x 10 hexahedra numbered naturally and at random, ncpu=1
-#     and 2 (tools/bench_ordering.py: solid phase, medians of 3 alternating runs).
+#     and 2 (tools/bench_ordering.py: solid phase, medians of 3 alternating runs);
+#  6. the vehicle front structure of inputs/vehicle_front (about 11,300 shells of 8-60 mm, one
+#     single-surface contact over all parts), its first 3 ms into the wall, ncpu=1: nanoseconds per
+#     shell per cycle for the shells, the contact and the rest (tools/bench_vehicle.py).
 set -euo pipefail
 python=${PYTHON:-python3}
 directory=build/bench
@@ -29,6 +32,11 @@ run "$directory/coupled_7.k" coupled_7 1
 run "$directory/coupled_19.k" coupled_19 1
 run "$directory/efg_block.k" efg_block 1
 run "$directory/tube.k" tube_shells 1
+[ -f "$directory/vehicle_front.k" ] || "$python" inputs/vehicle_front/generate_vehicle.py --end-time 3 \
+  --output "$directory/vehicle_front.k" > /dev/null
+run "$directory/vehicle_front.k" vehicle_front 1
 "$python" tools/bench_report.py "$directory"
 echo
 "$python" tools/bench_ordering.py --directory "$directory/ordering" | sed -n '/^Solid phase/,$p'
+echo
+"$python" tools/bench_vehicle.py "$directory/vehicle_front.h5"
