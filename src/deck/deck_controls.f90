@@ -327,12 +327,13 @@ contains
         "NFAIL1 NFAIL4 PSNFAIL KEEPCS DELFR DRCPSID DRCPRM INTPERR"], &
         "crashfree's shell is the Belytschko-Tsay shell of *SECTION_SHELL ELFORM 2, with "// &
         "constant thickness and Gauss points through it; the global shell options do not "// &
-        "change it", warnings)
+        "change it, and triangles (N3 = N4) always run as C0 triangles, as with ESORT = 1", warnings)
     else if (index(name, "CONTROL_SOLID") == 1) then
       call note_not_acted_upon(deck, block, [character(len=60) :: &
         "ESORT FMATRX NIPTETS SWLOCL PSFAIL T10JTOL ICOH TET13K"], &
-        "solids take their formulation from *SECTION_SOLID ELFORM; degenerate elements are "// &
-        "not sorted into other formulations", warnings)
+        "solids take their formulation from *SECTION_SOLID ELFORM; degenerate tetrahedra "// &
+        "always run as one-point tetrahedra (as with ESORT = 1), wedges and pyramids as "// &
+        "degenerate hexahedra", warnings)
     else if (index(name, "CONTROL_ACCURACY") == 1) then
       call note_not_acted_upon(deck, block, [character(len=40) :: "OSU INN PIDOSU IACC EXACC"], &
         "stresses are rotated objectively in every cycle and results do not depend on the "// &
