@@ -712,10 +712,10 @@ contains
                                  "the FORCES card (SOFT SSID N1 N2 N3 N4)", "SOFT")) exit
           call warn_if_set(deck, card, 1, "SOFT", "the wall force is not softened", warnings)
         end if
+        ! the DISPLAY card may be left out at the end of the keyword (LS-DYNA reads it as
+        ! defaults; public decks do so): it only shows the wall in a post-processor
         if (keyword%display) then
-          if (.not. require_card(deck, block, line, standard_widths, card, log, &
-                                 "the DISPLAY card (PID RO E PR)", "PID")) exit
-          call note_display_card(deck, line, warnings)
+          if (next_line(deck, block, line, .false.)) call note_display_card(deck, line, warnings)
         end if
       end associate
     end do
@@ -774,10 +774,10 @@ contains
           call read_vector(deck, card, 3, ["VX", "VY", "VZ"], wall%motion_direction, log)
           if (.not. card%failed) call check_cylinder_motion(deck, card, wall, log)
         end if
+        ! the DISPLAY card may be left out at the end of the keyword (LS-DYNA reads it as
+        ! defaults; public decks do so): it only shows the wall in a post-processor
         if (keyword%display) then
-          if (.not. require_card(deck, block, line, standard_widths, card, log, &
-                                 "the DISPLAY card (PID RO E PR)", "PID")) exit
-          call note_display_card(deck, line, warnings)
+          if (next_line(deck, block, line, .false.)) call note_display_card(deck, line, warnings)
         end if
       end associate
     end do

@@ -56,7 +56,7 @@ contains
     type(card_t) :: card
     type(rigid_material_input_t) :: entry
     integer :: line, n, spc_node
-    real(wp) :: mode, translations, rotations
+    real(wp) :: mode, translations, rotations, coupling
     character(len=:), allocatable :: title
 
     line = 0
@@ -81,9 +81,13 @@ contains
             call card_problem(deck, log, card, "PR", "must lie in [0, 0.5), found "// &
                               real_text(material%poissons_ratio))
         end if
-        if (.not. field_is_blank(card, 5)) call no_coupling("N")
-        if (.not. field_is_blank(card, 6)) call no_coupling("COUPLE")
-        if (.not. field_is_blank(card, 7)) call no_coupling("M")
+        ! N COUPLE M: 0 (or blank) is "no coupling", as LS-DYNA reads it
+        call get_real(deck, card, 5, "N", coupling, log)
+        if (coupling /= 0.0_wp) call no_coupling("N")
+        call get_real(deck, card, 6, "COUPLE", coupling, log)
+        if (coupling /= 0.0_wp) call no_coupling("COUPLE")
+        call get_real(deck, card, 7, "M", coupling, log)
+        if (coupling /= 0.0_wp) call no_coupling("M")
       end associate
       ! card 2 (optional at the end of the keyword)
       if (next_line(deck, block, line, .false.)) then

@@ -357,3 +357,25 @@ def test_lsdyna_command_line(tmp_path):
                      "d=nodump: ignored", "s=iff: ignored", "ncpu=-1: read as ncpu=1"]:
         assert any(fragment in note for note in notes), fragment
     assert_same_results(plain.parent / "out" / "results.h5", lsdyna.parent / "results.h5")
+
+
+@pytest.mark.parametrize("coupling", ["       0.0       0.0       0.0", "                              ",
+                                      "       1.0       0.0       0.0"])
+def test_rigid_material_coupling_zero_is_none(tmp_path, coupling):
+    """*MAT_RIGID N COUPLE M written as 0.0 (as public decks do) mean no coupling, as blank
+    does; a nonzero N asks for MADYMO/CAL3D coupling and is refused naming the field. The rigid
+    cube, thrown at SPEED, keeps its velocity exactly."""
+    text = CUBE.format(**WRITTEN_OUT)
+    text = text.replace("*MAT_ELASTIC\n         1   7.85e-6     210.0       0.3",
+                        "*MAT_RIGID\n         1   7.85e-6     210.0       0.3" + coupling)
+    deck = write(tmp_path, "rigid", text)
+    shown = run(deck)
+    if coupling.split() and float(coupling.split()[0]) != 0.0:
+        assert shown.returncode == 2 and "field N: MADYMO/CAL3D coupling" in shown.stderr + shown.stdout
+        return
+    assert shown.returncode == 0, shown.stderr + shown.stdout
+    with h5py.File(deck.parent / "out" / "results.h5", "r") as results:
+        last = results["states"][sorted(results["states"].keys())[-1]]
+        velocity = last["velocity"][...]
+    # the rigid body carries the thrown face's momentum: SPEED/2 in x for every node
+    assert np.abs(velocity[:, 0] - SPEED / 2).max() < 1e-9 * SPEED
