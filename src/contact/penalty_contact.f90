@@ -8,7 +8,8 @@
 !> Searching", bucket sort): the segments, with their bounding boxes grown by a margin, are
 !> sorted into a uniform grid, and every secondary node keeps the segments of its cell whose box
 !> holds it. The lists stay valid until some node of the pass has moved half the margin since
-!> they were built (or BSORT / NSBCS cycles have passed), then they are rebuilt. Meshes mix
+!> they were built, apart from the motion common to the whole pass (or BSORT / NSBCS cycles have
+!> passed), then they are rebuilt. Meshes mix
 !> sizes (a 700 mm panel next to 30 mm rails): the margin and the cell are sized by the median
 !> segment, not the largest, and a large segment is entered in every cell its box covers, so a
 !> node's candidates are the segments that are really near it and a rebuild costs time linear in
@@ -535,14 +536,27 @@ contains
     type(contact_pass_t), intent(inout) :: pass
     real(wp), intent(in) :: coordinates(:, :)
     integer, intent(in) :: bucket_interval
-    real(wp) :: moved
+    real(wp) :: moved, low(3), high(3), common(3)
     integer :: n
     pass%cycles_since_build = pass%cycles_since_build + 1
     moved = 0.0_wp
-    if (pass%built) then
+    if (pass%built .and. size(pass%tracked) > 0) then
+      ! Pairs depend on relative motion only: a motion common to the whole pass (a car driving
+      ! into a wall) is taken out, so that the lists live until the parts move relative to each
+      ! other. Any common vector keeps the test safe; the midrange of the displacements (exact
+      ! min/max, the same for any thread count) makes the largest remaining motion smallest.
+      low = huge(1.0_wp)
+      high = -huge(1.0_wp)
+      !$omp parallel do schedule(static) default(shared) private(n) reduction(min:low) reduction(max:high)
+      do n = 1, size(pass%tracked)
+        low = min(low, coordinates(:, pass%tracked(n)) - pass%tracked_at_build(:, n))
+        high = max(high, coordinates(:, pass%tracked(n)) - pass%tracked_at_build(:, n))
+      end do
+      !$omp end parallel do
+      common = 0.5_wp*(low + high)
       !$omp parallel do schedule(static) default(shared) private(n) reduction(max:moved)
       do n = 1, size(pass%tracked)
-        moved = max(moved, norm2(coordinates(:, pass%tracked(n)) - pass%tracked_at_build(:, n)))
+        moved = max(moved, norm2(coordinates(:, pass%tracked(n)) - pass%tracked_at_build(:, n) - common))
       end do
       !$omp end parallel do
     end if
