@@ -31,6 +31,7 @@ module deck_keyword_table
   use deck_materials, only: read_elastic_materials, read_plastic_kinematic_materials, read_honeycomb_materials, &
     read_modified_honeycomb_materials, read_low_density_foam_materials, read_piecewise_linear_materials, &
     read_null_materials
+  use deck_add_erosion, only: read_add_erosions
   use deck_sets_curves, only: read_node_set, read_generated_node_set, read_part_set, read_segment_set, read_curve
   use deck_loads_bcs, only: read_node_spcs, read_set_spcs, read_node_motions, read_set_motions, read_node_loads, &
     read_set_loads, read_initial_velocities, read_initial_velocity_nodes, read_velocity_generations, &
@@ -176,7 +177,8 @@ contains
       keyword_entry_t("CONTROL_CONTACT", reader=read_control_contact), &
       keyword_entry_t("DATABASE_RCFORC", reader=read_rcforc), &
       law_keyword(law_piecewise_linear, read_piecewise_linear_materials), &
-      law_keyword(law_null, read_null_materials)]
+      law_keyword(law_null, read_null_materials), &
+      keyword_entry_t("MAT_ADD_EROSION", options="TITLE", reader=read_add_erosions)]
   end function keyword_table
 
   !> The row of material law `law` (a code of law_table): *MAT_<name>, also *MAT_<nnn>, with

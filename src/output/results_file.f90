@@ -272,7 +272,7 @@ contains
   !> keeps the states before it.
   subroutine write_state(results, time, displacement, velocity, solid_stress, &
                          solid_plastic_strain, error, shell_stress, shell_plastic_strain, shell_stress_peak, &
-                         shell_plastic_strain_peak, histories)
+                         shell_plastic_strain_peak, histories, solid_eroded, shell_eroded, eroded_count)
     type(results_file_t), intent(inout) :: results
     real(wp), intent(in) :: time
     ! Contiguous: the solver's whole arrays go to HDF5 without a copy.
@@ -284,6 +284,9 @@ contains
     real(wp), intent(in), contiguous, optional :: shell_stress(:, :), shell_stress_peak(:, :) !< (6, shells)
     real(wp), intent(in), contiguous, optional :: shell_plastic_strain(:), shell_plastic_strain_peak(:) !< (shells)
     type(history_set_t), intent(in), target, optional :: histories !< rows not yet in the file are added
+    !> deleted-element flags (1: eroded) and the count of eroded elements (explicit runs)
+    integer, intent(in), contiguous, optional :: solid_eroded(:), shell_eroded(:)
+    integer, intent(in), optional :: eroded_count
     real(wp) :: no_shell_stress(6, 0), no_shell_strain(0)
     real(wp), allocatable :: grown(:)
     type(error_t), allocatable :: space_error
@@ -356,6 +359,9 @@ contains
         call write_real_dataset_2d(group_id, path, "shell_stress", no_shell_stress, error, objects)
         call write_real_dataset_1d(group_id, path, "shell_plastic_strain", no_shell_strain, error, objects)
       end if
+      if (present(solid_eroded)) call write_integer_dataset_1d(group_id, path, "solid_eroded", solid_eroded, error)
+      if (present(shell_eroded)) call write_integer_dataset_1d(group_id, path, "shell_eroded", shell_eroded, error)
+      if (present(eroded_count)) call write_integer_attribute(group_id, path, "eroded_elements", eroded_count, error)
     end if
     if (present(histories)) call append_histories(results, histories, objects, error)
     call flush_file(results%file_id, error)

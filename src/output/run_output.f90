@@ -43,7 +43,8 @@ contains
         merge(state%next_time_step, state%time_step, state%cycle == 0), &
         energy%kinetic, energy%internal, energy%hourglass, energy%contact, &
         energy%external_work, total_energy(energy), energy%rigid_wall, energy_ratio(energy), &
-        state%added_mass, energy%momentum])
+        state%added_mass, energy%momentum, energy%eroded_internal, energy%eroded_hourglass, &
+        energy%eroded_kinetic, real(state%eroded_count, wp)])
     end if
     if (matsum_due) then
       call part_energies(model, state, size(model%parts), plan%part_kinetic, plan%part_internal, plan%part_hourglass)
@@ -153,10 +154,13 @@ contains
       if (size(model%shell_ids) > 0) then
         call write_state(results, state%time, plan%node_displacement, plan%node_velocity, fields%solid_stress, &
                          fields%solid_plastic_strain, error, fields%shell_stress, fields%shell_plastic_strain, &
-                         fields%shell_stress_peak, fields%shell_plastic_strain_peak, histories=histories)
+                         fields%shell_stress_peak, fields%shell_plastic_strain_peak, histories=histories, &
+                         solid_eroded=fields%solid_eroded, shell_eroded=fields%shell_eroded, &
+                         eroded_count=state%eroded_count)
       else
         call write_state(results, state%time, plan%node_displacement, plan%node_velocity, fields%solid_stress, &
-                         fields%solid_plastic_strain, error, histories=histories)
+                         fields%solid_plastic_strain, error, histories=histories, solid_eroded=fields%solid_eroded, &
+                         eroded_count=state%eroded_count)
       end if
     end associate
   end subroutine write_current_state

@@ -226,6 +226,9 @@ contains
     call exchange_restart(store, path//"/external_work", energy%external_work, error)
     call exchange_restart(store, path//"/initial_total", energy%initial_total, error)
     call exchange_restart(store, path//"/momentum", energy%momentum, error)
+    call exchange_restart(store, path//"/eroded_internal", energy%eroded_internal, error)
+    call exchange_restart(store, path//"/eroded_hourglass", energy%eroded_hourglass, error)
+    call exchange_restart(store, path//"/eroded_kinetic", energy%eroded_kinetic, error)
   end subroutine exchange_energy
 
   !> What the run checks remember from cycle to cycle (and their bounds, set at cycle 0).
