@@ -387,6 +387,9 @@ contains
     integer :: group, element
     logical :: not_finite
     call smallest_group_step(state%groups, smallest, group, element, not_finite)
+    ! every element eroded: the free nodes fly on with the last stable step
+    if (smallest >= huge(1.0_wp) .and. state%eroded_count > 0 .and. state%stable_time_step > 0.0_wp) &
+      smallest = state%stable_time_step
     ! rigid elements: the step of an elastic element with their E, PR and RO (constant)
     if (state%rigid_time_step < smallest) then
       smallest = state%rigid_time_step
