@@ -315,6 +315,9 @@ contains
     what = "state "//integer_text(results%state_count)//" at time "//real_text(time)
     state_bytes = 8_long_int*(6_long_int*results%node_count + 7_long_int*results%solid_count + &
                               14_long_int*results%shell_count)
+    ! the deleted-element flags, 32-bit
+    if (present(solid_eroded)) state_bytes = state_bytes + 4_long_int*size(solid_eroded)
+    if (present(shell_eroded)) state_bytes = state_bytes + 4_long_int*size(shell_eroded)
     history_bytes = 0
     history_space = 0
     if (present(histories)) call new_history_bytes(results, histories, history_bytes, history_space)
