@@ -202,7 +202,7 @@ def test_add_erosion_effective_plastic_strain_and_numfip(tmp_path, run_deck):
         assert abs(time - expected) < 5e-3 * expected
 
 
-def crushed_block_deck(path, erode):
+def crushed_block_deck(path, erode, material=None, minimum_step_factor=0.5):
     """One hexahedron crushed at 10 m/s (10 mm/ms) against its held face: its step shrinks with
     its length; DTMIN = 0.5 x the first step."""
     nodes, elements = block_mesh((1, 1, 1), (1.0, 1.0, 1.0))
@@ -215,12 +215,12 @@ def crushed_block_deck(path, erode):
     pushed = list(np.flatnonzero(np.abs(nodes[:, 0] - 1.0) < 1e-9) + 1)
     return write_deck(
         path,
-        "*CONTROL_TERMINATION\n" + fields(0.09, 0, 0.5),
+        "*CONTROL_TERMINATION\n" + fields(0.09, 0, minimum_step_factor),
         "*CONTROL_TIMESTEP\n" + fields(0.0, 0.9, 0, 0.0, 0.0, 0, erode),
         "*DATABASE_GLSTAT\n" + fields(0.001),
         "*PART\nblock\n" + fields(1, 1, 1),
         "*SECTION_SOLID\n" + fields(1, 1),
-        "*MAT_ELASTIC\n" + fields(1, DENSITY, E, NU),
+        material or "*MAT_ELASTIC\n" + fields(1, DENSITY, E, NU),
         "*DEFINE_CURVE\n" + fields(1) + "\n" + fields(0.0, 1.0, width=20) + "\n" + fields(1.0, 1.0, width=20),
         node_list_set(1, pushed),
         "*BOUNDARY_PRESCRIBED_MOTION_SET\n" + fields(1, 1, 0, 1, -10.0),
@@ -246,6 +246,30 @@ def test_erode_with_dtmin_deletes_the_element_instead_of_stopping(tmp_path, run_
     assert 0.35 < length < 0.55
     with run.open() as results:
         check_energy_balance(results, tolerance=1e-2)
+
+
+def test_tdel_of_mat_024_deletes_the_element_at_its_smallest_step(tmp_path, run_deck):
+    """TDEL = half the first stable step: the crushed solid of MAT_024 erodes as with ERODE and
+    DTMIN = 0.5 (at the same time to 0.2 %: TDEL is written with 5 digits), without any
+    *CONTROL_TIMESTEP flag."""
+    reference = run_deck(crushed_block_deck(tmp_path / "erode.k", 1), jobid="erode")
+    assert reference.status == 0, reference.stderr
+    with reference.open() as results:
+        first_stable_step = results["history/glstat/time_step"][0] / 0.9
+    material = ("*MAT_PIECEWISE_LINEAR_PLASTICITY\n" + fields(1, DENSITY, E, NU, 100.0, 0.0, 0.0,
+                                                              float(f"{0.5 * first_stable_step:.4e}")) +
+                "\n" + fields(0.0))
+    run = run_deck(crushed_block_deck(tmp_path / "tdel.k", 0, material, 0.0), jobid="tdel")
+    assert run.status == 0, run.stderr
+    eroded, expected = failures(run), failures(reference)
+    print(f"  TDEL: {eroded}, ERODE: {expected}")
+    assert len(eroded) == 1 and abs(eroded[0][2] - expected[0][2]) < 2e-3 * expected[0][2]
+
+
+def test_bad_erode_is_refused(tmp_path, run_deck):
+    run = run_deck(crushed_block_deck(tmp_path / "bad.k", 2))
+    assert run.status == 2
+    assert "field ERODE:" in run.stderr
 
 
 def plate_deck(path):
