@@ -14,13 +14,15 @@ module deck_add_erosion
   use deck_lexer, only: deck_t
   use deck_keywords, only: keyword_t
   use deck_fields, only: card_t, require_card, next_line, get_integer, get_real, card_problem, line_problem, &
-                         located_problem
+                         located_problem, located_warning
+  use model, only: formulation_efg
+  use erosion_criteria, only: erodes_on_strain
   use deck_input, only: deck_input_t, add_erosion_input_t
   use deck_id_index, only: id_index_t, find_id
   implicit none
   private
 
-  public :: read_add_erosions, apply_add_erosions
+  public :: read_add_erosions, apply_add_erosions, warn_parts_that_do_not_erode
 
   integer, parameter :: standard_widths(8) = 10
 
@@ -144,4 +146,30 @@ contains
       end associate
     end do
   end subroutine apply_add_erosions
+
+  !> A warning at each part whose material has failure criteria (FS, FAIL, TDEL, *MAT_ADD_EROSION)
+  !> that its elements do not apply: meshfree (EFG) parts, and every part of the linear static
+  !> analysis.
+  subroutine warn_parts_that_do_not_erode(deck, input, warnings)
+    type(deck_t), intent(in) :: deck
+    type(deck_input_t), intent(in) :: input
+    type(error_list_t), intent(inout) :: warnings
+    integer :: k
+    do k = 1, input%part_count
+      associate (part => input%model%parts(k))
+        if (part%material <= 0) cycle
+        associate (material => input%model%materials(part%material))
+          if (.not. (erodes_on_strain(material) .or. material%failure_time_step > 0.0_wp)) cycle
+          if (input%model%implicit_static) then
+            call located_warning(deck, warnings, input%part_lines(k), "MID", "the failure criteria of material "// &
+              integer_text(material%id)//" are ignored: the linear static analysis does not erode elements")
+          else if (part%formulation == formulation_efg) then
+            call located_warning(deck, warnings, input%part_lines(k), "MID", "the failure criteria of material "// &
+              integer_text(material%id)//" are ignored for part "//integer_text(part%id)// &
+              ": meshfree (EFG) parts do not erode")
+          end if
+        end associate
+      end associate
+    end do
+  end subroutine warn_parts_that_do_not_erode
 end module deck_add_erosion

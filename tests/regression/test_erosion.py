@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from test_restart import assert_same, contents, copy_run, restart, run_fresh
-from deck_writer import (block_mesh, fields, node_list_set, nodes_card, plate_mesh, round_to_node_card,
+from deck_writer import (block_mesh, efg_section, fields, node_list_set, nodes_card, plate_mesh, round_to_node_card,
                          shells_card, solids_card, write_deck)
 
 E, NU, SIGY, ETAN, DENSITY = 200.0, 0.3, 0.25, 2.0, 7.85e-6   # GPa, kg/mm^3 (mm, ms)
@@ -349,6 +349,16 @@ def test_bad_erosion_input_is_refused(tmp_path, run_deck, cards, field):
     run = run_deck(bar_deck(tmp_path / "bad.k", cards))
     assert run.status == 2
     assert f"field {field}:" in run.stderr
+
+
+def test_meshfree_parts_warn_that_they_do_not_erode(tmp_path, run_deck):
+    deck = bar_deck(tmp_path / "efg.k", "*MAT_PLASTIC_KINEMATIC\n" + fields(1, DENSITY, E, NU, SIGY, ETAN, 1.0) +
+                    "\n" + fields(0.0, 0.0, 0.02), end_time=0.01)
+    deck.write_text(deck.read_text().replace("*SECTION_SOLID\n" + fields(1, 1), efg_section(1)))
+    run = run_deck(deck)
+    assert run.status == 0, run.stderr
+    assert "field MID: the failure criteria of material 1 are ignored for part 1: meshfree (EFG) parts do not " \
+           "erode" in run.stdout + run.stderr
 
 
 def test_excl_switches_a_criterion_off(tmp_path, run_deck):
