@@ -102,6 +102,9 @@ module shell_block
     logical :: newly_eroded(block_size) = .false.        !< eroded by the last call
     real(wp) :: erosion_time_step = 0.0_wp               !< ERODE: a lane whose step falls below erodes (0: off)
     real(wp) :: reference_coordinates(block_size, 4, 3) = 0.0_wp
+    !> Points whose plastic strain reached the failure strain: they carry no stress from then on
+    !> (as in LS-DYNA) until enough of them have failed for the shell to erode.
+    logical :: point_failed(block_size, max_shell_points) = .false.
   end type shell_block_t
 
 contains
@@ -332,6 +335,14 @@ contains
         block%stress(i, 5, point) = block%stress(i, 5, point) + block%shear_factor*shear_modulus*dt*shear(i, 1)
       end do
     end do
+    ! failed points carry no stress (erode_failed_lanes)
+    if (any(block%point_failed(1:nel, 1:block%point_count))) then
+      do point = 1, block%point_count
+        do i = 1, nel
+          if (block%point_failed(i, point)) block%stress(i, :, point) = 0.0_wp
+        end do
+      end do
+    end if
 
     ! forces and moments on the end-of-step configuration
     call shell_geometry(nel, x, frame, xl, yl, b1, b2, area)
@@ -447,7 +458,11 @@ contains
       do point = 1, block%point_count
         call plane_stress_plastic_strain(material, nel, block%history(:, :, point), point_strain)
         do i = 1, nel
-          if (point_strain(i) >= limit) failed_points(i) = failed_points(i) + 1
+          if (point_strain(i) >= limit .and. .not. block%eroded(i)) then
+            block%point_failed(i, point) = .true.
+            block%stress(i, :, point) = 0.0_wp
+          end if
+          if (block%point_failed(i, point)) failed_points(i) = failed_points(i) + 1
         end do
       end do
       needed = failed_points_needed(material, block%point_count, .true.)

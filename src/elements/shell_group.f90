@@ -376,5 +376,6 @@ contains
     call exchange_restart(store, path//"/history", block%history, error)
     call exchange_restart(store, path//"/eroded", block%eroded, error)
     call exchange_restart(store, path//"/newly_eroded", block%newly_eroded, error)
+    call exchange_restart(store, path//"/point_failed", block%point_failed, error)
   end subroutine exchange_shell_block
 end module shell_group

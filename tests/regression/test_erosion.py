@@ -202,6 +202,55 @@ def test_add_erosion_effective_plastic_strain_and_numfip(tmp_path, run_deck):
         assert abs(time - expected) < 5e-3 * expected
 
 
+def bent_strip_deck(path, failed_points):
+    """A cantilever strip of ten shells (NIP 5, MAT_024 FAIL 0.05) clamped at x = 0, its tip
+    pushed sideways at 5 mm/ms: bending, the outer points fail first; *MAT_ADD_EROSION NUMFIP
+    `failed_points` (None: no *MAT_ADD_EROSION, all five points)."""
+    nodes, shells = plate_mesh((10, 1), (10.0, 1.0))
+    nodes = round_to_node_card(nodes)
+    root = [k + 1 for k, node in enumerate(nodes) if abs(node[0]) < 1e-9]
+    tip = [k + 1 for k, node in enumerate(nodes) if abs(node[0] - 10.0) < 1e-9]
+    erosion = []
+    if failed_points is not None:
+        erosion = ["*MAT_ADD_EROSION\n" + fields(1, 0.0, 0.0, 0.0, 0.0, 0.0, float(failed_points)) + "\n" + fields(0.0)]
+    return write_deck(
+        path,
+        "*CONTROL_TERMINATION\n" + fields(1.5),
+        "*DATABASE_GLSTAT\n" + fields(0.01),
+        "*PART\nstrip\n" + fields(1, 1, 1),
+        "*SECTION_SHELL\n" + fields(1, 2, 0.8333, 5) + "\n" + fields(*[0.5] * 4),
+        "*MAT_PIECEWISE_LINEAR_PLASTICITY\n" + fields(1, DENSITY, E, NU, SIGY, ETAN, 0.05) + "\n" + fields(0.0),
+        *erosion,
+        ramp_curve(),
+        node_list_set(1, root),
+        "*BOUNDARY_SPC_SET\n" + fields(1, 0, 1, 1, 1, 1, 1, 1),
+        node_list_set(2, tip),
+        "*BOUNDARY_PRESCRIBED_MOTION_SET\n" + fields(2, 3, 0, 1, 5.0),
+        nodes_card(nodes),
+        shells_card(shells),
+    )
+
+
+def test_numfip_counts_the_failed_points_of_a_bent_shell(tmp_path, run_deck):
+    """In bending the outer points of the root shell fail first (top and bottom within a few
+    cycles: the large deflection adds some tension), the next pair later, the mid-surface point
+    never: NUMFIP 1 erodes it first, 2 a little later, 3 and -60 (60 % of 5 points) much later
+    and at the same cycle; without *MAT_ADD_EROSION (all five points) it does not erode. Failed
+    points carry no stress, and the energy balance holds."""
+    first = {}
+    for failed_points in (1, 2, 3, -60, None):
+        run = run_deck(bent_strip_deck(tmp_path / f"strip_{failed_points}.k", failed_points), jobid=str(failed_points))
+        assert run.status == 0, run.stderr
+        eroded = failures(run)
+        first[failed_points] = min((cycle for *_, cycle in eroded), default=None)
+        with run.open() as results:
+            check_energy_balance(results, tolerance=1e-2)
+    print(f"  first erosion cycle by NUMFIP: {first}")
+    assert first[1] is not None and first[1] <= first[2] < first[1] + 100
+    assert first[3] is not None and first[3] == first[-60] and first[3] > first[2] + 1000
+    assert first[None] is None
+
+
 def crushed_block_deck(path, erode, material=None, minimum_step_factor=0.5):
     """One hexahedron crushed at 10 m/s (10 mm/ms) against its held face: its step shrinks with
     its length; DTMIN = 0.5 x the first step."""
@@ -316,21 +365,35 @@ def test_erosion_is_bit_identical_on_one_and_two_threads(tmp_path):
         check_energy_balance(results)
 
 
-def test_restart_with_eroded_elements_reproduces_the_uninterrupted_run(tmp_path):
-    """Dumps before and after the solids eroded (the eroded masks, the energy they took and
-    the counts are in the dump): each continued run gives the uninterrupted file bit for bit."""
-    deck = bar_deck(tmp_path / "bar.k", "*MAT_PLASTIC_KINEMATIC\n" + fields(1, DENSITY, E, NU, SIGY, ETAN, 1.0) +
-                    "\n" + fields(0.0, 0.0, 0.02), extra=["*DATABASE_BINARY_D3DUMP\n" + fields(2200)])
-    run_fresh(deck, tmp_path / "one")
+@pytest.mark.parametrize("model", ["solid bar", "bent shells"])
+def test_restart_with_eroded_elements_reproduces_the_uninterrupted_run(tmp_path, model):
+    """Dumps before and after elements eroded (the eroded masks, the shells' failed points, the
+    energy eroded elements took and the counts are in the dump): each continued run gives the
+    uninterrupted file bit for bit. The solids erode at cycle 4124 (dumps at 2200 and 4400); the
+    root shell's outer points fail near cycle 5400 and it erodes at 7233 (dumps every 3000
+    cycles: the one at 6000 between the two)."""
+    if model == "solid bar":
+        interval = 2200
+        deck = bar_deck(tmp_path / "bar.k", "*MAT_PLASTIC_KINEMATIC\n" + fields(1, DENSITY, E, NU, SIGY, ETAN, 1.0) +
+                        "\n" + fields(0.0, 0.0, 0.02), extra=["*DATABASE_BINARY_D3DUMP\n" + fields(interval)])
+    else:
+        interval = 3000
+        deck = bent_strip_deck(tmp_path / "strip.k", 3)
+        deck.write_text(deck.read_text().replace("*END", "*DATABASE_BINARY_D3DUMP\n" + fields(interval) + "\n*END"))
+    uninterrupted = run_fresh(deck, tmp_path / "one")
+    eroded_cycles = [int(cycle) for *_, cycle in FAILURE_LINE.findall(uninterrupted.stdout)]
+    assert eroded_cycles
     reference = contents(tmp_path / "one" / "results.h5")
     dumps = sorted(p.name for p in (tmp_path / "one").glob("d3dump*"))
-    assert len(dumps) == 2, dumps       # cycles 2200 and 4400; the elements erode at cycle 4124
-    for dump in dumps:
+    assert len(dumps) >= 2 and any(interval * (k + 1) > max(eroded_cycles) for k in range(len(dumps))), dumps
+    for k, dump in enumerate(dumps):
         target = copy_run(tmp_path / "one", tmp_path / f"restart_{dump}")
         process = restart(target / dump, 2)
         assert process.returncode == 0, process.stdout + process.stderr
         assert_same(reference, contents(target / "results.h5"), f"continued from {dump}")
-        assert (process.stdout.count("failed at time") == 4) == (dump == dumps[0])
+        # the failure lines come from the part of the run that was continued
+        later = [cycle for cycle in eroded_cycles if cycle > interval * (k + 1)]
+        assert len(FAILURE_LINE.findall(process.stdout)) == len(later)
 
 
 @pytest.mark.parametrize("cards, field", [
