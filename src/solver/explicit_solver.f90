@@ -162,6 +162,8 @@ contains
       do k = 1, size(state%groups)
         call state%groups(k)%group%mark_eroded(state%solid_eroded, state%shell_eroded)
       end do
+      ! (after a restart the masks may hold elements eroded before the dump: contacts whose
+      ! state does not keep the segments they dropped take them out again here)
     end if
     if (state%watch%first_time_step > 0.0_wp .and. model%minimum_time_step_factor > 0.0_wp .and. &
         (model%erode_solids_on_step .or. model%erode_shells_on_step)) then

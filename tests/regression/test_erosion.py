@@ -42,12 +42,10 @@ def bar_deck(path, material_cards, kind="solid", formulation=1, end_time=0.6, ex
         nodes, elements = block_mesh((CELLS, 1, 1), (LENGTH, 1.0, 1.0))
         element_cards = solids_card(elements)
         section = "*SECTION_SOLID\n" + fields(1, formulation)
-        held = [0, 1, 2]
     else:
         nodes, elements = plate_mesh((CELLS, 1), (LENGTH, 1.0))
         element_cards = shells_card(elements)
         section = "*SECTION_SHELL\n" + fields(1, 2, 1.0, 3) + "\n" + fields(*[0.1] * 4)
-        held = [0, 1]
     nodes = round_to_node_card(nodes)
     spc = ["*BOUNDARY_SPC_NODE"]
     for k, node in enumerate(nodes):
@@ -57,7 +55,6 @@ def bar_deck(path, material_cards, kind="solid", formulation=1, end_time=0.6, ex
         if any(dofs):
             spc.append(fields(k + 1, 0, *dofs, *([1, 1, 1] if kind == "shell" else [0, 0, 0])))
     pulled = list(np.flatnonzero(np.abs(nodes[:, 0] - LENGTH) < 1e-9) + 1)
-    del held
     return write_deck(
         path,
         "*CONTROL_TERMINATION\n" + fields(end_time),
