@@ -38,7 +38,7 @@ contains
 
     if (restart%resuming) then
       ! the run state at the end of the dump's cycle, before its output
-      call resume_run(restart, run, error)
+      call resume_run(restart, model, run, error)
       if (allocated(error)) return
       finished = reached_end(model, run%state)
     else
@@ -62,7 +62,7 @@ contains
       finished = finished .or. allocated(error)
       ! restart dumps: the run state of this cycle before its output (none after a run-time
       ! error; a stop signal writes one and says where)
-      if (clean) call write_due_dumps(restart, run, summary%setup_s, results, allocated(error), finished, error)
+      if (clean) call write_due_dumps(restart, model, run, summary%setup_s, results, allocated(error), finished, error)
       call check_distortion(model, run, finished)
       call output(model, run, results, finished, output_error)
       if (allocated(output_error)) exit

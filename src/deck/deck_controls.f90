@@ -81,7 +81,7 @@ contains
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
-    integer :: line, limit_curve
+    integer :: line, limit_curve, erode
     line = 0
     if (.not. require_card(deck, block, line, standard_widths, card, log, "card 1 (DTINIT "// &
                            "TSSFAC ISDO TSLIMT DT2MS LCTM ERODE MS1ST)", "DTINIT")) return
@@ -90,7 +90,18 @@ contains
       call get_real(deck, card, 2, "TSSFAC", model%time_step_scale, log)
       call get_real(deck, card, 5, "DT2MS", model%mass_scaled_time_step, log)
       call get_integer(deck, card, 6, "LCTM", limit_curve, log)
+      call get_integer(deck, card, 7, "ERODE", erode, log)
       if (card%failed) return
+      ! ERODE's digits: 1 solids, 10 shells, 100 beams (none in crashfree)
+      if (erode < 0 .or. erode > 111 .or. mod(erode, 10) > 1 .or. mod(erode/10, 10) > 1) then
+        call card_problem(deck, log, card, "ERODE", "must be 0 or a sum of 1 (erode solids), 10 (shells) and "// &
+          "100 (beams) when the step falls below DTMIN times the first, found "//integer_text(erode))
+      else
+        model%erode_solids_on_step = mod(erode, 10) == 1
+        model%erode_shells_on_step = mod(erode/10, 10) == 1
+        if (erode >= 100) call located_warning(deck, warnings, card%line, "ERODE", &
+          "100 (erode beams): there are no beam elements")
+      end if
       if (model%time_step_scale == 0.0_wp) model%time_step_scale = 0.9_wp
       if (model%initial_time_step < 0.0_wp) call card_problem(deck, log, card, "DTINIT", &
         "must be >= 0 (0: computed), found "//real_text(model%initial_time_step))
@@ -104,7 +115,6 @@ contains
     end associate
     call warn_if_set(deck, card, 3, "ISDO", "shells only", warnings)
     call warn_if_set(deck, card, 4, "TSLIMT", "shells only", warnings)
-    call warn_if_set(deck, card, 7, "ERODE", "elements do not erode", warnings)
     call warn_if_set(deck, card, 8, "MS1ST", "mass scaling is applied every cycle", warnings)
   end subroutine read_time_step
 

@@ -13,6 +13,7 @@ module deck_cross_check
   use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t, line_location
   use deck_fields, only: located_problem, located_warning
+  use deck_add_erosion, only: apply_add_erosions, warn_parts_that_do_not_erode
   use deck_input, only: deck_input_t, set_input_t, velocity_input_t, velocity_by_set, &
                         velocity_by_node, velocity_generation, set_general, set_added, &
                         general_all, general_node, general_part, general_box, &
@@ -72,6 +73,8 @@ contains
     call check_static_shells(deck, input, log)
     call resolve_material_curves(deck, input%model, input%material_lines, input%part_lines, log)
     call resolve_frames(deck, input, indices%nodes, log)
+    call apply_add_erosions(deck, input, indices%materials, log)
+    call warn_parts_that_do_not_erode(deck, input, warnings)
     call resolve_node_sets(deck, input, indices, log)
     call resolve_part_sets(deck, input, indices, log)
     call resolve_segment_sets(deck, input, indices, log)

@@ -13,7 +13,7 @@ module deck_input
 
   public :: id_list_t, set_input_t, spc_input_t, motion_input_t, load_input_t
   public :: velocity_input_t, wall_input_t, segment_set_input_t, segment_load_input_t
-  public :: deck_input_t, prepare_input, append_id
+  public :: deck_input_t, prepare_input, append_id, add_erosion_input_t
   public :: box_input_t, frame_input_t, vector_input_t
 
   !> The lists of definitions the keyword readers fill, one entry per definition. Each keyword
@@ -190,6 +190,17 @@ module deck_input
 
   !> Everything read, before ids are resolved. Arrays are sized by prepare_input and hold
   !> `*_count` entries.
+  !> One *MAT_ADD_EROSION as read (deck_add_erosion), applied to its material once the
+  !> materials are indexed.
+  type :: add_erosion_input_t
+    integer :: material_id = 0             !< MID
+    integer :: line = 0                    !< card 1
+    real(wp) :: plastic_strain = 0.0_wp    !< EFFEPS
+    real(wp) :: max_principal = 0.0_wp     !< MXEPS
+    real(wp) :: min_principal = 0.0_wp     !< MNEPS
+    real(wp) :: failed_points = 0.0_wp     !< NUMFIP (0: blank)
+  end type add_erosion_input_t
+
   type :: deck_input_t
     type(model_t) :: model
     integer :: node_count = 0, solid_count = 0, part_count = 0, section_count = 0
@@ -224,6 +235,7 @@ module deck_input
     type(rigid_input_t) :: rigid           !< *MAT_RIGID, rigid motions, nodal rigid bodies, masses
     type(contact_input_t) :: contact       !< *CONTACT_AUTOMATIC_... definitions
     type(tied_input_t) :: tied             !< *CONTACT_TIED_..., *CONTACT_SPOTWELD definitions
+    type(add_erosion_input_t), allocatable :: add_erosions(:)  !< *MAT_ADD_EROSION, in deck order
     !> *DATABASE_HISTORY_NODE(_SET) requests in deck order; a node set id is stored with a
     !> negative field number (-k for field IDk) so that nodes and sets keep their order.
     type(id_list_t) :: history_requests

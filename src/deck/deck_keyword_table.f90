@@ -31,6 +31,7 @@ module deck_keyword_table
   use deck_materials, only: read_elastic_materials, read_plastic_kinematic_materials, read_honeycomb_materials, &
     read_modified_honeycomb_materials, read_low_density_foam_materials, read_piecewise_linear_materials, &
     read_null_materials
+  use deck_add_erosion, only: read_add_erosions
   use deck_sets_curves, only: read_node_set, read_generated_node_set, read_part_set, read_segment_set, read_curve, &
     read_generated_part_set, read_general_node_set, read_added_node_set, read_added_part_set
   use deck_boxes_frames, only: read_boxes, read_local_boxes, read_point_frames, read_node_frames, &
@@ -286,7 +287,8 @@ contains
                       reader=read_node_frames), &
       keyword_entry_t("DEFINE_COORDINATE_VECTOR", options="TITLE", fills=[list_frames, list_none], &
                       reader=read_vector_frames), &
-      keyword_entry_t("DEFINE_VECTOR", options="TITLE", fills=[list_vectors, list_none], reader=read_vectors)]
+      keyword_entry_t("DEFINE_VECTOR", options="TITLE", fills=[list_vectors, list_none], reader=read_vectors), &
+      keyword_entry_t("MAT_ADD_EROSION", options="TITLE", reader=read_add_erosions)]
   end function keyword_table
 
   !> The row of material law `law` (a code of law_table): *MAT_<name>, also *MAT_<nnn>, with

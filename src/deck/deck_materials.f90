@@ -30,8 +30,6 @@ module deck_materials
   public :: read_piecewise_linear_materials, read_null_materials, append_material
 
   integer, parameter :: standard_widths(8) = 10
-  !> Largest FAIL that still means "no failure" (LS-DYNA's default is 1e21).
-  real(wp), parameter :: no_failure_strain = 1.0e20_wp
 
 contains
 
@@ -79,9 +77,9 @@ contains
         if (material%failure_strain < 0.0_wp .and. .not. card%failed) call card_problem(deck, log, card, "FAIL", &
           "FAIL < 0 (a user failure subroutine) is not available; give 0 or a plastic failure strain, found "// &
           real_text(material%failure_strain))
-        if (material%failure_strain > 0.0_wp .and. material%failure_strain < no_failure_strain) &
-          call warn_if_set(deck, card, 7, "FAIL", "elements do not erode", warnings)
-        call warn_if_set(deck, card, 8, "TDEL", "elements do not erode", warnings)
+        if (material%failure_time_step < 0.0_wp .and. .not. card%failed) call card_problem(deck, log, card, &
+          "TDEL", "the smallest element step before erosion must be >= 0 (0: off), found "// &
+          real_text(material%failure_time_step))
         first_card = card
 
         if (.not. require_card(deck, block, line, standard_widths, card, log, &
@@ -297,13 +295,14 @@ contains
         call get_real(deck, card, 3, "FS", material%failure_strain, log)
         call get_real(deck, card, 4, "VP", material%rate_formulation, log)
         if (.not. card%failed) then
+          if (material%failure_strain < 0.0_wp) call card_problem(deck, log, card, "FS", "the effective "// &
+            "plastic strain at failure must be > 0 (0: no failure), found "//real_text(material%failure_strain))
           call check_rate(deck, card, material, log, "SRC", "SRP")
           if (material%rate_formulation /= 0.0_wp .and. material%rate_formulation /= 1.0_wp) &
             call card_problem(deck, log, card, "VP", "must be 0 (scale the yield stress) or 1 "// &
                               "(viscoplastic), found "//real_text(material%rate_formulation))
         end if
       end associate
-      call warn_if_set(deck, card, 3, "FS", "elements do not erode", warnings)
     end do
   end subroutine read_plastic_kinematic_materials
 

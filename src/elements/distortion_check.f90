@@ -36,6 +36,7 @@ contains
       block_worst_ratio(b) = huge(1.0_wp)
       block_worst_element(b) = 0
       do lane = 1, blocks(b)%element_count
+        if (blocks(b)%eroded(lane)) cycle      ! out of the model: its nodes fly free
         do k = 1, 8
           corners(:, k) = coordinates(:, blocks(b)%nodes(lane, k))
         end do

@@ -49,6 +49,8 @@ module element_group
     real(wp), allocatable :: beam_resultant(:, :)
     real(wp), allocatable :: beam_plastic_strain(:)      !< (beams) largest over the section points
     real(wp), allocatable :: beam_failed(:)              !< (beams) 1 failed (*MAT_SPOTWELD), 0 not
+    !> deleted-element flags: 1 for an eroded element, 0 otherwise (solids, shells)
+    integer, allocatable :: solid_eroded(:), shell_eroded(:)
   end type element_results_t
 
   type, abstract :: element_group_t
@@ -58,6 +60,16 @@ module element_group
     logical :: step_not_finite = .false.           !< a block's step was NaN (comparisons skip it)
     integer :: failed_element = 0                  !< an element that inverted or degenerated (0: none)
     type(phase_timer_t) :: timer                   !< wall-clock time of its force calls
+    !> Erosion: an element that meets its material's failure criterion (erosion_criteria) or,
+    !> with ERODE, whose step falls below `erosion_time_step`, leaves the force loops for good
+    !> in the force call where it fails (no stress, forces, hourglass forces or step from then
+    !> on; its nodes keep their mass). The group keeps a per-element eroded mask, reports the
+    !> count of its last call here and lists them (newly_eroded_elements), sets the model-indexed
+    !> masks the contacts read (mark_eroded) and reports the energy its eroded elements took
+    !> along (add_eroded_energies; add_energies no longer counts them).
+    integer :: newly_eroded = 0                    !< elements eroded by the last force call
+    integer :: eroded_count = 0                    !< elements eroded so far
+    real(wp) :: erosion_time_step = 0.0_wp         !< ERODE: DTMIN x the first step (0: off), set by the solver
   contains
     !> Once before the first cycle: its element count (0: the group is dropped).
     procedure(count_interface), deferred :: element_count
@@ -95,6 +107,13 @@ module element_group
     procedure :: thinnest
     !> Optional: count the elements folded at a corner, warn when more are (solids).
     procedure :: check_distortion
+    !> Optional (kinds that erode): its elements eroded by the last force call, in its order.
+    procedure :: newly_eroded_elements
+    !> Optional (kinds that erode): set the entries of its eroded elements in the model-indexed
+    !> masks (solids in `solid_eroded`, shells in `shell_eroded`); others are left alone.
+    procedure :: mark_eroded
+    !> Optional (kinds that erode): internal and hourglass energy of its eroded elements.
+    procedure :: add_eroded_energies
   end type element_group_t
 
   !> An array element holding one group of any kind.
@@ -227,6 +246,22 @@ contains
     real(wp), intent(in) :: time
     type(distortion_t), intent(inout) :: distortion
   end subroutine check_distortion
+
+  function newly_eroded_elements(self) result(elements)
+    class(element_group_t), intent(in) :: self
+    integer, allocatable :: elements(:)
+    allocate (elements(0))
+  end function newly_eroded_elements
+
+  subroutine mark_eroded(self, solid_eroded, shell_eroded)
+    class(element_group_t), intent(in) :: self
+    logical, intent(inout) :: solid_eroded(:), shell_eroded(:)
+  end subroutine mark_eroded
+
+  subroutine add_eroded_energies(self, internal, hourglass)
+    class(element_group_t), intent(in) :: self
+    real(wp), intent(inout) :: internal, hourglass
+  end subroutine add_eroded_energies
 
   real(wp) function thinnest(self)
     class(element_group_t), intent(in) :: self

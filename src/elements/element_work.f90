@@ -6,7 +6,8 @@ module element_work
   implicit none
   private
 
-  public :: add_force_work, smallest_time_step, booked_energy, add_kinetic_energy, scale_block_density, raise_largest_scaling
+  public :: add_force_work, smallest_time_step, booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, &
+            raise_largest_scaling
 
 contains
 
@@ -52,11 +53,30 @@ contains
 
   !> Energy of the first `count` lanes of a block as the solver reports it: the work booked by
   !> the elements plus the step correction of their newest forces' power (see solid_block).
-  pure real(wp) function booked_energy(energy, power, count, step_correction)
+  !> Eroded lanes (`eroded`) are left out: their energy is reported apart (eroded_energy).
+  pure real(wp) function booked_energy(energy, power, count, step_correction, eroded)
     real(wp), intent(in) :: energy(:), power(:), step_correction
     integer, intent(in) :: count
-    booked_energy = sum(energy(1:count)) + step_correction*sum(power(1:count))
+    logical, intent(in), optional :: eroded(:)
+    logical :: some_eroded
+    some_eroded = .false.
+    if (present(eroded)) some_eroded = any(eroded(1:count))
+    if (some_eroded) then
+      booked_energy = sum(energy(1:count), mask=.not. eroded(1:count)) &
+                      + step_correction*sum(power(1:count), mask=.not. eroded(1:count))
+    else
+      booked_energy = sum(energy(1:count)) + step_correction*sum(power(1:count))
+    end if
   end function booked_energy
+
+  !> Energy the eroded lanes of a block took along (their powers are zero).
+  pure real(wp) function eroded_energy(energy, count, eroded)
+    real(wp), intent(in) :: energy(:)
+    integer, intent(in) :: count
+    logical, intent(in) :: eroded(:)
+    eroded_energy = 0.0_wp
+    if (any(eroded(1:count))) eroded_energy = sum(energy(1:count), mask=eroded(1:count))
+  end function eroded_energy
 
   !> Add a mass's share of the conserved kinetic energy 1/2 m v^{n-1/2} . v^{n+1/2}, split as
   !> explained at energy_balance: 1/2 m (v^n)^2 to `kinetic`, -1/8 m (dt a)^2 to `internal`.

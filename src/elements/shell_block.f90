@@ -50,6 +50,8 @@ module shell_block
                                    update_plane_stress_block, plane_stress_plastic_strain
   use element_work, only: add_force_work, smallest_time_step
   use gauss_legendre, only: gauss_legendre_rule
+  use erosion_criteria, only: plastic_failure_limit, principal_strains_active, failed_points_needed, &
+                              principal_log_strains_2d
   use element_ordering, only: spatial_element_order
   use shell_triangle, only: triangle_shear_operator
   implicit none
@@ -101,6 +103,15 @@ module shell_block
     real(wp), allocatable :: stress(:, :, :)
     !> Plane-stress material history (block_size, count, point_count).
     real(wp), allocatable :: history(:, :, :)
+    !> Erosion (erode_failed_lanes): as the solids' (solid_block), on the reference geometry
+    !> at rest; an eroded lane adds no area to its nodes' normals.
+    logical :: eroded(block_size) = .false.
+    logical :: newly_eroded(block_size) = .false.        !< eroded by the last call
+    real(wp) :: erosion_time_step = 0.0_wp               !< ERODE: a lane whose step falls below erodes (0: off)
+    real(wp) :: reference_coordinates(block_size, 4, 3) = 0.0_wp
+    !> Points whose plastic strain reached the failure strain: they carry no stress from then on
+    !> (as in LS-DYNA) until enough of them have failed for the shell to erode.
+    logical :: point_failed(block_size, max_shell_points) = .false.
   end type shell_block_t
 
 contains
@@ -204,6 +215,7 @@ contains
     end do
     block%density(1:nel) = model%materials(block%material)%density
     call gather_nodal(nel, block%nodes, model%coordinates, x)
+    block%reference_coordinates = x
     call shell_geometry(nel, x, block%frame, xl, yl, b1, b2, block%reference_area)
     block%area(1:nel) = block%reference_area(1:nel)
   end subroutine finish_block
@@ -277,6 +289,7 @@ contains
     real(wp) :: hourglass_global(block_size, 4, 6), element_time_step(block_size)
     real(wp) :: old_power(block_size), new_power(block_size), old_hourglass(block_size), new_hourglass(block_size)
     real(wp) :: shear_modulus, height, spin_angle(block_size)
+    real(wp) :: held_internal(block_size), held_hourglass(block_size)
     integer :: nel, i, point
 
     nel = block%element_count
@@ -284,6 +297,18 @@ contains
     call gather_nodal(nel, block%nodes, coordinates, x)
     call gather_nodal(nel, block%nodes, velocities, v)
     call gather_nodal(nel, block%nodes, angular_velocities, w)
+    block%newly_eroded = .false.
+    held_internal = block%internal_energy
+    held_hourglass = block%hourglass_energy
+    if (any(block%eroded(1:nel))) then
+      ! eroded lanes run on their reference geometry at rest (solid_block's hold_eroded_lanes)
+      do i = 1, nel
+        if (.not. block%eroded(i)) cycle
+        x(i, :, :) = block%reference_coordinates(i, :, :)
+        v(i, :, :) = 0.0_wp
+        w(i, :, :) = 0.0_wp
+      end do
+    end if
     shear_modulus = 0.0_wp
     if (material%law /= law_null) shear_modulus = material%youngs_modulus/(2.0_wp*(1.0_wp + material%poissons_ratio))
 
@@ -318,6 +343,14 @@ contains
         block%stress(i, 5, point) = block%stress(i, 5, point) + block%shear_factor*shear_modulus*dt*shear(i, 1)
       end do
     end do
+    ! failed points carry no stress (erode_failed_lanes)
+    if (any(block%point_failed(1:nel, 1:block%point_count))) then
+      do point = 1, block%point_count
+        do i = 1, nel
+          if (block%point_failed(i, point)) block%stress(i, :, point) = 0.0_wp
+        end do
+      end do
+    end if
 
     ! forces and moments on the end-of-step configuration
     call shell_geometry(nel, x, frame, xl, yl, b1, b2, area)
@@ -349,9 +382,12 @@ contains
 
     element_time_step = huge(1.0_wp)
     call stable_steps(block, material, x, area, xl, yl, b1, b2, element_time_step)
+    call erode_failed_lanes(block, material, nel, dt, xl, yl, held_internal, held_hourglass, element_time_step, &
+                            nodal_force)
     call smallest_time_step(nel, element_time_step, block%elements, critical_time_step, critical_element)
     degenerate_element = 0
     do i = 1, nel
+      if (block%eroded(i)) cycle
       if (.not. area(i) > 0.0_wp) then
         degenerate_element = block%elements(i)
         exit
@@ -404,6 +440,87 @@ contains
       block%hourglass_force(i, 5) = s*first + c*second
     end do
   end subroutine rotate_with_material
+
+  !> After the kernel, as solid_block's erode_failed_lanes: lanes eroded before give no force,
+  !> moment or step and keep their energy; lanes that fail now (enough points at the effective
+  !> plastic strain limit, in-plane principal strains of the mid-surface from the current local
+  !> corners `xl`, `yl`, ERODE's smallest step) erode at once, without the forces of this call
+  !> and the half step of their work.
+  subroutine erode_failed_lanes(block, material, nel, dt, xl, yl, held_internal, held_hourglass, &
+                                element_time_step, nodal_force)
+    type(shell_block_t), intent(inout) :: block
+    type(material_t), intent(in) :: material
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: dt, xl(block_size, 4), yl(block_size, 4)
+    real(wp), intent(in) :: held_internal(block_size), held_hourglass(block_size)
+    real(wp), intent(inout) :: element_time_step(block_size), nodal_force(block_size, 4, 6)
+    real(wp) :: limit, point_strain(block_size), gradient(2, 2), largest, smallest
+    real(wp) :: frame(block_size, 3, 3), xl0(block_size, 4), yl0(block_size, 4)
+    real(wp) :: b1(block_size, 4), b2(block_size, 4), area(block_size)
+    integer :: failed_points(block_size), needed, i, point
+    logical :: failed(block_size)
+
+    failed(1:nel) = .false.
+    limit = plastic_failure_limit(material)
+    if (limit < huge(1.0_wp) .and. size(block%history, 2) > 0) then
+      failed_points(1:nel) = 0
+      do point = 1, block%point_count
+        call plane_stress_plastic_strain(material, nel, block%history(:, :, point), point_strain)
+        do i = 1, nel
+          if (point_strain(i) >= limit .and. .not. block%eroded(i)) then
+            block%point_failed(i, point) = .true.
+            block%stress(i, :, point) = 0.0_wp
+          end if
+          if (block%point_failed(i, point)) failed_points(i) = failed_points(i) + 1
+        end do
+      end do
+      needed = failed_points_needed(material, block%point_count, .true.)
+      failed(1:nel) = failed_points(1:nel) >= needed
+    end if
+    if (principal_strains_active(material)) then
+      ! in-plane F of the mid-surface: current local corners against the reference gradients
+      call shell_geometry(nel, block%reference_coordinates, frame, xl0, yl0, b1, b2, area)
+      do i = 1, nel
+        if (block%eroded(i) .or. failed(i)) cycle
+        gradient(1, 1) = sum(xl(i, :)*b1(i, :))
+        gradient(1, 2) = sum(xl(i, :)*b2(i, :))
+        gradient(2, 1) = sum(yl(i, :)*b1(i, :))
+        gradient(2, 2) = sum(yl(i, :)*b2(i, :))
+        call principal_log_strains_2d(gradient, largest, smallest)
+        if (material%erosion_max_principal_strain > 0.0_wp .and. largest >= material%erosion_max_principal_strain) &
+          failed(i) = .true.
+        if (material%erosion_min_principal_strain < 0.0_wp .and. smallest <= material%erosion_min_principal_strain) &
+          failed(i) = .true.
+      end do
+    end if
+    if (block%erosion_time_step > 0.0_wp) then
+      do i = 1, nel
+        if (element_time_step(i) < block%erosion_time_step) failed(i) = .true.
+      end do
+    end if
+    do i = 1, nel
+      if (block%eroded(i)) then
+        block%internal_energy(i) = held_internal(i)
+        block%hourglass_energy(i) = held_hourglass(i)
+      else if (failed(i)) then
+        block%internal_energy(i) = block%internal_energy(i) - 0.5_wp*dt*block%force_power(i)
+        block%hourglass_energy(i) = block%hourglass_energy(i) - 0.5_wp*dt*block%hourglass_power(i)
+        block%eroded(i) = .true.
+        block%newly_eroded(i) = .true.
+      else
+        cycle
+      end if
+      block%force_power(i) = 0.0_wp
+      block%hourglass_power(i) = 0.0_wp
+      block%stress(i, :, :) = 0.0_wp
+      block%hourglass_force(i, :) = 0.0_wp
+      block%previous_force(i, :, :) = 0.0_wp
+      block%previous_hourglass_force(i, :, :) = 0.0_wp
+      block%area(i) = 0.0_wp
+      nodal_force(i, :, :) = 0.0_wp
+      element_time_step(i) = huge(1.0_wp)
+    end do
+  end subroutine erode_failed_lanes
 
   !> Corotational frame, local corner coordinates (origin at node 1), one-point gradients and
   !> area of each lane: e3 along r31 x r42, e1 along r21 projected on the plane.

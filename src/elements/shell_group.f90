@@ -13,7 +13,7 @@ module shell_group
   use run_summary, only: run_summary_t
   use nodal_state, only: nodal_state_t
   use element_group, only: element_group_t, element_results_t
-  use element_work, only: booked_energy, add_kinetic_energy, scale_block_density, raise_largest_scaling
+  use element_work, only: booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, raise_largest_scaling
   use shell_block, only: shell_block_t, build_shell_blocks, shell_block_masses, shell_block_time_steps, &
                          compute_shell_block, shell_block_element_results
   implicit none
@@ -43,6 +43,9 @@ module shell_group
     procedure :: failure_text
     procedure :: most_scaled
     procedure :: thinnest
+    procedure :: newly_eroded_elements
+    procedure :: mark_eroded
+    procedure :: add_eroded_energies
   end type shell_group_t
 
 contains
@@ -139,6 +142,11 @@ contains
     real(wp), intent(in) :: step
     real(wp) :: shell_force(block_size, 4, 6)
     integer :: colour, k, b
+    do b = 1, size(self%blocks)
+      ! ERODE's step, or the material's TDEL (MAT_024), whichever is larger
+      self%blocks(b)%erosion_time_step = max(merge(self%erosion_time_step, 0.0_wp, model%erode_shells_on_step), &
+                                             model%materials(self%blocks(b)%material)%failure_time_step)
+    end do
     do colour = 1, size(self%colours%offsets) - 1
       !$omp parallel do schedule(dynamic, 2) default(shared) private(k, b, shell_force)
       do k = self%colours%offsets(colour), self%colours%offsets(colour + 1) - 1
@@ -152,7 +160,51 @@ contains
       !$omp end parallel do
     end do
     call self%header_from_blocks(self%block_time_step, self%block_critical_element, self%block_degenerate_element)
+    self%newly_eroded = 0
+    do b = 1, size(self%blocks)
+      self%newly_eroded = self%newly_eroded + count(self%blocks(b)%newly_eroded)
+    end do
+    self%eroded_count = self%eroded_count + self%newly_eroded
   end subroutine add_internal_forces
+
+  !> Its shells eroded by the last force call, block by block.
+  function newly_eroded_elements(self) result(elements)
+    class(shell_group_t), intent(in) :: self
+    integer, allocatable :: elements(:)
+    integer :: b, lane, n
+    allocate (elements(self%newly_eroded))
+    n = 0
+    do b = 1, size(self%blocks)
+      do lane = 1, self%blocks(b)%element_count
+        if (.not. self%blocks(b)%newly_eroded(lane) .or. n >= size(elements)) cycle
+        n = n + 1
+        elements(n) = self%blocks(b)%elements(lane)
+      end do
+    end do
+  end function newly_eroded_elements
+
+  subroutine mark_eroded(self, solid_eroded, shell_eroded)
+    class(shell_group_t), intent(in) :: self
+    logical, intent(inout) :: solid_eroded(:), shell_eroded(:)
+    integer :: b, lane
+    do b = 1, size(self%blocks)
+      do lane = 1, self%blocks(b)%element_count
+        if (self%blocks(b)%eroded(lane)) shell_eroded(self%blocks(b)%elements(lane)) = .true.
+      end do
+    end do
+  end subroutine mark_eroded
+
+  subroutine add_eroded_energies(self, internal, hourglass)
+    class(shell_group_t), intent(in) :: self
+    real(wp), intent(inout) :: internal, hourglass
+    integer :: b
+    do b = 1, size(self%blocks)
+      associate (shell => self%blocks(b))
+        internal = internal + eroded_energy(shell%internal_energy, shell%element_count, shell%eroded)
+        hourglass = hourglass + eroded_energy(shell%hourglass_energy, shell%element_count, shell%eroded)
+      end associate
+    end do
+  end subroutine add_eroded_energies
 
   !> internal_force and internal_moment of the block's nodes += the shells' nodal forces and
   !> moments, corner by corner, lane by lane; and each node's sums of area x normal and area of
@@ -184,9 +236,9 @@ contains
     do b = 1, size(self%blocks)
       associate (shell => self%blocks(b))
         internal = internal + booked_energy(shell%internal_energy, shell%force_power, shell%element_count, &
-                                            step_correction)
+                                            step_correction, shell%eroded)
         hourglass = hourglass + booked_energy(shell%hourglass_energy, shell%hourglass_power, shell%element_count, &
-                                              step_correction)
+                                              step_correction, shell%eroded)
       end associate
     end do
   end subroutine add_energies
@@ -200,9 +252,9 @@ contains
     do b = 1, size(self%blocks)
       associate (shell => self%blocks(b))
         internal(shell%part) = internal(shell%part) + booked_energy(shell%internal_energy, shell%force_power, &
-          shell%element_count, step_correction)
+          shell%element_count, step_correction, shell%eroded)
         hourglass(shell%part) = hourglass(shell%part) + booked_energy(shell%hourglass_energy, shell%hourglass_power, &
-          shell%element_count, step_correction)
+          shell%element_count, step_correction, shell%eroded)
         do corner = 1, 4
           do lane = 1, shell%element_count
             node = shell%nodes(lane, corner)
@@ -221,11 +273,15 @@ contains
     class(shell_group_t), intent(in) :: self
     type(model_t), intent(in) :: model
     type(element_results_t), intent(inout) :: results
-    integer :: b
+    integer :: b, lane
     do b = 1, size(self%blocks)
       call shell_block_element_results(self%blocks(b), model%materials(self%blocks(b)%material), &
                                        results%shell_stress, results%shell_stress_peak, results%shell_plastic_strain, &
                                        results%shell_plastic_strain_peak)
+      if (.not. allocated(results%shell_eroded)) cycle
+      do lane = 1, self%blocks(b)%element_count
+        results%shell_eroded(self%blocks(b)%elements(lane)) = merge(1, 0, self%blocks(b)%eroded(lane))
+      end do
     end do
   end subroutine element_results
 
@@ -290,6 +346,8 @@ contains
     call exchange_restart(store, path//"/time_step", self%block_time_step, error)
     call exchange_restart(store, path//"/critical_element", self%block_critical_element, error)
     call exchange_restart(store, path//"/degenerate_element", self%block_degenerate_element, error)
+    call exchange_restart(store, path//"/newly_eroded_count", self%newly_eroded, error)
+    call exchange_restart(store, path//"/eroded_count", self%eroded_count, error)
     do b = 1, size(self%blocks)
       call exchange_shell_block(store, path//"/"//integer_text(b), self%blocks(b), error)
     end do
@@ -316,5 +374,8 @@ contains
     call exchange_restart(store, path//"/frame", block%frame, error)
     call exchange_restart(store, path//"/stress", block%stress, error)
     call exchange_restart(store, path//"/history", block%history, error)
+    call exchange_restart(store, path//"/eroded", block%eroded, error)
+    call exchange_restart(store, path//"/newly_eroded", block%newly_eroded, error)
+    call exchange_restart(store, path//"/point_failed", block%point_failed, error)
   end subroutine exchange_shell_block
 end module shell_group

@@ -49,6 +49,8 @@ module solid_block
   use solid_exposure, only: exposed_elements
   use element_ordering, only: spatial_element_order
   use element_time_step, only: bulk_viscosity_pressure, solid_element_time_steps, eigenvalue_time_steps
+  use erosion_criteria, only: plastic_failure_limit, principal_strains_active, failed_points_needed, &
+                              principal_log_strains_3d
   implicit none
   private
 
@@ -107,6 +109,13 @@ module solid_block
     !> accumulated state of the stiffness forms (IHQ 4, 5), kept by the viscous forms for the
     !> work of the forces; (block_size, 3, 0) for ELFORM 2.
     real(wp), allocatable :: hourglass_force(:, :, :)
+    !> Erosion (erode_failed_lanes): lanes that failed are out of the force loops for good; the
+    !> kernels run them on their reference geometry at rest, and their forces, powers and step
+    !> are discarded.
+    logical :: eroded(block_size) = .false.
+    logical :: newly_eroded(block_size) = .false.        !< eroded by the last call
+    real(wp) :: erosion_time_step = 0.0_wp               !< ERODE: a lane whose step falls below erodes (0: off)
+    real(wp) :: reference_coordinates(block_size, 8, 3) = 0.0_wp
   end type solid_block_t
 
 contains
@@ -230,6 +239,9 @@ contains
     end if
     block%density(1:nel) = model%materials(block%material)%density
     call gather_coordinates(nel, block%nodes, model%coordinates, x, y, z)
+    block%reference_coordinates(:, :, 1) = x
+    block%reference_coordinates(:, :, 2) = y
+    block%reference_coordinates(:, :, 3) = z
     ! Element edges 1-2 and 1-4: the material axes of AOPT 0 (honeycombs).
     element_edges(1:nel, :) = reshape([x(1:nel, 2) - x(1:nel, 1), y(1:nel, 2) - y(1:nel, 1), &
                                        z(1:nel, 2) - z(1:nel, 1), x(1:nel, 4) - x(1:nel, 1), &
@@ -544,12 +556,16 @@ contains
     integer, intent(out) :: critical_element
     integer, intent(out) :: inverted_element
     real(wp) :: element_time_step(block_size), step
+    real(wp) :: held_internal(block_size), held_hourglass(block_size)
     integer :: nel, i, point, element, k
 
     nel = block%element_count
     ! The kernels write lanes 1..nel only; the rest stay zero (huge for the time step).
     corner_force(nel + 1:, :, :) = 0.0_wp
     element_time_step(nel + 1:) = huge(1.0_wp)
+    block%newly_eroded = .false.
+    held_internal = block%internal_energy
+    held_hourglass = block%hourglass_energy
     if (block%formulation == formulation_selective_reduced) then
       call compute_selective_reduced(block, material, coordinates, velocities, dt, corner_force, &
                                      element_time_step)
@@ -558,6 +574,8 @@ contains
                              element_time_step)
     end if
     block%previous_time_step = dt
+    call erode_failed_lanes(block, material, nel, dt, coordinates, held_internal, held_hourglass, &
+                            element_time_step, corner_force)
 
     call smallest_time_step(nel, element_time_step, block%elements, step, element)
     critical_time_step = step
@@ -573,6 +591,7 @@ contains
     inverted_element = 0
     ! Inverted: element volume (ELFORM 1) or a Gauss point volume (ELFORM 2) <= 0.
     lanes: do i = 1, nel
+      if (block%eroded(i)) cycle
       do point = 1, block%point_count
         if (block%point_volume(i, point) <= 0.0_wp) then
           inverted_element = block%elements(i)
@@ -612,6 +631,7 @@ contains
     nel = block%element_count
     call gather_coordinates(nel, block%nodes, coordinates, x, y, z)
     call gather_coordinates(nel, block%nodes, velocities, vx, vy, vz)
+    call hold_eroded_lanes(block, nel, x, y, z, vx, vy, vz)
     ! the state that made the previous call's forces, for their work over this step
     old_stress(1:nel, :) = block%stress(1:nel, :, 1)
     old_bulk_viscosity(1:nel) = block%bulk_viscosity(1:nel)
@@ -713,6 +733,7 @@ contains
     call hex8_gauss_natural_derivatives(natural)
     call gather_coordinates(nel, block%nodes, coordinates, x, y, z)
     call gather_coordinates(nel, block%nodes, velocities, vx, vy, vz)
+    call hold_eroded_lanes(block, nel, x, y, z, vx, vy, vz)
 
     ! Power of the forces f(n) of the previous call over this step, from the point stresses and
     ! q they were made of on the configuration x(n) = x(n+1) - dt v(n+1/2).
@@ -813,6 +834,118 @@ contains
     block%volume(1:nel) = volume(1:nel)
     block%bulk_viscosity(1:nel) = bulk_viscosity(1:nel)
   end subroutine compute_selective_reduced
+
+  !> Eroded lanes run on their reference geometry at rest: no strain, finite geometry however
+  !> far their nodes have flown, so nothing in the kernels can overflow or trap.
+  pure subroutine hold_eroded_lanes(block, nel, x, y, z, vx, vy, vz)
+    type(solid_block_t), intent(in) :: block
+    integer, intent(in) :: nel
+    real(wp), intent(inout) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
+    real(wp), intent(inout) :: vx(block_size, 8), vy(block_size, 8), vz(block_size, 8)
+    integer :: i
+    if (.not. any(block%eroded(1:nel))) return
+    do i = 1, nel
+      if (.not. block%eroded(i)) cycle
+      x(i, :) = block%reference_coordinates(i, :, 1)
+      y(i, :) = block%reference_coordinates(i, :, 2)
+      z(i, :) = block%reference_coordinates(i, :, 3)
+      vx(i, :) = 0.0_wp
+      vy(i, :) = 0.0_wp
+      vz(i, :) = 0.0_wp
+    end do
+  end subroutine hold_eroded_lanes
+
+  !> After the kernel: lanes eroded before give no force and no step and keep the energy they
+  !> had (`held_*`, before the call); lanes that fail now (effective plastic strain of enough
+  !> points, principal strains of the centre, ERODE's smallest step) erode at once: their forces
+  !> of this call are dropped and so is the half step of work add_force_work booked for them, so
+  !> that their energy is exactly the work their applied forces did. Their stress, hourglass
+  !> forces and bulk viscosity go to zero.
+  subroutine erode_failed_lanes(block, material, nel, dt, coordinates, held_internal, held_hourglass, &
+                                element_time_step, corner_force)
+    type(solid_block_t), intent(inout) :: block
+    type(material_t), intent(in) :: material
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: dt
+    real(wp), intent(in), contiguous :: coordinates(:, :)
+    real(wp), intent(in) :: held_internal(block_size), held_hourglass(block_size)
+    real(wp), intent(inout) :: element_time_step(block_size)
+    real(wp), intent(inout) :: corner_force(block_size, 8, 3)
+    real(wp) :: limit, point_strain(block_size), x(block_size, 8, 3)
+    real(wp) :: bx(block_size, 8), by(block_size, 8), bz(block_size, 8), volume(block_size)
+    real(wp) :: gradient(3, 3), largest, smallest
+    integer :: failed_points(block_size), needed, i, point, k
+    logical :: failed(block_size)
+
+    failed(1:nel) = .false.
+    limit = plastic_failure_limit(material)
+    if (limit < huge(1.0_wp) .and. size(block%history, 2) > 0) then
+      failed_points(1:nel) = 0
+      do point = 1, block%point_count
+        call material_plastic_strain(block%material_law, nel, block%history(:, :, point), point_strain)
+        do i = 1, nel
+          if (point_strain(i) >= limit) failed_points(i) = failed_points(i) + 1
+        end do
+      end do
+      needed = failed_points_needed(material, block%point_count, .false.)
+      failed(1:nel) = failed_points(1:nel) >= needed
+    end if
+    if (principal_strains_active(material)) then
+      ! F of the centre: sum over the corners of x_I (x) dV0/dX_I / V0 (the mean F of the element)
+      call gather_coordinates(nel, block%nodes, coordinates, x(:, :, 1), x(:, :, 2), x(:, :, 3))
+      call hex8_volume_derivatives(nel, block%reference_coordinates(:, :, 1), block%reference_coordinates(:, :, 2), &
+                                   block%reference_coordinates(:, :, 3), bx, by, bz, volume)
+      do i = 1, nel
+        if (block%eroded(i) .or. failed(i)) cycle
+        do k = 1, 3
+          gradient(k, 1) = sum(x(i, :, k)*bx(i, :))/volume(i)
+          gradient(k, 2) = sum(x(i, :, k)*by(i, :))/volume(i)
+          gradient(k, 3) = sum(x(i, :, k)*bz(i, :))/volume(i)
+        end do
+        call principal_log_strains_3d(gradient, largest, smallest)
+        if (material%erosion_max_principal_strain > 0.0_wp .and. largest >= material%erosion_max_principal_strain) &
+          failed(i) = .true.
+        if (material%erosion_min_principal_strain < 0.0_wp .and. smallest <= material%erosion_min_principal_strain) &
+          failed(i) = .true.
+      end do
+    end if
+    if (block%erosion_time_step > 0.0_wp) then
+      do i = 1, nel
+        if (element_time_step(i) < block%erosion_time_step) failed(i) = .true.
+      end do
+    end if
+    do i = 1, nel
+      if (block%eroded(i)) then
+        block%internal_energy(i) = held_internal(i)
+        block%hourglass_energy(i) = held_hourglass(i)
+      else if (failed(i)) then
+        block%internal_energy(i) = block%internal_energy(i) - 0.5_wp*dt*block%force_power(i)
+        block%hourglass_energy(i) = block%hourglass_energy(i) - 0.5_wp*dt*block%hourglass_power(i)
+        block%eroded(i) = .true.
+        block%newly_eroded(i) = .true.
+      else
+        cycle
+      end if
+      block%force_power(i) = 0.0_wp
+      block%hourglass_power(i) = 0.0_wp
+      block%stress(i, :, :) = 0.0_wp
+      block%hourglass_force(i, :, :) = 0.0_wp
+      block%bulk_viscosity(i) = 0.0_wp
+      corner_force(i, :, :) = 0.0_wp
+      element_time_step(i) = huge(1.0_wp)
+    end do
+    ! an eroded element no longer sets the step through the last calls' memory (compute_solid_block)
+    if (any(block%newly_eroded(1:nel))) then
+      do k = 1, 2
+        do i = 1, nel
+          if (block%newly_eroded(i) .and. block%recent_critical_element(k) == block%elements(i)) then
+            block%recent_time_step(k) = huge(1.0_wp)
+            block%recent_critical_element(k) = 0
+          end if
+        end do
+      end do
+    end if
+  end subroutine erode_failed_lanes
 
   !> x(i, I) = coordinates(1, nodes(i, I)) etc. for lanes 1..nel (also used for velocities).
   !> A plain scalar loop: on the machines measured it beats the vector gather instructions.

@@ -11,7 +11,7 @@ module solid_group
   use run_summary, only: run_summary_t
   use nodal_state, only: nodal_state_t
   use element_group, only: element_group_t, element_results_t, distortion_t
-  use element_work, only: booked_energy, add_kinetic_energy, scale_block_density, raise_largest_scaling
+  use element_work, only: booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, raise_largest_scaling
   use solid_block, only: solid_block_t, build_solid_blocks, solid_block_corner_masses, solid_block_time_steps, &
                          compute_solid_block, solid_block_element_results
   use distortion_check, only: check_solid_distortion
@@ -41,6 +41,9 @@ module solid_group
     procedure :: failure_text
     procedure :: most_scaled
     procedure :: check_distortion
+    procedure :: newly_eroded_elements
+    procedure :: mark_eroded
+    procedure :: add_eroded_energies
   end type solid_group_t
 
 contains
@@ -138,6 +141,11 @@ contains
     real(wp), intent(in) :: step
     real(wp) :: block_force(block_size, 8, 3)
     integer :: colour, k, b
+    do b = 1, size(self%blocks)
+      ! ERODE's step, or the material's TDEL (MAT_024), whichever is larger
+      self%blocks(b)%erosion_time_step = max(merge(self%erosion_time_step, 0.0_wp, model%erode_solids_on_step), &
+                                             model%materials(self%blocks(b)%material)%failure_time_step)
+    end do
     do colour = 1, size(self%colours%offsets) - 1
       !$omp parallel do schedule(dynamic, 2) default(shared) private(k, b, block_force)
       do k = self%colours%offsets(colour), self%colours%offsets(colour + 1) - 1
@@ -152,7 +160,51 @@ contains
       !$omp end parallel do
     end do
     call self%header_from_blocks(self%block_time_step, self%block_critical_element, self%block_inverted_element)
+    self%newly_eroded = 0
+    do b = 1, size(self%blocks)
+      self%newly_eroded = self%newly_eroded + count(self%blocks(b)%newly_eroded)
+    end do
+    self%eroded_count = self%eroded_count + self%newly_eroded
   end subroutine add_internal_forces
+
+  !> Its solids eroded by the last force call, block by block.
+  function newly_eroded_elements(self) result(elements)
+    class(solid_group_t), intent(in) :: self
+    integer, allocatable :: elements(:)
+    integer :: b, lane, n
+    allocate (elements(self%newly_eroded))
+    n = 0
+    do b = 1, size(self%blocks)
+      do lane = 1, self%blocks(b)%element_count
+        if (.not. self%blocks(b)%newly_eroded(lane) .or. n >= size(elements)) cycle
+        n = n + 1
+        elements(n) = self%blocks(b)%elements(lane)
+      end do
+    end do
+  end function newly_eroded_elements
+
+  subroutine mark_eroded(self, solid_eroded, shell_eroded)
+    class(solid_group_t), intent(in) :: self
+    logical, intent(inout) :: solid_eroded(:), shell_eroded(:)
+    integer :: b, lane
+    do b = 1, size(self%blocks)
+      do lane = 1, self%blocks(b)%element_count
+        if (self%blocks(b)%eroded(lane)) solid_eroded(self%blocks(b)%elements(lane)) = .true.
+      end do
+    end do
+  end subroutine mark_eroded
+
+  subroutine add_eroded_energies(self, internal, hourglass)
+    class(solid_group_t), intent(in) :: self
+    real(wp), intent(inout) :: internal, hourglass
+    integer :: b
+    do b = 1, size(self%blocks)
+      associate (block => self%blocks(b))
+        internal = internal + eroded_energy(block%internal_energy, block%element_count, block%eroded)
+        hourglass = hourglass + eroded_energy(block%hourglass_energy, block%element_count, block%eroded)
+      end associate
+    end do
+  end subroutine add_eroded_energies
 
   subroutine add_energies(self, step_correction, internal, hourglass)
     class(solid_group_t), intent(in) :: self
@@ -162,9 +214,9 @@ contains
     do b = 1, size(self%blocks)
       associate (block => self%blocks(b))
         internal = internal + booked_energy(block%internal_energy, block%force_power, block%element_count, &
-                                            step_correction)
+                                            step_correction, block%eroded)
         hourglass = hourglass + booked_energy(block%hourglass_energy, block%hourglass_power, block%element_count, &
-                                              step_correction)
+                                              step_correction, block%eroded)
       end associate
     end do
   end subroutine add_energies
@@ -179,9 +231,9 @@ contains
     do b = 1, size(self%blocks)
       associate (block => self%blocks(b))
         internal(block%part) = internal(block%part) + booked_energy(block%internal_energy, block%force_power, &
-          block%element_count, step_correction)
+          block%element_count, step_correction, block%eroded)
         hourglass(block%part) = hourglass(block%part) + booked_energy(block%hourglass_energy, block%hourglass_power, &
-          block%element_count, step_correction)
+          block%element_count, step_correction, block%eroded)
         do corner = 1, 8
           do lane = 1, block%element_count
             node = block%nodes(lane, corner)
@@ -197,9 +249,13 @@ contains
     class(solid_group_t), intent(in) :: self
     type(model_t), intent(in) :: model
     type(element_results_t), intent(inout) :: results
-    integer :: b
+    integer :: b, lane
     do b = 1, size(self%blocks)
       call solid_block_element_results(self%blocks(b), results%solid_stress, results%solid_plastic_strain)
+      if (.not. allocated(results%solid_eroded)) cycle
+      do lane = 1, self%blocks(b)%element_count
+        results%solid_eroded(self%blocks(b)%elements(lane)) = merge(1, 0, self%blocks(b)%eroded(lane))
+      end do
     end do
   end subroutine element_results
 
@@ -281,6 +337,8 @@ contains
     call exchange_restart(store, path//"/time_step", self%block_time_step, error)
     call exchange_restart(store, path//"/critical_element", self%block_critical_element, error)
     call exchange_restart(store, path//"/inverted_element", self%block_inverted_element, error)
+    call exchange_restart(store, path//"/newly_eroded_count", self%newly_eroded, error)
+    call exchange_restart(store, path//"/eroded_count", self%eroded_count, error)
     do b = 1, size(self%blocks)
       call exchange_solid_block(store, path//"/"//integer_text(b), self%blocks(b), error)
     end do
@@ -309,5 +367,7 @@ contains
     call exchange_restart(store, path//"/history", block%history, error)
     call exchange_restart(store, path//"/point_volume", block%point_volume, error)
     call exchange_restart(store, path//"/hourglass_force", block%hourglass_force, error)
+    call exchange_restart(store, path//"/eroded", block%eroded, error)
+    call exchange_restart(store, path//"/newly_eroded", block%newly_eroded, error)
   end subroutine exchange_solid_block
 end module solid_group

@@ -50,11 +50,13 @@ module model
     real(wp) :: hardening_beta = 0.0_wp     !< BETA: 0 kinematic ... 1 isotropic
     real(wp) :: rate_c = 0.0_wp             !< SRC, Cowper-Symonds C (0: no rate effect)
     real(wp) :: rate_p = 0.0_wp             !< SRP, Cowper-Symonds P (0: no rate effect)
-    real(wp) :: failure_strain = 0.0_wp     !< FS (read and kept; erosion is not modelled)
+    !> FS (MAT_003) / FAIL (MAT_024): effective plastic strain at which the element erodes
+    !> (0 or >= 1e20: never)
+    real(wp) :: failure_strain = 0.0_wp
     real(wp) :: rate_formulation = 0.0_wp   !< VP: 0 scale yield stress, 1 viscoplastic
     ! *MAT_PIECEWISE_LINEAR_PLASTICITY (SIGY, ETAN, FAIL, C, P, VP above; curves in the slots
     ! piecewise_hardening_curve and piecewise_rate_curve)
-    real(wp) :: failure_time_step = 0.0_wp  !< TDEL (read and kept; erosion is not modelled)
+    real(wp) :: failure_time_step = 0.0_wp  !< TDEL: an element whose stable step falls below erodes (0: off)
     ! *MAT_SPOTWELD (E, PR, SIGY above; ET in tangent_modulus)
     real(wp) :: failure_time = 0.0_wp       !< TFAIL: the weld fails at this time (0: never)
     real(wp) :: failure_plastic_strain = 0.0_wp !< EFAIL: plastic strain at failure (0: none)
@@ -62,6 +64,14 @@ module model
     real(wp) :: failure_resultants(6) = 0.0_wp
     ! *MAT_NULL
     real(wp) :: pressure_cutoff = 0.0_wp    !< PC (read and kept)
+    ! *MAT_ADD_EROSION of this material (0: the criterion is off)
+    logical :: has_add_erosion = .false.
+    real(wp) :: erosion_plastic_strain = 0.0_wp       !< EFFEPS: effective plastic strain
+    real(wp) :: erosion_max_principal_strain = 0.0_wp !< MXEPS: largest principal (logarithmic) strain
+    real(wp) :: erosion_min_principal_strain = 0.0_wp !< MNEPS: smallest principal strain (< 0)
+    !> NUMFIP: failed points before a shell erodes (> 0 a count, < 0 a percentage); without
+    !> *MAT_ADD_EROSION a shell erodes when all its points failed (0 here)
+    real(wp) :: erosion_failed_points = 0.0_wp
     ! *MAT_HONEYCOMB, *MAT_MODIFIED_HONEYCOMB (E, PR, SIGY above: the fully compacted material)
     real(wp) :: compaction_volume = 0.0_wp  !< VF: relative volume at full compaction, (0, 1]
     real(wp) :: viscosity = 0.0_wp          !< MU (honeycombs), DAMP (foam): viscous coefficient
@@ -415,6 +425,9 @@ module model
     real(wp) :: end_time = 0.0_wp                    !< ENDTIM
     integer :: end_cycle = 0                         !< ENDCYC (0 = no limit)
     real(wp) :: minimum_time_step_factor = 0.0_wp    !< DTMIN: stop below this times the first step (0: off)
+    !> *CONTROL_TIMESTEP ERODE: solids / shells whose step falls below DTMIN x the first step
+    !> erode instead of stopping the run
+    logical :: erode_solids_on_step = .false., erode_shells_on_step = .false.
     real(wp) :: energy_ratio_change_limit = 0.0_wp   !< ENDENG: stop when |energy ratio - 1| exceeds this
                                                      !< many percent (0: off)
     real(wp) :: mass_change_limit = 1.0e8_wp         !< ENDMAS: percent of mass that mass scaling may add

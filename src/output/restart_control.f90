@@ -112,8 +112,9 @@ contains
   !> SIGINT / SIGTERM (sw1; `error` holds its message, to which where the dump is gets
   !> added); `finished`: the run reached its end (no dump then). The periodic dumps go by the
   !> cycle number, so a restarted run writes them at the cycles the uninterrupted one did.
-  subroutine write_due_dumps(control, run, setup_s, results, stopped, finished, error)
+  subroutine write_due_dumps(control, model, run, setup_s, results, stopped, finished, error)
     type(restart_control_t), intent(inout) :: control
+    type(model_t), intent(in) :: model
     type(run_state_t), intent(inout) :: run
     real(wp), intent(in) :: setup_s
     type(results_file_t), intent(inout) :: results
@@ -168,7 +169,7 @@ contains
                                      failure)
         call write_restart_attribute(store, "setup_seconds", control%earlier_setup_s + setup_s, failure)
         call write_restart(store, "deck/files", control%deck_files, failure)
-        call exchange_run_state(store, run, failure)
+        call exchange_run_state(store, model, run, failure)
         call exchange_results_progress(store, "results", results, failure)
         if (allocated(failure)) then
           call discard_restart_store(store)
@@ -318,12 +319,13 @@ contains
   end subroutine continue_restart_results
 
   !> Read the run state from the dump into the run state that the deck built, and close the dump.
-  subroutine resume_run(control, run, error)
+  subroutine resume_run(control, model, run, error)
     type(restart_control_t), intent(inout) :: control
+    type(model_t), intent(in) :: model
     type(run_state_t), intent(inout) :: run
     type(error_t), allocatable, intent(out) :: error
     character(len=60) :: text
-    call exchange_run_state(control%source, run, error)
+    call exchange_run_state(control%source, model, run, error)
     call close_restart_store(control%source)
     if (allocated(error)) return
     write (text, '(es12.5,a,i0)') run%state%time, ", cycle ", run%state%cycle

@@ -275,7 +275,8 @@ contains
   !> keeps the states before it.
   subroutine write_state(results, time, displacement, velocity, solid_stress, &
                          solid_plastic_strain, error, shell_stress, shell_plastic_strain, shell_stress_peak, &
-                         shell_plastic_strain_peak, histories, beam_resultant, beam_plastic_strain, beam_failed)
+                         shell_plastic_strain_peak, histories, beam_resultant, beam_plastic_strain, beam_failed, &
+                         solid_eroded, shell_eroded, eroded_count)
     type(results_file_t), intent(inout) :: results
     real(wp), intent(in) :: time
     ! Contiguous: the solver's whole arrays go to HDF5 without a copy.
@@ -289,6 +290,9 @@ contains
     type(history_set_t), intent(in), target, optional :: histories !< rows not yet in the file are added
     real(wp), intent(in), contiguous, optional :: beam_resultant(:, :)   !< (6, beams)
     real(wp), intent(in), contiguous, optional :: beam_plastic_strain(:), beam_failed(:) !< (beams)
+    !> deleted-element flags (1: eroded) and the count of eroded elements (explicit runs)
+    integer, intent(in), contiguous, optional :: solid_eroded(:), shell_eroded(:)
+    integer, intent(in), optional :: eroded_count
     real(wp) :: no_shell_stress(6, 0), no_shell_strain(0)
     real(wp), allocatable :: grown(:)
     type(error_t), allocatable :: space_error
@@ -317,6 +321,9 @@ contains
     what = "state "//integer_text(results%state_count)//" at time "//real_text(time)
     state_bytes = 8_long_int*(6_long_int*results%node_count + 7_long_int*results%solid_count + &
                               14_long_int*results%shell_count)
+    ! the deleted-element flags, 32-bit
+    if (present(solid_eroded)) state_bytes = state_bytes + 4_long_int*size(solid_eroded)
+    if (present(shell_eroded)) state_bytes = state_bytes + 4_long_int*size(shell_eroded)
     history_bytes = 0
     history_space = 0
     if (present(histories)) call new_history_bytes(results, histories, history_bytes, history_space)
@@ -368,6 +375,9 @@ contains
           call write_real_dataset_1d(group_id, path, "beam_failed", beam_failed, error, objects)
         end if
       end if
+      if (present(solid_eroded)) call write_integer_dataset_1d(group_id, path, "solid_eroded", solid_eroded, error)
+      if (present(shell_eroded)) call write_integer_dataset_1d(group_id, path, "shell_eroded", shell_eroded, error)
+      if (present(eroded_count)) call write_integer_attribute(group_id, path, "eroded_elements", eroded_count, error)
     end if
     if (present(histories)) call append_histories(results, histories, objects, error)
     call flush_file(results%file_id, error)

@@ -44,7 +44,8 @@ contains
         merge(state%next_time_step, state%time_step, state%cycle == 0), &
         energy%kinetic, energy%internal, energy%hourglass, energy%contact, &
         energy%external_work, total_energy(energy), energy%rigid_wall, energy_ratio(energy), &
-        state%added_mass, energy%momentum])
+        state%added_mass, energy%momentum, energy%eroded_internal, energy%eroded_hourglass, &
+        energy%eroded_kinetic, real(state%eroded_count, wp)])
       if (plan%weld_series > 0) call append_history_row(histories%series(plan%weld_series), &
                                                         [state%time, real(failed_weld_count(state%welds), wp)])
     end if
@@ -158,13 +159,16 @@ contains
                          fields%solid_plastic_strain, error, fields%shell_stress, fields%shell_plastic_strain, &
                          fields%shell_stress_peak, fields%shell_plastic_strain_peak, histories=histories, &
                          beam_resultant=fields%beam_resultant, beam_plastic_strain=fields%beam_plastic_strain, &
-                         beam_failed=fields%beam_failed)
+                         beam_failed=fields%beam_failed, &
+                         solid_eroded=fields%solid_eroded, shell_eroded=fields%shell_eroded, &
+                         eroded_count=state%eroded_count)
       else
         ! (beam fields not allocated: a model without beams; the dummies are then absent)
         call write_state(results, state%time, plan%node_displacement, plan%node_velocity, fields%solid_stress, &
                          fields%solid_plastic_strain, error, histories=histories, &
                          beam_resultant=fields%beam_resultant, beam_plastic_strain=fields%beam_plastic_strain, &
-                         beam_failed=fields%beam_failed)
+                         beam_failed=fields%beam_failed, &
+                         solid_eroded=fields%solid_eroded, eroded_count=state%eroded_count)
       end if
     end associate
   end subroutine write_current_state

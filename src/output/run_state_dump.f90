@@ -39,6 +39,9 @@ module run_state_dump
   use wall_state, only: wall_state_t
   use rigid_body_state, only: rigid_body_state_t
   use penalty_contact, only: contact_state_t, contact_pass_t
+  use contact_erosion, only: remove_eroded_elements
+  use element_groups, only: eroded_element_masks
+  use model, only: model_t
   use output_plan, only: output_plan_t
   use history_buffer, only: history_set_t, add_history_series
   use element_group, only: distortion_t
@@ -56,8 +59,9 @@ contains
 
   !> The whole run state at the end of a cycle. Reading needs a run state built from the same
   !> deck (explicit_setup's set_up_run_state).
-  subroutine exchange_run_state(store, run, error)
+  subroutine exchange_run_state(store, model, run, error)
     type(restart_store_t), intent(inout) :: store
+    type(model_t), intent(in) :: model
     type(run_state_t), intent(inout) :: run
     type(error_t), allocatable, intent(inout) :: error
     integer :: k
@@ -88,6 +92,13 @@ contains
       do k = 1, size(state%walls)
         call exchange_wall(store, "walls/"//integer_text(k), state%walls(k), error)
       end do
+      ! contacts built from the deck still hold the segments of elements eroded before the dump:
+      ! they drop them as the run did, so that the dump's search lists and pairs fit them
+      if (.not. store%writing .and. .not. allocated(error)) then
+        call eroded_element_masks(model, state%groups, state%solid_eroded, state%shell_eroded)
+        if (any(state%solid_eroded) .or. any(state%shell_eroded)) &
+          call remove_eroded_elements(model, state%contacts, state%solid_eroded, state%shell_eroded)
+      end if
       call exchange_restart_count(store, "contacts/count", "contacts", size(state%contacts), error)
       do k = 1, size(state%contacts)
         call exchange_contact(store, "contacts/"//integer_text(k), state%contacts(k), error)
@@ -237,6 +248,9 @@ contains
     call exchange_restart(store, path//"/external_work", energy%external_work, error)
     call exchange_restart(store, path//"/initial_total", energy%initial_total, error)
     call exchange_restart(store, path//"/momentum", energy%momentum, error)
+    call exchange_restart(store, path//"/eroded_internal", energy%eroded_internal, error)
+    call exchange_restart(store, path//"/eroded_hourglass", energy%eroded_hourglass, error)
+    call exchange_restart(store, path//"/eroded_kinetic", energy%eroded_kinetic, error)
   end subroutine exchange_energy
 
   !> What the run checks remember from cycle to cycle (and their bounds, set at cycle 0).

@@ -20,7 +20,7 @@ module element_groups
   private
 
   public :: build_element_groups, set_up_group_masses, compute_internal_forces, smallest_group_step
-  public :: collect_element_results, group_failure
+  public :: collect_element_results, group_failure, eroded_element_masks
 
 contains
 
@@ -151,4 +151,22 @@ contains
       call groups(k)%group%element_results(model, results)
     end do
   end subroutine collect_element_results
+  !> The model-indexed masks of eroded solids and shells (what contacts read), from the groups'
+  !> own masks: at the first erosion phase of a run, and when a restart dump is read.
+  subroutine eroded_element_masks(model, groups, solid_eroded, shell_eroded)
+    type(model_t), intent(in) :: model
+    type(group_holder_t), intent(in) :: groups(:)
+    logical, allocatable, intent(out) :: solid_eroded(:), shell_eroded(:)
+    integer :: k, solids, shells
+    solids = 0
+    shells = 0
+    if (allocated(model%solid_part)) solids = size(model%solid_part)
+    if (allocated(model%shell_part)) shells = size(model%shell_part)
+    allocate (solid_eroded(solids), shell_eroded(shells))
+    solid_eroded = .false.
+    shell_eroded = .false.
+    do k = 1, size(groups)
+      call groups(k)%group%mark_eroded(solid_eroded, shell_eroded)
+    end do
+  end subroutine eroded_element_masks
 end module element_groups

@@ -82,6 +82,12 @@ contains
     do k = 1, size(state%groups)
       call state%groups(k)%group%add_energies(step_correction, energy%internal, energy%hourglass)
     end do
+    energy%eroded_internal = 0.0_wp
+    energy%eroded_hourglass = 0.0_wp
+    energy%eroded_kinetic = 0.0_wp
+    do k = 1, size(state%groups)
+      call state%groups(k)%group%add_eroded_energies(energy%eroded_internal, energy%eroded_hourglass)
+    end do
   end subroutine measured_energies
 
 
@@ -115,10 +121,12 @@ contains
     end do
   end subroutine part_energies
 
-  !> Total energy: kinetic + internal + hourglass + contact + rigid-wall (energy the walls took).
+  !> Total energy: kinetic + internal + hourglass + contact + rigid-wall (energy the walls took)
+  !> + the energy eroded elements took along.
   pure real(wp) function total_energy(energy)
     type(energy_totals_t), intent(in) :: energy
-    total_energy = energy%kinetic + energy%internal + energy%hourglass + energy%contact + energy%rigid_wall
+    total_energy = energy%kinetic + energy%internal + energy%hourglass + energy%contact + energy%rigid_wall &
+                   + energy%eroded_internal + energy%eroded_hourglass + energy%eroded_kinetic
   end function total_energy
 
   !> Energy ratio as in glstat: total / (initial total + external work); 1 is a perfect balance.

@@ -7,6 +7,7 @@
 !>   advance_rigid_bodies     rigid bodies and the shell nodes that turn with them
 !>   advance_positions        x^{n+1} = x^n + dt v^{n+1/2}; the clock
 !>   internal_forces          every element group, in one call that clears and fills
+!>   erode_elements           the elements that failed in that call: masks, messages, counts
 !>   contact_forces           penalty contacts
 !>   external_forces          nodal loads at t^{n+1}
 !>   accelerations            a = (f_ext - f_int + f_contact) / m, prescribed motions held, tied
@@ -27,8 +28,9 @@ module explicit_solver
   use explicit_state, only: explicit_state_t
   use run_state, only: run_state_t, phase_velocities, phase_constraints, phase_walls, phase_rigid_bodies, &
                        phase_positions, phase_internal_forces, phase_contact, phase_external_forces, &
-                       phase_accelerations, phase_time_step, phase_checks, phase_output
-  use element_groups, only: compute_internal_forces, smallest_group_step
+                       phase_accelerations, phase_time_step, phase_checks, phase_output, phase_erosion
+  use element_groups, only: compute_internal_forces, smallest_group_step, eroded_element_masks
+  use contact_erosion, only: remove_eroded_elements
   use boundary_conditions, only: assemble_nodal_loads, load_work, impose_kinematic_conditions, &
                                  hold_prescribed_accelerations
   use planar_rigid_walls, only: enforce_planar_walls
@@ -42,6 +44,7 @@ module explicit_solver
                         energy_check_interval
   use output_plan, only: clock_is_due
   use run_summary, only: run_summary_t
+  use text_format, only: integer_text
   use wall_clock, only: start_phase, stop_phase
   implicit none
   private
@@ -123,6 +126,9 @@ contains
     call start_phase(run%timers(phase_internal_forces))
     call compute_internal_forces(model, run%state%groups, run%state%nodes, step)
     call stop_phase(run%timers(phase_internal_forces))
+    call start_phase(run%timers(phase_erosion))
+    call erode_elements(model, run%state)
+    call stop_phase(run%timers(phase_erosion))
     call start_phase(run%timers(phase_contact))
     call contact_forces(model, run%state, step)
     call stop_phase(run%timers(phase_contact))
@@ -136,6 +142,47 @@ contains
     call next_time_step(model, run%state)
     call stop_phase(run%timers(phase_time_step))
   end subroutine forces_and_next_step
+
+  !> Erosion phase, after the force call in which elements failed (the groups took them out of
+  !> their force loops there: element_group). Keeps the model-indexed masks `solid_eroded` and
+  !> `shell_eroded` (allocated at the first call, also after a restart, from the groups' own
+  !> masks), sets `eroded_this_cycle`, counts, and writes one line per eroded element as
+  !> LS-DYNA's messag file does. With *CONTROL_TIMESTEP ERODE the groups get their erosion step,
+  !> DTMIN times the first step (before TSSFAC), once that step is known. The energy eroded
+  !> elements took along is measured with the others (energy_balance), nothing is booked here.
+  subroutine erode_elements(model, state)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(inout) :: state
+    integer, allocatable :: elements(:)
+    integer :: k, n
+    character(len=24) :: time_text
+    if (.not. allocated(state%solid_eroded)) &
+      call eroded_element_masks(model, state%groups, state%solid_eroded, state%shell_eroded)
+    if (state%watch%first_time_step > 0.0_wp .and. model%minimum_time_step_factor > 0.0_wp .and. &
+        (model%erode_solids_on_step .or. model%erode_shells_on_step)) then
+      do k = 1, size(state%groups)
+        state%groups(k)%group%erosion_time_step = model%minimum_time_step_factor*state%watch%first_time_step &
+                                                  /model%time_step_scale
+      end do
+    end if
+    state%eroded_this_cycle = .false.
+    state%eroded_count = 0
+    do k = 1, size(state%groups)
+      state%eroded_count = state%eroded_count + state%groups(k)%group%eroded_count
+      if (state%groups(k)%group%newly_eroded == 0) cycle
+      state%eroded_this_cycle = .true.
+      call state%groups(k)%group%mark_eroded(state%solid_eroded, state%shell_eroded)
+      elements = state%groups(k)%group%newly_eroded_elements()
+      write (time_text, '(es12.5)') state%time
+      do n = 1, size(elements)
+        write (*, '(a)') state%groups(k)%group%describe(model, elements(n))//" failed at time "// &
+          trim(adjustl(time_text))//", cycle "//integer_text(state%cycle)
+      end do
+    end do
+    ! the contacts drop the eroded elements' segments before their forces of this cycle
+    if (state%eroded_this_cycle) &
+      call remove_eroded_elements(model, state%contacts, state%solid_eroded, state%shell_eroded)
+  end subroutine erode_elements
 
   !> v^{n+1/2} = v^{n-1/2} + a^n (dt^{n-1/2} + dt^{n+1/2}) / 2, and the same for the angular
   !> velocities (their rotations need no update: the shells take their frame from the nodes);
@@ -363,6 +410,9 @@ contains
     integer :: group, element
     logical :: not_finite
     call smallest_group_step(state%groups, smallest, group, element, not_finite)
+    ! every element eroded: the free nodes fly on with the last stable step
+    if (smallest >= huge(1.0_wp) .and. state%eroded_count > 0 .and. state%stable_time_step > 0.0_wp) &
+      smallest = state%stable_time_step
     ! rigid elements: the step of an elastic element with their E, PR and RO (constant)
     if (state%rigid_time_step < smallest) then
       smallest = state%rigid_time_step

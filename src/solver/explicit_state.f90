@@ -28,6 +28,12 @@ module explicit_state
     real(wp) :: external_work = 0.0_wp       !< loads, prescribed motions, supports, drilling constraint
     real(wp) :: initial_total = 0.0_wp
     real(wp) :: momentum(3) = 0.0_wp         !< linear momentum of all nodes
+    !> Energy eroded elements took along (glstat's eroded energies), measured from the groups:
+    !> their internal and hourglass energy at erosion. Their nodes stay in the model with their
+    !> mass, so their kinetic energy stays in `kinetic` and the eroded kinetic energy is 0.
+    real(wp) :: eroded_internal = 0.0_wp
+    real(wp) :: eroded_hourglass = 0.0_wp
+    real(wp) :: eroded_kinetic = 0.0_wp
   end type energy_totals_t
 
   !> What the run checks (run_checks) compare against and remember from cycle to cycle.
@@ -63,6 +69,11 @@ module explicit_state
     type(tied_state_t) :: ties                           !< work arrays of the tied contacts
     type(wall_state_t), allocatable :: walls(:)          !< indexed like model%walls
     type(contact_state_t), allocatable :: contacts(:)    !< indexed like model%contacts
+    ! erosion (the erosion phase of explicit_solver): model-indexed masks of the eroded solids
+    ! and shells (for the contacts), whether an element eroded in this cycle, and how many so far
+    logical, allocatable :: solid_eroded(:), shell_eroded(:)
+    logical :: eroded_this_cycle = .false.
+    integer :: eroded_count = 0
     ! bookkeeping
     real(wp), allocatable :: chunk_sums(:, :)            !< (5, chunks of nodes): scratch of the fixed-order
                                                          !< sums (fixed_order_sum), allocated once

@@ -48,10 +48,11 @@ module output_plan
     real(wp), allocatable :: part_kinetic(:), part_internal(:), part_hourglass(:)
   end type output_plan_t
 
-  character(len=32), parameter :: glstat_columns(12) = [character(len=32) :: "time", "time_step", &
+  character(len=32), parameter :: glstat_columns(16) = [character(len=32) :: "time", "time_step", &
     "kinetic_energy", "internal_energy", "hourglass_energy", "contact_energy", "external_work", &
-    "total_energy", "rigid_wall_energy", "energy_ratio", "added_mass", "momentum"]
-  integer, parameter :: glstat_widths(12) = [1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 3]
+    "total_energy", "rigid_wall_energy", "energy_ratio", "added_mass", "momentum", &
+    "eroded_internal_energy", "eroded_hourglass_energy", "eroded_kinetic_energy", "eroded_elements"]
+  integer, parameter :: glstat_widths(16) = [1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 3, 1, 1, 1, 1]
 
 
 contains
@@ -167,6 +168,9 @@ contains
         results%beam_plastic_strain = 0.0_wp
         results%beam_failed = 0.0_wp
       end if
+      allocate (results%solid_eroded(size(model%solid_ids)), results%shell_eroded(size(model%shell_ids)))
+      results%solid_eroded = 0
+      results%shell_eroded = 0
     end associate
     allocate (plan%node_velocity(3, size(model%node_ids)), plan%node_displacement(3, size(model%node_ids)), &
               plan%generalized_velocity(3, size(model%node_ids)), plan%node_acceleration(3, size(model%node_ids)))

@@ -18,16 +18,16 @@ module run_state
   public :: run_state_t, phase_names, phase_count
   public :: phase_velocities, phase_constraints, phase_walls, phase_rigid_bodies, phase_positions, &
             phase_internal_forces, phase_contact, phase_external_forces, phase_accelerations, phase_time_step, &
-            phase_checks, phase_output
+            phase_checks, phase_output, phase_erosion
 
   !> The phases of a cycle, in order (explicit_solver), each with its timer.
   integer, parameter :: phase_velocities = 1, phase_constraints = 2, phase_walls = 3, phase_rigid_bodies = 4, &
                         phase_positions = 5, phase_internal_forces = 6, phase_contact = 7, &
                         phase_external_forces = 8, phase_accelerations = 9, phase_time_step = 10, &
-                        phase_checks = 11, phase_output = 12, phase_count = 12
+                        phase_checks = 11, phase_output = 12, phase_erosion = 13, phase_count = 13
   character(len=16), parameter :: phase_names(phase_count) = [character(len=16) :: "velocities", "constraints", &
     "walls", "rigid_bodies", "positions", "internal_forces", "contact", "external_forces", "accelerations", &
-    "time_step", "checks", "output"]
+    "time_step", "checks", "output", "erosion"]
 
   type :: run_state_t
     type(explicit_state_t) :: state
