@@ -430,17 +430,14 @@ def test_excl_switches_a_criterion_off(tmp_path, run_deck):
     assert failures(run) == []
 
 
-def test_ball_through_eroding_plate(tmp_path, run_deck):
-    """An elastic block (the ball) shot at 200 m/s through a free, eroding shell plate: the
-    shells under it erode and it passes through; with no support, the momentum of the model is
-    kept to round-off, and the energy balance holds with the eroded energies. (Until the
-    contacts drop eroded segments, the ball pushes the eroded shells' free nodes ahead of it;
-    the checks hold either way.)"""
+def ball_deck(path, extra=()):
+    """An elastic block (the ball) at 200 m/s over a free shell plate of MAT_024 with FAIL
+    0.05, in surface-to-surface contact; returns the deck and the ball's node count."""
     ball_nodes, ball_elements = block_mesh((3, 3, 3), (3.0, 3.0, 3.0), origin=(3.5, 3.5, 0.6))
     plate_nodes, shells = plate_mesh((10, 10), (10.0, 10.0))
     offset = len(ball_nodes)
     deck = write_deck(
-        tmp_path / "ball.k",
+        path,
         "*CONTROL_TERMINATION\n" + fields(0.05),
         "*DATABASE_GLSTAT\n" + fields(0.001),
         "*DATABASE_BINARY_D3PLOT\n" + fields(0.01),
@@ -456,7 +453,17 @@ def test_ball_through_eroding_plate(tmp_path, run_deck):
         nodes_card(np.vstack([ball_nodes, round_to_node_card(plate_nodes)])),
         solids_card(ball_elements),
         shells_card(shells, part_id=2, first_id=1000, first_node_id=offset + 1),
+        *extra,
     )
+    return deck, offset
+
+
+def test_ball_through_eroding_plate(tmp_path, run_deck):
+    """An elastic block (the ball) shot at 200 m/s through a free, eroding shell plate: the
+    shells under it erode, leave the contact, and the ball passes through; with no support, the
+    momentum of the model is kept to round-off, and the energy balance holds with the eroded
+    energies."""
+    deck, offset = ball_deck(tmp_path / "ball.k")
     run = run_deck(deck)
     assert run.status == 0, run.stderr
     eroded = failures(run)
@@ -473,3 +480,22 @@ def test_ball_through_eroding_plate(tmp_path, run_deck):
         live = results["mesh/shells/connectivity_index"][...][last["shell_eroded"][...] == 0].ravel()
         plate_z = (results["mesh/nodes/coordinates"][...][live, 2] + last["displacement"][...][live, 2]).min()
         assert ball_z < plate_z        # the whole ball is below the plate that is left: it went through
+
+
+def test_restart_after_erosion_with_contact(tmp_path):
+    """A dump written after shells eroded in a contact: the restarted run builds its contacts
+    from the deck, drops the eroded shells' segments again before reading the dump's search
+    lists and pairs, and continues to the uninterrupted file bit for bit."""
+    deck, _ = ball_deck(tmp_path / "probe.k")
+    probe = run_fresh(deck, tmp_path / "probe")
+    first = min(int(cycle) for *_, cycle in FAILURE_LINE.findall(probe.stdout))
+    interval = first + 7
+    deck, _ = ball_deck(tmp_path / "ball.k", extra=["*DATABASE_BINARY_D3DUMP\n" + fields(interval)])
+    uninterrupted = run_fresh(deck, tmp_path / "one")
+    assert uninterrupted.returncode == 0, uninterrupted.stderr
+    reference = contents(tmp_path / "one" / "results.h5")
+    dump = sorted((tmp_path / "one").glob("d3dump*"))[0]
+    target = copy_run(tmp_path / "one", tmp_path / "continued")
+    process = restart(target / dump.name, 1)
+    assert process.returncode == 0, process.stdout + process.stderr
+    assert_same(reference, contents(target / "results.h5"), f"continued from {dump.name}")
