@@ -82,6 +82,7 @@ module beam_block
     real(wp) :: resultant(block_size, 6) = 0.0_wp
     !> Failed beams: no stress, no force (material_spotweld).
     logical :: failed(block_size) = .false.
+    logical :: newly_failed(block_size) = .false.    !< failed in the last call (erosion)
     real(wp) :: time = 0.0_wp                    !< the sum of the steps taken (TFAIL)
     real(wp), allocatable :: stress(:, :, :)     !< (block_size, 3, point_count): s11 s12 s13
     real(wp), allocatable :: plastic_strain(:, :) !< (block_size, point_count)
@@ -347,6 +348,7 @@ contains
     end_length = 1.0_wp
     old_power = 0.0_wp
     new_power = 0.0_wp
+    block%newly_failed = .false.
     block%time = block%time + dt
     do i = 1, nel
       do node = 1, 2
@@ -417,6 +419,7 @@ contains
       block%resultant(i, :) = r
       if (spotweld_fails(material, block%time, r, block%plastic_strain(i, 1:block%point_count))) then
         block%failed(i) = .true.
+        block%newly_failed(i) = .true.
         block%stress(i, :, :) = 0.0_wp
         block%resultant(i, :) = 0.0_wp
         cycle

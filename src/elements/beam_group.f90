@@ -1,7 +1,9 @@
 !> The beams (Hughes-Liu, spot weld beams) as an element group (element_group): the blocks of
 !> beam_block, their colouring, nodal masses and rotary inertias, and the per-block results of
 !> the last force call. Failed welds are masked in their blocks (beam_block_t%failed: no stress,
-!> no force from the cycle they fail in); `failed_beams` counts them (run summary, /timing).
+!> no force from the cycle they fail in) and are the group's eroded elements (element_group's
+!> erosion contract: a message line each, glstat's count, their energy as eroded internal
+!> energy); `failed_beams` counts them (run summary, /timing).
 module beam_group
   use kinds, only: wp, block_size
   use gather_list, only: gather_list_t
@@ -13,7 +15,7 @@ module beam_group
   use run_summary, only: run_summary_t
   use nodal_state, only: nodal_state_t
   use element_group, only: element_group_t, element_results_t
-  use element_work, only: booked_energy, add_kinetic_energy, scale_block_density, raise_largest_scaling
+  use element_work, only: booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, raise_largest_scaling
   use beam_block, only: beam_block_t, build_beam_blocks, beam_block_masses, beam_block_time_steps, &
                         compute_beam_block
   implicit none
@@ -42,6 +44,8 @@ module beam_group
     procedure :: exchange_state
     procedure :: failure_text
     procedure :: most_scaled
+    procedure :: newly_eroded_elements
+    procedure :: add_eroded_energies
   end type beam_group_t
 
 contains
@@ -158,7 +162,40 @@ contains
       !$omp end parallel do
     end do
     call self%header_from_blocks(self%block_time_step, self%block_critical_element, self%block_degenerate_element)
+    ! a failed weld is an eroded element of the group (element_group's erosion contract)
+    self%newly_eroded = 0
+    do b = 1, size(self%blocks)
+      self%newly_eroded = self%newly_eroded + count(self%blocks(b)%newly_failed(1:self%blocks(b)%element_count))
+    end do
+    self%eroded_count = self%eroded_count + self%newly_eroded
   end subroutine add_internal_forces
+
+  !> Its beams failed in the last force call, block by block.
+  function newly_eroded_elements(self) result(elements)
+    class(beam_group_t), intent(in) :: self
+    integer, allocatable :: elements(:)
+    integer :: b, lane, n
+    allocate (elements(self%newly_eroded))
+    n = 0
+    do b = 1, size(self%blocks)
+      do lane = 1, self%blocks(b)%element_count
+        if (.not. self%blocks(b)%newly_failed(lane) .or. n >= size(elements)) cycle
+        n = n + 1
+        elements(n) = self%blocks(b)%elements(lane)
+      end do
+    end do
+  end function newly_eroded_elements
+
+  !> The internal energy its failed beams took along (reported apart, as eroded energy).
+  subroutine add_eroded_energies(self, internal, hourglass)
+    class(beam_group_t), intent(in) :: self
+    real(wp), intent(inout) :: internal, hourglass
+    integer :: b
+    do b = 1, size(self%blocks)
+      internal = internal + eroded_energy(self%blocks(b)%internal_energy, self%blocks(b)%element_count, &
+                                          self%blocks(b)%failed)
+    end do
+  end subroutine add_eroded_energies
 
   subroutine add_beam_forces(block, beam_force, internal_force, internal_moment)
     type(beam_block_t), intent(in) :: block
@@ -182,7 +219,7 @@ contains
     do b = 1, size(self%blocks)
       associate (beam => self%blocks(b))
         internal = internal + booked_energy(beam%internal_energy, beam%force_power, beam%element_count, &
-                                            step_correction)
+                                            step_correction, beam%failed)
       end associate
     end do
   end subroutine add_energies
@@ -196,7 +233,7 @@ contains
     do b = 1, size(self%blocks)
       associate (beam => self%blocks(b))
         internal(beam%part) = internal(beam%part) + booked_energy(beam%internal_energy, beam%force_power, &
-          beam%element_count, step_correction)
+          beam%element_count, step_correction, beam%failed)
         do end = 1, 2
           do lane = 1, beam%element_count
             node = beam%nodes(lane, end)
@@ -282,6 +319,8 @@ contains
     call exchange_restart(store, path//"/time_step", self%block_time_step, error)
     call exchange_restart(store, path//"/critical_element", self%block_critical_element, error)
     call exchange_restart(store, path//"/degenerate_element", self%block_degenerate_element, error)
+    call exchange_restart(store, path//"/newly_eroded_count", self%newly_eroded, error)
+    call exchange_restart(store, path//"/eroded_count", self%eroded_count, error)
     do b = 1, size(self%blocks)
       call exchange_beam_block(store, path//"/"//integer_text(b), self%blocks(b), error)
     end do
@@ -303,6 +342,7 @@ contains
     call exchange_restart(store, path//"/previous_force", block%previous_force, error)
     call exchange_restart(store, path//"/resultant", block%resultant, error)
     call exchange_restart(store, path//"/failed", block%failed, error)
+    call exchange_restart(store, path//"/newly_failed", block%newly_failed, error)
     call exchange_restart(store, path//"/time", block%time, error)
     call exchange_restart(store, path//"/stress", block%stress, error)
     call exchange_restart(store, path//"/plastic_strain", block%plastic_strain, error)

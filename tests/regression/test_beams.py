@@ -14,6 +14,8 @@ f. 1 and 2 threads bit-identical; a restart bit-identical to the uninterrupted r
 g. decks with beam features crashfree does not have are refused with a clear message.
 """
 import h5py
+import re
+
 import numpy as np
 import pytest
 
@@ -388,6 +390,15 @@ def test_spot_weld_fails_when_the_force_reaches_nrr(tmp_path, run_deck, criterio
     assert failed_at is not None
     assert abs(failed_at - expected) <= step, (failed_at, expected, step)
     assert failed.ravel()[0] == 1.0
+    # a failed weld is an eroded element: one message line, glstat counts it, and its stored
+    # energy moves to the eroded internal energy with the balance kept
+    assert re.search(r"beam element \d+ \(part \d+\) failed at time", run.stdout), run.stdout
+    with run.open() as results:
+        glstat = results["history/glstat"]
+        assert glstat["eroded_elements"][-1] == 1 and glstat["eroded_elements"][0] == 0
+        assert glstat["eroded_internal_energy"][-1] > 0.0
+        total, work = glstat["total_energy"][...], glstat["external_work"][...]
+        assert np.abs(total - total[0] - work).max() < 1e-3 * np.abs(work).max()
 
 
 def test_spot_weld_fails_by_plastic_strain(tmp_path, run_deck):
