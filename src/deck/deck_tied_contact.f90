@@ -319,6 +319,13 @@ contains
             do j = 1, size(model%shell_part)
               if (model%shell_part(j) == m) chosen(model%shell_nodes(:, j)) = .true.
             end do
+            ! beams: their two nodes (spot weld beams of *CONTACT_SPOTWELD), not the
+            ! orientation node
+            if (allocated(model%beam_part)) then
+              do j = 1, size(model%beam_part)
+                if (model%beam_part(j) == m) chosen(model%beam_nodes(1:2, j)) = .true.
+              end do
+            end if
           end do
         end select
       end associate

@@ -624,3 +624,46 @@ def test_plastic_cantilever_root_moment_saturates_at_the_section_points_capacity
     assert abs(moment[-1] / capacity - 1.0) < 1e-2, (moment[-1], capacity)
     assert moment.max() < 1.01 * capacity, (moment.max(), capacity)
     assert strain[0] > 0.0
+
+
+def test_weld_tied_by_contact_spotweld_acts_as_on_shared_nodes(tmp_path, run_deck):
+    """The vehicle decks' way of writing a beam weld: its two nodes are its own, on the sheets'
+    mid-surfaces, and *CONTACT_SPOTWELD ties them (translations and rotations) to the shells
+    of both plates. With the weld's nodes where the plates' centre nodes are, the tie carries
+    the weld's mass, force and moment to those nodes: the weld's axial force, the plate's
+    deflection and the failure at NRR follow the shared-node weld (within 1% of NRR before it
+    fails, the same state of failure)."""
+    shared_deck, centre = welded_plates_deck(tmp_path / "shared.k")
+    text = shared_deck.read_text()
+    count = (PLATE_CELLS + 1) ** 2
+    weld_nodes = nodes_card([(PLATE_SIDE / 2, PLATE_SIDE / 2, 0.0), (PLATE_SIDE / 2, PLATE_SIDE / 2, PLATE_GAP)],
+                            first_id=2 * count + 1)
+    shared_beam = beams_card([(centre + 1, count + centre + 1)], part_id=3)
+    tied_beam = beams_card([(2 * count + 1, 2 * count + 2)], part_id=3)
+    assert shared_beam in text
+    tied_text = text.replace(shared_beam, weld_nodes + "\n" + tied_beam + "\n" +
+                             "*SET_PART_LIST\n" + fields(7) + "\n" + fields(1, 2) + "\n" +
+                             "*CONTACT_SPOTWELD\n" + fields(3, 7, 3, 2) + "\n" + fields(0.0) + "\n" + fields(0.0))
+    tied_deck = tmp_path / "tied" / "tied.k"
+    tied_deck.parent.mkdir()
+    tied_deck.write_text(tied_text)
+    shared = run_deck(shared_deck, jobid="shared")
+    tied = run_deck(tied_deck, jobid="tied")
+    assert shared.status == 0 and tied.status == 0, tied.stdout + tied.stderr
+
+    def series(run):
+        with run.open() as results:
+            keys = sorted(results["states"].keys())
+            force = np.array([results["states"][k]["beam_resultant"][...].ravel()[0] for k in keys])
+            failed = np.array([results["states"][k]["beam_failed"][...].ravel()[0] for k in keys])
+            deflection = np.array([results["states"][k]["displacement"][centre, 2] for k in keys])
+        return force, failed, deflection
+
+    force_shared, failed_shared, deflection_shared = series(shared)
+    force_tied, failed_tied, deflection_tied = series(tied)
+    assert np.array_equal(failed_shared, failed_tied)
+    assert failed_tied[-1] == 1.0
+    before = failed_shared == 0.0
+    assert np.abs(force_tied[before] - force_shared[before]).max() < 0.01 * WELD_NRR
+    assert np.abs(deflection_tied[before] - deflection_shared[before]).max() < \
+        0.01 * np.abs(deflection_shared[before]).max()
