@@ -20,11 +20,11 @@ z up; the floor lies at z = 0):
                they carry the rails' load to the rear mass, as the rails of a real car run on
                under the floor (without them the whole load would pass through the 1 mm floor)
   rockers      hat sections 100 x 120, x = 915 .. 2115, at y = +-700, opening inboard
-Joints: the hat flanges and their closing plates are joined either by shared nodes along the
-whole flange (--welds merged: a continuous seam; this branch runs it), or by spot welds every
---pitch mm at mid-flange, the closing plate then lying (t_hat + t_plate) / 2 off the flange
-(--welds spotweld: *CONSTRAINED_SPOTWELD pairs; --welds generalized:
-*CONSTRAINED_GENERALIZED_WELD_SPOT on two-node sets). The bolted joints (bumper to cans, cans to
+Joints: the hat flanges and their closing plates are joined by spot welds every --pitch mm at
+mid-flange, the closing plate lying (t_hat + t_plate) / 2 off the flange (--welds spotweld, the
+default: *CONSTRAINED_SPOTWELD pairs failing at SN = SS = --weld-strength kN; --welds generalized:
+*CONSTRAINED_GENERALIZED_WELD_SPOT on two-node sets, the same failure), or by shared nodes along
+the whole flange (--welds merged: a continuous seam). The bolted joints (bumper to cans, cans to
 rails, rails to the floor) are *CONSTRAINED_NODAL_RIGID_BODY ties of the end rings. The floor
 and the rockers share nodes along the rockers' closing plates. The rest of the car is a lumped
 mass (*ELEMENT_MASS) spread over the nodes of the rear ends of the floor, the rockers and the rail
@@ -295,15 +295,18 @@ def write_deck(args, mesh, welds, ties, rear):
         for k in range(0, len(unique), 8):
             lines.append("".join(f"{n:10d}" for n in unique[k:k + 8]))
         lines += ["*CONSTRAINED_NODAL_RIGID_BODY", f"{tie_id:10d}{0:10d}{tie_id:10d}"]
+    strength = args.weld_strength
     if args.welds == "spotweld":
-        lines += ["$ spot welds at mid-flange (no failure: SN, SS, TF left at their defaults)",
-                  "*CONSTRAINED_SPOTWELD"]
+        lines += [f"$ spot welds at mid-flange: they fail at (fn/SN)^2 + (fs/SS)^2 = 1, SN = SS = {strength:g} kN",
+                  "*CONSTRAINED_SPOTWELD",
+                  "$#     n1        n2        sn        ss         n         m        tf        ep"]
         for a, b in welds:
-            lines.append(f"{a:10d}{b:10d}")
+            lines.append(f"{a:10d}{b:10d}{strength:10.3f}{strength:10.3f}{2.0:10.1f}{2.0:10.1f}")
     elif args.welds == "generalized":
         for number, (a, b) in enumerate(welds, start=1):
             set_id = 1000 + number
-            lines += ["*CONSTRAINED_GENERALIZED_WELD_SPOT", f"{set_id:10d}", f"{1e20:10.2e}",
+            lines += ["*CONSTRAINED_GENERALIZED_WELD_SPOT", f"{set_id:10d}",
+                      f"{1e20:10.2e}{0.0:10.1f}{strength:10.3f}{strength:10.3f}{2.0:10.1f}{2.0:10.1f}",
                       "*SET_NODE_LIST", f"{set_id:10d}", f"{a:10d}{b:10d}"]
     lines += ["*CONTACT_AUTOMATIC_SINGLE_SURFACE_ID", f"{1:10d}{'':70s}structure",
               f"{0:10d}{0:10d}{5:10d}{0:10d}", f"{0.2:10.2f}{0.2:10.2f}", ""]
@@ -327,9 +330,11 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--size", choices=sorted(SIZES), default="default",
                         help="element sizes: default (8-60 mm, about 11,300 shells) or coarse (17-100 mm, about 4,100)")
-    parser.add_argument("--welds", choices=("merged", "spotweld", "generalized"), default="merged",
-                        help="flange joints: shared nodes (default), *CONSTRAINED_SPOTWELD pairs or "
-                             "*CONSTRAINED_GENERALIZED_WELD_SPOT")
+    parser.add_argument("--welds", choices=("merged", "spotweld", "generalized"), default="spotweld",
+                        help="flange joints: *CONSTRAINED_SPOTWELD pairs (default), "
+                             "*CONSTRAINED_GENERALIZED_WELD_SPOT, or shared nodes along the whole flange")
+    parser.add_argument("--weld-strength", type=float, default=8.0,
+                        help="normal and shear force at which a spot weld fails, kN (default 8)")
     parser.add_argument("--pitch", type=float, default=40.0, help="spot weld pitch along the flanges, mm")
     parser.add_argument("--barrier", choices=("wall", "pole"), default="wall")
     parser.add_argument("--pole-offset", type=float, default=0.0, help="y of the pole's axis, mm (default 0: centre)")

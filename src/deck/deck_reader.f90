@@ -107,6 +107,14 @@ contains
         "does not read at all, so remove the option or the keyword", unreadable=.true.)
       return
     end if
+    if (ignore_unknown .and. index(name, "CASE_BEGIN_") == 1) then
+      ! the keywords between *CASE_BEGIN_n and *CASE_END_n belong to case n only: skipping the
+      ! markers would read every case's keywords into one run
+      call report_problem(log, where//": *CASE blocks are not available, and --ignore-unknown "// &
+        "cannot skip them: the keywords inside would be read into every case; keep one case's "// &
+        "keywords and remove the *CASE_BEGIN_/*CASE_END_ lines", unreadable=.true.)
+      return
+    end if
     if (ignore_unknown) then
       call add_error(warnings, printable(where)//": unknown keyword skipped ("// &
                      integer_text(data_lines)//" data lines not read)")

@@ -379,3 +379,17 @@ def test_rigid_material_coupling_zero_is_none(tmp_path, coupling):
         velocity = last["velocity"][...]
     # the rigid body carries the thrown face's momentum: SPEED/2 in x for every node
     assert np.abs(velocity[:, 0] - SPEED / 2).max() < 1e-9 * SPEED
+
+
+def test_ignore_unknown_refuses_case_blocks(tmp_path):
+    """*CASE_BEGIN_n ... *CASE_END_n hold keywords of case n only (a public projectile deck
+    gives each case its own initial velocity): skipping the markers would apply every case's
+    velocity in one run, so --ignore-unknown refuses them, naming the line."""
+    text = CUBE.format(**WRITTEN_OUT).replace(
+        "*END", "*CASE_BEGIN_2\n*INITIAL_VELOCITY_GENERATION\n         1         3       0.0       9.0"
+                "       0.0       0.0\n       0.0       0.0       0.0       0.0       0.0       0.0"
+                "       0.0         0\n*CASE_END_2\n*END")
+    deck = write(tmp_path, "cases", text)
+    shown = run(deck, f"i={deck}", f"outdir={deck.parent / 'out'}", "--ignore-unknown")
+    assert shown.returncode == 2
+    assert "*CASE_BEGIN_2: *CASE blocks are not available" in shown.stdout + shown.stderr
