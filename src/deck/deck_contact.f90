@@ -16,7 +16,7 @@ module deck_contact
   use deck_keywords, only: keyword_t
   use deck_fields, only: card_t, open_card, next_line, require_card, get_integer, get_real, &
                          card_problem, warn_if_set, id_heading, line_problem, located_problem, &
-                         located_warning
+                         located_warning, keyword_label
   use deck_input, only: deck_input_t
   use deck_contact_input, only: contact_entry_t
   use contact_surfaces, only: find_segment_owners, find_shell_owners
@@ -174,6 +174,14 @@ contains
         if (entry%contact%scale_b == 0.0_wp) entry%contact%scale_b = 1.0_wp
         if (entry%contact%friction_scale == 0.0_wp) entry%contact%friction_scale = 1.0_wp
         if (entry%contact%viscous_scale == 0.0_wp) entry%contact%viscous_scale = 1.0_wp
+      end if
+      ! *CONTACT_ERODING_...: its card ISYM EROSOP IADJ comes before the optional cards
+      if (index(keyword_label(deck, block), "CONTACT_ERODING_") == 1) then
+        if (next_line(deck, block, line, .false.)) then
+          call open_card(deck, block, line, standard_widths, card, log)
+          call warn_if_set(deck, card, 1, "ISYM", "no symmetry planes in contact", warnings)
+          call warn_if_set(deck, card, 3, "IADJ", "the faces of all remaining solids are exposed", warnings)
+        end if
       end if
       ! optional card A: SOFT SOFSCL LCIDAB MAXPAR SBOPT DEPTH BSORT FRCFRQ
       if (next_line(deck, block, line, .false.)) then

@@ -263,6 +263,14 @@ contains
                       fills=[list_contacts, list_none], entries=per_block, reader=read_surface_to_surface_contacts), &
       keyword_entry_t("CONTACT_AUTOMATIC_SINGLE_SURFACE", options="ID TITLE", one_option=.true., &
                       fills=[list_contacts, list_none], entries=per_block, reader=read_single_surface_contacts), &
+      ! the eroding contacts: the automatic ones already drop eroded elements' segments and
+      ! expose the faces under them; their extra card (ISYM EROSOP IADJ) is read
+      keyword_entry_t("CONTACT_ERODING_NODES_TO_SURFACE", options="ID TITLE", one_option=.true., &
+                      fills=[list_contacts, list_none], entries=per_block, reader=read_nodes_to_surface_contacts), &
+      keyword_entry_t("CONTACT_ERODING_SURFACE_TO_SURFACE", options="ID TITLE", one_option=.true., &
+                      fills=[list_contacts, list_none], entries=per_block, reader=read_surface_to_surface_contacts), &
+      keyword_entry_t("CONTACT_ERODING_SINGLE_SURFACE", options="ID TITLE", one_option=.true., &
+                      fills=[list_contacts, list_none], entries=per_block, reader=read_single_surface_contacts), &
       keyword_entry_t("CONTROL_CONTACT", reader=read_control_contact), &
       keyword_entry_t("DATABASE_RCFORC", reader=read_rcforc), &
       law_keyword(law_piecewise_linear, read_piecewise_linear_materials), &

@@ -499,3 +499,26 @@ def test_restart_after_erosion_with_contact(tmp_path):
     process = restart(target / dump.name, 1)
     assert process.returncode == 0, process.stdout + process.stderr
     assert_same(reference, contents(target / "results.h5"), f"continued from {dump.name}")
+
+
+def test_eroding_contact_keyword_acts_as_the_automatic_one(tmp_path):
+    """*CONTACT_ERODING_SURFACE_TO_SURFACE with its card ISYM EROSOP IADJ (the form of LS-DYNA's
+    penetration examples) is the automatic contact, which already drops eroded segments: the
+    ball through the plate gives the same results file bit for bit."""
+    deck, _ = ball_deck(tmp_path / "automatic.k")
+    automatic = run_fresh(deck, tmp_path / "automatic")
+    eroding_deck = tmp_path / "eroding.k"
+    text = deck.read_text()
+    card_3 = fields(0.0)
+    old = "*CONTACT_AUTOMATIC_SURFACE_TO_SURFACE\n" + fields(1, 2, 3, 3) + "\n" + fields(0.0) + "\n" + card_3
+    assert old in text
+    eroding_deck.write_text(text.replace(old, "*CONTACT_ERODING_SURFACE_TO_SURFACE\n" + fields(1, 2, 3, 3) + "\n" +
+                                         fields(0.0) + "\n" + card_3 + "\n" + fields(0, 1, 1)))
+    eroding = run_fresh(eroding_deck, tmp_path / "eroding")
+    assert automatic.returncode == 0 and eroding.returncode == 0, eroding.stdout + eroding.stderr
+    assert FAILURE_LINE.findall(automatic.stdout)
+    first, second = (contents(tmp_path / name / "results.h5") for name in ("automatic", "eroding"))
+    for run_attribute in ("run@deck", "run@deck_absolute"):     # the deck's own name
+        first.pop(run_attribute, None)
+        second.pop(run_attribute, None)
+    assert_same(first, second, "eroding contact keyword")
