@@ -15,7 +15,8 @@ module beam_group
   use run_summary, only: run_summary_t
   use nodal_state, only: nodal_state_t
   use element_group, only: element_group_t, element_results_t
-  use element_work, only: booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, raise_largest_scaling
+  use element_work, only: append_marked_lanes, booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, &
+                          raise_largest_scaling
   use beam_block, only: beam_block_t, build_beam_blocks, beam_block_masses, beam_block_time_steps, &
                         compute_beam_block
   implicit none
@@ -174,15 +175,12 @@ contains
   function newly_eroded_elements(self) result(elements)
     class(beam_group_t), intent(in) :: self
     integer, allocatable :: elements(:)
-    integer :: b, lane, n
+    integer :: b, n
     allocate (elements(self%newly_eroded))
     n = 0
     do b = 1, size(self%blocks)
-      do lane = 1, self%blocks(b)%element_count
-        if (.not. self%blocks(b)%newly_failed(lane) .or. n >= size(elements)) cycle
-        n = n + 1
-        elements(n) = self%blocks(b)%elements(lane)
-      end do
+      call append_marked_lanes(self%blocks(b)%element_count, self%blocks(b)%newly_failed, self%blocks(b)%elements, &
+                               elements, n)
     end do
   end function newly_eroded_elements
 

@@ -6,6 +6,7 @@ module element_work
   implicit none
   private
 
+  public :: append_marked_lanes
   public :: add_force_work, smallest_time_step, booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, &
             raise_largest_scaling
 
@@ -68,6 +69,21 @@ contains
       booked_energy = sum(energy(1:count)) + step_correction*sum(power(1:count))
     end if
   end function booked_energy
+
+  !> Append to `elements` (`n` used) the elements (`lane_elements`) of the first `count` lanes
+  !> of a block that `marked` flags, as long as there is room: the elements an element group
+  !> eroded in its last force call, block after block.
+  pure subroutine append_marked_lanes(count, marked, lane_elements, elements, n)
+    integer, intent(in) :: count, lane_elements(:)
+    logical, intent(in) :: marked(:)
+    integer, intent(inout) :: elements(:), n
+    integer :: lane
+    do lane = 1, count
+      if (.not. marked(lane) .or. n >= size(elements)) cycle
+      n = n + 1
+      elements(n) = lane_elements(lane)
+    end do
+  end subroutine append_marked_lanes
 
   !> Energy the eroded lanes of a block took along (their powers are zero).
   pure real(wp) function eroded_energy(energy, count, eroded)

@@ -50,7 +50,7 @@ module shell_block
                                    update_plane_stress_block, plane_stress_plastic_strain
   use element_work, only: add_force_work, smallest_time_step
   use gauss_legendre, only: gauss_legendre_rule
-  use erosion_criteria, only: plastic_failure_limit, principal_strains_active, failed_points_needed, &
+  use erosion_criteria, only: plastic_failure_limit, principal_strains_active, failed_points_needed, principal_strains_fail, &
                               principal_log_strains_2d
   use element_ordering, only: spatial_element_order
   use shell_triangle, only: triangle_shear_operator
@@ -487,10 +487,7 @@ contains
         gradient(2, 1) = sum(yl(i, :)*b1(i, :))
         gradient(2, 2) = sum(yl(i, :)*b2(i, :))
         call principal_log_strains_2d(gradient, largest, smallest)
-        if (material%erosion_max_principal_strain > 0.0_wp .and. largest >= material%erosion_max_principal_strain) &
-          failed(i) = .true.
-        if (material%erosion_min_principal_strain < 0.0_wp .and. smallest <= material%erosion_min_principal_strain) &
-          failed(i) = .true.
+        if (principal_strains_fail(material, largest, smallest)) failed(i) = .true.
       end do
     end if
     if (block%erosion_time_step > 0.0_wp) then

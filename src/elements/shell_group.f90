@@ -13,7 +13,8 @@ module shell_group
   use run_summary, only: run_summary_t
   use nodal_state, only: nodal_state_t
   use element_group, only: element_group_t, element_results_t
-  use element_work, only: booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, raise_largest_scaling
+  use element_work, only: append_marked_lanes, booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, &
+                          raise_largest_scaling
   use shell_block, only: shell_block_t, build_shell_blocks, shell_block_masses, shell_block_time_steps, &
                          compute_shell_block, shell_block_element_results
   implicit none
@@ -171,15 +172,12 @@ contains
   function newly_eroded_elements(self) result(elements)
     class(shell_group_t), intent(in) :: self
     integer, allocatable :: elements(:)
-    integer :: b, lane, n
+    integer :: b, n
     allocate (elements(self%newly_eroded))
     n = 0
     do b = 1, size(self%blocks)
-      do lane = 1, self%blocks(b)%element_count
-        if (.not. self%blocks(b)%newly_eroded(lane) .or. n >= size(elements)) cycle
-        n = n + 1
-        elements(n) = self%blocks(b)%elements(lane)
-      end do
+      call append_marked_lanes(self%blocks(b)%element_count, self%blocks(b)%newly_eroded, self%blocks(b)%elements, &
+                               elements, n)
     end do
   end function newly_eroded_elements
 

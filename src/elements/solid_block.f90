@@ -49,7 +49,7 @@ module solid_block
   use solid_exposure, only: exposed_elements
   use element_ordering, only: spatial_element_order
   use element_time_step, only: bulk_viscosity_pressure, solid_element_time_steps, eigenvalue_time_steps
-  use erosion_criteria, only: plastic_failure_limit, principal_strains_active, failed_points_needed, &
+  use erosion_criteria, only: plastic_failure_limit, principal_strains_active, failed_points_needed, principal_strains_fail, &
                               principal_log_strains_3d
   implicit none
   private
@@ -903,10 +903,7 @@ contains
           gradient(k, 3) = sum(x(i, :, k)*bz(i, :))/volume(i)
         end do
         call principal_log_strains_3d(gradient, largest, smallest)
-        if (material%erosion_max_principal_strain > 0.0_wp .and. largest >= material%erosion_max_principal_strain) &
-          failed(i) = .true.
-        if (material%erosion_min_principal_strain < 0.0_wp .and. smallest <= material%erosion_min_principal_strain) &
-          failed(i) = .true.
+        if (principal_strains_fail(material, largest, smallest)) failed(i) = .true.
       end do
     end if
     if (block%erosion_time_step > 0.0_wp) then

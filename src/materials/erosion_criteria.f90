@@ -14,7 +14,7 @@ module erosion_criteria
   private
 
   public :: erodes_on_strain, plastic_failure_limit, principal_strains_active, failed_points_needed
-  public :: principal_log_strains_3d, principal_log_strains_2d
+  public :: principal_log_strains_3d, principal_log_strains_2d, principal_strains_fail
 
   !> A failure strain at or above this means "no failure" (LS-DYNA's default is 1e21).
   real(wp), parameter :: no_failure = 1.0e20_wp
@@ -43,6 +43,15 @@ contains
     type(material_t), intent(in) :: material
     erodes_on_strain = plastic_failure_limit(material) < huge(1.0_wp) .or. principal_strains_active(material)
   end function erodes_on_strain
+
+  !> Whether the principal strains `largest` and `smallest` of an element centre meet MXEPS or
+  !> MNEPS of `material` (a criterion left at 0 is off).
+  pure logical function principal_strains_fail(material, largest, smallest) result(fails)
+    type(material_t), intent(in) :: material
+    real(wp), intent(in) :: largest, smallest
+    fails = (material%erosion_max_principal_strain > 0.0_wp .and. largest >= material%erosion_max_principal_strain) &
+            .or. (material%erosion_min_principal_strain < 0.0_wp .and. smallest <= material%erosion_min_principal_strain)
+  end function principal_strains_fail
 
   !> Failed points after which an element of `point_count` points erodes. Without
   !> *MAT_ADD_EROSION: one for a solid, all of them for a shell (LS-DYNA deletes a shell whose
