@@ -1024,6 +1024,16 @@ contains
       end associate
     end do
     input%model%loads = loads(1:count)
+    ! body loads (*LOAD_BODY_...): every node, its mass times the base acceleration
+    allocate (input%model%body_loads(input%body_load_count))
+    do k = 1, input%body_load_count
+      associate (given => input%body_loads(k))
+        input%model%body_loads(k) = nodal_load_t(node=0, direction=given%direction, &
+          curve=find_curve(deck, indices, given%curve_id, given%line, log), scale=given%scale)
+        if (input%model%implicit_static) call located_problem(deck, log, given%line, "LCID", &
+          "body loads are not available in the linear static analysis (*CONTROL_IMPLICIT_GENERAL IMFLAG = 1)")
+      end associate
+    end do
   end subroutine build_loads
 
   !> One segment_load_t per segment: a *LOAD_SEGMENT(_NONUNIFORM) segment as given, a

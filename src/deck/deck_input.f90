@@ -26,9 +26,10 @@ module deck_input
     list_velocities = 14, list_walls = 15, list_segment_sets = 16, list_segment_loads = 17, &
     list_rigid_materials = 18, list_rigid_motions = 19, list_nodal_rigid_bodies = 20, &
     list_element_masses = 21, list_contacts = 22, list_boxes = 23, list_frames = 24, list_vectors = 25, &
-    list_spot_welds = 26, list_rigid_links = 27, list_tied_contacts = 28, list_beams = 29
+    list_spot_welds = 26, list_rigid_links = 27, list_tied_contacts = 28, list_beams = 29, &
+    list_body_loads = 30
   !> Number of lists.
-  integer, parameter, public :: list_count = 29
+  integer, parameter, public :: list_count = 30
 
   !> How a set's members are given (set_input_t%kind): listed ids (or ranges when `generated`),
   !> *SET_NODE_GENERAL operations, or *SET_..._ADD set ids.
@@ -206,7 +207,7 @@ module deck_input
     integer :: node_count = 0, solid_count = 0, part_count = 0, section_count = 0
     integer :: material_count = 0, hourglass_count = 0, curve_count = 0
     integer :: node_set_count = 0, part_set_count = 0, spc_count = 0, motion_count = 0
-    integer :: load_count = 0, velocity_count = 0, wall_count = 0
+    integer :: load_count = 0, velocity_count = 0, wall_count = 0, body_load_count = 0
     integer :: segment_set_count = 0, segment_load_count = 0
     integer :: box_count = 0, frame_count = 0, vector_count = 0
     type(box_input_t), allocatable :: boxes(:)
@@ -228,6 +229,8 @@ module deck_input
     type(spc_input_t), allocatable :: spcs(:)
     type(motion_input_t), allocatable :: motions(:)
     type(load_input_t), allocatable :: loads(:)
+    !> *LOAD_BODY_X/_Y/_Z: direction, curve, scale (target unused: every node)
+    type(load_input_t), allocatable :: body_loads(:)
     type(velocity_input_t), allocatable :: velocities(:)
     type(wall_input_t), allocatable :: walls(:)
     type(segment_set_input_t), allocatable :: segment_sets(:)
@@ -285,6 +288,7 @@ contains
     allocate (input%spcs(capacity(list_spcs)))
     allocate (input%motions(capacity(list_motions)))
     allocate (input%loads(capacity(list_loads)))
+    allocate (input%body_loads(capacity(list_body_loads)))
     allocate (input%velocities(capacity(list_velocities)))
     allocate (input%walls(capacity(list_walls)))
     allocate (input%segment_sets(capacity(list_segment_sets)))

@@ -24,7 +24,8 @@ module deck_keyword_table
     list_sections, list_materials, list_hourglasses, list_curves, list_node_sets, list_part_sets, list_spcs, &
     list_motions, list_loads, list_velocities, list_walls, list_segment_sets, list_segment_loads, &
     list_rigid_materials, list_rigid_motions, list_nodal_rigid_bodies, list_element_masses, list_contacts, &
-    list_count, list_boxes, list_frames, list_vectors, list_spot_welds, list_rigid_links, list_tied_contacts, list_beams
+    list_count, list_boxes, list_frames, list_vectors, list_spot_welds, list_rigid_links, list_tied_contacts, list_beams, &
+    list_body_loads
   use deck_nodes_elements, only: read_nodes, read_solid_elements, read_shell_elements, read_thick_shell_elements
   use deck_parts_sections, only: read_parts, read_solid_sections, read_efg_sections, read_shell_sections, &
     read_hourglasses
@@ -39,7 +40,7 @@ module deck_keyword_table
   use deck_loads_bcs, only: read_node_spcs, read_set_spcs, read_node_motions, read_set_motions, read_node_loads, &
     read_set_loads, read_initial_velocities, read_initial_velocity_nodes, read_velocity_generations, &
     read_planar_walls, read_cylinder_walls, read_segment_loads, read_segment_set_loads, &
-    read_nonuniform_segment_loads
+    read_nonuniform_segment_loads, read_body_loads
   use deck_controls, only: read_title, read_termination, read_time_step, read_hourglass_control, &
     read_bulk_viscosity, read_energy_control, read_implicit_general, read_implicit_solution, &
     read_unused_control, read_sensor_definition
@@ -188,6 +189,9 @@ contains
                       reader=read_set_motions), &
       keyword_entry_t("LOAD_NODE_POINT", fills=[list_loads, list_none], reader=read_node_loads), &
       keyword_entry_t("LOAD_NODE_SET", fills=[list_loads, list_none], reader=read_set_loads), &
+      keyword_entry_t("LOAD_BODY_X", fills=[list_body_loads, list_none], entries=per_block, reader=read_body_loads), &
+      keyword_entry_t("LOAD_BODY_Y", fills=[list_body_loads, list_none], entries=per_block, reader=read_body_loads), &
+      keyword_entry_t("LOAD_BODY_Z", fills=[list_body_loads, list_none], entries=per_block, reader=read_body_loads), &
       keyword_entry_t("RIGIDWALL_PLANAR", options="FINITE MOVING FORCES DISPLAY ID", fills=[list_walls, list_none], &
                       reader=read_planar_walls), &
       keyword_entry_t("DATABASE_BINARY_D3PLOT", reader=read_plot_output), &

@@ -13,7 +13,7 @@ module deck_loads_bcs
   use deck_keywords, only: keyword_t
   use deck_fields, only: card_t, open_card, next_line, require_card, has_data, get_integer, &
                          get_real, card_problem, warn_if_set, id_heading, line_problem, &
-                         card_is_empty, field_is_blank, located_warning
+                         card_is_empty, field_is_blank, located_warning, keyword_label
   use deck_input, only: deck_input_t, velocity_input_t, velocity_by_set, velocity_by_node, &
                         velocity_generation, segment_load_input_t, wall_input_t
   use deck_segments, only: read_segment_nodes
@@ -25,6 +25,7 @@ module deck_loads_bcs
   public :: read_initial_velocity_nodes, read_velocity_generations, read_planar_walls
   public :: read_cylinder_walls
   public :: read_segment_loads, read_segment_set_loads, read_nonuniform_segment_loads
+  public :: read_body_loads
 
   integer, parameter :: standard_widths(8) = 10
   character(len=*), parameter :: no_rotations = "solid nodes have no rotations"
@@ -273,6 +274,44 @@ contains
       end associate
     end do
   end subroutine read_load_cards
+
+  !> *LOAD_BODY_X / _Y / _Z: LCID SF LCIDDR XC YC ZC CID, a base acceleration SF*curve(t) along
+  !> the axis; every node takes the inertial force -m SF curve(t) (LS-DYNA: gravity in -z is
+  !> *LOAD_BODY_Z with a positive curve, 9.81 m/s^2 in the deck's units).
+  subroutine read_body_loads(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    character(len=:), allocatable :: name
+    integer :: line, system, n
+    line = 0
+    if (.not. require_card(deck, block, line, standard_widths, card, log, &
+                           "card 1 (LCID SF LCIDDR XC YC ZC CID)", "LCID")) return
+    n = input%body_load_count + 1
+    input%body_load_count = n
+    name = keyword_label(deck, block)
+    associate (load => input%body_loads(n))
+      load%line = line
+      load%direction = index("XYZ", name(len(name):len(name)))
+      call get_integer(deck, card, 1, "LCID", load%curve_id, log)
+      call get_real(deck, card, 2, "SF", load%scale, log)
+      if (load%scale == 0.0_wp) load%scale = 1.0_wp
+      call warn_if_set(deck, card, 3, "LCIDDR", "no dynamic relaxation: the run starts from the deck's state", &
+                       warnings)
+      call warn_if_set(deck, card, 4, "XC", "the centre is only used by angular body loads", warnings)
+      call warn_if_set(deck, card, 5, "YC", "the centre is only used by angular body loads", warnings)
+      call warn_if_set(deck, card, 6, "ZC", "the centre is only used by angular body loads", warnings)
+      call get_integer(deck, card, 7, "CID", system, log)
+      if (card%failed) return
+      call check_curve_given(deck, card, 1, load%curve_id, log)
+      if (system /= 0) call card_problem(deck, log, card, "CID", "a body load in a local system is "// &
+        "not available; give the load along a global axis (CID 0)")
+    end associate
+  end subroutine read_body_loads
 
   !> *LOAD_SEGMENT(_ID): one segment per line, LCID SF AT N1 N2 N3 N4 N5: a pressure, uniform
   !> over the segment, SF*curve(t - AT). A line that sets nothing is skipped: pydyna writes a card

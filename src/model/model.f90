@@ -413,6 +413,8 @@ module model
     type(local_spc_t), allocatable :: local_spcs(:)  !< SPCs in local systems (CID)
     type(prescribed_motion_t), allocatable :: motions(:)
     type(nodal_load_t), allocatable :: loads(:)
+    !> *LOAD_BODY_X/_Y/_Z: base accelerations (node 0: they act on every node, -m a)
+    type(nodal_load_t), allocatable :: body_loads(:)
     type(segment_load_t), allocatable :: segment_loads(:)
     type(rigid_wall_t), allocatable :: walls(:)
     ! rigid bodies and lumped masses (deck_rigid_bodies)

@@ -102,18 +102,43 @@ contains
     end do
   end subroutine remove_local_components
 
+  !> The number of body loads (none in a model built without them).
+  pure integer function body_load_count(model)
+    type(model_t), intent(in) :: model
+    body_load_count = 0
+    if (allocated(model%body_loads)) body_load_count = size(model%body_loads)
+  end function body_load_count
+
   !> External nodal forces at `time` (overwrites `external_force`).
-  subroutine assemble_nodal_loads(model, time, external_force)
+  subroutine assemble_nodal_loads(model, time, mass, external_force)
     type(model_t), intent(in) :: model
     real(wp), intent(in) :: time
+    real(wp), intent(in) :: mass(:)                 !< nodal masses (body loads)
     real(wp), intent(inout) :: external_force(:, :)
-    integer :: k
-    if (size(model%loads) == 0) return
-    do k = 1, size(model%loads)
-      associate (load => model%loads(k))
-        external_force(load%direction, load%node) = 0.0_wp
-      end associate
-    end do
+    real(wp) :: acceleration(3)
+    integer :: k, node
+    if (size(model%loads) == 0 .and. body_load_count(model) == 0) return
+    if (body_load_count(model) > 0) then
+      ! base accelerations: every node takes -m a (gravity in -z is a positive *LOAD_BODY_Z)
+      acceleration = 0.0_wp
+      do k = 1, size(model%body_loads)
+        associate (load => model%body_loads(k))
+          acceleration(load%direction) = acceleration(load%direction) + &
+                                         load%scale*curve_value(model%curves(load%curve), time)
+        end associate
+      end do
+      !$omp parallel do schedule(static) default(shared) private(node)
+      do node = 1, size(mass)
+        external_force(:, node) = -mass(node)*acceleration
+      end do
+      !$omp end parallel do
+    else
+      do k = 1, size(model%loads)
+        associate (load => model%loads(k))
+          external_force(load%direction, load%node) = 0.0_wp
+        end associate
+      end do
+    end if
     do k = 1, size(model%loads)
       associate (load => model%loads(k))
         external_force(load%direction, load%node) = external_force(load%direction, load%node) &
@@ -122,14 +147,14 @@ contains
     end do
   end subroutine assemble_nodal_loads
 
-  !> Work of the nodal loads over the step, f . (v dt) summed over every dof (call with f at the
-  !> start and at the end of the step, each weighted 1/2).
+  !> Work of the nodal and body loads over the step, f . (v dt) summed over every dof (call with
+  !> f at the start and at the end of the step, each weighted 1/2).
   function load_work(model, external_force, velocity, step) result(work)
     type(model_t), intent(in) :: model
     real(wp), intent(in) :: external_force(:, :), velocity(:, :), step
     real(wp) :: work
     work = 0.0_wp
-    if (size(model%loads) == 0) return
+    if (size(model%loads) == 0 .and. body_load_count(model) == 0) return
     work = step*sum(external_force*velocity)
   end function load_work
 

@@ -362,7 +362,7 @@ contains
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(inout) :: state
     real(wp), intent(in) :: step
-    call assemble_nodal_loads(model, state%time, state%nodes%external_force)
+    call assemble_nodal_loads(model, state%time, state%nodes%mass, state%nodes%external_force)
     state%energy%external_work = state%energy%external_work + &
                                  0.5_wp*load_work(model, state%nodes%external_force, state%nodes%velocity, step)
   end subroutine external_forces
