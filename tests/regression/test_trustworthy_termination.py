@@ -190,8 +190,11 @@ def long_run_deck(path):
 def test_a_stop_signal_ends_the_run_with_its_results(tmp_path, signal_number, name):
     deck = long_run_deck(tmp_path / "block.k")
     output = tmp_path / "out"
+    # (a test run started in the background inherits SIGINT ignored, as shells do for
+    # background jobs, and the solver keeps an ignored signal ignored: give it the default)
     process = subprocess.Popen([str(BINARY), f"i={deck}", f"outdir={output}", "ncpu=1"],
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     results_path = output / "results.h5"
     deadline = time.time() + 60.0
     while time.time() < deadline and not results_path.exists():
