@@ -831,7 +831,10 @@ contains
       segment_mass = 0.0_wp
       do j = 1, 4
         relative = relative - best_weights(j)*velocity(:, pass%segments(j, best))
-        segment_mass = segment_mass + best_weights(j)*mass(pass%segments(j, best))
+        ! a point just outside the segment (the parametric tolerance) has a slightly negative
+        ! weight: with a heavy corner (a lumped mass) the weighted mass would turn negative and
+        ! the pair spring infinite, so only the corners it lies towards count
+        segment_mass = segment_mass + max(best_weights(j), 0.0_wp)*mass(pass%segments(j, best))
       end do
       node_mass = mass(pass%nodes(i))
       reduced_mass = node_mass*segment_mass/max(node_mass + segment_mass, tiny(1.0_wp))

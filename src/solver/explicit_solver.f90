@@ -450,8 +450,12 @@ contains
     call start_phase(run%timers(phase_checks))
     call check_elements(model, run%state, error)
     if (.not. allocated(error)) call check_time_step(model, run%state, run%state%stable_time_step, error)
-    if (.not. allocated(error) .and. (last .or. mod(run%state%cycle, energy_check_interval) == 0)) &
-      call check_energy(model, run%state, run%energy_scratch, error)
+    if (.not. allocated(error) .and. (last .or. mod(run%state%cycle, energy_check_interval) == 0)) then
+      ! a node gone non-finite in this cycle makes the energies so too: name the node first
+      ! (the next cycle's check would), rather than only the energies
+      call check_runaway_motion(model, run%state, 0.5_wp*(run%state%time_step + run%state%next_time_step), error)
+      if (.not. allocated(error)) call check_energy(model, run%state, run%energy_scratch, error)
+    end if
     call stop_phase(run%timers(phase_checks))
   end subroutine check_state
 

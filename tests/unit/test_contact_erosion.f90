@@ -8,7 +8,8 @@
 !>  - A node 0.03 mm into the contact surface of a 2 x 2 plate of 1 mm shells (t = 0.2 mm):
 !>    force SLSFAC K A / diagonal x 0.03; it keeps its pair and its force when a shell elsewhere
 !>    erodes, and falls through (no force) once the shell under it has eroded. Plate nodes that
-!>    lost all their shells are no longer checked.
+!>    lost all their shells are no longer checked. A node just beside the plate's edge gets the
+!>    same force whatever the masses of the segment's corners it lies away from.
 program test_contact_erosion
   use kinds, only: wp
   use testing, only: test_suite_t, check, check_close, finish_suite
@@ -123,7 +124,7 @@ contains
     character(len=80), allocatable :: lines(:)
     integer :: i, j, k, probe, pair
     integer :: corners(4)
-    real(wp) :: on_plate, expected
+    real(wp) :: on_plate, expected, beside
 
     allocate (lines(0))
     lines = [character(len=80) :: "*KEYWORD", "*CONTROL_TERMINATION", "1.0", &
@@ -168,6 +169,20 @@ contains
     expected = stiffness_scale*1.0_wp/sqrt(2.0_wp)*0.03_wp
     call check_close(suite, "plate: a node 0.03 into the shell's contact surface gets SLSFAC K A / diagonal x 0.03", &
                      on_plate, expected, rel=1.0e-9_wp)
+    ! just outside the plate's edge x = 0 (within the parametric tolerance) the far corners of
+    ! the segment have negative weights; made heavy (a lumped mass), they once turned the pair's
+    ! mass negative and its spring infinite: the force must not depend on them
+    x(:, probe) = [-0.01_wp, 0.5_wp, 0.07_wp]
+    call evaluate(model, contacts, x, v, mass, force)
+    beside = force(3, probe)
+    mass([2, 5]) = 1.0e4_wp
+    call evaluate(model, contacts, x, v, mass, force)
+    call check(suite, "plate: a node just beside the edge is in contact", beside > 0.0_wp)
+    call check_close(suite, "plate: ... with the same force when the corners it lies away from are heavy", &
+                     force(3, probe), beside, rel=1.0e-12_wp)
+    mass = 1.0_wp
+    x(:, probe) = [0.5_wp, 0.4_wp, 0.07_wp]
+    call evaluate(model, contacts, x, v, mass, force)
     pair = contacts(1)%passes(1)%pair_segment(1)
     corners = contacts(1)%passes(1)%segments(:, max(1, pair))
     allocate (solid_eroded(size(model%solid_part)), shell_eroded(size(model%shell_part)))
