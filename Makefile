@@ -3,7 +3,7 @@
 #   make run        install what is missing, build, run the default job (the ODB component test,
 #                   coupled FE/EFG, about 2 min on one core), plot and tabulate (ODB_FE=1: run fe.k too)
 #   make taylor     the same for the Taylor bar
-#   make vehicle    the same for the vehicle front structure (inputs/vehicle_front; 20-40 min on one core)
+#   make vehicle    the same for the vehicle front structure (inputs/vehicle_front; 8 min on 2 threads, NCPU=2)
 #   make test       install what is missing, build, layer check, unit tests (debug build) and
 #                   regression tests
 #   make layers     check that each folder of src/ uses only the folders below it
