@@ -238,8 +238,8 @@ contains
         call warn_if_set(deck, card, 3, "PC", "no equation of state: a null shell carries no pressure", warnings)
         call warn_if_set(deck, card, 4, "MU", "no equation of state: a null shell carries no viscous stress", &
                          warnings)
-        call warn_if_set(deck, card, 5, "TEROD", "elements do not erode", warnings)
-        call warn_if_set(deck, card, 6, "CEROD", "elements do not erode", warnings)
+        call warn_if_set(deck, card, 5, "TEROD", "null shells do not erode by volume strain", warnings)
+        call warn_if_set(deck, card, 6, "CEROD", "null shells do not erode by volume strain", warnings)
       end associate
     end do
   end subroutine read_null_materials
@@ -447,8 +447,8 @@ contains
         do k = 1, 3
           call get_real(deck, card, k, "D"//achar(iachar("0") + k), material%axis_d(k), log)
         end do
-        call require_zero(deck, card, 4, "TSEF", "elements do not erode (tensile failure strain)", log)
-        call require_zero(deck, card, 5, "SSEF", "elements do not erode (shear failure strain)", log)
+        call require_zero(deck, card, 4, "TSEF", "honeycomb failure strains are not available (tensile failure strain)", log)
+        call require_zero(deck, card, 5, "SSEF", "honeycomb failure strains are not available (shear failure strain)", log)
         if (modified) then
           call require_zero(deck, card, 6, "VREF", "the reference-geometry update is not available", log)
           call require_zero(deck, card, 7, "TREF", "the reference-geometry update is not available", log)
