@@ -283,7 +283,8 @@ contains
 
   !> *CONSTRAINED_SPOTWELD(_ID): with _ID a card WID before each weld; card 1 N1 N2 SN SS N M TF
   !> EP. SN or SS 0 leaves that term out of the failure criterion; N and M 0 take 2; TF 0 takes
-  !> 1e20 (never). EP (failure by the plastic strain of the shells) is read but not evaluated.
+  !> 1e20 (never). EP > 0: the weld fails once a shell at one of its nodes reaches that effective
+  !> plastic strain.
   subroutine read_spot_welds(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
@@ -314,8 +315,9 @@ contains
       call get_integer(deck, card, 2, "N2", weld%node_ids(2), log)
       call read_weld_strengths(deck, card, 3, weld, log)
       call get_real(deck, card, 7, "TF", weld%failure_time, log)
-      call warn_if_set(deck, card, 8, "EP", "failure by plastic strain is not evaluated (the weld fails by "// &
-                       "force or at TF only)", warnings)
+      call get_real(deck, card, 8, "EP", weld%failure_plastic_strain, log)
+      if (weld%failure_plastic_strain < 0.0_wp) call card_problem(deck, log, card, "EP", &
+        "must be >= 0 (0: no failure by plastic strain), found "//real_text(weld%failure_plastic_strain))
       if (card%failed) cycle
       if (weld%failure_time == 0.0_wp) weld%failure_time = 1.0e20_wp
       if (any(weld%node_ids <= 0)) then
@@ -336,7 +338,7 @@ contains
   !> *CONSTRAINED_GENERALIZED_WELD_SPOT(_ID): with _ID a card WID; card 1 NSID CID FILTER WINDOW
   !> NPR NPRT; card 2 TFAIL EPSF SN SS N M. The node set is held as one rigid body until the
   !> weld fails. CID (a local system for the failure forces) is refused; FILTER, WINDOW, NPR,
-  !> NPRT (force filtering and printing) and EPSF are read but not used.
+  !> NPRT (force filtering and printing) are read but not used; EPSF as EP of *CONSTRAINED_SPOTWELD.
   subroutine read_generalized_spot_welds(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
@@ -379,8 +381,9 @@ contains
       end if
       call open_card(deck, block, line, standard_widths, card, log)
       call get_real(deck, card, 1, "TFAIL", weld%failure_time, log)
-      call warn_if_set(deck, card, 2, "EPSF", "failure by plastic strain is not evaluated (the weld fails by "// &
-                       "force or at TFAIL only)", warnings)
+      call get_real(deck, card, 2, "EPSF", weld%failure_plastic_strain, log)
+      if (weld%failure_plastic_strain < 0.0_wp) call card_problem(deck, log, card, "EPSF", &
+        "must be >= 0 (0: no failure by plastic strain), found "//real_text(weld%failure_plastic_strain))
       call read_weld_strengths(deck, card, 3, weld, log)
       if (card%failed) cycle
       if (weld%node_set <= 0) cycle
@@ -780,7 +783,8 @@ contains
         associate (given => input%rigid%welds(k))
           welds(count + 1) = spot_weld_t(id=given%id, normal_strength=given%normal_strength, &
                                          shear_strength=given%shear_strength, normal_exponent=given%normal_exponent, &
-                                         shear_exponent=given%shear_exponent, failure_time=given%failure_time)
+                                         shear_exponent=given%shear_exponent, failure_time=given%failure_time, &
+                                         failure_plastic_strain=given%failure_plastic_strain)
           if (welds(count + 1)%id == 0) welds(count + 1)%id = k
           good = .true.
           if (given%node_set == 0) then

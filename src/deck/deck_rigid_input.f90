@@ -55,6 +55,7 @@ module deck_rigid_input
     integer :: node_set = 0          !< NSID (a generalized weld; 0 for a spot weld)
     real(wp) :: normal_strength = 0.0_wp, shear_strength = 0.0_wp
     real(wp) :: normal_exponent = 2.0_wp, shear_exponent = 2.0_wp
+    real(wp) :: failure_plastic_strain = 0.0_wp  !< EP / EPSF (0: none)
     real(wp) :: failure_time = 1.0e20_wp
     integer :: line = 0              !< the card with the nodes (or the set)
   end type spot_weld_input_t

@@ -114,6 +114,9 @@ module element_group
     procedure :: mark_eroded
     !> Optional (kinds that erode): internal and hourglass energy of its eroded elements.
     procedure :: add_eroded_energies
+    !> Optional (shells): raise `strain(node)`, at the nodes `wanted` flags, to the largest
+    !> effective plastic strain of its elements on the node (spot welds failing by EP).
+    procedure :: raise_nodal_plastic_strain
   end type element_group_t
 
   !> An array element holding one group of any kind.
@@ -267,4 +270,11 @@ contains
     class(element_group_t), intent(in) :: self
     thinnest = huge(1.0_wp)
   end function thinnest
+
+  subroutine raise_nodal_plastic_strain(self, model, wanted, strain)
+    class(element_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    logical, intent(in) :: wanted(:)
+    real(wp), intent(inout) :: strain(:)
+  end subroutine raise_nodal_plastic_strain
 end module element_group

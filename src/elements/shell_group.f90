@@ -7,6 +7,7 @@ module shell_group
   use gather_list, only: gather_list_t
   use block_colouring, only: colour_blocks_by_nodes
   use model, only: model_t
+  use plane_stress_dispatch, only: plane_stress_plastic_strain
   use error_handling, only: error_t
   use text_format, only: integer_text
   use restart_file, only: restart_store_t, exchange_restart, exchange_restart_count
@@ -47,6 +48,7 @@ module shell_group
     procedure :: newly_eroded_elements
     procedure :: mark_eroded
     procedure :: add_eroded_energies
+    procedure :: raise_nodal_plastic_strain
   end type shell_group_t
 
 contains
@@ -167,6 +169,33 @@ contains
     end do
     self%eroded_count = self%eroded_count + self%newly_eroded
   end subroutine add_internal_forces
+
+  !> The largest effective plastic strain over the points of its shells, raised into the nodes
+  !> `wanted` flags (the nodes of spot welds that fail by EP / EPSF).
+  subroutine raise_nodal_plastic_strain(self, model, wanted, strain)
+    class(shell_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    logical, intent(in) :: wanted(:)
+    real(wp), intent(inout) :: strain(:)
+    real(wp) :: point_strain(block_size), largest(block_size)
+    integer :: b, point, lane, corner, node
+    do b = 1, size(self%blocks)
+      associate (block => self%blocks(b))
+        largest = 0.0_wp
+        do point = 1, block%point_count
+          call plane_stress_plastic_strain(model%materials(block%material), block%element_count, &
+                                           block%history(:, :, point), point_strain)
+          largest(1:block%element_count) = max(largest(1:block%element_count), point_strain(1:block%element_count))
+        end do
+        do lane = 1, block%element_count
+          do corner = 1, 4
+            node = block%nodes(lane, corner)
+            if (wanted(node)) strain(node) = max(strain(node), largest(lane))
+          end do
+        end do
+      end associate
+    end do
+  end subroutine raise_nodal_plastic_strain
 
   !> Its shells eroded by the last force call, block by block.
   function newly_eroded_elements(self) result(elements)

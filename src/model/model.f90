@@ -300,6 +300,9 @@ module model
     real(wp) :: normal_exponent = 2.0_wp     !< N
     real(wp) :: shear_exponent = 2.0_wp      !< M
     real(wp) :: failure_time = 1.0e20_wp     !< TF / TFAIL
+    !> EP / EPSF: the weld fails once the effective plastic strain of a shell at one of its nodes
+    !> reaches this (0: never)
+    real(wp) :: failure_plastic_strain = 0.0_wp
   end type spot_weld_t
 
   !> *SET_SEGMENT, node indices (a triangle repeats node 3); segments with a reported problem

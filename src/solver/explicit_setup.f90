@@ -81,7 +81,12 @@ contains
                            state%nodes%velocity, state%welds)
     allocate (state%held_by_weld(state%nodes%count))
     state%held_by_weld = .false.
+    allocate (state%plastic_weld_node(state%nodes%count), state%weld_node_plastic_strain(state%nodes%count))
+    state%plastic_weld_node = .false.
+    state%weld_node_plastic_strain = 0.0_wp
     do b = 1, size(state%welds)
+      if (model%spot_welds(b)%failure_plastic_strain > 0.0_wp) &
+        state%plastic_weld_node(model%spot_welds(b)%nodes) = .true.
       state%held_by_weld(model%spot_welds(b)%nodes) = .true.
     end do
     call set_up_tied_contacts(model, state%nodes%mass, state%nodes%rotary_inertia, state%nodes%velocity, &

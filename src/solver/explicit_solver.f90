@@ -305,9 +305,17 @@ contains
       end do
     end if
     if (size(state%welds) == 0) return
+    ! welds that fail by plastic strain: the largest of the shells on their nodes
+    if (any(state%plastic_weld_node)) then
+      where (state%plastic_weld_node) state%weld_node_plastic_strain = 0.0_wp
+      do k = 1, size(state%groups)
+        call state%groups(k)%group%raise_nodal_plastic_strain(model, state%plastic_weld_node, &
+                                                              state%weld_node_plastic_strain)
+      end do
+    end if
     call advance_spot_welds(model, state%welds, state%time, step, average_step, state%nodes%coordinates, &
                             state%nodes%angular_acceleration, state%nodes%rotary_inertia, state%nodes%velocity, &
-                            state%nodes%angular_velocity)
+                            state%nodes%angular_velocity, state%weld_node_plastic_strain)
   end subroutine move_rigid_bodies
 
   !> The nodes of failed welds are free (drilling constraint included) from the step after the

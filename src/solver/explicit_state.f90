@@ -66,6 +66,10 @@ module explicit_state
     real(wp) :: rigid_time_step = huge(1.0_wp)           !< smallest stable step of the rigid elements
     type(spot_weld_state_t), allocatable :: welds(:)     !< indexed like model%spot_welds
     logical, allocatable :: held_by_weld(:)              !< (nodes) in a weld that has not failed
+    !> (nodes) the nodes of welds that fail by plastic strain (EP / EPSF), and the largest plastic
+    !> strain of the shells on each (recomputed every cycle from the shells)
+    logical, allocatable :: plastic_weld_node(:)
+    real(wp), allocatable :: weld_node_plastic_strain(:)
     type(tied_state_t) :: ties                           !< work arrays of the tied contacts
     type(wall_state_t), allocatable :: walls(:)          !< indexed like model%walls
     type(contact_state_t), allocatable :: contacts(:)    !< indexed like model%contacts

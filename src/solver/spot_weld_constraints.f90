@@ -91,11 +91,14 @@ contains
   !> `velocity` holds v^{n+1/2} after the ordinary update; `angular_velocity` of weld nodes with
   !> rotary inertia follows the weld. Failures are printed.
   subroutine advance_spot_welds(model, welds, time, dt, average_dt, coordinates, angular_acceleration, &
-                                rotary_inertia, velocity, angular_velocity)
+                                rotary_inertia, velocity, angular_velocity, node_plastic_strain)
     type(model_t), intent(in) :: model
     type(spot_weld_state_t), intent(inout) :: welds(:)
     real(wp), intent(in) :: time, dt, average_dt
     real(wp), intent(in) :: coordinates(:, :), angular_acceleration(:, :), rotary_inertia(:)
+    !> (nodes) the largest effective plastic strain of the shells on each node of a weld that
+    !> fails by plastic strain (EP / EPSF)
+    real(wp), intent(in) :: node_plastic_strain(:)
     real(wp), intent(inout) :: velocity(:, :), angular_velocity(:, :)
     real(wp) :: work, force(3), axis(3), value
     logical :: was_failed
@@ -133,6 +136,10 @@ contains
           value = value + (weld%shear_force/given%shear_strength)**given%shear_exponent
         weld%failure_value = value
         was_failed = value >= 1.0_wp
+        ! EP / EPSF: a shell on one of its nodes has reached the plastic strain at failure
+        if (given%failure_plastic_strain > 0.0_wp) then
+          if (maxval(node_plastic_strain(given%nodes)) >= given%failure_plastic_strain) was_failed = .true.
+        end if
         if (was_failed) then
           weld%failed = .true.
           weld%failure_time = time
@@ -147,6 +154,10 @@ contains
       associate (weld => welds(w), given => model%spot_welds(w))
         if (time >= given%failure_time) then
           write (text, '(a,i0,a,es12.5,a)') "spot weld ", given%id, " fails at its failure time (t = ", time, ")"
+        else if (weld%failure_value < 1.0_wp) then
+          write (text, '(a,i0,a,a,a,es12.5,a,es12.5,a)') "spot weld ", given%id, " (nodes ", &
+            node_list(model, given%nodes), ") fails at t = ", time, ": a shell on its nodes reached the "// &
+            "plastic strain ", given%failure_plastic_strain, " (EP)"
         else
           write (text, '(a,i0,a,a,a,es12.5,a,es12.5,a,es12.5,a)') "spot weld ", given%id, " (nodes ", &
             node_list(model, given%nodes), ") fails at t = ", time, ": normal force ", weld%normal_force, &

@@ -448,3 +448,44 @@ def test_restart_with_welds_reproduces_the_uninterrupted_run(tmp_path):
         process = restart(target / dump, 2)
         assert process.returncode == 0, process.stdout + process.stderr
         assert_same(reference, contents(target / "results.h5"), f"welds continued from {dump}")
+
+
+def test_spot_weld_fails_when_a_shell_on_its_nodes_reaches_ep(tmp_path, run_deck):
+    """EP of *CONSTRAINED_SPOTWELD (and EPSF of the generalized weld): the weld fails once a shell
+    on one of its nodes reaches that effective plastic strain. The lap joint of elastic-plastic
+    strips (MAT_024, SIGY 0.2 GPa) with no force criterion (SN = SS = 0) never fails; with EP =
+    0.002 it fails between the last state (every 0.01 ms) at which the shells on its nodes are
+    below 0.002 and one step after the first at which one reaches it (the runs are the same
+    until then)."""
+    plastic = "*MAT_PIECEWISE_LINEAR_PLASTICITY\n" + fields(1, DENSITY, YOUNGS, POISSON, 0.2, 1.0) + "\n" + fields(0.0)
+    decks = {}
+    for name, weld_strain in (("reference", 0.0), ("ep", 0.002)):
+        deck = lap_joint_deck(tmp_path / f"{name}.k", 0.0)
+        text = deck.read_text().replace("*MAT_ELASTIC\n" + fields(1, DENSITY, YOUNGS, POISSON), plastic)
+        text = text.replace("*DATABASE_BINARY_D3PLOT\n" + fields(0.5), "*DATABASE_BINARY_D3PLOT\n" + fields(0.01))
+        lines = text.splitlines()
+        weld = lines.index("*CONSTRAINED_SPOTWELD") + 1
+        lines[weld] = lines[weld] + fields(0.0, 0.0, 0.0, weld_strain)[:40]
+        deck.write_text("\n".join(lines) + "\n")
+        decks[name] = deck
+    reference = run_deck(decks["reference"], jobid="reference")
+    assert reference.status == 0 and "spot weld" not in reference.stdout, reference.stdout + reference.stderr
+    ep = run_deck(decks["ep"], jobid="ep")
+    assert ep.status == 0, ep.stdout + ep.stderr
+    assert "reached the plastic strain" in ep.stdout
+    failed_at = failure_time(ep.stdout)
+    weld_line = decks["ep"].read_text().splitlines()[decks["ep"].read_text().splitlines().index("*CONSTRAINED_SPOTWELD") + 1]
+    weld_nodes = [int(weld_line[0:10]) - 1, int(weld_line[10:20]) - 1]
+    with reference.open() as results:
+        connectivity = results["mesh/shells/connectivity_index"][...]
+        on_weld = np.flatnonzero(np.isin(connectivity, weld_nodes).any(axis=1))
+        keys = sorted(results["states"].keys())
+        times = np.array([results["states"][k].attrs["time"] for k in keys])
+        strain = np.array([results["states"][k]["shell_plastic_strain_peak"][...][on_weld].max() for k in keys])
+        steps = np.diff(results["history/glstat/time"][...])
+    reached = np.flatnonzero(strain >= 0.002)
+    assert len(reached) > 0 and reached[0] > 0, strain
+    first = reached[0]
+    print(f"EP 0.002 reached between states at {times[first - 1]:.4f} and {times[first]:.4f} ms; "
+          f"weld failed at {failed_at:.5f} ms")
+    assert times[first - 1] < failed_at <= times[first] + 2.0 * steps.max()
