@@ -30,5 +30,8 @@ module run_summary
     integer :: tangled_solids = 0                !< at the last state
     real(wp) :: worst_corner_jacobian_ratio = 1.0_wp !< smallest corner Jacobian ratio of the run
     integer :: worst_corner_jacobian_element = 0 !< its solid ID (0: no FE solid)
+    !> seconds of each phase of the explicit cycle (/timing phase_<name>_s; none for a static run)
+    character(len=16), allocatable :: phase_names(:)
+    real(wp), allocatable :: phase_seconds(:)
   end type run_summary_t
 end module run_summary

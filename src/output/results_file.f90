@@ -1378,6 +1378,13 @@ contains
       call write_integer_attribute(group_id, "/timing", trim(count_names(entry)), counts(entry), &
                                    error)
     end do
+    ! the explicit cycle's phases (explicit_solver): where "other" time goes
+    if (allocated(summary%phase_seconds)) then
+      do entry = 1, size(summary%phase_seconds)
+        call write_real_attribute(group_id, "/timing", "phase_"//trim(summary%phase_names(entry))//"_s", &
+                                  summary%phase_seconds(entry), error)
+      end do
+    end if
     call write_long_attribute(group_id, "/timing", "output_bytes", results%output_bytes, error)
     call write_integer_attribute(group_id, "/timing", "xdmf_writes", results%xdmf_writes, error)
     call h5gclose_f(group_id, status)

@@ -28,7 +28,7 @@ module explicit_solver
   use explicit_state, only: explicit_state_t
   use run_state, only: run_state_t, phase_velocities, phase_constraints, phase_walls, phase_rigid_bodies, &
                        phase_positions, phase_internal_forces, phase_contact, phase_external_forces, &
-                       phase_accelerations, phase_time_step, phase_checks, phase_output, phase_erosion
+                       phase_accelerations, phase_time_step, phase_checks, phase_output, phase_erosion, phase_names
   use element_groups, only: compute_internal_forces, smallest_group_step, eroded_element_masks
   use contact_erosion, only: remove_eroded_elements
   use boundary_conditions, only: assemble_nodal_loads, load_work, impose_kinematic_conditions, &
@@ -497,6 +497,8 @@ contains
     end do
     summary%contact_s = run%timers(phase_contact)%seconds + run%timers(phase_walls)%seconds
     summary%output_s = run%timers(phase_output)%seconds
+    summary%phase_names = phase_names
+    summary%phase_seconds = run%timers%seconds
     summary%tangled_solids = run%distortion%tangled
     summary%worst_corner_jacobian_ratio = run%distortion%worst_ratio
     if (run%distortion%worst_element > 0) &

@@ -233,13 +233,13 @@ def test_two_solver_runs_and_a_killed_one(tmp_path):
 
 
 def test_every_full_disk_failure_says_so(tmp_path, disk_shim):
-    """Disks of 40 to 200 kB without fallocate under a run of 20 states: wherever the disk fills
+    """Disks of 40 to 240 kB without fallocate under a run of 20 states: wherever the disk fills
     (a state, the histories, the XDMF file or the run status at the end), a run that does not end
     normally says "no space left on device" (a failure that first happened while the file was
     closed was reported only as what the file keeps)."""
     deck = cube_deck(tmp_path / "cube.k", 20)
     endings = set()
-    for size in range(40000, 200000, 4000):
+    for size in range(40000, 240000, 5000):
         output = tmp_path / f"disk_{size}"
         output.mkdir()
         run = run_solver(BINARY, deck, output, {"LD_PRELOAD": str(disk_shim), "CRASHFREE_TEST_DISK_DIR": str(output),

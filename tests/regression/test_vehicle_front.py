@@ -40,6 +40,12 @@ def test_coarse_vehicle_front(tmp_path, run_deck):
     assert run.status == 0, run.stdout + run.stderr
     with run.open() as results:
         assert results["run"].attrs["status"] == "normal termination"
+        # /timing splits the time loop by the phases of the cycle; the contact's time is the
+        # contact and wall phases' (bookkeeping, not a speed check)
+        timing = results["timing"].attrs
+        phases = {name: timing[name] for name in timing if name.startswith("phase_")}
+        assert len(phases) == 13 and min(phases.values()) >= 0.0
+        assert timing["contact_s"] == phases["phase_contact_s"] + phases["phase_walls_s"]
         figures = summary(results, "1", "200", GAP)
         total_mass = float(np.asarray(results["history/glstat/momentum"])[0, 0]) / -SPEED
     assert abs(figures["energy_ratio"] - 1.0) < 0.01, figures["energy_ratio"]
