@@ -574,7 +574,7 @@ contains
     type(contact_pass_t), intent(inout) :: pass
     real(wp), intent(in) :: coordinates(:, :)
     real(wp) :: low(3), high(3), cell, extent(3), grow
-    integer :: dims(3), s, i, c, total, lo(3), hi(3), ix, iy, iz, cell_count, own
+    integer :: dims(3), s, i, c, j, total, lo(3), hi(3), ix, iy, iz, cell_count, own
     integer, allocatable :: counts(:)
     pass%built = .true.
     pass%cycles_since_build = 0
@@ -587,10 +587,12 @@ contains
       return
     end if
     do s = 1, pass%segment_count
-      associate (x => coordinates(:, pass%segments(:, s)))
-        pass%box(1:3, s) = minval(x, dim=2)
-        pass%box(4:6, s) = maxval(x, dim=2)
-      end associate
+      do j = 1, 3
+        pass%box(j, s) = min(coordinates(j, pass%segments(1, s)), coordinates(j, pass%segments(2, s)), &
+                             coordinates(j, pass%segments(3, s)), coordinates(j, pass%segments(4, s)))
+        pass%box(j + 3, s) = max(coordinates(j, pass%segments(1, s)), coordinates(j, pass%segments(2, s)), &
+                                 coordinates(j, pass%segments(3, s)), coordinates(j, pass%segments(4, s)))
+      end do
       ! pair_forces reaches the node offset, the depth and the parametric tolerance of the
       ! segment's current extent (which may grow by the margin before the next build)
       grow = pass%margin + pass%depth(s) + pass%largest_node_offset + &
@@ -744,7 +746,10 @@ contains
       best_side = 1.0_wp
       do c = pass%candidate_first(i), pass%candidate_first(i + 1) - 1
         seg = pass%candidates(c)
-        corners = coordinates(:, pass%segments(:, seg))
+        ! (corner by corner: a vector subscript would make a heap temporary per candidate)
+        do j = 1, 4
+          corners(:, j) = coordinates(:, pass%segments(j, seg))
+        end do
         ! the candidate lists hold every segment within the search margin; most are out of
         ! reach this cycle, which the segment's current box (grown by the deepest contact and
         ! the parametric tolerance) shows without projecting
