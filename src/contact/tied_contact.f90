@@ -88,10 +88,10 @@ contains
       do c = 1, size(model%tied_contacts)
         associate (tie => model%tied_contacts(c))
           do i = 1, size(tie%nodes)
-            velocity(:, tie%nodes(i)) = matmul(velocity(:, tie%segments(:, i)), tie%weights(:, i))
+            velocity(:, tie%nodes(i)) = interpolated(velocity, tie%segments(:, i), tie%weights(:, i))
             if (tie%rotations .and. rotary_inertia(tie%nodes(i)) > 0.0_wp .and. &
                 all(rotary_inertia(tie%segments(:, i)) > 0.0_wp)) &
-              angular_velocity(:, tie%nodes(i)) = matmul(angular_velocity(:, tie%segments(:, i)), tie%weights(:, i))
+              angular_velocity(:, tie%nodes(i)) = interpolated(angular_velocity, tie%segments(:, i), tie%weights(:, i))
           end do
         end associate
       end do
@@ -166,11 +166,11 @@ contains
       associate (tie => model%tied_contacts(c))
         do i = 1, size(tie%nodes)
           node = tie%nodes(i)
-          acceleration(:, node) = matmul(acceleration(:, tie%segments(:, i)), tie%weights(:, i))
-          velocity(:, node) = matmul(velocity(:, tie%segments(:, i)), tie%weights(:, i))
+          acceleration(:, node) = interpolated(acceleration, tie%segments(:, i), tie%weights(:, i))
+          velocity(:, node) = interpolated(velocity, tie%segments(:, i), tie%weights(:, i))
           if (.not. ties_rotations(tie%rotations, node, tie%segments(:, i), rotary_inertia)) cycle
-          angular_acceleration(:, node) = matmul(angular_acceleration(:, tie%segments(:, i)), tie%weights(:, i))
-          angular_velocity(:, node) = matmul(angular_velocity(:, tie%segments(:, i)), tie%weights(:, i))
+          angular_acceleration(:, node) = interpolated(angular_acceleration, tie%segments(:, i), tie%weights(:, i))
+          angular_velocity(:, node) = interpolated(angular_velocity, tie%segments(:, i), tie%weights(:, i))
         end do
       end associate
     end do
@@ -186,4 +186,17 @@ contains
     if (.not. wanted) return
     ties_rotations = rotary_inertia(node) > 0.0_wp .and. all(rotary_inertia(segment) > 0.0_wp)
   end function ties_rotations
+  !> The value at a tied node's point of its segment: the corners' values weighted by the
+  !> shape functions, corner by corner (a vector subscript would make a heap temporary per
+  !> node and cycle).
+  pure function interpolated(values, corners, weights) result(value)
+    real(wp), intent(in) :: values(:, :), weights(:)
+    integer, intent(in) :: corners(:)
+    real(wp) :: value(3)
+    integer :: j
+    value = 0.0_wp
+    do j = 1, size(corners)
+      value = value + weights(j)*values(:, corners(j))
+    end do
+  end function interpolated
 end module tied_contact
