@@ -6,7 +6,7 @@ module element_work
   implicit none
   private
 
-  public :: append_marked_lanes
+  public :: append_marked_lanes, mark_lanes
   public :: add_force_work, smallest_time_step, booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, &
             raise_largest_scaling
 
@@ -84,6 +84,18 @@ contains
       elements(n) = lane_elements(lane)
     end do
   end subroutine append_marked_lanes
+
+  !> Set `mask(lane_elements(lane))` for the first `count` lanes of a block that `marked` flags
+  !> (a group's eroded elements in the model-indexed masks the contacts read).
+  pure subroutine mark_lanes(count, marked, lane_elements, mask)
+    integer, intent(in) :: count, lane_elements(:)
+    logical, intent(in) :: marked(:)
+    logical, intent(inout) :: mask(:)
+    integer :: lane
+    do lane = 1, count
+      if (marked(lane)) mask(lane_elements(lane)) = .true.
+    end do
+  end subroutine mark_lanes
 
   !> Energy the eroded lanes of a block took along (their powers are zero).
   pure real(wp) function eroded_energy(energy, count, eroded)

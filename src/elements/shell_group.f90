@@ -14,7 +14,7 @@ module shell_group
   use run_summary, only: run_summary_t
   use nodal_state, only: nodal_state_t
   use element_group, only: element_group_t, element_results_t
-  use element_work, only: append_marked_lanes, booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, &
+  use element_work, only: append_marked_lanes, mark_lanes, booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, &
                           raise_largest_scaling
   use shell_block, only: shell_block_t, build_shell_blocks, shell_block_masses, shell_block_time_steps, &
                          compute_shell_block, shell_block_element_results
@@ -213,11 +213,9 @@ contains
   subroutine mark_eroded(self, solid_eroded, shell_eroded)
     class(shell_group_t), intent(in) :: self
     logical, intent(inout) :: solid_eroded(:), shell_eroded(:)
-    integer :: b, lane
+    integer :: b
     do b = 1, size(self%blocks)
-      do lane = 1, self%blocks(b)%element_count
-        if (self%blocks(b)%eroded(lane)) shell_eroded(self%blocks(b)%elements(lane)) = .true.
-      end do
+      call mark_lanes(self%blocks(b)%element_count, self%blocks(b)%eroded, self%blocks(b)%elements, shell_eroded)
     end do
   end subroutine mark_eroded
 

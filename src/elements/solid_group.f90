@@ -11,7 +11,7 @@ module solid_group
   use run_summary, only: run_summary_t
   use nodal_state, only: nodal_state_t
   use element_group, only: element_group_t, element_results_t, distortion_t
-  use element_work, only: append_marked_lanes, booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, &
+  use element_work, only: append_marked_lanes, mark_lanes, booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, &
                           raise_largest_scaling
   use solid_block, only: solid_block_t, build_solid_blocks, solid_block_corner_masses, solid_block_time_steps, &
                          compute_solid_block, solid_block_element_results
@@ -184,11 +184,9 @@ contains
   subroutine mark_eroded(self, solid_eroded, shell_eroded)
     class(solid_group_t), intent(in) :: self
     logical, intent(inout) :: solid_eroded(:), shell_eroded(:)
-    integer :: b, lane
+    integer :: b
     do b = 1, size(self%blocks)
-      do lane = 1, self%blocks(b)%element_count
-        if (self%blocks(b)%eroded(lane)) solid_eroded(self%blocks(b)%elements(lane)) = .true.
-      end do
+      call mark_lanes(self%blocks(b)%element_count, self%blocks(b)%eroded, self%blocks(b)%elements, solid_eroded)
     end do
   end subroutine mark_eroded
 

@@ -306,7 +306,7 @@ contains
     end if
     if (size(state%welds) == 0) return
     ! welds that fail by plastic strain: the largest of the shells on their nodes
-    if (any(state%plastic_weld_node)) then
+    if (any(model%spot_welds%failure_plastic_strain > 0.0_wp)) then
       where (state%plastic_weld_node) state%weld_node_plastic_strain = 0.0_wp
       do k = 1, size(state%groups)
         call state%groups(k)%group%raise_nodal_plastic_strain(model, state%plastic_weld_node, &
@@ -455,14 +455,17 @@ contains
     type(run_state_t), intent(inout) :: run
     logical, intent(in) :: last
     type(error_t), allocatable, intent(out) :: error
+    type(error_t), allocatable :: node_error
     call start_phase(run%timers(phase_checks))
     call check_elements(model, run%state, error)
     if (.not. allocated(error)) call check_time_step(model, run%state, run%state%stable_time_step, error)
     if (.not. allocated(error) .and. (last .or. mod(run%state%cycle, energy_check_interval) == 0)) then
-      ! a node gone non-finite in this cycle makes the energies so too: name the node first
-      ! (the next cycle's check would), rather than only the energies
-      call check_runaway_motion(model, run%state, 0.5_wp*(run%state%time_step + run%state%next_time_step), error)
-      if (.not. allocated(error)) call check_energy(model, run%state, run%energy_scratch, error)
+      call check_energy(model, run%state, run%energy_scratch, error)
+      ! energies gone wrong in this cycle because a node ran away: name the node, as the next
+      ! cycle's check would, rather than only the energies
+      if (allocated(error)) call check_runaway_motion(model, run%state, &
+                                                      0.5_wp*(run%state%time_step + run%state%next_time_step), node_error)
+      if (allocated(node_error)) call move_alloc(node_error, error)
     end if
     call stop_phase(run%timers(phase_checks))
   end subroutine check_state

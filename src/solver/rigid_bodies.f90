@@ -382,7 +382,7 @@ contains
   !> forces, walls and supports of this velocity update) and I dt_avg alpha for the rotations of
   !> shell nodes (their moments; the shells' drilling constraint does not act on a body). With
   !> `constraint_impulse`, each node's impulse from the body, m (v_rigid - v), is returned: what
-  !> the rigid link had to do (a weld's force).
+  !> the rigid link exerted on the node (a weld measures its force from it).
   subroutine advance_body(model, b, nodes, body, time, dt, average_dt, coordinates, angular_acceleration, &
                           rotary_inertia, velocity, support_work, constraint_impulse)
     type(model_t), intent(in) :: model
