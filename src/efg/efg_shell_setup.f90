@@ -287,7 +287,9 @@ contains
     type(shell_cell_context_t), intent(in) :: context
     real(wp), intent(in) :: parametric(2)
     real(wp) :: planar(2)
-    planar = matmul(context%planar, corner_functions(context%corners, parametric))
+    real(wp) :: phi(4)
+    phi = corner_functions(context%corners, parametric)
+    planar = matmul(context%planar, phi)
   end function planar_point
 
   !> Signed area (shoelace) in the cell's plane of a parametric polygon with straight images.
