@@ -3,9 +3,9 @@
 !>
 !> Gamma nodes are the nodes on the part's boundary edges (an edge that only one cell of the part
 !> uses: free edges, and interfaces with FE shells or other parts; also an edge that three or
-!> more cells share, a junction) and the nodes the caller asks
-!> to keep (supports, constraints, spot welds, nodes shared with beams or solids). They keep their
-!> FE shell functions. The other nodes of the part's cells are interior particles.
+!> more cells share, a junction), the nodes that elements of other parts use (shells, solids,
+!> beams), and the nodes the caller asks to keep (supports, constraints, spot welds). They keep
+!> their FE shell functions. The other nodes of the part's cells are interior particles.
 !>
 !> Each particle I has its own tangent frame T_I = (t1, t2, n): n the mean of the normals e3 of
 !> its cells (made to agree in sign), t1 the global axis least aligned with n projected on the
@@ -97,6 +97,7 @@ contains
     do j = 1, count
       if (extra_gamma_nodes(supports%nodes(j))) on_boundary(j) = .true.
     end do
+    call mark_shared_nodes(model, part, node_local, on_boundary)
     supports%gamma_nodes = pack(supports%nodes, on_boundary)
     supports%particles = pack(supports%nodes, .not. on_boundary)
     allocate (supports%particle_of_node(model_node_count))
@@ -170,6 +171,45 @@ contains
       end if
     end do
   end subroutine build_shell_supports
+
+  !> Mark the part nodes (part numbering) that an element of another part also uses: shells of
+  !> other parts (also where they meet the part along a line of its interior, not at an edge),
+  !> solids, and beams (N1, N2). Such nodes couple the part to its neighbours and keep FE
+  !> functions whatever the caller lists.
+  subroutine mark_shared_nodes(model, part, node_local, on_boundary)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: part, node_local(:)
+    logical, intent(inout) :: on_boundary(:)
+    integer :: element, a, node
+
+    if (allocated(model%shell_part)) then
+      do element = 1, size(model%shell_part)
+        if (model%shell_part(element) == part) cycle
+        do a = 1, 4
+          node = model%shell_nodes(a, element)
+          if (node_local(node) > 0) on_boundary(node_local(node)) = .true.
+        end do
+      end do
+    end if
+    if (allocated(model%solid_nodes)) then
+      do element = 1, size(model%solid_nodes, 2)
+        do a = 1, 8
+          node = model%solid_nodes(a, element)
+          if (node_local(node) > 0) on_boundary(node_local(node)) = .true.
+        end do
+      end do
+    end if
+    if (allocated(model%beam_nodes)) then
+      do element = 1, size(model%beam_nodes, 2)
+        do a = 1, 2
+          node = model%beam_nodes(a, element)
+          if (node > 0) then
+            if (node_local(node) > 0) on_boundary(node_local(node)) = .true.
+          end if
+        end do
+      end do
+    end if
+  end subroutine mark_shared_nodes
 
   !> Frame (t1, t2, n) from a normal direction: t1 is the global axis least aligned with n,
   !> projected on the tangent plane (the first such axis on a tie, so flat parts in a

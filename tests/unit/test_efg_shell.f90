@@ -441,7 +441,33 @@ contains
     call build_efg_shell_part(model, 1, extra, geometry, error)
     call check(suite, "node classes: an extra Gamma node is kept", .not. allocated(error) .and. &
                size(geometry%gamma_nodes) == on_outline + 1 .and. size(geometry%particles) == 5)
+    ! an FE shell of part 2 on corners of the part's first cell (a T-junction inside the part):
+    ! its nodes keep FE functions without being listed by the caller
+    extra = .false.
+    model%shell_nodes = reshape([model%shell_nodes, model%shell_nodes(:, 6)], [4, size(model%shell_part) + 1])
+    model%shell_part = [model%shell_part, 2]
+    model%shell_ids = [model%shell_ids, 999]
+    model%shell_thickness = reshape([model%shell_thickness, model%shell_thickness(:, 6)], [4, size(model%shell_part)])
+    call build_efg_shell_part(model, 1, extra, geometry, error)
+    call check(suite, "node classes: nodes shared with another part's shell are Gamma nodes", .not. allocated(error) &
+               .and. size(geometry%particles) == 6 - count(is_interior(model, model%shell_nodes(:, 6))) .and. &
+               count(is_interior(model, model%shell_nodes(:, 6))) > 0 .and. &
+               .not. any([(any(geometry%particles == model%shell_nodes(node, 6)), node=1, 4)]))
   end subroutine test_node_classes
+
+  !> Which of `nodes` lie inside the plate's outline.
+  function is_interior(model, nodes) result(inside)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: nodes(:)
+    logical :: inside(size(nodes))
+    integer :: k
+    do k = 1, size(nodes)
+      associate (x => model%coordinates(:, nodes(k)))
+        inside(k) = x(1) > 1e-12_wp .and. x(1) < plate_length - 1e-12_wp .and. x(2) > 1e-12_wp .and. &
+                    x(2) < plate_width - 1e-12_wp
+      end associate
+    end do
+  end function is_interior
 
   !> Parts the set-up does not take are refused with the part named.
   subroutine test_errors()
