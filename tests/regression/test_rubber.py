@@ -15,7 +15,7 @@ docs/materials.md), the lateral stretch solved here by bisection."""
 import numpy as np
 import pytest
 
-from deck_writer import block_mesh, fields, nodes_card, plate_mesh, round_to_node_card, shells_card, \
+from deck_writer import block_mesh, efg_section, fields, nodes_card, plate_mesh, round_to_node_card, shells_card, \
     solids_card, write_deck
 
 DENSITY = 1.1e-6
@@ -260,3 +260,109 @@ def test_viscoelastic_shear_relaxation(tmp_path, run_deck):
     assert times[-1] > 0.99 * RELAXATION_TIME
     assert shear[-1] < 0.5 * shear.max()         # it relaxed
     assert error < 0.01
+
+
+# ---------------------------------------------------------------------------------------------
+# d. the rib foam (*MAT_LOW_DENSITY_FOAM) on meshfree and on FE solids
+
+# Chosen rib-foam set: the loading curve is the elastic part of the EuroSID rib-foam example of
+# *MAT_VISCOUS_FOAM (E1 = 1 MPa, N1 = 4: Altair Radioss /MAT/LAW134 VISCOUS_FOAM, "the open-celled
+# urethane foam used for the ribs of a Euro-SID side impact dummy"): a tangent modulus
+# E1 V^-N1 with V = 1 - eps (no lateral strain), integrated to sigma(eps) = E1/3 ((1 - eps)^-3 - 1).
+# HU = 0.1, SHAPE = 5 (strong hysteresis) and the density 100 kg/m^3 are chosen.
+FOAM_E1, FOAM_DENSITY, FOAM_HU, FOAM_SHAPE = 1.0e-3, 1.0e-7, 0.1, 5.0
+FOAM_SIDE, FOAM_CRUSH, FOAM_TIME = 10.0, 6.0, 4.0     # mm, mm (60%), ms (down and back)
+FOAM_STRAINS = np.linspace(0.0, 0.8, 17)
+FOAM_STRESSES = FOAM_E1 / 3.0 * ((1.0 - FOAM_STRAINS) ** -3 - 1.0)
+
+
+def foam_deck(path, meshfree):
+    nodes, elements = block_mesh((4, 4, 4), (FOAM_SIDE, FOAM_SIDE, FOAM_SIDE))
+    section = efg_section(1, 1.2) if meshfree else "*SECTION_SOLID\n" + fields(1, 2)
+    spc = ["*BOUNDARY_SPC_NODE"]
+    motion = ["*BOUNDARY_PRESCRIBED_MOTION_NODE"]
+    for k, node in enumerate(nodes):
+        # confined laterally (every node, particles too): with Poisson's ratio 0 the foam has no
+        # lateral stress either way, and the confinement keeps the block from the shear
+        # instability of a foam under 60% compression (its tangent shear stiffness falls below
+        # |sigma| / 2), which grows from round-off differently in the two discretizations
+        spc.append(fields(k + 1, 0, 1, 1, int(abs(node[2]) < 1e-9), 0, 0, 0))
+        if abs(node[2] - FOAM_SIDE) < 1e-9:
+            motion.append(fields(k + 1, 3, 2, 1, -1.0))
+    times = np.linspace(0.0, FOAM_TIME, 401)
+    crush = 0.5 * FOAM_CRUSH * (1.0 - np.cos(2.0 * np.pi * times / FOAM_TIME))
+    curve = ["*DEFINE_CURVE", fields(1)] + [fields(float(t), float(u), width=20) for t, u in zip(times, crush)]
+    curve += [fields(100.0, 0.0, width=20)]
+    loading = ["*DEFINE_CURVE", fields(2)] + [fields(float(e), float(s), width=20)
+                                              for e, s in zip(FOAM_STRAINS, FOAM_STRESSES)]
+    return write_deck(
+        path,
+        "*CONTROL_TERMINATION\n" + fields(FOAM_TIME),
+        "*DATABASE_GLSTAT\n" + fields(FOAM_TIME / 400),
+        "*DATABASE_BINARY_D3PLOT\n" + fields(FOAM_TIME / 4),
+        "*PART\nrib foam\n" + fields(1, 1, 1),
+        section,
+        # MID RO E LCID TC HU BETA DAMP / SHAPE FAIL BVFLAG
+        "*MAT_LOW_DENSITY_FOAM\n" + fields(1, FOAM_DENSITY, FOAM_E1, 2, 0.0, FOAM_HU, 0.0, 0.0) + "\n" +
+        fields(FOAM_SHAPE, 0.0, 0.0),
+        "\n".join(curve),
+        "\n".join(loading),
+        "\n".join(spc),
+        "\n".join(motion),
+        nodes_card(nodes),
+        solids_card(elements),
+    )
+
+
+def foam_force(run):
+    """(crush, force, loading) from glstat: F = dW_ext/dt / (du/dt), where the speed is above
+    20% of its peak."""
+    with run.open() as results:
+        time = results["history/glstat/time"][...]
+        work = results["history/glstat/external_work"][...]
+        ratio = results["history/glstat/energy_ratio"][...]
+    middle = 0.5 * (time[1:] + time[:-1])
+    speed = 0.5 * FOAM_CRUSH * 2.0 * np.pi / FOAM_TIME * np.sin(2.0 * np.pi * middle / FOAM_TIME)
+    crush = 0.5 * FOAM_CRUSH * (1.0 - np.cos(2.0 * np.pi * middle / FOAM_TIME))
+    force = np.diff(work) / np.diff(time) / speed
+    fast = np.abs(speed) > 0.2 * np.abs(speed).max()
+    return middle[fast], crush[fast], force[fast], (speed > 0)[fast], ratio
+
+
+def foam_analytical(crush, loading):
+    strain = crush / FOAM_SIDE
+    stress = np.interp(strain, FOAM_STRAINS, FOAM_STRESSES)
+    largest = FOAM_CRUSH / FOAM_SIDE
+    factor = np.where(loading, 1.0, 1.0 - (1.0 - FOAM_HU) * (1.0 - (strain / largest) ** FOAM_SHAPE))
+    return factor * stress * FOAM_SIDE ** 2
+
+
+def test_rib_foam_on_meshfree_and_fe_solids(tmp_path, run_deck):
+    """A uniform foam block crushed to 60% and released by a prescribed face displacement: the
+    force (from the external work) on loading and on the hysteretic unloading path, EFG
+    (ELFORM 41) and FE (ELFORM 2) against the analytical curve (3%) and against each other
+    (2%); the hysteresis loop dissipates (work left at the end > 50% of the peak work)."""
+    results = {}
+    for meshfree in (False, True):
+        run = run_deck(foam_deck(tmp_path / f"foam_{meshfree}.k", meshfree), jobid=f"foam_{int(meshfree)}")
+        assert run.status == 0, run.stdout + run.stderr
+        results[meshfree] = foam_force(run)
+    time, crush, fe_force, loading, fe_ratio = results[False]
+    efg_time, efg_crush, efg_force, efg_loading, efg_ratio = results[True]
+    expected = foam_analytical(crush, loading)
+    scale = np.abs(expected).max()
+    fe_error = np.abs(fe_force - expected).max() / scale
+    efg_error = np.abs(efg_force - foam_analytical(efg_crush, efg_loading)).max() / scale
+    # the two runs' glstat times differ by a fraction of a step: compare on the loading and the
+    # unloading half separately, interpolated in time
+    between = max(np.abs(np.interp(time[part], efg_time[efg_part], efg_force[efg_part]) - fe_force[part]).max()
+                  for part, efg_part in ((loading, efg_loading), (~loading, ~efg_loading))) / scale
+    unloading = ~loading & (crush > 0.3 * FOAM_CRUSH)
+    hysteresis = (fe_force[unloading] / np.interp(crush[unloading] / FOAM_SIDE, FOAM_STRAINS, FOAM_STRESSES)
+                  / FOAM_SIDE ** 2).min()
+    print(f"foam: FE error {fe_error:.2e}, EFG error {efg_error:.2e}, EFG - FE {between:.2e} of the peak "
+          f"force {scale:.4e} kN; unloading force down to {hysteresis:.2f} of the loading curve; "
+          f"energy ratio FE {fe_ratio[-1]:.4f} EFG {efg_ratio[-1]:.4f}")
+    assert fe_error < 0.03 and efg_error < 0.03
+    assert between < 0.02
+    assert hysteresis < 0.5
