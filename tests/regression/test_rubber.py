@@ -366,3 +366,62 @@ def test_rib_foam_on_meshfree_and_fe_solids(tmp_path, run_deck):
     assert fe_error < 0.03 and efg_error < 0.03
     assert between < 0.02
     assert hysteresis < 0.5
+
+
+# ---------------------------------------------------------------------------------------------
+# e. what the readers reject (file:line, keyword, field, exit status 2)
+
+RUBBER_CASES = [
+    # (description, material cards, expected fragments of the message)
+    ("Mooney-Rivlin REF", "*MAT_MOONEY-RIVLIN_RUBBER\n         1    1.1e-6      0.49    4.0e-4    1.0e-4       1.0",
+     ["deck.k:12:", "*MAT_MOONEY-RIVLIN_RUBBER", "field REF", "reference geometry"]),
+    ("Mooney-Rivlin LCID1", "*MAT_027\n         1    1.1e-6      0.49    4.0e-4    1.0e-4\n" +
+     "      10.0       1.0       1.0         5",
+     ["deck.k:13:", "field LCID1", "fitting A and B"]),
+    ("Mooney-Rivlin LCID2", "*MAT_027\n         1    1.1e-6      0.49    4.0e-4    1.0e-4\n" +
+     "                                                           7",
+     ["deck.k:13:", "field LCID2", "viscoelastic relaxation"]),
+    ("Mooney-Rivlin PR 0.5", "*MAT_MOONEY-RIVLIN_RUBBER\n         1    1.1e-6       0.5    4.0e-4    1.0e-4",
+     ["deck.k:12:", "field PR", "must be < 0.5"]),
+    ("Mooney-Rivlin PR 0.3", "*MAT_MOONEY-RIVLIN_RUBBER\n         1    1.1e-6       0.3    4.0e-4    1.0e-4",
+     ["deck.k:12:", "field PR", "D < 0"]),
+    ("Mooney-Rivlin A + B <= 0", "*MAT_MOONEY-RIVLIN_RUBBER\n         1    1.1e-6      0.49    1.0e-4   -2.0e-4",
+     ["deck.k:12:", "field A", "2 (A + B) must be > 0"]),
+    ("Blatz-Ko REF", "*MAT_BLATZ-KO_RUBBER\n         1    1.1e-6    1.0e-3       1.0",
+     ["deck.k:12:", "*MAT_BLATZ-KO_RUBBER", "field REF"]),
+    ("Blatz-Ko G blank", "*MAT_007\n         1    1.1e-6",
+     ["deck.k:12:", "field G", "the field is blank"]),
+    ("viscoelastic GI > G0", "*MAT_VISCOELASTIC\n         1    1.1e-6    2.0e-2    3.0e-3    4.0e-3       1.0",
+     ["deck.k:12:", "*MAT_VISCOELASTIC", "field GI", "[0, G0"]),
+    ("viscoelastic BULK 0", "*MAT_006\n         1    1.1e-6       0.0    3.0e-3    1.0e-3       1.0",
+     ["deck.k:12:", "field BULK", "must be > 0"]),
+    ("viscoelastic BETA < 0", "*MAT_006\n         1    1.1e-6    2.0e-2    3.0e-3    1.0e-3      -1.0",
+     ["deck.k:12:", "field BETA", ">= 0"]),
+]
+
+
+@pytest.mark.parametrize("description, cards, fragments", RUBBER_CASES, ids=[c[0] for c in RUBBER_CASES])
+def test_bad_rubber_cards_are_rejected(tmp_path, run_deck, description, cards, fragments):
+    from test_bad_input import GOOD
+    old = "*MAT_ELASTIC\n         1   7.85e-6     210.0       0.3"
+    assert old in GOOD
+    deck = tmp_path / "deck.k"
+    deck.write_text(GOOD.replace(old, cards, 1))
+    run = run_deck(deck)
+    assert run.status == 2, f"{description}: exit status {run.status}\n{run.stderr}"
+    for fragment in fragments:
+        assert fragment in run.stderr, f"{description}: '{fragment}' not in:\n{run.stderr}"
+    assert "At line" not in run.stderr, "a Fortran runtime error escaped"
+
+
+def test_rubber_card_defaults_run(tmp_path, run_deck):
+    """Blank card 2 of *MAT_027 and the shortest cards of 007 and 006 are accepted."""
+    from test_bad_input import GOOD
+    old = "*MAT_ELASTIC\n         1   7.85e-6     210.0       0.3"
+    for cards in ("*MAT_027\n         1    1.1e-6      0.49    4.0e-4    1.0e-4\n",
+                  "*MAT_BLATZ-KO_RUBBER_TITLE\njacket\n         1    1.1e-6    1.0e-3",
+                  "*MAT_VISCOELASTIC\n         1    1.1e-6    2.0e-2    3.0e-3"):
+        deck = tmp_path / "deck.k"
+        deck.write_text(GOOD.replace(old, cards, 1))
+        run = run_deck(deck)
+        assert run.status == 0, cards + "\n" + run.stderr
