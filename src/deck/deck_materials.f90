@@ -573,7 +573,7 @@ contains
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
-    integer :: line, n
+    integer :: line, n, curve
     real(wp) :: lowest_ratio, value
     character(len=:), allocatable :: title
 
@@ -615,15 +615,18 @@ contains
         end if
         if (.not. next_line(deck, block, line, .false.)) exit
         call open_card(deck, block, line, standard_widths, card, log)
-        call require_zero(deck, card, 4, "LCID1", "fitting A and B to a uniaxial test curve is not "// &
-                          "available; give A and B", log)
+        call get_integer(deck, card, 4, "LCID1", curve, log)
+        if (curve /= 0 .and. .not. card%failed) call card_problem(deck, log, card, "LCID1", "must be blank or "// &
+          "0, found "//integer_text(curve)//": fitting A and B to a test curve is not available; give A and B")
         call warn_if_set(deck, card, 1, "SGL", "specimen gauge length: used only with LCID1", warnings)
         call warn_if_set(deck, card, 2, "SW", "specimen width: used only with LCID1", warnings)
         call warn_if_set(deck, card, 3, "ST", "specimen thickness: used only with LCID1", warnings)
         call get_real(deck, card, 5, "DATA", value, log)
         call warn_if_set(deck, card, 5, "DATA", "used only with LCID1", warnings)
-        call require_zero(deck, card, 6, "LCID2", "viscoelastic relaxation of this rubber is not available "// &
-                          "(use *MAT_VISCOELASTIC for a viscoelastic part)", log)
+        call get_integer(deck, card, 6, "LCID2", curve, log)
+        if (curve /= 0 .and. .not. card%failed) call card_problem(deck, log, card, "LCID2", "must be blank or "// &
+          "0, found "//integer_text(curve)//": viscoelastic relaxation of this rubber is not available (use "// &
+          "*MAT_VISCOELASTIC for a viscoelastic part)")
         call require_zero(deck, card, 7, "BSTART", "used only with LCID2, which is not available", log)
         call require_zero(deck, card, 8, "TRAMP", "used only with LCID2, which is not available", log)
       end associate
