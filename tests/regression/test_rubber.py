@@ -36,7 +36,7 @@ def principal_stress(law, stretch):
     squared = stretch ** 2
     third = np.prod(squared)
     volume = np.sqrt(third)
-    if law == "mooney":
+    if law in ("mooney", "mooney-fit"):
         a, b, c, d = mooney_constants()
         return 2 / volume * ((a + squared.sum() * b) * squared - b * squared ** 2 +
                              third * (-2 * c / third ** 3 + 2 * d * (third - 1)))
@@ -57,7 +57,19 @@ def uniaxial(law, stretch):
     return lateral, principal_stress(law, [stretch, lateral, lateral])[0]
 
 
+SPECIMEN = (50.0, 10.0, 2.0)     # SGL SW ST (mm) of the LCID1 test curve
+
+
 def material_card(law):
+    if law == "mooney-fit":
+        # card 1's A and B left blank: fitted to a uniaxial test curve made from the same A and B
+        # (incompressible curve, stretch 0.7 to 2.5): the fit must give them back
+        stretches = np.linspace(0.7, 2.5, 13)
+        forces = 2 * (stretches - stretches ** -2) * (MOONEY_A + MOONEY_B / stretches) * SPECIMEN[1] * SPECIMEN[2]
+        changes = (stretches - 1.0) * SPECIMEN[0]
+        return ("*MAT_MOONEY-RIVLIN_RUBBER\n" + fields(1, DENSITY, MOONEY_PR) + "\n" +
+                fields(*SPECIMEN, 9, 1.0) + "\n*DEFINE_CURVE\n" + fields(9) + "\n" +
+                "\n".join(fields(float(c), float(f), width=20) for c, f in zip(changes, forces)))
     if law == "mooney":
         return ("*MAT_MOONEY-RIVLIN_RUBBER\n" + fields(1, DENSITY, MOONEY_PR, MOONEY_A, MOONEY_B) + "\n" +
                 fields(0.0, 0.0, 0.0, 0))
@@ -108,11 +120,12 @@ def cube_deck(path, law, element_formulation, final_stretch):
 
 @pytest.mark.parametrize("law, element_formulation, final_stretch",
                          [("mooney", 1, 2.0), ("mooney", 2, 0.6), ("blatz", 1, 2.0), ("blatz", 2, 0.6),
-                          ("mooney", 41, 2.0), ("blatz", 41, 0.6)])
+                          ("mooney", 41, 2.0), ("blatz", 41, 0.6), ("mooney-fit", 1, 2.0)])
 def test_rubber_cube_force_follows_the_uniaxial_curve(tmp_path, run_deck, law, element_formulation, final_stretch):
     """The face force F = sigma_xx (current area) against P(lambda) A0, at every state after the
     first 10% of the stretch (1%: the slow smooth ramp keeps inertia forces below 0.1%); the
-    meshfree cube (ELFORM 41) takes the mean stress of its cells' points."""
+    meshfree cube (ELFORM 41) takes the mean stress of its cells' points. "mooney-fit": A and B
+    from LCID1's least-squares fit."""
     deck, nodes = cube_deck(tmp_path / "cube.k", law, element_formulation, final_stretch)
     run = run_deck(deck)
     assert run.status == 0, run.stdout + run.stderr
@@ -385,7 +398,16 @@ RUBBER_CASES = [
      ["deck.k:12:", "*MAT_MOONEY-RIVLIN_RUBBER", "field REF", "reference geometry"]),
     ("Mooney-Rivlin LCID1", "*MAT_027\n         1    1.1e-6      0.49    4.0e-4    1.0e-4\n" +
      "      10.0       1.0       1.0         5",
-     ["deck.k:13:", "field LCID1", "fitting A and B"]),
+     ["deck.k:13:", "field LCID1", "curve 5 of material 1 is not defined"]),
+    ("Mooney-Rivlin LCID1 without specimen", "*MAT_027\n         1    1.1e-6      0.49\n" +
+     "      50.0                           5\n*DEFINE_CURVE\n         5\n0.0,0.0\n10.0,1.0e-3\n20.0,2.0e-3",
+     ["deck.k:13:", "field SW", "must be > 0 with LCID1"]),
+    ("Mooney-Rivlin DATA 2", "*MAT_027\n         1    1.1e-6      0.49\n" +
+     "      50.0      10.0       2.0         5       2.0\n*DEFINE_CURVE\n         5\n0.0,0.0\n10.0,1.0e-3",
+     ["deck.k:13:", "field DATA", "uniaxial test data"]),
+    ("Mooney-Rivlin LCID1 one stretch", "*MAT_027\n         1    1.1e-6      0.49\n" +
+     "      50.0      10.0       2.0         5\n*DEFINE_CURVE\n         5\n0.0,0.0\n10.0,1.0e-3",
+     ["deck.k:13:", "field LCID1", "two or more different changes of gauge length"]),
     ("Mooney-Rivlin LCID2", "*MAT_027\n         1    1.1e-6      0.49    4.0e-4    1.0e-4\n" +
      "                                                           7",
      ["deck.k:13:", "field LCID2", "viscoelastic relaxation"]),

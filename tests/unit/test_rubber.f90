@@ -22,7 +22,8 @@ program test_rubber
   use plane_stress_dispatch, only: update_plane_stress_block, plane_stress_history_count, &
                                    rotate_plane_stress_history
   use material_rubber, only: rubber_cauchy_stress, rubber_plane_stress_update, rubber_mooney_rivlin, &
-                             rubber_blatz_ko, mooney_rivlin_constants, rubber_thickness_tolerance
+                             rubber_blatz_ko, mooney_rivlin_constants, rubber_thickness_tolerance, &
+                             mooney_rivlin_fit
   use testing, only: test_suite_t, check, check_close, finish_suite
   implicit none
 
@@ -53,6 +54,7 @@ program test_rubber
   call test_shell_objectivity(mooney_rivlin(0.49_wp), "Mooney-Rivlin")
   call test_viscoelastic_solid_relaxation()
   call test_viscoelastic_shell()
+  call test_mooney_rivlin_fit()
   call finish_suite(suite)
 
 contains
@@ -638,6 +640,25 @@ contains
                worst < 1.0e-12_wp .and. worst_zz < 1.0e-12_wp, &
                "in-plane "//real_text(worst)//", sigma_zz "//real_text(worst_zz))
   end subroutine test_viscoelastic_shell
+
+  !> LCID1's least-squares fit: exact incompressible uniaxial data (stretch 0.7 to 2.5, a point at
+  !> stretch 1 included) give A and B back to 1e-12; one stretch only is not enough.
+  subroutine test_mooney_rivlin_fit()
+    real(wp) :: stretch(13), nominal(13), a, b
+    logical :: fitted
+    integer :: k
+    do k = 1, 13
+      stretch(k) = 0.7_wp + 0.15_wp*real(k - 1, wp)
+      if (k == 3) stretch(k) = 1.0_wp
+      nominal(k) = 2.0_wp*(stretch(k) - stretch(k)**(-2))*(mooney_a + mooney_b/stretch(k))
+    end do
+    call mooney_rivlin_fit(stretch, nominal, a, b, fitted)
+    call check(suite, "Mooney-Rivlin fit: fitted", fitted)
+    call check_close(suite, "Mooney-Rivlin fit: A and B recovered (1e-12)", [a, b], [mooney_a, mooney_b], &
+                     rel=1.0e-12_wp)
+    call mooney_rivlin_fit([1.0_wp, 1.5_wp, 1.5_wp], [0.0_wp, 1.0_wp, 1.0_wp], a, b, fitted)
+    call check(suite, "Mooney-Rivlin fit: one stretch besides 1 is not enough", .not. fitted)
+  end subroutine test_mooney_rivlin_fit
 
   function rotation_matrix(axis, angle) result(r)
     real(wp), intent(in) :: axis(3), angle
