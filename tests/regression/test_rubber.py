@@ -12,6 +12,8 @@ c. *MAT_VISCOELASTIC: a hexahedron sheared by a ramp then held, sigma_xy(t) agai
    hereditary integral of G(t) = GI + (G0 - GI) exp(-BETA t) (1% of the peak).
 d. The rib foam (*MAT_LOW_DENSITY_FOAM) on meshfree and FE solids, loading and unloading.
 e. The cards' rejected fields.
+f. Simple shear to gamma = 1 of a rubber shell and of rubber solids (FE and meshfree): the
+   history b turns with the stress.
 
 Units: mm, ms, kg, kN, GPa. Analytical curves: principal-stretch forms of the laws (see
 docs/materials.md), the lateral stretch solved here by bisection."""
@@ -455,3 +457,135 @@ def test_rubber_card_defaults_run(tmp_path, run_deck):
         deck.write_text(GOOD.replace(old, cards, 1))
         run = run_deck(deck)
         assert run.status == 0, cards + "\n" + run.stderr
+
+
+# ---------------------------------------------------------------------------------------------
+# f. simple shear of a rubber shell: the history turns with the stress
+
+def plane_stress_shear(law, shear):
+    """(sigma_xx, sigma_yy, sigma_xy) of plane-stress simple shear F = [[1, shear], [0, 1]]:
+    b2 = [[1 + shear^2, shear], [shear, 1]], det b2 = 1, b_zz = x from sigma_zz = 0 (bisection)."""
+    b = np.array([[1 + shear ** 2, shear, 0.0], [shear, 1.0, 0.0], [0.0, 0.0, 1.0]])
+
+    def stress(x):
+        b[2, 2] = x
+        third = np.linalg.det(b)
+        volume = np.sqrt(third)
+        if law == "mooney":
+            a, bb, c, d = mooney_constants()
+            first = np.trace(b)
+            return 2 / volume * ((a + first * bb) * b - bb * b @ b +
+                                 third * (-2 * c / third ** 3 + 2 * d * (third - 1)) * np.eye(3))
+        beta = 1 / (1 - 2 * BLATZ_PR)
+        return BLATZ_G / volume * (b @ b / volume - volume ** -beta * b)
+
+    low, high = 0.05, 5.0
+    for _ in range(200):
+        middle = 0.5 * (low + high)
+        if stress(middle)[2, 2] > 0:
+            high = middle
+        else:
+            low = middle
+    result = stress(0.5 * (low + high))
+    return result[0, 0], result[1, 1], result[0, 1]
+
+
+@pytest.mark.parametrize("law", ["mooney", "blatz"])
+def test_rubber_shell_in_simple_shear(tmp_path, run_deck, law):
+    """One shell in homogeneous simple shear to gamma = 1 (every node prescribed, side 1-2 along
+    x, so the element's frame does not turn while the material spins by up to -gamma/2 per unit
+    gamma): the shell turns its stress by the material spin, and b with it
+    (rotate_plane_stress_history). sigma_xx, sigma_yy, sigma_xy against the analytical plane-stress
+    simple shear within 1% of the largest component (b left unturned would be off by tens of %)."""
+    nodes, shells = plate_mesh((1, 1), (1.0, 1.0))
+    spc = ["*BOUNDARY_SPC_NODE"]
+    motion = ["*BOUNDARY_PRESCRIBED_MOTION_NODE"]
+    for k, node in enumerate(nodes):
+        top = node[1] > 0.5
+        spc.append(fields(k + 1, 0, int(not top), 1, 1, 1, 1, 1))
+        if top:
+            motion.append(fields(k + 1, 1, 2, 1, 1.0))
+    deck = write_deck(
+        tmp_path / "shear.k",
+        "*CONTROL_TERMINATION\n" + fields(CUBE_TIME),
+        "*DATABASE_BINARY_D3PLOT\n" + fields(CUBE_TIME / 24),
+        "*PART\nsheet\n" + fields(1, 1, 1),
+        "*SECTION_SHELL\n" + fields(1, 2, 1.0, 3) + "\n" + fields(*[0.1] * 4),
+        material_card(law),
+        displacement_curve(1.0, 10.0, CUBE_TIME),
+        nodes_card(nodes),
+        shells_card(shells),
+        "\n".join(spc),
+        "\n".join(motion),
+    )
+    run = run_deck(deck)
+    assert run.status == 0, run.stdout + run.stderr
+    worst = 0.0
+    top = nodes[:, 1] > 0.5
+    with run.open() as results:
+        for name in sorted(results["states"]):
+            state = results["states"][name]
+            shear = state["displacement"][top, 0].mean()
+            if shear < 0.1:
+                continue
+            stress = state["shell_stress"][0]
+            expected = np.array(plane_stress_shear(law, shear))
+            worst = max(worst, np.abs(stress[[0, 1, 3]] - expected).max() / np.abs(expected).max())
+    print(f"{law} shell simple shear to {shear:.3f}: worst error {worst:.2e} of the largest component")
+    assert abs(shear - 1.0) < 1e-6
+    assert worst < 0.01
+
+
+@pytest.mark.parametrize("law, element_formulation", [("mooney", 1), ("blatz", 2), ("mooney", 41)])
+def test_rubber_solid_in_simple_shear(tmp_path, run_deck, law, element_formulation):
+    """Homogeneous simple shear of a cube to gamma = 1 (every node prescribed, z held): the stress
+    of b = F F^T, F = [[1, gamma, 0], [0, 1, 0], [0, 0, 1]], within 1% of the largest component.
+    The material spins while the strain grows, so this checks the turn of b with the stress
+    (rotate_material_history) through the elements, FE and meshfree."""
+    meshfree = element_formulation == 41
+    nodes, elements = block_mesh((2, 2, 2) if meshfree else (1, 1, 1), (1.0, 1.0, 1.0))
+    section = efg_section(1, 1.2) if meshfree else "*SECTION_SOLID\n" + fields(1, element_formulation)
+    spc = ["*BOUNDARY_SPC_NODE"]
+    motion = ["*BOUNDARY_PRESCRIBED_MOTION_NODE"]
+    for k, node in enumerate(nodes):
+        # every node follows u_x = gamma(t) y (interior particles of the meshfree cube too: a
+        # linear field is reproduced exactly); y = 0 is held (SF 0 would read as 1)
+        bottom = abs(node[1]) < 1e-9
+        spc.append(fields(k + 1, 0, int(bottom), 1, 1, 0, 0, 0))
+        if not bottom:
+            motion.append(fields(k + 1, 1, 2, 1, float(node[1])))
+    deck = write_deck(
+        tmp_path / "shear.k",
+        "*CONTROL_TERMINATION\n" + fields(CUBE_TIME),
+        "*DATABASE_BINARY_D3PLOT\n" + fields(CUBE_TIME / 24),
+        "*PART\ncube\n" + fields(1, 1, 1),
+        section,
+        material_card(law),
+        displacement_curve(1.0, 10.0, CUBE_TIME),
+        "\n".join(spc),
+        "\n".join(motion),
+        nodes_card(nodes),
+        solids_card(elements),
+    )
+    run = run_deck(deck)
+    assert run.status == 0, run.stdout + run.stderr
+    top = np.abs(nodes[:, 1] - 1.0) < 1e-9
+    worst = 0.0
+    with run.open() as results:
+        for name in sorted(results["states"]):
+            state = results["states"][name]
+            shear = state["displacement"][top, 0].mean()
+            if shear < 0.1:
+                continue
+            b = np.array([[1 + shear ** 2, shear, 0.0], [shear, 1.0, 0.0], [0.0, 0.0, 1.0]])
+            if law == "mooney":
+                a, bb, c, d = mooney_constants()
+                expected = 2 * ((a + np.trace(b) * bb) * b - bb * b @ b + (-2 * c + 0.0) * np.eye(3))
+            else:
+                expected = BLATZ_G * (b @ b - b)
+            expected = expected[[0, 1, 2, 0], [0, 1, 2, 1]]
+            stress = state["solid_stress"][...].mean(axis=0)[[0, 1, 2, 3]]
+            worst = max(worst, np.abs(stress - expected).max() / np.abs(expected).max())
+    print(f"{law} ELFORM {element_formulation} simple shear to {shear:.3f}: worst error {worst:.2e}")
+    assert abs(shear - 1.0) < 1e-6
+    assert worst < 0.01

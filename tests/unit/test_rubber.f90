@@ -22,7 +22,7 @@ program test_rubber
   use plane_stress_dispatch, only: update_plane_stress_block, plane_stress_history_count, &
                                    rotate_plane_stress_history
   use material_rubber, only: rubber_cauchy_stress, rubber_plane_stress_update, rubber_mooney_rivlin, &
-                             rubber_blatz_ko, mooney_rivlin_constants, rubber_thickness_tolerance, &
+                             mooney_rivlin_constants, rubber_thickness_tolerance, &
                              mooney_rivlin_fit
   use testing, only: test_suite_t, check, check_close, finish_suite
   implicit none
