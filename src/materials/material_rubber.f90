@@ -153,52 +153,69 @@ contains
     real(wp), intent(inout), contiguous :: history(:, :)
     real(wp), intent(out) :: thickness_strain_increment(block_size)
     integer, intent(out), optional :: iterations
-    real(wp) :: rate(2, 2), half(2, 2), update(2, 2), b(2, 2), squared(2, 2), previous, thickness, trace
-    real(wp) :: det, third, volume, first, derivative, scale, lane_stress(2, 2)
+    real(wp) :: d11, d22, d12, m11, m22, m12, p11, p22, p12, inverse_det, u11, u12, u21, u22
+    real(wp) :: t11, t12, t21, t22, b11, b22, b12, s11, s22, s12, previous, thickness, trace
+    real(wp) :: det, third, volume, first, derivative, scale, factor, power
     integer :: i, used, most
+    ! explicit 2x2 algebra (no matmul temporaries): M = (I - L/2)^-1 (I + L/2), b2 <- M b2 M^T
     most = 0
     do i = 1, nel
-      rate(1, 1) = strain_increment(i, 1)
-      rate(2, 2) = strain_increment(i, 2)
-      rate(1, 2) = 0.5_wp*strain_increment(i, 3)
-      rate(2, 1) = rate(1, 2)
-      half = -0.5_wp*rate
-      half(1, 1) = half(1, 1) + 1.0_wp
-      half(2, 2) = half(2, 2) + 1.0_wp
-      update = 0.5_wp*rate
-      update(1, 1) = update(1, 1) + 1.0_wp
-      update(2, 2) = update(2, 2) + 1.0_wp
-      update = matmul(inverse2(half), update)
-      b(1, 1) = history(i, 1) + 1.0_wp
-      b(2, 2) = history(i, 2) + 1.0_wp
-      b(1, 2) = history(i, 3)
-      b(2, 1) = history(i, 3)
-      b = matmul(update, matmul(b, transpose(update)))
+      d11 = 0.5_wp*strain_increment(i, 1)
+      d22 = 0.5_wp*strain_increment(i, 2)
+      d12 = 0.25_wp*strain_increment(i, 3)
+      m11 = 1.0_wp - d11
+      m22 = 1.0_wp - d22
+      m12 = -d12
+      p11 = 1.0_wp + d11
+      p22 = 1.0_wp + d22
+      p12 = d12
+      inverse_det = 1.0_wp/(m11*m22 - m12*m12)
+      ! (I - L/2)^-1 = [m22, -m12; -m12, m11] / det, times (I + L/2)
+      u11 = (m22*p11 - m12*p12)*inverse_det
+      u12 = (m22*p12 - m12*p22)*inverse_det
+      u21 = (-m12*p11 + m11*p12)*inverse_det
+      u22 = (-m12*p12 + m11*p22)*inverse_det
+      b11 = history(i, 1) + 1.0_wp
+      b22 = history(i, 2) + 1.0_wp
+      b12 = history(i, 3)
+      t11 = u11*b11 + u12*b12
+      t12 = u11*b12 + u12*b22
+      t21 = u21*b11 + u22*b12
+      t22 = u21*b12 + u22*b22
+      b11 = t11*u11 + t12*u12
+      b12 = 0.5_wp*((t11*u21 + t12*u22) + (t21*u11 + t22*u12))
+      b22 = t21*u21 + t22*u22
       previous = history(i, 4) + 1.0_wp
-      trace = b(1, 1) + b(2, 2)
-      det = max(b(1, 1)*b(2, 2) - b(1, 2)*b(2, 1), tiny(1.0_wp))
+      trace = b11 + b22
+      det = max(b11*b22 - b12*b12, tiny(1.0_wp))
       call rubber_plane_stress_thickness(form, constants, trace, det, previous, thickness, used)
       most = max(most, used)
       third = det*thickness
       volume = sqrt(third)
-      squared = matmul(b, b)
+      ! b2^2 of the symmetric 2x2 block
+      s11 = b11*b11 + b12*b12
+      s22 = b22*b22 + b12*b12
+      s12 = b12*trace
       if (form == rubber_mooney_rivlin) then
         first = trace + thickness
         derivative = -2.0_wp*constants(3)/third**3 + 2.0_wp*constants(4)*(third - 1.0_wp)
-        lane_stress = (2.0_wp/volume)*((constants(1) + first*constants(2))*b - constants(2)*squared)
+        factor = 2.0_wp/volume
+        power = constants(1) + first*constants(2)
         scale = 2.0_wp*volume*derivative
-        lane_stress(1, 1) = lane_stress(1, 1) + scale
-        lane_stress(2, 2) = lane_stress(2, 2) + scale
+        stress(i, 1) = factor*(power*b11 - constants(2)*s11) + scale
+        stress(i, 2) = factor*(power*b22 - constants(2)*s22) + scale
+        stress(i, 3) = factor*(power*b12 - constants(2)*s12)
       else
-        lane_stress = (constants(1)/volume)*(squared/volume - volume**(-constants(2))*b)
+        factor = constants(1)/volume
+        power = volume**(-constants(2))
+        stress(i, 1) = factor*(s11/volume - power*b11)
+        stress(i, 2) = factor*(s22/volume - power*b22)
+        stress(i, 3) = factor*(s12/volume - power*b12)
       end if
-      stress(i, 1) = lane_stress(1, 1)
-      stress(i, 2) = lane_stress(2, 2)
-      stress(i, 3) = 0.5_wp*(lane_stress(1, 2) + lane_stress(2, 1))
       thickness_strain_increment(i) = 0.5_wp*log(thickness/previous)
-      history(i, 1) = b(1, 1) - 1.0_wp
-      history(i, 2) = b(2, 2) - 1.0_wp
-      history(i, 3) = 0.5_wp*(b(1, 2) + b(2, 1))
+      history(i, 1) = b11 - 1.0_wp
+      history(i, 2) = b22 - 1.0_wp
+      history(i, 3) = b12
       history(i, 4) = thickness - 1.0_wp
     end do
     if (present(iterations)) iterations = most
@@ -295,12 +312,6 @@ contains
     inverse(3, 3) = m(1, 1)*m(2, 2) - m(1, 2)*m(2, 1)
     inverse = inverse/determinant(m)
   end function inverse3
-
-  pure function inverse2(m) result(inverse)
-    real(wp), intent(in) :: m(2, 2)
-    real(wp) :: inverse(2, 2)
-    inverse = reshape([m(2, 2), -m(2, 1), -m(1, 2), m(1, 1)], [2, 2])/(m(1, 1)*m(2, 2) - m(1, 2)*m(2, 1))
-  end function inverse2
 
   pure function unpacked(tensor) result(matrix)
     real(wp), intent(in) :: tensor(6)
