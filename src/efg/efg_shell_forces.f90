@@ -59,7 +59,7 @@ module efg_shell_forces
 
   public :: efg_shell_block_t, efg_shell_solver_t, set_up_efg_shell_solver, compute_efg_shell_forces
   public :: efg_shell_cell_results, efg_shell_nodal_masses, transform_shell_to_physical, transpose_shell_to_generalized
-  public :: efg_shell_rotary_factor
+  public :: efg_shell_rotary_factor, raise_corner_plastic_strain
 
   !> Whole cells whose membrane/bending points fill at most block_size lanes, and their state.
   type :: efg_shell_block_t
@@ -967,6 +967,36 @@ contains
       end associate
     end do
   end subroutine efg_shell_cell_results
+
+  !> The largest effective plastic strain over the points of each cell, raised into its corner
+  !> nodes that `wanted` flags (the nodes of spot welds that fail by EP / EPSF), as the FE shells.
+  subroutine raise_corner_plastic_strain(material, solver, wanted, strain)
+    type(material_t), intent(in) :: material
+    type(efg_shell_solver_t), intent(in) :: solver
+    logical, intent(in) :: wanted(:)
+    real(wp), intent(inout) :: strain(:)
+    real(wp) :: point_strain(block_size), largest(block_size)
+    integer :: b, point, i, c, corner, node
+    do b = 1, size(solver%blocks)
+      associate (block => solver%blocks(b))
+        if (size(block%history, 2) == 0) cycle
+        largest = 0.0_wp
+        do point = 1, solver%thickness_points
+          call plane_stress_plastic_strain(material, block%point_count, block%history(:, :, point), point_strain)
+          do i = 1, block%point_count
+            c = solver%geometry%point_cell(block%first_point + i - 1) - block%first_cell + 1
+            largest(c) = max(largest(c), point_strain(i))
+          end do
+        end do
+        do c = 1, block%cell_count
+          do corner = 1, 4
+            node = solver%cell_nodes(corner, block%first_cell + c - 1)
+            if (wanted(node)) strain(node) = max(strain(node), largest(c))
+          end do
+        end do
+      end associate
+    end do
+  end subroutine raise_corner_plastic_strain
 
   !> Global components (xx, yy, zz, xy, yz, zx) of a local shell stress (xx, yy, xy, yz, zx):
   !> sigma = E s E^T with the columns of E the frame vectors.
