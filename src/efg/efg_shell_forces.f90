@@ -49,7 +49,7 @@ module efg_shell_forces
   use model, only: model_t, material_t, law_null
   use efg_shell_part, only: efg_shell_part_t, shell_cell_frame
   use plane_stress_dispatch, only: plane_stress_history_count, initialize_plane_stress_history, &
-                                   update_plane_stress_block, plane_stress_plastic_strain
+                                   update_plane_stress_block, plane_stress_plastic_strain, rotate_plane_stress_history
   use element_work, only: add_force_work
   use gauss_legendre, only: gauss_legendre_rule
   use shell_block, only: max_shell_points
@@ -512,7 +512,7 @@ contains
     ! end frame
     do i = 1, nel
       lane = geometry%point_cell(block%first_point + i - 1) - block%first_cell + 1
-      call rotate_point_stress(block, i, thickness_points, spin(i) + first_turn(lane))
+      call rotate_point_stress(block, material%law, i, thickness_points, spin(i) + first_turn(lane))
     end do
     do point = 1, thickness_points
       do i = 1, nel
@@ -525,7 +525,7 @@ contains
     do i = 1, nel
       g = block%first_point + i - 1
       lane = geometry%point_cell(g) - block%first_cell + 1
-      call rotate_point_stress(block, i, thickness_points, spin(i) + second_turn(lane))
+      call rotate_point_stress(block, material%law, i, thickness_points, spin(i) + second_turn(lane))
       ! resultants per unit current length, times the point's current area W J
       resultant = 0.0_wp
       do point = 1, thickness_points
@@ -797,10 +797,11 @@ contains
 
   !> Turn lane i's stresses (every thickness point) by `angle` (components kept in a frame that
   !> turned by phi while the material turned by psi turn by psi - phi: shell_block's
-  !> rotate_with_material).
-  pure subroutine rotate_point_stress(block, i, thickness_points, angle)
+  !> rotate_with_material). Tensor history (the rubbers' b, the viscoelastic branch) turns with
+  !> the stress.
+  pure subroutine rotate_point_stress(block, law, i, thickness_points, angle)
     type(efg_shell_block_t), intent(inout) :: block
-    integer, intent(in) :: i, thickness_points
+    integer, intent(in) :: law, i, thickness_points
     real(wp), intent(in) :: angle
     real(wp) :: c, s, sxx, syy, sxy
     integer :: point
@@ -813,6 +814,7 @@ contains
       block%stress(i, 1, point) = c*c*sxx - 2.0_wp*c*s*sxy + s*s*syy
       block%stress(i, 2, point) = s*s*sxx + 2.0_wp*c*s*sxy + c*c*syy
       block%stress(i, 3, point) = c*s*(sxx - syy) + (c*c - s*s)*sxy
+      if (size(block%history, 2) > 0) call rotate_plane_stress_history(law, c, s, block%history(i, :, point))
     end do
   end subroutine rotate_point_stress
 
