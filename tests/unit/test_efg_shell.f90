@@ -529,7 +529,9 @@ contains
                all(single%transform_value == several%transform_value))
   end subroutine test_thread_counts
 
-  !> Set-up time of a 100 x 100 plate (printed); a loose bound only catches a quadratic search.
+  !> Set-up of a 100 x 100 plate: its seconds are printed (tests never assert wall-clock time;
+  !> tools/bench figures do); what is asserted is that every point's pair list stays local (a
+  !> support of DX 1.1 reaches the cells around the point's own: at most 5 x 5 nodes).
   subroutine test_setup_time()
     type(model_t) :: model
     type(efg_shell_part_t) :: geometry
@@ -544,7 +546,8 @@ contains
     write (line, '(a,f0.3,a,i0,a)') "efg_shell: 100 x 100 plate set-up ", geometry%setup_seconds, " s (", &
       geometry%point_offsets(size(geometry%point_offsets)) - 1, " pairs)"
     write (*, '(a)') trim(line)
-    call check(suite, "100 x 100 plate: set-up under 20 s", geometry%setup_seconds < 20.0_wp)
+    call check(suite, "100 x 100 plate: at most 25 pairs per point", &
+               maxval(geometry%point_offsets(2:) - geometry%point_offsets(:size(geometry%point_offsets) - 1)) <= 25)
   end subroutine test_setup_time
 
   function real_text(value) result(text)
