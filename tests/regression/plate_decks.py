@@ -19,11 +19,12 @@ FE, EFG = 2, 41
 
 def shell_section(section_id, formulation, thickness, points=3, support=1.5, kernel=0):
     """*SECTION_SHELL of one formulation; an EFG section (41) gets its EFG card DX = DY =
-    support, ISPLINE = kernel, IDILA 0."""
+    support (None: blank, the default 1.1), ISPLINE = kernel, IDILA 0 (IEBT, IDIM blank)."""
     text = ("*SECTION_SHELL\n" + fields(section_id, formulation, f"{SHEAR_FACTOR:10.7f}", points) + "\n" +
             fields(*[float(thickness)] * 4))
     if formulation == EFG:
-        text += "\n" + fields(float(support), float(support), kernel, 0)
+        size = None if support is None else float(support)
+        text += "\n" + fields(size, size, kernel, 0)
     return text
 
 
@@ -169,11 +170,15 @@ def middle_node(nodes, candidates, width):
     return candidates[np.argmin(np.abs(nodes[candidates, 1] - width / 2))]
 
 
-def cantilever_deck(path, formulation, cells, length, width, thickness, load, ramp, hold, poisson=0.0, support=1.5):
+def cantilever_deck(path, formulation, cells, length, width, thickness, load, ramp, hold, poisson=0.0, support=1.5,
+                    triangles=False):
     """A strip clamped at x = 0 with a total transverse force `load` (z) spread over its tip edge
     as consistent nodal forces, raised linearly over `ramp` (whole periods of the first mode:
-    that leaves no first-mode vibration) and then held. History of the tip nodes."""
+    that leaves no first-mode vibration) and then held. History of the tip nodes. `triangles`:
+    every cell split into two triangles."""
     nodes, shells, root, tip = clamped_strip(cells, length, width)
+    if triangles:
+        shells = split_into_triangles(shells, set(range(len(shells))))
     share = np.full(len(tip), load / cells[1])
     share[np.isclose(nodes[tip, 1], 0.0) | np.isclose(nodes[tip, 1], width)] *= 0.5
     sample = (ramp + hold) / 2000.0
@@ -238,15 +243,16 @@ def spinning_plate_deck(path, formulation, cells, side, thickness, omega, end_ti
 
 
 def interface_strip_deck(path, efg_half, cells, length, width, thickness, poisson, speed, pulse, end_time,
-                         probes, support=1.5):
-    """A strip along x, part 1 on x < length / 2 FE shells, part 2 on x > length / 2 FE shells
+                         probes, direction=1, interface=None, support=1.5):
+    """A strip along x, part 1 on x < interface (default length / 2) FE shells, part 2 beyond it FE shells
     (efg_half False) or EFG shells (True), both the same material and mesh. The nodes at x = 0
-    get an axial velocity pulse speed sin^2(pi t / pulse) for 0 < t < pulse (smooth), then are held; the
-    histories of the nodes nearest the middle line at the x of `probes`."""
+    get a velocity pulse speed sin^2(pi t / pulse) for 0 < t < pulse (smooth) along `direction`
+    (1 axial, 3 transverse), then are held in that direction; the histories of the nodes nearest
+    the middle line at the x of `probes`."""
     nodes, shells = plate_mesh(cells, (length, width))
     nodes = round_to_node_card(nodes)
     centre = nodes[shells].mean(axis=1)[:, 0]
-    parts = np.where(centre > length / 2.0, 2, 1)
+    parts = np.where(centre > (length / 2.0 if interface is None else interface), 2, 1)
     left = np.flatnonzero(np.isclose(nodes[:, 0], 0.0))
     probe_nodes = []
     for x in probes:
@@ -272,7 +278,7 @@ def interface_strip_deck(path, efg_half, cells, length, width, thickness, poisso
                "*HOURGLASS\n" + fields(1, 4, 0.1),
                curve_card(1, pulse_curve),
                nodes_card(nodes), "\n".join(element_lines),
-               "*BOUNDARY_PRESCRIBED_MOTION_NODE\n" + "\n".join(fields(k + 1, 1, 0, 1, float(speed)) for k in left))
+               "*BOUNDARY_PRESCRIBED_MOTION_NODE\n" + "\n".join(fields(k + 1, direction, 0, 1, float(speed)) for k in left))
     return nodes, probe_nodes
 
 

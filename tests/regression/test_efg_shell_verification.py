@@ -4,7 +4,15 @@ mesh-convergence table is tools/efg_shell_convergence.py, docs/verification.md "
 shells"). Every case runs with both formulations where the FE value is a useful baseline.
 
 All runs are explicit (the linear static analysis takes no shells): a static value is read from
-a slowly driven run, and each test says what precision that allows. Decks: plate_decks.py.
+a slowly driven run, and each test says what precision that allows. Decks: plate_decks.py. The
+EFG sections write DX = DY = 1.5 (the issue's and the paper's support; a blank field gives
+LS-DYNA's 1.1, at which the EFG shell is close to the FE shell: cantilever 5 x 2 0.98958 against
+FE 0.98951, see tools/efg_shell_convergence.py).
+
+Four EFG cases are marked xfail (strict) with the measured figures in their reasons: the
+constant-curvature patch test (regular and irregular mesh), the cantilever of triangles (shear
+locking of triangle cells) and the flexural pulse through the FE/EFG interface. They are the
+problems this verification found; a pass makes them fail, so that the mark goes with the fix.
 
 1. Membrane patch test: an irregular 5 x 5 plate with two cells split into triangles, every
    node started with the velocity of a linear field, the boundary nodes held to it. The exact
@@ -69,7 +77,7 @@ def run_case(run_deck, deck, formulation, available, jobid="results"):
         with run.open() as results:
             kinds = [k.decode() if isinstance(k, bytes) else str(k) for k in results["mesh/parts/formulation"][...]]
             assert "efg" in kinds
-            assert results["timing"].attrs["efg_particles"] > 0, "the EFG shell part has no interior particles"
+            assert results["timing"].attrs["efg_shell_particles"] > 0, "the EFG shell part has no interior particles"
     return run
 
 
@@ -138,14 +146,15 @@ BENDING_POINT = np.sqrt(0.6) / 2.0       # outer point of NIP 3, z / t
 BENDING_TURN = 30.0                      # degrees between the strip and x: all of kappa_xx, yy, xy
 
 
-def bending_errors(run_deck, tmp_path, formulation, available, perturbation, triangles, degrees=BENDING_TURN):
+def bending_errors(run_deck, tmp_path, formulation, available, perturbation, triangles, degrees=BENDING_TURN,
+                   support=1.5):
     """Largest error of w over the interior nodes (relative to the largest w), the range of the
     stress along the strip at the outer point (relative to E kappa z) and the largest of its
     other in-plane components (relative to the same), all from the states of the hold,
     averaged; kinetic / internal energy at the end."""
     strip, shells = decks.irregular_plate(BENDING_CELLS, BENDING_SIZE, perturbation=perturbation, triangles=triangles)
     nodes = decks.pure_bending_deck(tmp_path / "bending.k", formulation, strip, shells, CURVATURE, BENDING_RAMP,
-                                    BENDING_HOLD, BENDING_HOLD / 8, degrees=degrees)
+                                    BENDING_HOLD, BENDING_HOLD / 8, degrees=degrees, support=support)
     run = run_case(run_deck, tmp_path / "bending.k", formulation, available)
     length = BENDING_SIZE[0]
     exact = CURVATURE * (strip[:, 0]**2 - length * strip[:, 0]) / 2.0
@@ -184,25 +193,37 @@ def test_pure_bending_deck_is_exact_for_fe_shells_on_a_regular_mesh(tmp_path, ru
     assert ratio < 1e-5
 
 
-def test_pure_bending_patch_test_of_efg_shells_on_an_irregular_mesh(tmp_path, run_deck, efg_shells_available):
-    """EFG shells on the irregular mesh (interior nodes moved by up to 25% of a cell, two cells
-    split into triangles, the strip at 30 degrees to x) to the precision of the quasi-static
-    run: w within 1e-3 of the largest w at every interior node, the stress along the strip at
-    the outer point within 0.5% of E kappa z, the other components below 5e-3 of it. The FE
-    shells on the same mesh are printed for comparison: they do not pass (the one-point
-    shell's transverse shear is not zero for a constant curvature on a distorted
-    quadrilateral)."""
-    w_error, (low, high), other, ratio = bending_errors(run_deck, tmp_path, EFG, efg_shells_available, 0.25, (9, 22))
+BENDING_EFG_FAILS = ("EFG shells do not reproduce constant curvature: at DX 1.5 measured w error 6.9e-3 "
+                     "(regular mesh with two triangles, strip at 30 degrees; FE 1.5e-5) and 3.5e-2 (irregular), "
+                     "stress along the strip -0.6%..+1.6% and -3%..+9.5%; at DX 1.1 6.4e-3 and 4.1e-2. "
+                     "The cell-centre transverse shear sees the MLS gradient of w, which a linear basis does "
+                     "not make exact for the quadratic w of bending (report of the verification branch)")
+
+
+@pytest.mark.parametrize("perturbation", [pytest.param(0.0, id="regular"), pytest.param(0.25, id="irregular")])
+@pytest.mark.xfail(reason=BENDING_EFG_FAILS, strict=True)
+def test_pure_bending_patch_test_of_efg_shells(tmp_path, run_deck, efg_shells_available, perturbation):
+    """EFG shells (DX 1.5) on the regular mesh and on the irregular one (interior nodes moved by
+    up to 25% of a cell), each with two cells split into triangles, the strip at 30 degrees to
+    x, to the precision of the quasi-static run: w within 1e-3 of the largest w at every
+    interior node, the stress along the strip at the outer point within 0.5% of E kappa z, the
+    other components below 5e-3 of it. The FE shells on the same mesh are printed beside: on
+    the irregular mesh they do not pass either (the one-point shell's transverse shear is not
+    zero for a constant curvature on a distorted quadrilateral). Expected to fail until the
+    EFG shell's transverse shear is consistent with its bending (xfail, strict: a pass is
+    reported as a failure, so that the mark is removed then)."""
+    w_error, (low, high), other, ratio = bending_errors(run_deck, tmp_path, EFG, efg_shells_available, perturbation,
+                                                        (9, 22))
     fe_folder = tmp_path / "fe"
     fe_folder.mkdir()
-    fe_error, (fe_low, fe_high), fe_other, _ = bending_errors(run_deck, fe_folder, FE, True, 0.25, (9, 22))
-    print(f"figure: pure bending, irregular mesh: EFG w error {w_error:.1e}, sigma_ss {low:+.1e} to {high:+.1e}, "
-          f"other {other:.1e}, KE/IE {ratio:.1e}; FE w error {fe_error:.1e}, sigma_ss {fe_low:+.1e} to "
-          f"{fe_high:+.1e}, other {fe_other:.1e}")
+    fe_error, (fe_low, fe_high), fe_other, _ = bending_errors(run_deck, fe_folder, FE, True, perturbation, (9, 22))
+    print(f"figure: pure bending, perturbation {perturbation}: EFG w error {w_error:.1e}, sigma_ss {low:+.1e} to "
+          f"{high:+.1e}, other {other:.1e}, KE/IE {ratio:.1e}; FE w error {fe_error:.1e}, sigma_ss {fe_low:+.1e} "
+          f"to {fe_high:+.1e}, other {fe_other:.1e}")
+    assert ratio < 1e-5
     assert w_error < 1e-3
     assert -5e-3 < low <= high < 5e-3
     assert other < 5e-3
-    assert ratio < 1e-5
 
 
 # 3. cantilever plate ---------------------------------------------------------------------------
@@ -211,11 +232,11 @@ CANTILEVER = dict(length=100.0, width=20.0, thickness=2.0, load=1.0e-5)   # tip 
 CANTILEVER_CELLS = (5, 2)
 
 
-def cantilever_ratio(run_deck, path, formulation, cells, available):
+def cantilever_ratio(run_deck, path, formulation, cells, available, triangles=False):
     """Tip deflection (mean over the tip nodes of w averaged over the hold) / Timoshenko."""
     period = decks.beam_period(CANTILEVER["length"], CANTILEVER["width"], CANTILEVER["thickness"])
     ramp, hold = 3.0 * period, 2.0 * period
-    decks.cantilever_deck(path, formulation, cells, ramp=ramp, hold=hold, **CANTILEVER)
+    decks.cantilever_deck(path, formulation, cells, ramp=ramp, hold=hold, triangles=triangles, **CANTILEVER)
     run = run_case(run_deck, path, formulation, available, jobid=f"cantilever{formulation}")
     with run.open() as results:
         return decks.held_tip_deflection(results, ramp) / decks.timoshenko_tip_deflection(**CANTILEVER)
@@ -239,6 +260,29 @@ def test_cantilever_plate_efg_tip_deflection_within_one_percent(tmp_path, run_de
     print(f"figure: cantilever 5 x 2: tip deflection / Timoshenko FE {fe:.5f}, EFG {efg:.5f}")
     assert abs(efg - 1.0) < 0.01
     assert abs(efg - 1.0) < abs(fe - 1.0)
+
+
+TRIANGLE_CELLS = (10, 2)
+
+
+def test_cantilever_plate_of_fe_triangles(tmp_path, run_deck):
+    """10 x 2 cells, each split into two triangles: the FE triangles (edge-based transverse
+    shear) within 1% (measured 0.9975, the quadrilaterals 0.9974): the baseline of the EFG
+    triangles below."""
+    fe = cantilever_ratio(run_deck, tmp_path / "fe.k", FE, TRIANGLE_CELLS, True, triangles=True)
+    print(f"figure: cantilever 10 x 2 split into triangles: tip deflection / Timoshenko FE {fe:.5f}")
+    assert abs(fe - 1.0) < 0.01
+
+
+@pytest.mark.xfail(reason="EFG triangle cells lock in transverse shear: measured 0.578 of the deflection at DX 1.5, "
+                          "0.468 at DX 1.1 (FE triangles 0.9975); one shear point at the centroid locks a "
+                          "triangle (docs/shells.md, the FE triangle before its edge-based shear: 0.46)", strict=True)
+def test_cantilever_plate_of_efg_triangles(tmp_path, run_deck, efg_shells_available):
+    """The same mesh of triangles as EFG shells: within 1% (expected to fail until triangle
+    cells get a shear that does not lock; strict xfail)."""
+    efg = cantilever_ratio(run_deck, tmp_path / "efg.k", EFG, TRIANGLE_CELLS, efg_shells_available, triangles=True)
+    print(f"figure: cantilever 10 x 2 split into triangles: tip deflection / Timoshenko EFG {efg:.5f}")
+    assert abs(efg - 1.0) < 0.01
 
 
 # 4, 5. clamped strip: first frequency and energy drift ------------------------------------------
@@ -267,7 +311,7 @@ def vibrating_strips(tmp_path_factory, efg_shells_available):
             total = results["history/glstat/total_energy"][...]
             internal = results["history/glstat/internal_energy"][...]
             if formulation == EFG:
-                assert results["timing"].attrs["efg_particles"] > 0
+                assert results["timing"].attrs["efg_shell_particles"] > 0
         assert crossings >= 2 * STRIP_PERIODS - 1
         outcome[formulation] = (measured / period,
                                 np.abs(total - total[0]).max() / total[0], internal.max() / total[0])
@@ -329,51 +373,76 @@ def test_spinning_plate_stores_no_strain_energy(tmp_path, run_deck, formulation,
 
 # 7. FE / EFG interface -------------------------------------------------------------------------
 
-WAVE = dict(length=400.0, width=5.0, thickness=1.0, poisson=0.0)
-WAVE_CELLS, WAVE_SPEED = (160, 2), 0.1
-BAR_SPEED = np.sqrt(YOUNGS / DENSITY)
-WAVE_PULSE = 50.0 / BAR_SPEED            # a 50 mm (20 cells) sin^2 pulse
+BAR_SPEED = np.sqrt(YOUNGS / DENSITY)    # nu = 0: also the plate speed, the fastest wave
+WAVE_PULSE = 50.0 / BAR_SPEED            # a sin^2 pulse 50 mm (20 cells) long as an axial wave
+# 1 axial: 400 mm, interface in the middle, probes 100 mm either side; the histories end 50 mm of
+# travel before the far end's reflection can reach the first probe.
+# 3 transverse (flexural, dispersive: its peak travels at about 1000 mm/ms): 800 mm, interface at
+# 100 mm, probes at 50 and 150 mm; 0.25 ms, before anything from the far end can come back to the
+# first probe even at the bar speed ((800 + 750) / c = 0.30 ms).
+WAVE_CASES = {1: dict(length=400.0, cells=(160, 2), interface=200.0, probes=(100.0, 300.0),
+                      end_time=650.0 / BAR_SPEED),
+              3: dict(length=800.0, cells=(320, 2), interface=100.0, probes=(50.0, 150.0), end_time=0.25)}
+WAVE = dict(width=5.0, thickness=1.0, poisson=0.0, speed=0.1, pulse=WAVE_PULSE)
 
 
-def pulse_reflection(run_deck, path, efg_half, available):
-    """The largest axial velocity at a probe a quarter along the strip between the incident
-    pulse's passing and the return of the far end's reflection, relative to the incident
-    peak; and the peak transmitted to a probe three quarters along."""
-    length = WAVE["length"]
-    end_time = (2.0 * length - length / 4.0) / BAR_SPEED
-    nodes, probes = decks.interface_strip_deck(path, efg_half, WAVE_CELLS, speed=WAVE_SPEED, pulse=WAVE_PULSE,
-                                               end_time=end_time, probes=[length / 4.0, 3.0 * length / 4.0], **WAVE)
-    run = run_case(run_deck, path, EFG if efg_half else FE, available, jobid=f"wave{int(efg_half)}")
+def pulse_histories(run_deck, path, efg_half, available, direction):
+    """Velocity along `direction` at the two probes (one in the FE part, one beyond the
+    interface), sampled at the same times in every run."""
+    case = WAVE_CASES[direction]
+    _, probes = decks.interface_strip_deck(path, efg_half, case["cells"], case["length"], end_time=case["end_time"],
+                                           probes=case["probes"], direction=direction, interface=case["interface"],
+                                           **WAVE)
+    run = run_case(run_deck, path, EFG if efg_half else FE, available, jobid=f"wave{int(efg_half)}{direction}")
     with run.open() as results:
-        first = results["history/nodout"][str(probes[0] + 1)]
-        second = results["history/nodout"][str(probes[1] + 1)]
-        time, velocity = first["time"][...], first["velocity"][:, 0]
-        transmitted = second["velocity"][:, 0].max()
-    cell = length / WAVE_CELLS[0]
-    start = nodes[probes[0], 0] / BAR_SPEED + WAVE_PULSE + 2.0 * cell / BAR_SPEED
-    stop = (2.0 * length - nodes[probes[0], 0]) / BAR_SPEED - WAVE_PULSE / 2.0
-    window = (time > start) & (time < stop)
-    incident = velocity.max()
-    return np.abs(velocity[window]).max() / incident, transmitted / incident
+        near = results["history/nodout"][str(probes[0] + 1)]
+        far = results["history/nodout"][str(probes[1] + 1)]
+        time = near["time"][...]
+        return time, near["velocity"][:, direction - 1], np.interp(time, far["time"][...], far["velocity"][:, direction - 1])
 
 
-def test_pulse_runs_through_an_fe_strip_with_a_small_numerical_tail(tmp_path, run_deck):
-    """400 x 5 mm strip, 160 x 2 FE cells, nu = 0 (a one-dimensional wave): the baseline of the
-    interface test, the FE strip's own tail behind the pulse (measured 0.33% of the incident
-    peak; transmitted peak 1.0012 of the incident)."""
-    baseline, transmitted = pulse_reflection(run_deck, tmp_path / "fe.k", False, True)
-    print(f"figure: axial pulse, FE only: velocity in the reflection window / incident {baseline:.2e}, "
-          f"transmitted {transmitted:.4f}")
-    assert baseline < 5e-3
-    assert abs(transmitted - 1.0) < 0.01
+def interface_reflection(run_deck, tmp_path, available, direction):
+    """The FE/EFG strip against the FE strip on the same mesh: up to the end of the histories
+    the runs differ at the first probe (in the FE half) only by what the EFG half sends back,
+    so the largest difference of their velocities is the spurious reflection; relative to the
+    FE run's incident peak. Also the FE run's tail behind the pulse (the largest velocity after
+    the pulse has passed), and the peaks at the second probe (inside the EFG half)."""
+    time, near_fe, far_fe = pulse_histories(run_deck, tmp_path / "fe.k", False, True, direction)
+    time_efg, near_efg, far_efg = pulse_histories(run_deck, tmp_path / "efg.k", True, available, direction)
+    near_efg = np.interp(time, time_efg, near_efg)
+    far_efg = np.interp(time, time_efg, far_efg)
+    incident = np.abs(near_fe).max()
+    reflected = np.abs(near_efg - near_fe).max() / incident
+    case = WAVE_CASES[direction]
+    passed = time > case["probes"][0] / BAR_SPEED + WAVE_PULSE + 2.0 * case["length"] / case["cells"][0] / BAR_SPEED
+    tail = np.abs(near_fe[passed]).max() / incident
+    return reflected, tail, np.abs(far_fe).max() / incident, np.abs(far_efg).max() / incident
 
 
-def test_pulse_crosses_the_fe_efg_interface_without_spurious_reflection(tmp_path, run_deck, efg_shells_available):
-    """The same strip with its second half EFG shells: the velocity in the reflection window
-    stays below 2% of the incident peak, and the transmitted peak is within 3% of it."""
-    reflected, transmitted = pulse_reflection(run_deck, tmp_path / "efg.k", True, efg_shells_available)
-    baseline, _ = pulse_reflection(run_deck, tmp_path / "fe.k", False, True)
-    print(f"figure: axial pulse: reflected / incident FE only {baseline:.2e}, FE/EFG {reflected:.2e}; "
-          f"transmitted FE/EFG {transmitted:.4f}")
+def test_axial_pulse_crosses_the_fe_efg_interface_without_spurious_reflection(tmp_path, run_deck,
+                                                                               efg_shells_available):
+    """400 x 5 x 1 mm strip, 160 x 2 cells, nu = 0 (a one-dimensional wave), a 50 mm axial
+    pulse; the second half EFG shells: the reflection is below 1% of the incident peak (the FE strip's
+    own numerical tail behind the pulse, measured 0.33%, is the scale of what the mesh itself
+    does), and the peak that reaches the EFG half is within 3% of the FE strip's there."""
+    reflected, tail, far_fe, far_efg = interface_reflection(run_deck, tmp_path, efg_shells_available, 1)
+    print(f"figure: axial pulse: reflection at the FE/EFG interface / incident {reflected:.2e} "
+          f"(FE strip's tail {tail:.2e}); peak in the far half FE {far_fe:.4f}, FE/EFG {far_efg:.4f}")
+    assert tail < 5e-3
+    assert reflected < 0.01
+    assert abs(far_efg / far_fe - 1.0) < 0.03
+
+
+@pytest.mark.xfail(reason="the flexural pulse reflects at the FE/EFG interface: measured 1.0e-1 of the incident peak "
+                          "at DX 1.5 (9.3e-4 at DX 1.1, 2.1e-1 at DX 2.0), growing with the support like the "
+                          "bending patch test's error", strict=True)
+def test_bending_pulse_crosses_the_fe_efg_interface_without_spurious_reflection(tmp_path, run_deck,
+                                                                                 efg_shells_available):
+    """An 800 x 5 x 1 mm strip, 320 x 2 cells, EFG from x = 100 mm on, a transverse velocity
+    pulse at its end (a dispersive flexural wave, carried by the rotations): the reflection at the interface is below 2% of the incident peak
+    at the probe, and the peak in the EFG half within 5% of the FE strip's."""
+    reflected, tail, far_fe, far_efg = interface_reflection(run_deck, tmp_path, efg_shells_available, 3)
+    print(f"figure: bending pulse: reflection at the FE/EFG interface / incident {reflected:.2e}; "
+          f"peak in the far half FE {far_fe:.4f}, FE/EFG {far_efg:.4f}")
     assert reflected < 0.02
-    assert abs(transmitted - 1.0) < 0.03
+    assert abs(far_efg / far_fe - 1.0) < 0.05
