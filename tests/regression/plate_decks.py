@@ -260,7 +260,8 @@ def interface_strip_deck(path, efg_half, cells, length, width, thickness, poisso
         probe_nodes.append(middle_node(nodes, near, width))
     second = EFG if efg_half else FE
     element_lines = ["*ELEMENT_SHELL"] + [
-        f"{k + 1:8d}{p:8d}" + "".join(f"{c + 1:8d}" for c in corners) for k, (p, corners) in enumerate(zip(parts, shells))]
+        f"{k + 1:8d}{p:8d}" + "".join(f"{c + 1:8d}" for c in corners)
+        for k, (p, corners) in enumerate(zip(parts, shells))]
     sample = end_time / 1000.0
     pulse_curve = [(a * pulse, round(np.sin(np.pi * a)**2, 12)) for a in np.linspace(0.0, 1.0, 81)] + [(1.0e3, 0.0)]
     write_deck(path,
@@ -278,7 +279,8 @@ def interface_strip_deck(path, efg_half, cells, length, width, thickness, poisso
                "*HOURGLASS\n" + fields(1, 4, 0.1),
                curve_card(1, pulse_curve),
                nodes_card(nodes), "\n".join(element_lines),
-               "*BOUNDARY_PRESCRIBED_MOTION_NODE\n" + "\n".join(fields(k + 1, direction, 0, 1, float(speed)) for k in left))
+               "*BOUNDARY_PRESCRIBED_MOTION_NODE\n" +
+               "\n".join(fields(k + 1, direction, 0, 1, float(speed)) for k in left))
     return nodes, probe_nodes
 
 

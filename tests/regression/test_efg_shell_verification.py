@@ -18,7 +18,8 @@ problems this verification found; a pass makes them fail, so that the mark goes 
    node started with the velocity of a linear field, the boundary nodes held to it. The exact
    solution of the explicit run itself is the homogeneous motion with uniform stress (no node
    accelerates), so the check is to round-off (1e-10), dynamics included.
-2. Pure bending (constant curvature) patch test: an irregular 8 x 4 strip with triangles, at 30
+2. Pure bending (constant curvature) patch test: a regular and an irregular 8 x 4 strip, each
+   with two triangles, at 30
    degrees to x (so that kappa_xx, kappa_yy and kappa_xy are all present), its end edges nodal
    rigid bodies turned by +/- kappa L / 2 along a smooth ramp (crashfree has no rotational
    prescribed motions of shell nodes, nor initial rotational velocities, so the constant-rate
@@ -33,8 +34,11 @@ problems this verification found; a pass makes them fail, so that the mark goes 
    shorter), and 5. the drift of its total energy over eight periods.
 6. A free plate spun about its normal through three turns: the strain energy is the
    centrifugal stretching only, (omega R / c)^2 small.
-7. An axial pulse through a strip half FE, half EFG shells: the reflection at the interface
-   against the FE-only strip's numerical tail on the same mesh.
+7. An axial and a flexural pulse through a strip part FE, part EFG shells: the reflection at
+   the interface is the difference of the velocity histories at a probe in the FE part to those
+   of the FE-only strip on the same mesh (whose own tail behind the pulse gives the scale).
+Besides, a cantilever whose cells are all split into triangles (FE triangles against EFG
+triangle cells). The mesh-convergence table (item 7 of the issue's list) is the tool's.
 """
 from __future__ import annotations
 
@@ -398,7 +402,8 @@ def pulse_histories(run_deck, path, efg_half, available, direction):
         near = results["history/nodout"][str(probes[0] + 1)]
         far = results["history/nodout"][str(probes[1] + 1)]
         time = near["time"][...]
-        return time, near["velocity"][:, direction - 1], np.interp(time, far["time"][...], far["velocity"][:, direction - 1])
+        far_velocity = np.interp(time, far["time"][...], far["velocity"][:, direction - 1])
+        return time, near["velocity"][:, direction - 1], far_velocity
 
 
 def interface_reflection(run_deck, tmp_path, available, direction):
@@ -439,8 +444,10 @@ def test_axial_pulse_crosses_the_fe_efg_interface_without_spurious_reflection(tm
 def test_bending_pulse_crosses_the_fe_efg_interface_without_spurious_reflection(tmp_path, run_deck,
                                                                                  efg_shells_available):
     """An 800 x 5 x 1 mm strip, 320 x 2 cells, EFG from x = 100 mm on, a transverse velocity
-    pulse at its end (a dispersive flexural wave, carried by the rotations): the reflection at the interface is below 2% of the incident peak
-    at the probe, and the peak in the EFG half within 5% of the FE strip's."""
+    pulse at its end (a dispersive flexural wave, carried by the rotations): the reflection at
+    the interface is below 2% of the incident peak at the probe, and the peak in the EFG half
+    within 5% of the FE strip's. Expected to fail until the EFG shell's bending is consistent
+    (strict xfail)."""
     reflected, tail, far_fe, far_efg = interface_reflection(run_deck, tmp_path, efg_shells_available, 3)
     print(f"figure: bending pulse: reflection at the FE/EFG interface / incident {reflected:.2e}; "
           f"peak in the far half FE {far_fe:.4f}, FE/EFG {far_efg:.4f}")
