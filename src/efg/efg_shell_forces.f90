@@ -28,10 +28,10 @@
 !> through the thickness as in shell_block.
 !>
 !> Energies are the exact work of the nodal forces and moments (element_work's add_force_work,
-!> as efg_forces and shell_block). Their power needs no pair loop: with the sums Vb, Wb of a
-!> point, the power of any forces given by (E, G, W J N, W J M) is W J (N : L + M : k); the
-!> forces of the last call (kept per point) against this step's velocities complete the last
-!> step's work.
+!> as efg_forces and shell_block). Their power needs no pair loop: a point's forces and moments
+!> are f_I = P b_I and m_I = Q b_I (P, Q: 3 x 2 per point), so their power is P : Vb + Q : Wb
+!> (= W J (N : L + M : k)); the forces of the last call (kept per point) against this step's
+!> velocities complete the last step's work.
 !>
 !> Blocks are runs of whole cells, at most block_size membrane/bending points each (a lane per
 !> point for the materials; the block's cells and their shear points go with it). Blocks are
@@ -88,13 +88,17 @@ module efg_shell_forces
     !> Per cell, from the last call: frame(:, a, c) = e_a at the end of the step, current area.
     real(wp), allocatable :: cell_frame(:, :, :)
     real(wp), allocatable :: cell_area(:)
-    !> Per point, the forces of the last call: G = F^-T (2, 2), W J N and W J M (3 each).
-    real(wp), allocatable :: point_inverse(:, :, :)
+    !> Per point, the resultants of the last call times the point's current area, W J N and
+    !> W J M (local xx, yy, xy), and its forces and moments on a pair (I, b_I): global
+    !> f_I = P b_I, m_I = Q b_I with P, Q (3, 2) (forces_of_point).
     real(wp), allocatable :: point_membrane(:, :)
     real(wp), allocatable :: point_moment(:, :)
-    !> Per cell, the shear forces of the last call: G^s (2, 2) and A J_s Q (Q_zx, Q_yz).
-    real(wp), allocatable :: shear_inverse(:, :, :)
-    real(wp), allocatable :: shear_resultant(:, :)
+    real(wp), allocatable :: point_force(:, :, :)
+    real(wp), allocatable :: point_couple(:, :, :)
+    !> Per cell, its shear forces of the last call on a shear pair (I, Psi_I, b^s_I): global
+    !> f_I = S b^s_I, m_I = Psi_I R with S (3, 2), R (3).
+    real(wp), allocatable :: shear_force(:, :, :)
+    real(wp), allocatable :: shear_couple(:, :)
     type(gather_list_t) :: block_colours          !< colour -> blocks; blocks of one colour share no node
     real(wp), allocatable :: block_time_step(:)
     integer, allocatable :: block_critical_cell(:), block_failed_cell(:)
@@ -158,14 +162,15 @@ contains
     allocate (solver%cell_frame(3, 3, cell_count), solver%cell_area(cell_count))
     solver%cell_frame = geometry%cell_frame
     solver%cell_area = geometry%cell_area
-    allocate (solver%point_inverse(2, 2, point_count), solver%point_membrane(3, point_count), &
-              solver%point_moment(3, point_count), solver%shear_inverse(2, 2, cell_count), &
-              solver%shear_resultant(2, cell_count))
-    solver%point_inverse = 0.0_wp
+    allocate (solver%point_membrane(3, point_count), solver%point_moment(3, point_count), &
+              solver%point_force(3, 2, point_count), solver%point_couple(3, 2, point_count), &
+              solver%shear_force(3, 2, cell_count), solver%shear_couple(3, cell_count))
     solver%point_membrane = 0.0_wp
     solver%point_moment = 0.0_wp
-    solver%shear_inverse = 0.0_wp
-    solver%shear_resultant = 0.0_wp
+    solver%point_force = 0.0_wp
+    solver%point_couple = 0.0_wp
+    solver%shear_force = 0.0_wp
+    solver%shear_couple = 0.0_wp
     allocate (solver%block_time_step(block_count), solver%block_critical_cell(block_count), &
               solver%block_failed_cell(block_count))
     solver%block_time_step = huge(1.0_wp)
@@ -327,14 +332,13 @@ contains
           call compute_shell_block(material, solver%geometry, solver%cell_nodes, solver%density, &
                                    solver%shear_factor, solver%thickness_points, solver%point_height, &
                                    solver%point_weight, solver%blocks(b), coordinates, velocity, angular_velocity, &
-                                   dt, solver%cell_frame, solver%cell_area, solver%point_inverse, &
-                                   solver%point_membrane, solver%point_moment, solver%shear_inverse, &
-                                   solver%shear_resultant, solver%block_time_step(b), solver%block_critical_cell(b), &
+                                   dt, solver%cell_frame, solver%cell_area, solver%point_membrane, &
+                                   solver%point_moment, solver%point_force, solver%point_couple, solver%shear_force, &
+                                   solver%shear_couple, solver%block_time_step(b), solver%block_critical_cell(b), &
                                    solver%block_failed_cell(b))
           call add_block_forces(solver%geometry, solver%cell_nodes, solver%blocks(b), solver%cell_frame, &
-                                solver%cell_area, solver%point_inverse, solver%point_membrane, solver%point_moment, &
-                                solver%shear_inverse, solver%shear_resultant, internal_force, internal_moment, &
-                                normal_sum, area_sum)
+                                solver%cell_area, solver%point_force, solver%point_couple, solver%shear_force, &
+                                solver%shear_couple, internal_force, internal_moment, normal_sum, area_sum)
         end do
         !$omp end parallel do
       end do
@@ -346,8 +350,8 @@ contains
   !> Allocates nothing.
   subroutine compute_shell_block(material, geometry, cell_nodes, density, shear_factor, thickness_points, &
                                  point_height, point_weight, block, coordinates, velocity, angular_velocity, dt, &
-                                 cell_frame, cell_area, point_inverse, point_membrane, point_moment, shear_inverse, &
-                                 shear_resultant, critical_time_step, critical_cell, failed_cell)
+                                 cell_frame, cell_area, point_membrane, point_moment, point_force, point_couple, &
+                                 shear_force, shear_couple, critical_time_step, critical_cell, failed_cell)
     type(material_t), intent(in) :: material
     type(efg_shell_part_t), intent(in) :: geometry
     integer, intent(in) :: cell_nodes(:, :), thickness_points
@@ -355,18 +359,18 @@ contains
     type(efg_shell_block_t), intent(inout) :: block
     real(wp), intent(in), contiguous :: coordinates(:, :), velocity(:, :), angular_velocity(:, :)
     real(wp), intent(in) :: dt
-    real(wp), intent(inout) :: cell_frame(:, :, :), cell_area(:), point_inverse(:, :, :), point_membrane(:, :)
-    real(wp), intent(inout) :: point_moment(:, :), shear_inverse(:, :, :), shear_resultant(:, :)
+    real(wp), intent(inout) :: cell_frame(:, :, :), cell_area(:), point_membrane(:, :), point_moment(:, :)
+    real(wp), intent(inout) :: point_force(:, :, :), point_couple(:, :, :), shear_force(:, :, :), shear_couple(:, :)
     real(wp), intent(out) :: critical_time_step
     integer, intent(out) :: critical_cell, failed_cell
     real(wp) :: mid_frame(3, 3, block_size), end_frame(3, 3, block_size), first_turn(block_size)
     real(wp) :: second_turn(block_size), spin(block_size), jacobian(block_size), thickness(block_size)
     real(wp) :: membrane(block_size, 3), curvature(block_size, 3), increment(block_size, 3)
     real(wp) :: thickness_increment(block_size), old_power(block_size), new_power(block_size)
-    real(wp) :: velocity_sum(3, 2, block_size), rotation_sum(3, 2, block_size)
+    real(wp) :: velocity_sum(3, 2, block_size), rotation_sum(3, 2, block_size), end_inverse(2, 2, block_size)
     real(wp) :: shear_velocity(3, 2), shear_rotation(3), corners(3, 4), corner_velocity(3, 4)
     real(wp) :: position_sum(3, 2), inverse(2, 2), rate(2, 2), bend(2, 2), determinant
-    real(wp) :: shear_modulus, height, angle, c, s, first, second, gamma(2), resultant(6), weight, arm
+    real(wp) :: shear_modulus, height, angle, c, s, first, second, gamma(2), transverse(2), resultant(6), weight, arm
     real(wp) :: area, longest, wave_speed, cell_step, shear_jacobian, local_z(2)
     integer :: nel, i, g, cell, lane, point, corner, k, node
 
@@ -432,9 +436,9 @@ contains
       curvature(i, :) = [bend(2, 1), -bend(1, 2), bend(2, 2) - bend(1, 1)]
       ! half the material's spin over the step (the stress turns with it: module comment)
       spin(i) = 0.25_wp*dt*(rate(2, 1) - rate(1, 2))
-      old_power(i) = point_power(cell_frame(:, :, cell), point_inverse(:, :, g), point_membrane(:, g), &
-                                 point_moment(:, g), velocity_sum(:, :, i), rotation_sum(:, :, i))
-      call in_plane_inverse(end_frame(:, :, lane), position_sum, point_inverse(:, :, g), jacobian(i))
+      ! the power of the last call's forces f_I = P b_I, m_I = Q b_I: P : Vb + Q : Wb
+      old_power(i) = sum(point_force(:, :, g)*velocity_sum(:, :, i)) + sum(point_couple(:, :, g)*rotation_sum(:, :, i))
+      call in_plane_inverse(end_frame(:, :, lane), position_sum, end_inverse(:, :, i), jacobian(i))
       if (.not. jacobian(i) > 0.0_wp .and. failed_cell == 0) failed_cell = cell
     end do
 
@@ -467,8 +471,9 @@ contains
       resultant = geometry%point_area(g)*jacobian(i)*resultant
       point_membrane(:, g) = resultant(1:3)
       point_moment(:, g) = resultant(4:6)
-      new_power(i) = point_power(end_frame(:, :, lane), point_inverse(:, :, g), point_membrane(:, g), &
-                                 point_moment(:, g), velocity_sum(:, :, i), rotation_sum(:, :, i))
+      call forces_of_point(end_frame(:, :, lane), end_inverse(:, :, i), resultant, point_force(:, :, g), &
+                           point_couple(:, :, g))
+      new_power(i) = sum(point_force(:, :, g)*velocity_sum(:, :, i)) + sum(point_couple(:, :, g)*rotation_sum(:, :, i))
     end do
     call add_force_work(nel, dt, block%previous_time_step, old_power, new_power, block%force_power, &
                         block%internal_energy)
@@ -487,8 +492,7 @@ contains
         shear_velocity(:, 2) = shear_velocity(:, 2) + velocity(:, node)*geometry%shear_gradient(2, k)
         shear_rotation = shear_rotation + angular_velocity(:, node)*geometry%shear_value(k)
       end do
-      old_power(lane) = shear_power(cell_frame(:, :, cell), shear_inverse(:, :, cell), shear_resultant(:, cell), &
-                                    shear_velocity, shear_rotation)
+      old_power(lane) = sum(shear_force(:, :, cell)*shear_velocity) + dot_product(shear_couple(:, cell), shear_rotation)
       call in_plane_inverse(mid_frame(:, :, lane), position_sum - 0.5_wp*dt*shear_velocity, inverse, determinant)
       rate = local_gradient(mid_frame(:, :, lane), shear_velocity, inverse)
       local_z = [dot_product(mid_frame(:, 3, lane), shear_velocity(:, 1)), &
@@ -506,11 +510,13 @@ contains
         block%shear_stress(lane, 2) = s*first + c*second
         if (k == 1) block%shear_stress(lane, :) = block%shear_stress(lane, :) + shear_factor*shear_modulus*dt*gamma
       end do
-      call in_plane_inverse(end_frame(:, :, lane), position_sum, shear_inverse(:, :, cell), shear_jacobian)
-      shear_resultant(:, cell) = geometry%cell_area(cell)*shear_jacobian*geometry%cell_thickness(cell) &
-                                 *block%shear_stress(lane, :)
-      new_power(lane) = shear_power(end_frame(:, :, lane), shear_inverse(:, :, cell), shear_resultant(:, cell), &
-                                    shear_velocity, shear_rotation)
+      call in_plane_inverse(end_frame(:, :, lane), position_sum, inverse, shear_jacobian)
+      ! A J_s Q, and the shear forces f_I = e3 (q . G^s b^s_I) = S b^s_I, moments Psi_I (q_1 e2 - q_2 e1)
+      transverse = geometry%cell_area(cell)*shear_jacobian*geometry%cell_thickness(cell)*block%shear_stress(lane, :)
+      shear_force(:, 1, cell) = (transverse(1)*inverse(1, 1) + transverse(2)*inverse(2, 1))*end_frame(:, 3, lane)
+      shear_force(:, 2, cell) = (transverse(1)*inverse(1, 2) + transverse(2)*inverse(2, 2))*end_frame(:, 3, lane)
+      shear_couple(:, cell) = transverse(1)*end_frame(:, 2, lane) - transverse(2)*end_frame(:, 1, lane)
+      new_power(lane) = sum(shear_force(:, :, cell)*shear_velocity) + dot_product(shear_couple(:, cell), shear_rotation)
       cell_frame(:, :, cell) = end_frame(:, :, lane)
     end do
     call add_force_work(block%cell_count, dt, block%previous_time_step, old_power, new_power, block%shear_power, &
@@ -581,26 +587,24 @@ contains
     end do
   end function local_gradient
 
-  !> Power of a point's forces and moments given by (frame, G, W J N, W J M) against the
-  !> velocities and angular velocities whose pair sums are Vb and Wb: W J (N : L + M : k).
-  pure real(wp) function point_power(frame, inverse, membrane, moment, velocity_sum, rotation_sum)
-    real(wp), intent(in) :: frame(3, 3), inverse(2, 2), membrane(3), moment(3), velocity_sum(3, 2), rotation_sum(3, 2)
-    real(wp) :: rate(2, 2), bend(2, 2)
-    rate = local_gradient(frame, velocity_sum, inverse)
-    bend = local_gradient(frame, rotation_sum, inverse)
-    point_power = membrane(1)*rate(1, 1) + membrane(2)*rate(2, 2) + membrane(3)*(rate(1, 2) + rate(2, 1)) &
-                  + moment(1)*bend(2, 1) - moment(2)*bend(1, 2) + moment(3)*(bend(2, 2) - bend(1, 1))
-  end function point_power
-
-  !> Power of a cell's shear forces (frame, G^s, A J Q) against the velocities (pair sum over
-  !> the shear gradients) and angular velocities (sum of Psi w).
-  pure real(wp) function shear_power(frame, inverse, resultant, velocity_sum, rotation)
-    real(wp), intent(in) :: frame(3, 3), inverse(2, 2), resultant(2), velocity_sum(3, 2), rotation(3)
-    real(wp) :: local_z(2), gamma(2)
-    local_z = [dot_product(frame(:, 3), velocity_sum(:, 1)), dot_product(frame(:, 3), velocity_sum(:, 2))]
-    gamma = matmul(inverse, local_z) + [dot_product(frame(:, 2), rotation), -dot_product(frame(:, 1), rotation)]
-    shear_power = resultant(1)*gamma(1) + resultant(2)*gamma(2)
-  end function shear_power
+  !> A point's forces and moments on its pairs as global f_I = P b_I and m_I = Q b_I, from the
+  !> end frame, G = F^-T and the resultants times W J (N: xx, yy, xy; M: xx, yy, xy): with
+  !> g_I = G b_I the local force is (N g_I) and the local moment about e1, e2 is
+  !> (-M_xy g_1 - M_yy g_2, M_xx g_1 + M_xy g_2), the transposes of the rates (module comment).
+  pure subroutine forces_of_point(frame, inverse, resultant, force, couple)
+    real(wp), intent(in) :: frame(3, 3), inverse(2, 2), resultant(6)
+    real(wp), intent(out) :: force(3, 2), couple(3, 2)
+    real(wp) :: local_force(2, 2), local_couple(2, 2)
+    integer :: c
+    do c = 1, 2
+      local_force(1, c) = resultant(1)*inverse(1, c) + resultant(3)*inverse(2, c)
+      local_force(2, c) = resultant(3)*inverse(1, c) + resultant(2)*inverse(2, c)
+      local_couple(1, c) = -resultant(6)*inverse(1, c) - resultant(5)*inverse(2, c)
+      local_couple(2, c) = resultant(4)*inverse(1, c) + resultant(6)*inverse(2, c)
+      force(:, c) = local_force(1, c)*frame(:, 1) + local_force(2, c)*frame(:, 2)
+      couple(:, c) = local_couple(1, c)*frame(:, 1) + local_couple(2, c)*frame(:, 2)
+    end do
+  end subroutine forces_of_point
 
   !> Turn lane i's stresses (every thickness point) by `angle` (components kept in a frame that
   !> turned by phi while the material turned by psi turn by psi - phi: shell_block's
@@ -626,53 +630,41 @@ contains
   !> The block's forces and moments into the nodes: point by point, pair by pair (a node
   !> appears once among a point's pairs), then cell by cell its shear pairs and its corners'
   !> normal and area sums.
-  subroutine add_block_forces(geometry, cell_nodes, block, cell_frame, cell_area, point_inverse, point_membrane, &
-                              point_moment, shear_inverse, shear_resultant, internal_force, internal_moment, &
-                              normal_sum, area_sum)
+  subroutine add_block_forces(geometry, cell_nodes, block, cell_frame, cell_area, point_force, point_couple, &
+                              shear_force, shear_couple, internal_force, internal_moment, normal_sum, area_sum)
     type(efg_shell_part_t), intent(in) :: geometry
     integer, intent(in) :: cell_nodes(:, :)
     type(efg_shell_block_t), intent(in) :: block
-    real(wp), intent(in) :: cell_frame(:, :, :), cell_area(:), point_inverse(:, :, :), point_membrane(:, :)
-    real(wp), intent(in) :: point_moment(:, :), shear_inverse(:, :, :), shear_resultant(:, :)
+    real(wp), intent(in) :: cell_frame(:, :, :), cell_area(:), point_force(:, :, :), point_couple(:, :, :)
+    real(wp), intent(in) :: shear_force(:, :, :), shear_couple(:, :)
     real(wp), intent(inout) :: internal_force(:, :), internal_moment(:, :), normal_sum(:, :), area_sum(:)
-    real(wp) :: e1(3), e2(3), e3(3), g1, g2, n1, n2, m1, m2, transverse
+    real(wp) :: p(3, 2), q(3, 2), b1, b2, value
     integer :: gp, k, node, cell, corner
     do gp = block%first_point, block%first_point + block%point_count - 1
-      cell = geometry%point_cell(gp)
-      e1 = cell_frame(:, 1, cell)
-      e2 = cell_frame(:, 2, cell)
-      associate (inverse => point_inverse(:, :, gp), membrane => point_membrane(:, gp), moment => point_moment(:, gp))
-        do k = geometry%point_offsets(gp), geometry%point_offsets(gp + 1) - 1
-          node = geometry%pair_node(k)
-          g1 = inverse(1, 1)*geometry%pair_gradient(1, k) + inverse(1, 2)*geometry%pair_gradient(2, k)
-          g2 = inverse(2, 1)*geometry%pair_gradient(1, k) + inverse(2, 2)*geometry%pair_gradient(2, k)
-          n1 = membrane(1)*g1 + membrane(3)*g2
-          n2 = membrane(3)*g1 + membrane(2)*g2
-          m1 = -moment(2)*g2 - moment(3)*g1
-          m2 = moment(1)*g1 + moment(3)*g2
-          internal_force(:, node) = internal_force(:, node) + (n1*e1 + n2*e2)
-          internal_moment(:, node) = internal_moment(:, node) + (m1*e1 + m2*e2)
-        end do
-      end associate
+      p = point_force(:, :, gp)
+      q = point_couple(:, :, gp)
+      do k = geometry%point_offsets(gp), geometry%point_offsets(gp + 1) - 1
+        node = geometry%pair_node(k)
+        b1 = geometry%pair_gradient(1, k)
+        b2 = geometry%pair_gradient(2, k)
+        internal_force(:, node) = internal_force(:, node) + (p(:, 1)*b1 + p(:, 2)*b2)
+        internal_moment(:, node) = internal_moment(:, node) + (q(:, 1)*b1 + q(:, 2)*b2)
+      end do
     end do
     do cell = block%first_cell, block%first_cell + block%cell_count - 1
-      e1 = cell_frame(:, 1, cell)
-      e2 = cell_frame(:, 2, cell)
-      e3 = cell_frame(:, 3, cell)
-      associate (inverse => shear_inverse(:, :, cell), q => shear_resultant(:, cell))
-        do k = geometry%shear_offsets(cell), geometry%shear_offsets(cell + 1) - 1
-          node = geometry%shear_node(k)
-          g1 = inverse(1, 1)*geometry%shear_gradient(1, k) + inverse(1, 2)*geometry%shear_gradient(2, k)
-          g2 = inverse(2, 1)*geometry%shear_gradient(1, k) + inverse(2, 2)*geometry%shear_gradient(2, k)
-          transverse = q(1)*g1 + q(2)*g2
-          internal_force(:, node) = internal_force(:, node) + transverse*e3
-          internal_moment(:, node) = internal_moment(:, node) + geometry%shear_value(k)*(q(1)*e2 - q(2)*e1)
-        end do
-      end associate
+      p = shear_force(:, :, cell)
+      do k = geometry%shear_offsets(cell), geometry%shear_offsets(cell + 1) - 1
+        node = geometry%shear_node(k)
+        b1 = geometry%shear_gradient(1, k)
+        b2 = geometry%shear_gradient(2, k)
+        value = geometry%shear_value(k)
+        internal_force(:, node) = internal_force(:, node) + (p(:, 1)*b1 + p(:, 2)*b2)
+        internal_moment(:, node) = internal_moment(:, node) + value*shear_couple(:, cell)
+      end do
       do corner = 1, 4
         if (corner == 4 .and. cell_nodes(4, cell) == cell_nodes(3, cell)) cycle
         node = cell_nodes(corner, cell)
-        normal_sum(:, node) = normal_sum(:, node) + cell_area(cell)*e3
+        normal_sum(:, node) = normal_sum(:, node) + cell_area(cell)*cell_frame(:, 3, cell)
         area_sum(node) = area_sum(node) + cell_area(cell)
       end do
     end do

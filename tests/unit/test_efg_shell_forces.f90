@@ -220,8 +220,9 @@ contains
   subroutine force_call(model, solver, coordinates, velocity, angular_velocity, dt, force, moment)
     type(model_t), intent(in) :: model
     type(efg_shell_solver_t), intent(inout) :: solver
-    real(wp), intent(in) :: coordinates(:, :), velocity(:, :), angular_velocity(:, :), dt
-    real(wp), intent(out) :: force(:, :), moment(:, :)
+    real(wp), intent(in), contiguous :: coordinates(:, :), velocity(:, :), angular_velocity(:, :)
+    real(wp), intent(in) :: dt
+    real(wp), intent(out), contiguous :: force(:, :), moment(:, :)
     real(wp), allocatable :: normal_sum(:, :), area_sum(:)
     allocate (normal_sum(3, size(force, 2)), area_sum(size(force, 2)))
     force = 0.0_wp
