@@ -66,13 +66,13 @@ def velocity_lines(node_ids, velocities):
 
 
 def common_cards(title, end_time, state_interval, formulation, thickness, poisson, points=3, support=1.5,
-                 glstat_interval=None):
+                 glstat_interval=None, kernel=0):
     cards = [f"*TITLE\n{title}",
              "*CONTROL_TERMINATION\n" + fields(float(end_time)),
              "*CONTROL_TIMESTEP\n" + fields(0.0, 0.9),
              "*DATABASE_BINARY_D3PLOT\n" + fields(float(state_interval)),
              "*PART\nplate\n" + fields(1, 1, 1, 0, 1),
-             shell_section(1, formulation, thickness, points, support),
+             shell_section(1, formulation, thickness, points, support, kernel),
              "*MAT_ELASTIC\n" + fields(1, DENSITY, YOUNGS, float(poisson)),
              "*HOURGLASS\n" + fields(1, 4, 0.1)]
     if glstat_interval is not None:
@@ -81,7 +81,7 @@ def common_cards(title, end_time, state_interval, formulation, thickness, poisso
 
 
 def membrane_patch_deck(path, formulation, nodes, shells, gradient, offset, end_time, thickness=1.0, poisson=0.3,
-                        support=1.5):
+                        support=1.5, kernel=0):
     """Every node starts with the velocity v = gradient X + offset (in-plane, constant in time);
     the boundary nodes keep it (prescribed velocity, DOF 1 and 2), the interior nodes are free.
     The exact solution is the homogeneous motion u = t v(X) with uniform stress."""
@@ -98,7 +98,7 @@ def membrane_patch_deck(path, formulation, nodes, shells, gradient, offset, end_
                 motions.append(f"{k + 1},{direction + 1},0,2,1.0")
     write_deck(path,
                *common_cards("membrane patch test", end_time, end_time, formulation, thickness, poisson,
-                             support=support),
+                             support=support, kernel=kernel),
                curve_card(1, [(0.0, 1.0), (1.0e3, 1.0)]),
                curve_card(2, [(0.0, 0.0), (1.0e3, 0.0)]),
                nodes_card(nodes), shells_card(shells),

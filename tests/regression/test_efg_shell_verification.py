@@ -105,17 +105,23 @@ MEMBRANE_OFFSET = np.array([1.0e-3, -2.0e-3])                           # mm/ms
 MEMBRANE_TIME = 0.05                                                    # ms, about 300 cycles
 
 
-@pytest.mark.parametrize("formulation", FORMULATIONS)
-def test_membrane_patch_test_reproduces_the_linear_field_and_uniform_stress(tmp_path, run_deck, formulation,
-                                                                            efg_shells_available):
+MEMBRANE_CASES = [pytest.param(FE, 1.5, 0, id="fe"), pytest.param(EFG, 1.5, 0, id="efg-cubic-box-1.5"),
+                  pytest.param(EFG, None, 1, id="efg-quadratic-box-default"),
+                  pytest.param(EFG, 2.0, 2, id="efg-cubic-circle-2.0")]
+
+
+@pytest.mark.parametrize("formulation, support, kernel", MEMBRANE_CASES)
+def test_membrane_patch_test_reproduces_the_linear_field_and_uniform_stress(tmp_path, run_deck, formulation, support,
+                                                                            kernel, efg_shells_available):
     """Interior nodes (EFG: particles, physical values) follow u = t (G X + c) to 1e-10 of the
     largest displacement and the stress is uniform to 1e-10 of its largest component (FE
-    measured 3e-15 and 6e-14); the stress is plane-stress Hooke of the small strain (5e-4) to
+    measured 3e-15 and 6e-14; EFG the same with each kernel, ISPLINE 0, 1, 2, and DX blank
+    (1.1), 1.5 and 2.0); the stress is plane-stress Hooke of the small strain (5e-4) to
     1e-3 of its largest component (the rate form with the field's spin differs from it in second
     order: FE 1.1e-4)."""
     nodes, shells = decks.irregular_plate((5, 5), (10.0, 10.0), triangles=(6, 17))
     boundary = decks.membrane_patch_deck(tmp_path / "patch.k", formulation, nodes, shells, MEMBRANE_GRADIENT,
-                                         MEMBRANE_OFFSET, MEMBRANE_TIME)
+                                         MEMBRANE_OFFSET, MEMBRANE_TIME, support=support, kernel=kernel)
     run = run_case(run_deck, tmp_path / "patch.k", formulation, efg_shells_available)
     with run.open() as results:
         rows = node_rows(results, len(nodes))
@@ -128,7 +134,8 @@ def test_membrane_patch_test_reproduces_the_linear_field_and_uniform_stress(tmp_
     interior = np.setdiff1d(np.arange(len(nodes)), boundary)
     error = np.abs(displacement[interior] - exact[interior]).max() / np.abs(exact).max()
     spread = (stress.max(axis=0) - stress.min(axis=0)).max() / np.abs(stress).max()
-    print(f"figure: {NAMES[formulation]} membrane patch: interior error {error:.1e}, stress spread {spread:.1e}")
+    label = NAMES[formulation] + (f" (DX {support or 'blank'}, ISPLINE {kernel})" if formulation == EFG else "")
+    print(f"figure: {label} membrane patch: interior error {error:.1e}, stress spread {spread:.1e}")
     assert abs(time - MEMBRANE_TIME) < 1e-9
     assert error < 1e-10
     assert spread < 1e-10
