@@ -320,3 +320,34 @@ def vibration_period(results):
     index = np.flatnonzero(np.sign(w[:-1]) * np.sign(w[1:]) < 0)
     crossings = time[index] - w[index] * (time[index + 1] - time[index]) / (w[index + 1] - w[index])
     return 2.0 * float(np.diff(crossings).mean()), len(crossings)
+
+
+def quarter_ring_deck(path, formulation, cells, radius, width, thickness, load, ramp, hold, support=1.5):
+    """A quarter of a circular ring (mid-surface radius `radius` about the y axis, width along y)
+    of flat shells, nu = 0: x = R cos(phi), z = R sin(phi), phi from 0 (clamped edge) to pi/2
+    (free edge), `cells` = (along the arc, across the width). A total force `load` along z (radial
+    at the free edge), consistent nodal forces raised linearly over `ramp`, then held; history of
+    the free edge's nodes."""
+    along, across = cells
+    phi = np.linspace(0.0, np.pi / 2.0, along + 1)
+    y = np.linspace(0.0, width, across + 1)
+    nodes = np.array([[radius * np.cos(a), b, radius * np.sin(a)] for a in phi for b in y])
+    nodes = round_to_node_card(nodes)
+    index = lambda i, j: i * (across + 1) + j
+    shells = np.array([[index(i, j), index(i + 1, j), index(i + 1, j + 1), index(i, j + 1)]
+                       for i in range(along) for j in range(across)], dtype=int)
+    root = np.arange(across + 1)
+    tip = along * (across + 1) + np.arange(across + 1)
+    share = np.full(len(tip), load / across)
+    share[[0, -1]] *= 0.5
+    sample = (ramp + hold) / 2000.0
+    write_deck(path,
+               *common_cards("quarter ring, end load", ramp + hold, ramp + hold, formulation, thickness, 0.0,
+                             support=support, glstat_interval=sample),
+               "*DATABASE_NODOUT\n" + fields(sample),
+               history_nodes_card(tip + 1),
+               curve_card(1, [(0.0, 0.0), (ramp, 1.0), (1.0e3, 1.0)]),
+               nodes_card(nodes), shells_card(shells),
+               "*BOUNDARY_SPC_NODE\n" + "\n".join(fields(k + 1, 0, 1, 1, 1, 1, 1, 1) for k in root),
+               "*LOAD_NODE_POINT\n" + "\n".join(fields(k + 1, 3, 1, float(f)) for k, f in zip(tip, share)))
+    return nodes, tip
