@@ -39,7 +39,8 @@ problems this verification found; a pass makes them fail, so that the mark goes 
    the interface is the difference of the velocity histories at a probe in the FE part to those
    of the FE-only strip on the same mesh (whose own tail behind the pulse gives the scale).
 Besides, a cantilever whose cells are all split into triangles (FE triangles against EFG
-triangle cells) and a curved part, a quarter ring with an end load (against Castigliano). The mesh-convergence table (item 7 of the issue's list) is the tool's.
+triangle cells) and a curved part, a quarter ring with an end load (against Castigliano). The
+mesh-convergence table (item 7 of the issue's list) is the tool's.
 """
 from __future__ import annotations
 
