@@ -154,8 +154,9 @@ def section(cantilever, strip, formulations, command, tests):
         "-0.13% at 10 x 2). The EFG strip periods settle 0.4% below Euler-Bernoulli at 40 x 2 while "
         "FE's reach it; but FE with more cells across the width goes there too (40 x 4: 0.99639, "
         "40 x 8: 0.99595, the same deck, plate_decks.vibrating_strip_deck, with 4 and 8 cells "
-        "across): the plate's period is about 0.996 of the beam's (the clamp holds the anticlastic curvature), and the EFG strip "
-        "finds it with two cells across, where the one-point FE shell cannot.",
+        "across): the plate's period is about 0.996 of the beam's (the clamp holds the anticlastic "
+        "curvature), and the EFG strip finds it with two cells across, where the one-point FE shell "
+        "cannot.",
         "",
         "**Problems found** and their state on this build (the open ones are strict-xfail tests with "
         "the measured figures in their reasons):",
