@@ -59,7 +59,7 @@ module efg_shell_forces
 
   public :: efg_shell_block_t, efg_shell_solver_t, set_up_efg_shell_solver, compute_efg_shell_forces
   public :: efg_shell_cell_results, efg_shell_nodal_masses, transform_shell_to_physical, transpose_shell_to_generalized
-  public :: efg_shell_rotary_factor
+  public :: efg_shell_rotary_factor, raise_corner_plastic_strain
 
   !> Whole cells whose membrane/bending points fill at most block_size lanes, and their state.
   type :: efg_shell_block_t
@@ -432,7 +432,8 @@ contains
     real(wp) :: thickness_increment(block_size), old_power(block_size), new_power(block_size)
     real(wp) :: velocity_sum(3, 2, block_size), rotation_sum(3, 2, block_size), end_inverse(2, 2, block_size)
     real(wp) :: corners(3, 4), corner_velocity(3, 4), node_velocity(3, 4), physical_velocity(3, 4)
-    real(wp) :: physical_rotation(3, 4), operator(2, 4, 3, 4), corner_values(4, 3), corner_local(4, 3), area_scale
+    real(wp) :: physical_rotation(3, 4), shear_weights(2, 4, 3, 4), corner_values(4, 3), corner_local(4, 3)
+    real(wp) :: area_scale
     real(wp) :: position_sum(3, 2), inverse(2, 2), rate(2, 2), bend(2, 2), determinant
     real(wp) :: shear_modulus, height, gamma(2), transverse(2), resultant(6), weight, arm
     real(wp) :: area, longest, wave_speed, cell_step
@@ -559,25 +560,26 @@ contains
       end do
       old_power(lane) = sum(corner_force(1:3, :, cell)*physical_velocity) + sum(corner_force(4:6, :, cell)*physical_rotation)
       ! rates on the mid-step corners and frame
-      call shear_operator(mid_frame(:, :, lane), corners - 0.5_wp*dt*node_velocity, triangle, operator)
+      call shear_operator(mid_frame(:, :, lane), corners - 0.5_wp*dt*node_velocity, triangle, shear_weights)
       call local_corner_values(mid_frame(:, :, lane), physical_velocity, physical_rotation, corner_values)
       first_point = first_point_in_block(geometry, block, cell)
       do point = 1, merge(3, 4, triangle)
         i = first_point + point - 1
-        gamma = shear_rate(operator(:, :, :, point), corner_values)
+        gamma = shear_rate(shear_weights(:, :, :, point), corner_values)
         call rotate_shear_stress(block, i, spin(i) + first_turn(lane))
         block%shear_stress(i, :) = block%shear_stress(i, :) + shear_factor*shear_modulus*dt*gamma
         call rotate_shear_stress(block, i, spin(i) + second_turn(lane))
       end do
       ! forces on the end-of-step corners: the transposes, times each point's current area
-      call shear_operator(end_frame(:, :, lane), corners, triangle, operator)
+      call shear_operator(end_frame(:, :, lane), corners, triangle, shear_weights)
       area_scale = cell_area(cell)/geometry%cell_area(cell)
       corner_local = 0.0_wp
       do point = 1, merge(3, 4, triangle)
         i = first_point + point - 1
         transverse = geometry%point_area(block%first_point + i - 1)*area_scale*geometry%cell_thickness(cell) &
                      *block%shear_stress(i, :)
-        corner_local = corner_local + transverse(1)*operator(1, :, :, point) + transverse(2)*operator(2, :, :, point)
+        corner_local = corner_local + transverse(1)*shear_weights(1, :, :, point) &
+                       + transverse(2)*shear_weights(2, :, :, point)
       end do
       do corner = 1, 4
         corner_force(1:3, corner, cell) = corner_local(corner, 1)*end_frame(:, 3, lane)
@@ -678,17 +680,17 @@ contains
     end do
   end subroutine local_corner_values
 
-  !> (2 d_xz, 2 d_yz) of one point from its operator and the local corner values.
-  pure function shear_rate(operator, values) result(gamma)
-    real(wp), intent(in) :: operator(2, 4, 3), values(4, 3)
+  !> (2 d_xz, 2 d_yz) of one point from its shear_weights and the local corner values.
+  pure function shear_rate(shear_weights, values) result(gamma)
+    real(wp), intent(in) :: shear_weights(2, 4, 3), values(4, 3)
     real(wp) :: gamma(2)
-    gamma(1) = sum(operator(1, :, :)*values)
-    gamma(2) = sum(operator(2, :, :)*values)
+    gamma(1) = sum(shear_weights(1, :, :)*values)
+    gamma(2) = sum(shear_weights(2, :, :)*values)
   end function shear_rate
 
   !> The transverse shear operator of a cell at its membrane/bending points:
   !> (2 d_xz, 2 d_yz) at point p = sum over corners L and local dofs (v_z, w_x, w_y) of
-  !> operator(:, L, dof, p) times the corner's value. A quadrilateral takes MITC4 (Bathe &
+  !> shear_weights(:, L, dof, p) times the corner's value. A quadrilateral takes MITC4 (Bathe &
   !> Dvorkin 1985): the covariant shear at the midpoint of each edge (i, j),
   !> gamma_e = (w_j - w_i)/2 + g_x (th_y,i + th_y,j)/2 - g_y (th_x,i + th_x,j)/2 with
   !> g = (x_j - x_i)/2, interpolated linearly across the cell (gamma_xi between edges 1-2 and 4-3,
@@ -697,10 +699,10 @@ contains
   !> gradient) gives zero at every edge midpoint of any quadrilateral. A triangle (corner 4 =
   !> corner 3) takes the edge-based constant shear of the FE triangle (shell_triangle) at its
   !> three points.
-  pure subroutine shear_operator(frame, corners, triangle, operator)
+  pure subroutine shear_operator(frame, corners, triangle, shear_weights)
     real(wp), intent(in) :: frame(3, 3), corners(3, 4)
     logical, intent(in) :: triangle
-    real(wp), intent(out) :: operator(2, 4, 3, 4)
+    real(wp), intent(out) :: shear_weights(2, 4, 3, 4)
     real(wp), parameter :: point_xi(4) = [-0.5_wp, 0.5_wp, 0.5_wp, -0.5_wp]
     real(wp), parameter :: point_eta(4) = [-0.5_wp, -0.5_wp, 0.5_wp, 0.5_wp]
     real(wp) :: xl(4), yl(4), vz_weight(3, 2), wx_weight(3, 2), wy_weight(3, 2)
@@ -711,14 +713,14 @@ contains
       xl(corner) = dot_product(frame(:, 1), corners(:, corner) - corners(:, 1))
       yl(corner) = dot_product(frame(:, 2), corners(:, corner) - corners(:, 1))
     end do
-    operator = 0.0_wp
+    shear_weights = 0.0_wp
     if (triangle) then
       call triangle_shear_operator(xl(1:3), yl(1:3), vz_weight, wx_weight, wy_weight)
       do point = 1, 3
         do corner = 1, 3
-          operator(:, corner, 1, point) = vz_weight(corner, :)
-          operator(:, corner, 2, point) = wx_weight(corner, :)
-          operator(:, corner, 3, point) = wy_weight(corner, :)
+          shear_weights(:, corner, 1, point) = vz_weight(corner, :)
+          shear_weights(:, corner, 2, point) = wx_weight(corner, :)
+          shear_weights(:, corner, 3, point) = wy_weight(corner, :)
         end do
       end do
       return
@@ -740,8 +742,8 @@ contains
       determinant = x_xi*y_eta - y_xi*x_eta
       if (determinant == 0.0_wp) cycle
       ! [gamma_xi, gamma_eta] = J [gamma_x, gamma_y], J = [[x_xi, y_xi], [x_eta, y_eta]]
-      operator(1, :, :, point) = (y_eta*along_xi - y_xi*along_eta)/determinant
-      operator(2, :, :, point) = (-x_eta*along_xi + x_xi*along_eta)/determinant
+      shear_weights(1, :, :, point) = (y_eta*along_xi - y_xi*along_eta)/determinant
+      shear_weights(2, :, :, point) = (-x_eta*along_xi + x_xi*along_eta)/determinant
     end do
   contains
     !> Weights of the covariant shear at the midpoint of edge (i, j) on the corner values.
@@ -965,6 +967,36 @@ contains
       end associate
     end do
   end subroutine efg_shell_cell_results
+
+  !> The largest effective plastic strain over the points of each cell, raised into its corner
+  !> nodes that `wanted` flags (the nodes of spot welds that fail by EP / EPSF), as the FE shells.
+  subroutine raise_corner_plastic_strain(material, solver, wanted, strain)
+    type(material_t), intent(in) :: material
+    type(efg_shell_solver_t), intent(in) :: solver
+    logical, intent(in) :: wanted(:)
+    real(wp), intent(inout) :: strain(:)
+    real(wp) :: point_strain(block_size), largest(block_size)
+    integer :: b, point, i, c, corner, node
+    do b = 1, size(solver%blocks)
+      associate (block => solver%blocks(b))
+        if (size(block%history, 2) == 0) cycle
+        largest = 0.0_wp
+        do point = 1, solver%thickness_points
+          call plane_stress_plastic_strain(material, block%point_count, block%history(:, :, point), point_strain)
+          do i = 1, block%point_count
+            c = solver%geometry%point_cell(block%first_point + i - 1) - block%first_cell + 1
+            largest(c) = max(largest(c), point_strain(i))
+          end do
+        end do
+        do c = 1, block%cell_count
+          do corner = 1, 4
+            node = solver%cell_nodes(corner, block%first_cell + c - 1)
+            if (wanted(node)) strain(node) = max(strain(node), largest(c))
+          end do
+        end do
+      end associate
+    end do
+  end subroutine raise_corner_plastic_strain
 
   !> Global components (xx, yy, zz, xy, yz, zx) of a local shell stress (xx, yy, xy, yz, zx):
   !> sigma = E s E^T with the columns of E the frame vectors.

@@ -28,7 +28,7 @@ module efg_shell_group
   use efg_shell_setup, only: build_efg_shell_part
   use efg_shell_forces, only: efg_shell_solver_t, set_up_efg_shell_solver, compute_efg_shell_forces, &
                               efg_shell_cell_results, efg_shell_nodal_masses, transform_shell_to_physical, &
-                              transpose_shell_to_generalized
+                              transpose_shell_to_generalized, raise_corner_plastic_strain
   implicit none
   private
 
@@ -58,6 +58,7 @@ module efg_shell_group
     procedure :: to_physical
     procedure :: forces_to_generalized
     procedure :: thinnest
+    procedure :: raise_nodal_plastic_strain
   end type efg_shell_group_t
 
 contains
@@ -344,6 +345,18 @@ contains
       call transpose_shell_to_generalized(self%parts(k), physical, generalized)
     end do
   end subroutine forces_to_generalized
+
+  !> The largest plastic strain of the cells around each node of a spot weld that fails by EP.
+  subroutine raise_nodal_plastic_strain(self, model, wanted, strain)
+    class(efg_shell_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    logical, intent(in) :: wanted(:)
+    real(wp), intent(inout) :: strain(:)
+    integer :: k
+    do k = 1, size(self%parts)
+      call raise_corner_plastic_strain(model%materials(self%parts(k)%geometry%material), self%parts(k), wanted, strain)
+    end do
+  end subroutine raise_nodal_plastic_strain
 
   real(wp) function thinnest(self)
     class(efg_shell_group_t), intent(in) :: self

@@ -313,7 +313,7 @@ contains
     type(shell_supports_t), intent(in) :: supports
     type(cell_result_t), intent(in) :: results(:)
     type(efg_shell_part_t), intent(inout) :: geometry
-    integer :: cell_count, point_count, pair_total, shear_total, k, g, point, pair, offset, shear, j, row
+    integer :: cell_count, point_count, pair_total, shear_total, k, g, point, offset, shear, j, row
     integer, allocatable :: node_slot(:), row_start(:), row_size(:), row_owner(:), row_position(:)
     real(wp), allocatable :: mass(:)
 
@@ -340,7 +340,6 @@ contains
       geometry%cell_frame(:, :, k) = results(k)%frame
       geometry%cell_area(k) = results(k)%area
       geometry%cell_thickness(k) = results(k)%thickness
-      pair = 0
       do g = 1, size(results(k)%point_area)
         point = point + 1
         geometry%point_cell(point) = k

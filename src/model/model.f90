@@ -127,7 +127,7 @@ module model
     real(wp) :: reference_surface = 0.0_wp !< NLOC: 0 mid surface, 1 top, -1 bottom
     ! EFG card (ELFORM 41), meaningful only for meshfree sections
     !> DX, DY, DZ: normalized support (> 1). Meshfree shells (*SECTION_SHELL ELFORM 41) use
-    !> DX and DY, in the directions e1 and e2 of each cell's frame; their DZ is DX (not used).
+    !> DX and DY, along the two tangent directions of each particle's frame; their DZ is DX.
     real(wp) :: support_scale(3) = 1.01_wp
     !> ISPLINE: 0 cubic spline, box; 1 quadratic spline, box (shells); 2 cubic spline, sphere
     !> (shells: a circle in the surface)

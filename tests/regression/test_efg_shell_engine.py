@@ -222,3 +222,28 @@ def test_walls_and_failure_criteria_on_meshfree_shells_are_announced(tmp_path, r
     assert ("warning: rigid wall 1 tracks interior particles of meshfree parts: it acts on their generalized "
             "positions") in run.stderr
     assert "the failure criteria of material 1 are ignored for part 1: meshfree (EFG) parts do not erode" in run.stderr
+
+
+def test_spot_weld_on_meshfree_shells_fails_by_their_plastic_strain(tmp_path, run_deck):
+    """The lap joint of test_spot_welds with meshfree strips (ELFORM 41, DX 1.5; the weld's nodes
+    stay Gamma nodes): with EP = 0.002 the weld fails by the plastic strain of the cells around
+    its nodes, as on FE shells; with EP = 0 it holds."""
+    from test_spot_welds import lap_joint_deck
+    plastic = "*MAT_PIECEWISE_LINEAR_PLASTICITY\n" + fields(1, DENSITY, YOUNGS, POISSON, 0.2, 1.0) + "\n" + fields(0.0)
+    runs = {}
+    for name, weld_strain in (("holds", 0.0), ("fails", 0.002)):
+        deck = lap_joint_deck(tmp_path / f"{name}.k", 0.0)
+        text = deck.read_text().replace("*MAT_ELASTIC\n" + fields(1, DENSITY, YOUNGS, POISSON), plastic)
+        text = text.replace("*SECTION_SHELL\n" + fields(1, 2, 1.0, 3) + "\n" + fields(2.0, 2.0, 2.0, 2.0),
+                            "*SECTION_SHELL\n" + fields(1, 41, 1.0, 3) + "\n" + fields(2.0, 2.0, 2.0, 2.0) + "\n" +
+                            fields(1.5, 1.5))
+        lines = text.splitlines()
+        weld = lines.index("*CONSTRAINED_SPOTWELD") + 1
+        lines[weld] = lines[weld] + fields(0.0, 0.0, 0.0, weld_strain)[:40]
+        deck.write_text("\n".join(lines) + "\n")
+        runs[name] = run_deck(deck, jobid=name)
+    for name, run in runs.items():
+        assert run.status == 0, run.stdout + run.stderr
+        assert "meshfree shells: 16 cells" in run.stdout
+    assert "spot weld" not in runs["holds"].stdout
+    assert "reached the plastic strain" in runs["fails"].stdout

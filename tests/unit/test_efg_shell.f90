@@ -10,6 +10,7 @@
 !> * sub-cell areas adding up to the cell areas and to the plate's area; row-sum masses adding up
 !>   to t A; transformation rows summing to 1 and reproducing the particle's position (flat);
 !> * node classes (boundary edges and extra Gamma nodes), point counts, and error messages;
+!> * identical parts for one and three threads;
 !> * the set-up seconds of a 100 x 100 plate (printed; linear in the number of cells).
 !> Interior nodes are moved randomly by up to 25% of the cell size; the plate's outline stays a
 !> rectangle (2 x 1), so its area is known exactly.
@@ -28,6 +29,7 @@ program test_efg_shell
   use efg_neighbour_search, only: particle_grid_t, build_particle_grid
   use testing, only: test_suite_t, check, check_close, finish_suite
   use fixtures, only: random_uniform
+  use omp_lib, only: omp_get_max_threads, omp_set_num_threads
   implicit none
 
   type(test_suite_t) :: suite
@@ -46,6 +48,7 @@ program test_efg_shell
   call test_mesh("cylinder mixed, circle", 8, 6, .true., 1.5_wp, kernel_cubic_sphere, [1.3_wp, 1.3_wp])
   call test_node_classes()
   call test_errors()
+  call test_thread_counts()
   call test_setup_time()
   call finish_suite(suite)
 
@@ -500,6 +503,31 @@ contains
     if (allocated(error)) call check(suite, "errors: the degenerate cell named", &
                                      index(error%message, "element 501") > 0, error%message)
   end subroutine test_errors
+
+  !> One and three threads build bit-identical parts (cells are assembled in order).
+  subroutine test_thread_counts()
+    type(model_t) :: model
+    type(efg_shell_part_t) :: single, several
+    type(error_t), allocatable :: error
+    logical, allocatable :: extra(:)
+    integer :: threads
+    model = plate_model(12, 9, .true., 0.0_wp, kernel_quadratic_box, [1.3_wp, 1.2_wp])
+    allocate (extra(size(model%coordinates, 2)))
+    extra = .false.
+    threads = omp_get_max_threads()
+    call omp_set_num_threads(1)
+    call build_efg_shell_part(model, 1, extra, single, error)
+    call omp_set_num_threads(3)
+    call build_efg_shell_part(model, 1, extra, several, error)
+    call omp_set_num_threads(threads)
+    call check(suite, "threads: 1 and 3 threads give identical parts", &
+               all(single%point_offsets == several%point_offsets) .and. all(single%pair_node == several%pair_node) &
+               .and. all(single%pair_gradient == several%pair_gradient) .and. &
+               all(single%shear_value == several%shear_value) .and. &
+               all(single%shear_gradient == several%shear_gradient) .and. &
+               all(single%mass_volume == several%mass_volume) .and. &
+               all(single%transform_value == several%transform_value))
+  end subroutine test_thread_counts
 
   !> Set-up time of a 100 x 100 plate (printed); a loose bound only catches a quadratic search.
   subroutine test_setup_time()
