@@ -724,6 +724,11 @@ def write_document(doc: Path, figures: Path, patch, cantilever, results) -> str:
         parts.append(patch_case_table(patch["cases"], results))
     parts.append(FOOTER)
     text = re.sub(r"\n{3,}", "\n\n", "\n".join(parts))
+    # the meshfree shells' section is written by tools/efg_shell_convergence.py: carry it over
+    kept = re.search(r"<!-- begin: meshfree shells.*?<!-- end: meshfree shells -->",
+                     doc.read_text() if doc.is_file() else "", flags=re.S)
+    if kept:
+        text = text.rstrip("\n") + "\n\n" + kept.group(0) + "\n"
     doc.parent.mkdir(parents=True, exist_ok=True)
     doc.write_text(text)
     return text
