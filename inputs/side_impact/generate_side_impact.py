@@ -372,7 +372,7 @@ def main(argv=None):
     parser.add_argument("--ihq", type=int, default=1, help="hourglass type of the FE solids")
     parser.add_argument("--qh", type=float, default=0.1, help="hourglass coefficient")
     parser.add_argument("--tssfac", type=float, default=0.9, help="time step scale factor")
-    parser.add_argument("--jacket", choices=("rubber", "elastic"), default="rubber",
+    parser.add_argument("--jacket", choices=("rubber", "elastic"), default="elastic",
                         help="jacket material: *MAT_MOONEY-RIVLIN_RUBBER, or *MAT_ELASTIC of the same "
                              "small-strain modulus")
     parser.add_argument("--self-contact", action=argparse.BooleanOptionalAction, default=True,
