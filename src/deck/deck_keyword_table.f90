@@ -16,7 +16,8 @@ module deck_keyword_table
   use error_handling, only: error_list_t
   use material_laws, only: find_law, law_keyword_name, law_number_name, law_elastic, &
                            law_plastic_kinematic, law_honeycomb, law_modified_honeycomb, law_low_density_foam, &
-                           law_rigid, law_piecewise_linear, law_null, law_spotweld
+                           law_rigid, law_piecewise_linear, law_null, law_spotweld, law_mooney_rivlin, &
+                           law_blatz_ko, law_viscoelastic
   use deck_problems, only: problem_log_t
   use deck_lexer, only: deck_t
   use deck_keywords, only: keyword_t, keyword_unknown, read_options, suggest_keyword
@@ -31,6 +32,7 @@ module deck_keyword_table
     read_hourglasses
   use deck_materials, only: read_elastic_materials, read_plastic_kinematic_materials, read_honeycomb_materials, &
     read_modified_honeycomb_materials, read_low_density_foam_materials, read_piecewise_linear_materials, &
+    read_mooney_rivlin_materials, read_blatz_ko_materials, read_viscoelastic_materials, &
     read_null_materials
   use deck_add_erosion, only: read_add_erosions
   use deck_sets_curves, only: read_node_set, read_generated_node_set, read_part_set, read_segment_set, read_curve, &
@@ -214,6 +216,9 @@ contains
       law_keyword(law_honeycomb, read_honeycomb_materials), &
       law_keyword(law_modified_honeycomb, read_modified_honeycomb_materials), &
       law_keyword(law_low_density_foam, read_low_density_foam_materials), &
+      law_keyword(law_mooney_rivlin, read_mooney_rivlin_materials), &
+      law_keyword(law_blatz_ko, read_blatz_ko_materials), &
+      law_keyword(law_viscoelastic, read_viscoelastic_materials), &
       keyword_entry_t("RIGIDWALL_GEOMETRIC_CYLINDER", options="MOTION DISPLAY ID", fills=[list_walls, list_none], &
                       reader=read_cylinder_walls), &
       keyword_entry_t("ELEMENT_SHELL", fills=[list_shells, list_none], reader=read_shell_elements), &

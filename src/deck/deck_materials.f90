@@ -1,6 +1,7 @@
 !> *MAT_ELASTIC (*MAT_001), *MAT_PLASTIC_KINEMATIC (*MAT_003), *MAT_HONEYCOMB (*MAT_026),
 !> *MAT_MODIFIED_HONEYCOMB (*MAT_126), *MAT_LOW_DENSITY_FOAM (*MAT_057),
-!> *MAT_PIECEWISE_LINEAR_PLASTICITY (*MAT_024) and *MAT_NULL (*MAT_009), with the checks
+!> *MAT_PIECEWISE_LINEAR_PLASTICITY (*MAT_024), *MAT_NULL (*MAT_009), *MAT_VISCOELASTIC
+!> (*MAT_006), *MAT_BLATZ-KO_RUBBER (*MAT_007) and *MAT_MOONEY-RIVLIN_RUBBER (*MAT_027), with the checks
 !> that catch physically impossible values before they become a NaN in the first cycle, and
 !> errors naming each field whose LS-DYNA feature crashfree does not build (docs/materials.md).
 !> Curve ids are resolved by deck_material_curves after all keywords are read.
@@ -13,7 +14,8 @@ module deck_materials
   use error_handling, only: error_list_t
   use model, only: material_t, piecewise_hardening_curve
   use material_laws, only: law_elastic, law_plastic_kinematic, law_honeycomb, law_modified_honeycomb, &
-                           law_low_density_foam, law_piecewise_linear, law_null
+                           law_low_density_foam, law_piecewise_linear, law_null, law_viscoelastic, &
+                           law_blatz_ko, law_mooney_rivlin
   use curves, only: curve_t
   use deck_problems, only: problem_log_t
   use text_format, only: integer_text, real_text
@@ -28,6 +30,10 @@ module deck_materials
   public :: read_elastic_materials, read_plastic_kinematic_materials, read_honeycomb_materials
   public :: read_modified_honeycomb_materials, read_low_density_foam_materials
   public :: read_piecewise_linear_materials, read_null_materials, append_material
+  public :: read_mooney_rivlin_materials, read_blatz_ko_materials, read_viscoelastic_materials
+
+  !> Poisson's ratio of *MAT_BLATZ-KO_RUBBER (LS-DYNA Theory Manual, Material Model 7).
+  real(wp), parameter, public :: blatz_ko_poissons_ratio = 0.463_wp
 
   integer, parameter :: standard_widths(8) = 10
 
@@ -552,6 +558,166 @@ contains
       call warn_if_set(deck, card, 6, "KCON", "contact stiffness comes from the contact definition", warnings)
     end do
   end subroutine read_low_density_foam_materials
+
+  !> *MAT_MOONEY-RIVLIN_RUBBER: C1 MID RO PR A B REF; C2 (optional at the end of the keyword)
+  !> SGL SW ST LCID1 DATA LCID2 BSTART TRAMP. E and PR of the material are set to the
+  !> small-strain moduli (E = 2 G (1 + PR), G = 2 (A + B)) for the time step, the hourglass and
+  !> transverse shear stiffness and the contact stiffness. Not built, so rejected when given: the
+  !> fit of A and B to a test curve (LCID1), the viscoelastic relaxation curve (LCID2, BSTART,
+  !> TRAMP) and the reference geometry (REF).
+  subroutine read_mooney_rivlin_materials(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    integer :: line, n
+    real(wp) :: lowest_ratio, value
+    character(len=:), allocatable :: title
+
+    line = 0
+    do while (next_definition(deck, block, keyword%title, line, standard_widths, card, title, &
+                              log, "card 1 (MID RO PR A B REF)", "MID"))
+      n = append_material(input, line, law_mooney_rivlin, title)
+      associate (material => input%model%materials(n))
+        call get_integer(deck, card, 1, "MID", material%id, log)
+        call get_real(deck, card, 2, "RO", material%density, log)
+        call get_real(deck, card, 3, "PR", material%poissons_ratio, log)
+        call get_real(deck, card, 4, "A", material%mooney_rivlin_a, log)
+        call get_real(deck, card, 5, "B", material%mooney_rivlin_b, log)
+        call require_zero(deck, card, 6, "REF", "initialisation from a reference geometry "// &
+                          "(*INITIAL_FOAM_REFERENCE_GEOMETRY) is not available", log)
+        if (.not. card%failed) then
+          if (material%id <= 0) call card_problem(deck, log, card, "MID", "material id must be "// &
+                                                  "> 0, found "//integer_text(material%id))
+          if (material%density <= 0.0_wp) call card_problem(deck, log, card, "RO", "density must "// &
+            "be > 0, found "//shown(card, 2, material%density))
+          if (.not. material%mooney_rivlin_a + material%mooney_rivlin_b > 0.0_wp) then
+            call card_problem(deck, log, card, "A", "the shear modulus 2 (A + B) must be > 0, found A = "// &
+              real_text(material%mooney_rivlin_a)//", B = "//real_text(material%mooney_rivlin_b))
+          else if (material%poissons_ratio >= 0.5_wp) then
+            call card_problem(deck, log, card, "PR", "Poisson's ratio must be < 0.5 (0.49 to 0.495 are "// &
+              "usual for rubber), found "//shown(card, 3, material%poissons_ratio))
+          else
+            ! D >= 0 (the volumetric term convex, sigma_33 = 0 solvable in shells) needs
+            ! PR >= (2 A + 5 B) / (5 A + 11 B)
+            lowest_ratio = (2.0_wp*material%mooney_rivlin_a + 5.0_wp*material%mooney_rivlin_b)/ &
+                           (5.0_wp*material%mooney_rivlin_a + 11.0_wp*material%mooney_rivlin_b)
+            if (material%poissons_ratio < lowest_ratio) call card_problem(deck, log, card, "PR", &
+              "Poisson's ratio must lie in ["//real_text(lowest_ratio)//", 0.5) for these A and B (below, "// &
+              "the volumetric term D (I3 - 1)^2 has D < 0); rubber is nearly incompressible (0.49 to "// &
+              "0.495), found "//shown(card, 3, material%poissons_ratio))
+          end if
+          material%youngs_modulus = 4.0_wp*(material%mooney_rivlin_a + material%mooney_rivlin_b)* &
+                                    (1.0_wp + material%poissons_ratio)
+        end if
+        if (.not. next_line(deck, block, line, .false.)) exit
+        call open_card(deck, block, line, standard_widths, card, log)
+        call require_zero(deck, card, 4, "LCID1", "fitting A and B to a uniaxial test curve is not "// &
+                          "available; give A and B", log)
+        call warn_if_set(deck, card, 1, "SGL", "specimen gauge length: used only with LCID1", warnings)
+        call warn_if_set(deck, card, 2, "SW", "specimen width: used only with LCID1", warnings)
+        call warn_if_set(deck, card, 3, "ST", "specimen thickness: used only with LCID1", warnings)
+        call get_real(deck, card, 5, "DATA", value, log)
+        call warn_if_set(deck, card, 5, "DATA", "used only with LCID1", warnings)
+        call require_zero(deck, card, 6, "LCID2", "viscoelastic relaxation of this rubber is not available "// &
+                          "(use *MAT_VISCOELASTIC for a viscoelastic part)", log)
+        call require_zero(deck, card, 7, "BSTART", "used only with LCID2, which is not available", log)
+        call require_zero(deck, card, 8, "TRAMP", "used only with LCID2, which is not available", log)
+      end associate
+    end do
+  end subroutine read_mooney_rivlin_materials
+
+  !> *MAT_BLATZ-KO_RUBBER: MID RO G REF, one card per material. Poisson's ratio is 0.463 (the
+  !> law's); E = 2 G (1 + 0.463) is kept for the time step and the element stiffnesses.
+  subroutine read_blatz_ko_materials(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    integer :: line, n
+    real(wp) :: shear_modulus
+    character(len=:), allocatable :: title
+
+    line = 0
+    do while (next_definition(deck, block, keyword%title, line, standard_widths, card, title, &
+                              log, "card 1 (MID RO G REF)", "MID"))
+      n = append_material(input, line, law_blatz_ko, title)
+      associate (material => input%model%materials(n))
+        call get_integer(deck, card, 1, "MID", material%id, log)
+        call get_real(deck, card, 2, "RO", material%density, log)
+        call get_real(deck, card, 3, "G", shear_modulus, log)
+        call require_zero(deck, card, 4, "REF", "initialisation from a reference geometry "// &
+                          "(*INITIAL_FOAM_REFERENCE_GEOMETRY) is not available", log)
+        material%poissons_ratio = blatz_ko_poissons_ratio
+        material%youngs_modulus = 2.0_wp*shear_modulus*(1.0_wp + blatz_ko_poissons_ratio)
+        if (.not. card%failed) then
+          if (material%id <= 0) call card_problem(deck, log, card, "MID", "material id must be "// &
+                                                  "> 0, found "//integer_text(material%id))
+          if (material%density <= 0.0_wp) call card_problem(deck, log, card, "RO", "density must "// &
+            "be > 0, found "//shown(card, 2, material%density))
+          if (.not. shear_modulus > 0.0_wp) call card_problem(deck, log, card, "G", "shear modulus must "// &
+            "be > 0, found "//shown(card, 3, shear_modulus))
+        end if
+      end associate
+    end do
+  end subroutine read_blatz_ko_materials
+
+  !> *MAT_VISCOELASTIC: MID RO BULK G0 GI BETA, one card per material. E and PR of the material
+  !> are set from BULK and G0 (the instantaneous response) for the time step and the element
+  !> stiffnesses; GI and BETA are kept for the relaxation.
+  subroutine read_viscoelastic_materials(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    integer :: line, n
+    real(wp) :: bulk_modulus, short_term_shear
+    character(len=:), allocatable :: title
+
+    line = 0
+    do while (next_definition(deck, block, keyword%title, line, standard_widths, card, title, &
+                              log, "card 1 (MID RO BULK G0 GI BETA)", "MID"))
+      n = append_material(input, line, law_viscoelastic, title)
+      associate (material => input%model%materials(n))
+        call get_integer(deck, card, 1, "MID", material%id, log)
+        call get_real(deck, card, 2, "RO", material%density, log)
+        call get_real(deck, card, 3, "BULK", bulk_modulus, log)
+        call get_real(deck, card, 4, "G0", short_term_shear, log)
+        call get_real(deck, card, 5, "GI", material%long_term_shear_modulus, log)
+        call get_real(deck, card, 6, "BETA", material%decay_constant, log)
+        call require_zero(deck, card, 7, "REF", "initialisation from a reference geometry is not available", log)
+        if (.not. card%failed) then
+          if (material%id <= 0) call card_problem(deck, log, card, "MID", "material id must be "// &
+                                                  "> 0, found "//integer_text(material%id))
+          if (material%density <= 0.0_wp) call card_problem(deck, log, card, "RO", "density must "// &
+            "be > 0, found "//shown(card, 2, material%density))
+          if (.not. bulk_modulus > 0.0_wp) call card_problem(deck, log, card, "BULK", "bulk modulus must "// &
+            "be > 0, found "//shown(card, 3, bulk_modulus))
+          if (.not. short_term_shear > 0.0_wp) call card_problem(deck, log, card, "G0", "short-time shear "// &
+            "modulus must be > 0, found "//shown(card, 4, short_term_shear))
+          if (material%long_term_shear_modulus < 0.0_wp .or. material%long_term_shear_modulus > short_term_shear) &
+            call card_problem(deck, log, card, "GI", "long-time shear modulus must lie in [0, G0 = "// &
+              real_text(short_term_shear)//"], found "//real_text(material%long_term_shear_modulus))
+          if (material%decay_constant < 0.0_wp) call card_problem(deck, log, card, "BETA", "decay constant "// &
+            "must be >= 0, found "//real_text(material%decay_constant))
+          if (bulk_modulus > 0.0_wp .and. short_term_shear > 0.0_wp) then
+            material%youngs_modulus = 9.0_wp*bulk_modulus*short_term_shear/(3.0_wp*bulk_modulus + short_term_shear)
+            material%poissons_ratio = (3.0_wp*bulk_modulus - 2.0_wp*short_term_shear)/ &
+                                      (2.0_wp*(3.0_wp*bulk_modulus + short_term_shear))
+          end if
+        end if
+      end associate
+    end do
+  end subroutine read_viscoelastic_materials
 
   !> An error naming field `k` when it holds anything but blank or 0: the feature is not built.
   subroutine require_zero(deck, card, k, name, reason, log)

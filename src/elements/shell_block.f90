@@ -47,7 +47,8 @@ module shell_block
   use kinds, only: wp, block_size
   use model, only: model_t, material_t, formulation_fe, law_null
   use plane_stress_dispatch, only: plane_stress_history_count, initialize_plane_stress_history, &
-                                   update_plane_stress_block, plane_stress_plastic_strain
+                                   update_plane_stress_block, plane_stress_plastic_strain, &
+                                   rotate_plane_stress_history
   use element_work, only: add_force_work, smallest_time_step
   use gauss_legendre, only: gauss_legendre_rule
   use erosion_criteria, only: plastic_failure_limit, principal_strains_active, failed_points_needed, principal_strains_fail, &
@@ -325,7 +326,7 @@ contains
     do i = 1, nel
       spin_angle(i) = 0.25_wp*dt*sum(b1(i, :)*vl(i, :, 2) - b2(i, :)*vl(i, :, 1))
     end do
-    call rotate_with_material(block, nel, frame, spin_angle)
+    call rotate_with_material(block, material%law, nel, frame, spin_angle)
     block%frame(1:nel, :, :) = frame(1:nel, :, :)
 
     ! plane-stress update at every point through the thickness; elastic transverse shear
@@ -354,7 +355,7 @@ contains
 
     ! forces and moments on the end-of-step configuration
     call shell_geometry(nel, x, frame, xl, yl, b1, b2, area)
-    call rotate_with_material(block, nel, frame, spin_angle)
+    call rotate_with_material(block, material%law, nel, frame, spin_angle)
     call to_local(nel, frame, v, vl)
     call to_local(nel, frame, w, wl)
     call stress_resultants(block, nel, resultant)
@@ -406,8 +407,9 @@ contains
   !> (the mid-point rule, as the Hughes-Winget rotation of the solids). Without this (the classical element)
   !> a uniform membrane state becomes non-uniform wherever the sides of neighbouring elements
   !> rotate at different rates, and the membrane patch test fails at O(strain rate x dt).
-  pure subroutine rotate_with_material(block, nel, frame, spin_angle)
+  pure subroutine rotate_with_material(block, law, nel, frame, spin_angle)
     type(shell_block_t), intent(inout) :: block
+    integer, intent(in) :: law
     integer, intent(in) :: nel
     real(wp), intent(in) :: frame(block_size, 3, 3), spin_angle(block_size)
     real(wp) :: angle, c, s, sxx, syy, sxy, first, second
@@ -429,6 +431,8 @@ contains
         second = block%stress(i, 4, point)
         block%stress(i, 5, point) = c*first - s*second
         block%stress(i, 4, point) = s*first + c*second
+        ! tensor history (the rubbers' b, the viscoelastic branch) turns with the stress
+        if (size(block%history, 2) > 0) call rotate_plane_stress_history(law, c, s, block%history(i, :, point))
       end do
       first = block%hourglass_force(i, 1)
       second = block%hourglass_force(i, 2)

@@ -19,20 +19,23 @@ module material_dispatch
   use model, only: material_t, honeycomb_rate_curve, foam_loading_curve, piecewise_hardening_curve, &
                    piecewise_rate_curve
   use material_laws, only: law_table, find_law, law_elastic, law_plastic_kinematic, law_honeycomb, &
-                           law_modified_honeycomb, law_low_density_foam, law_piecewise_linear, law_null
+                           law_modified_honeycomb, law_low_density_foam, law_piecewise_linear, law_null, &
+                           law_viscoelastic, law_blatz_ko, law_mooney_rivlin
   use material_elastic, only: elastic_update
   use material_plastic_kinematic, only: plastic_kinematic_update, plastic_strain_slot, back_stress_first_slot
   use material_honeycomb, only: honeycomb_update, honeycomb_initialize_axes, honeycomb_axes_first_slot
   use material_piecewise_linear, only: piecewise_linear_update, piecewise_plastic_strain_slot
   use material_low_density_foam, only: low_density_foam_update, low_density_foam_initialize, &
                                        foam_left_cauchy_green_first_slot
+  use material_rubber, only: rubber_update, mooney_rivlin_constants, rubber_mooney_rivlin, rubber_blatz_ko
+  use material_viscoelastic, only: viscoelastic_update
   use objective_rotation, only: rotate_symmetric_tensors, rotate_vectors
   implicit none
   private
 
   public :: material_history_count, initialize_material_history, update_material_block
   public :: rotate_material_history, material_wave_modulus, material_plastic_strain
-  public :: elastic_moduli, plastic_hardening_modulus, material_stiffness_bounds
+  public :: elastic_moduli, plastic_hardening_modulus, material_stiffness_bounds, rubber_constants
 
 contains
 
@@ -150,6 +153,13 @@ contains
                                    material%curves(piecewise_rate_curve), material%rate_c, material%rate_p, &
                                    material%rate_formulation > 0.5_wp, time_step, strain_increment, stress, &
                                    history(:, piecewise_plastic_strain_slot))
+    case (law_mooney_rivlin)
+      call rubber_update(nel, rubber_mooney_rivlin, rubber_constants(material), strain_increment, stress, history)
+    case (law_blatz_ko)
+      call rubber_update(nel, rubber_blatz_ko, rubber_constants(material), strain_increment, stress, history)
+    case (law_viscoelastic)
+      call viscoelastic_update(nel, bulk_modulus, shear_modulus, material%long_term_shear_modulus, &
+                               material%decay_constant, time_step, strain_increment, stress, history)
     case (law_null)
       stress(1:nel, :) = 0.0_wp
     case default
@@ -175,6 +185,9 @@ contains
       ! B's Jaumann rate is D B + B D: the spin part is this rotation.
       call rotate_symmetric_tensors(nel, rotation, &
                                     history(:, foam_left_cauchy_green_first_slot:foam_left_cauchy_green_first_slot + 5))
+    case (law_mooney_rivlin, law_blatz_ko, law_viscoelastic)
+      ! the rubbers' b - I (b's Jaumann rate is D b + b D), the viscoelastic branch stress
+      call rotate_symmetric_tensors(nel, rotation, history(:, 1:6))
     case default
       continue
     end select
@@ -232,6 +245,21 @@ contains
       end if
     end select
   end subroutine material_stiffness_bounds
+
+  !> The rubbers' constants for material_rubber: *MAT_MOONEY-RIVLIN_RUBBER A, B, C, D (from A, B,
+  !> PR); *MAT_BLATZ-KO_RUBBER G (E / (2 (1 + nu)), the deck stores E = 2 G (1 + nu)) and
+  !> beta = 1 / (1 - 2 nu), nu = 0.463.
+  pure function rubber_constants(material) result(constants)
+    type(material_t), intent(in) :: material
+    real(wp) :: constants(4)
+    if (material%law == law_mooney_rivlin) then
+      constants = mooney_rivlin_constants(material%mooney_rivlin_a, material%mooney_rivlin_b, &
+                                          material%poissons_ratio)
+    else
+      constants = [material%youngs_modulus/(2.0_wp*(1.0_wp + material%poissons_ratio)), &
+                   1.0_wp/(1.0_wp - 2.0_wp*material%poissons_ratio), 0.0_wp, 0.0_wp]
+    end if
+  end function rubber_constants
 
   !> Stiffness bound of *MAT_LOW_DENSITY_FOAM: max(E, largest slope of the loading curve).
   pure function foam_stiffness_bound(material) result(modulus)

@@ -22,14 +22,16 @@ module plane_stress_dispatch
   use curves, only: curve_t
   use model, only: material_t, piecewise_hardening_curve, piecewise_rate_curve
   use material_laws, only: law_table, find_law, no_plane_stress_kernel, law_elastic, law_plastic_kinematic, &
-                           law_piecewise_linear, law_null
-  use material_dispatch, only: plastic_hardening_modulus
+                           law_piecewise_linear, law_null, law_viscoelastic, law_blatz_ko, law_mooney_rivlin
+  use material_dispatch, only: plastic_hardening_modulus, elastic_moduli, rubber_constants
+  use material_rubber, only: rubber_plane_stress_update, rubber_mooney_rivlin, rubber_blatz_ko
+  use material_viscoelastic, only: viscoelastic_plane_stress_update
   use plane_stress_plasticity, only: plane_stress_elastic_update, plane_stress_plasticity_update
   implicit none
   private
 
   public :: plane_stress_history_count, initialize_plane_stress_history, update_plane_stress_block
-  public :: plane_stress_plastic_strain
+  public :: plane_stress_plastic_strain, rotate_plane_stress_history
 
   !> History count returned for a law without a plane-stress kernel.
   integer, parameter, public :: plane_stress_unsupported = no_plane_stress_kernel
@@ -74,7 +76,7 @@ contains
     real(wp), intent(inout), contiguous :: history(:, :)
     real(wp), intent(out) :: thickness_strain_increment(block_size)
     type(curve_t) :: no_curve
-    real(wp) :: hardening_modulus
+    real(wp) :: hardening_modulus, bulk_modulus, shear_modulus
 
     ! A select case on the integer law code, as in update_material_block (material_dispatch).
     select case (material%law)
@@ -95,6 +97,17 @@ contains
         0.0_wp, material%curves(piecewise_rate_curve), material%rate_c, material%rate_p, &
         material%rate_formulation > 0.5_wp, dt, strain_increment, stress, &
         history(:, plane_stress_plastic_strain_slot), thickness_strain_increment)
+    case (law_mooney_rivlin)
+      call rubber_plane_stress_update(nel, rubber_mooney_rivlin, rubber_constants(material), strain_increment, &
+                                      stress, history, thickness_strain_increment)
+    case (law_blatz_ko)
+      call rubber_plane_stress_update(nel, rubber_blatz_ko, rubber_constants(material), strain_increment, &
+                                      stress, history, thickness_strain_increment)
+    case (law_viscoelastic)
+      call elastic_moduli(material, bulk_modulus, shear_modulus)
+      call viscoelastic_plane_stress_update(nel, bulk_modulus, shear_modulus, material%long_term_shear_modulus, &
+                                            material%decay_constant, dt, strain_increment, stress, history, &
+                                            thickness_strain_increment)
     case (law_null)
       ! A null shell carries no membrane or bending stress and keeps its thickness.
       stress(1:nel, :) = 0.0_wp
@@ -104,6 +117,38 @@ contains
         "(plane_stress_history_count returned -1: the deck check must reject the shell part)"
     end select
   end subroutine update_plane_stress_block
+
+  !> Turn the in-plane tensor history of one point with the stress, when the shell rotates its
+  !> stress by the material spin about the normal (angle with cosine c and sine s, the same
+  !> transformation as the stress): the rubbers' b_xx - 1, b_yy - 1, b_xy (slots 1-3; b_zz
+  !> stays), the viscoelastic branch h_xx, h_yy, h_xy (slots 1, 2, 4; h_zz stays). The other
+  !> laws keep their history as it is. `history`: the point's history row of one lane.
+  pure subroutine rotate_plane_stress_history(law, c, s, history)
+    integer, intent(in) :: law
+    real(wp), intent(in) :: c, s
+    real(wp), intent(inout) :: history(:)
+    select case (law)
+    case (law_mooney_rivlin, law_blatz_ko)
+      call rotate_in_plane(c, s, history(1), history(2), history(3))
+    case (law_viscoelastic)
+      call rotate_in_plane(c, s, history(1), history(2), history(4))
+    case default
+      continue
+    end select
+  end subroutine rotate_plane_stress_history
+
+  !> (xx, yy, xy) of a symmetric 2x2 tensor turned by the angle with cosine c and sine s.
+  pure subroutine rotate_in_plane(c, s, xx, yy, xy)
+    real(wp), intent(in) :: c, s
+    real(wp), intent(inout) :: xx, yy, xy
+    real(wp) :: old_xx, old_yy, old_xy
+    old_xx = xx
+    old_yy = yy
+    old_xy = xy
+    xx = c*c*old_xx - 2.0_wp*c*s*old_xy + s*s*old_yy
+    yy = s*s*old_xx + 2.0_wp*c*s*old_xy + c*c*old_yy
+    xy = c*s*(old_xx - old_yy) + (c*c - s*s)*old_xy
+  end subroutine rotate_in_plane
 
   !> Effective plastic strain of lanes 1..nel (0 for the elastic and null laws).
   subroutine plane_stress_plastic_strain(material, nel, history, plastic_strain)

@@ -28,6 +28,9 @@ module material_laws
   integer, parameter, public :: law_modified_honeycomb = 126  !< *MAT_MODIFIED_HONEYCOMB
   integer, parameter, public :: law_low_density_foam = 57     !< *MAT_LOW_DENSITY_FOAM
   integer, parameter, public :: law_spotweld = 100            !< *MAT_SPOTWELD (beams)
+  integer, parameter, public :: law_viscoelastic = 6          !< *MAT_VISCOELASTIC
+  integer, parameter, public :: law_blatz_ko = 7              !< *MAT_BLATZ-KO_RUBBER
+  integer, parameter, public :: law_mooney_rivlin = 27        !< *MAT_MOONEY-RIVLIN_RUBBER
 
   !> History count of a law without a plane-stress kernel (it cannot be used on shell blocks).
   integer, parameter, public :: no_plane_stress_kernel = -1
@@ -56,7 +59,7 @@ module material_laws
   end type material_law_t
 
   !> The laws, in the order messages list them.
-  type(material_law_t), parameter :: law_table(9) = [ &
+  type(material_law_t), parameter :: law_table(12) = [ &
     material_law_t(code=law_elastic, name="ELASTIC", solids=.true., shells=.true., meshfree=.true., &
                    beams=.true., history_count=0, shell_history_count=0), &
     material_law_t(code=law_plastic_kinematic, name="PLASTIC_KINEMATIC", solids=.true., shells=.true., &
@@ -76,7 +79,13 @@ module material_laws
                    curve_card=2), &
     material_law_t(code=law_low_density_foam, name="LOW_DENSITY_FOAM", solids=.true., meshfree=.true., &
                    hexahedra_only=.true., history_count=7, curve_fields="LCID", curve_card=1), &
-    material_law_t(code=law_spotweld, name="SPOTWELD", beams=.true.)]
+    material_law_t(code=law_spotweld, name="SPOTWELD", beams=.true.), &
+    material_law_t(code=law_viscoelastic, name="VISCOELASTIC", solids=.true., shells=.true., meshfree=.true., &
+                   history_count=6, shell_history_count=4), &
+    material_law_t(code=law_blatz_ko, name="BLATZ-KO_RUBBER", solids=.true., shells=.true., meshfree=.true., &
+                   history_count=6, shell_history_count=4), &
+    material_law_t(code=law_mooney_rivlin, name="MOONEY-RIVLIN_RUBBER", solids=.true., shells=.true., &
+                   meshfree=.true., history_count=6, shell_history_count=4)]
 
 contains
 

@@ -86,6 +86,12 @@ module model
     real(wp) :: tension_cutoff = 1.0e20_wp  !< TC: largest tensile (nominal) stress
     real(wp) :: hysteretic_unloading = 1.0_wp !< HU: 1 no dissipation ... 0 most
     real(wp) :: unloading_shape = 1.0_wp    !< SHAPE: exponent of the unloading factor
+    ! *MAT_MOONEY-RIVLIN_RUBBER (PR above; E holds the small-strain 2 G (1 + nu), G = 2 (A + B))
+    real(wp) :: mooney_rivlin_a = 0.0_wp    !< A
+    real(wp) :: mooney_rivlin_b = 0.0_wp    !< B
+    ! *MAT_VISCOELASTIC (E, PR above hold the instantaneous moduli from BULK and G0)
+    real(wp) :: long_term_shear_modulus = 0.0_wp !< GI
+    real(wp) :: decay_constant = 0.0_wp     !< BETA: G(t) = GI + (G0 - GI) exp(-BETA t)
     !> Curve ids as given on the cards with LS-DYNA's defaults applied (0: none); the slots are
     !> honeycomb_rate_curve, foam_loading_curve, ... above.
     integer, allocatable :: curve_ids(:)
