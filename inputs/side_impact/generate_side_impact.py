@@ -300,15 +300,15 @@ def write_deck(mesh: Mesh, path: Path, args, deck: str):
               "ribs_efg": "rib foams meshfree solids, jacket FE shells",
               "coupled": "rib foams meshfree solids, jacket meshfree shells"}
     spine_volume = np.prod([b - a for a, b in SPINE_BOX])
-    spine_density = THORAX_MASS / spine_volume
-    door_density = DOOR_MASS / (mesh.door_area * DOOR_THICKNESS)
+    spine_density = args.thorax_mass / spine_volume
+    door_density = args.door_mass / (mesh.door_area * DOOR_THICKNESS)
     counts = mesh.dof_counts({"fe": (), "ribs_efg": PART_FOAMS, "coupled": PART_FOAMS + (PART_JACKET,)}[deck])
     share = counts["efg"] / counts["total"]
     end = args.end_time
     out = ["*KEYWORD", "*TITLE", f"side-impact dummy component test, {titles[deck]}",
            "$ European side-impact dummy component test (Wang, Wu, Guo & Botkin 2009, section 4.4),",
            "$ written by inputs/side_impact/generate_side_impact.py. Units mm, ms, kg, kN, GPa.",
-           f"$ element size {args.size:g} mm; door {DOOR_MASS:g} kg at {SPEED:g} m/s into a {THORAX_MASS:g} kg thorax;",
+           f"$ element size {args.size:g} mm; door {args.door_mass:g} kg at {SPEED:g} m/s into a {args.thorax_mass:g} kg thorax;",
            f"$ meshfree dofs {counts['efg']} of {counts['total']} ({100 * share:.1f}%, 3 per node, 3 more per shell node).",
            "*CONTROL_TERMINATION", card(end),
            "*CONTROL_TIMESTEP", "$   DTINIT    TSSFAC", card(0.0, args.tssfac),
@@ -372,7 +372,10 @@ def main(argv=None):
     parser.add_argument("--ihq", type=int, default=1, help="hourglass type of the FE solids")
     parser.add_argument("--qh", type=float, default=0.1, help="hourglass coefficient")
     parser.add_argument("--tssfac", type=float, default=0.9, help="time step scale factor")
-    parser.add_argument("--jacket", choices=("rubber", "elastic"), default="elastic",
+    parser.add_argument("--door-mass", type=float, default=DOOR_MASS, help="door mass (kg)")
+    parser.add_argument("--thorax-mass", type=float, default=THORAX_MASS,
+                        help="mass of the spine box (kg): the thorax and what it carries")
+    parser.add_argument("--jacket", choices=("rubber", "elastic"), default="rubber",
                         help="jacket material: *MAT_MOONEY-RIVLIN_RUBBER, or *MAT_ELASTIC of the same "
                              "small-strain modulus")
     parser.add_argument("--self-contact", action=argparse.BooleanOptionalAction, default=True,
