@@ -8,10 +8,16 @@
 !> silent substitution. IDIM 4 is crashfree's own value (no LS-DYNA meaning): conventional EFG,
 !> 4x4x4 Gauss points per cell with direct MLS gradients, kept for the verification of Table 1
 !> of the paper.
+!>
+!> The EFG card of a meshfree shell section (*SECTION_SHELL ELFORM 41): DX DY ISPLINE IDILA
+!> IEBT IDIM. Blank or 0 DX, DY take LS-DYNA's default for the shell card, 1.1 (the keyword
+!> schema's value; the solids' 1.01 is the solid card's). IEBT blank is 3 and IDIM blank is 1,
+!> the coupled local-boundary method crashfree builds, where LS-DYNA's schema says 1 and 1
+!> (its help text: -1 and 2); every other value is refused.
 module deck_efg_cards
   use kinds, only: wp
   use error_handling, only: error_list_t
-  use model, only: section_t, kernel_cubic_box, kernel_cubic_sphere, &
+  use model, only: section_t, kernel_cubic_box, kernel_quadratic_box, kernel_cubic_sphere, &
                    boundary_full_transformation, boundary_coupled, integration_local_boundary, &
                    integration_gauss, integration_gauss_conventional
   use deck_problems, only: problem_log_t
@@ -21,7 +27,7 @@ module deck_efg_cards
   implicit none
   private
 
-  public :: read_efg_card, read_efg_options_card
+  public :: read_efg_card, read_efg_options_card, read_efg_shell_card
 
   !> ELFORM of the meshfree (EFG) solid, and of LS-DYNA's adaptive 4-node EFG solid, which
   !> crashfree does not have. Both are followed by the EFG card.
@@ -29,6 +35,9 @@ module deck_efg_cards
 
   !> Normalized support for a blank or zero DX, DY, DZ (LS-DYNA's default too).
   real(wp), parameter :: default_support_scale = 1.01_wp
+  !> Normalized support for a blank or zero DX, DY of the shell's EFG card (LS-DYNA's default
+  !> for *SECTION_SHELL ELFORM 41/42).
+  real(wp), parameter :: default_shell_support_scale = 1.1_wp
 
   character(len=2), parameter :: support_names(3) = ["DX", "DY", "DZ"]
 
@@ -126,6 +135,85 @@ contains
       section%kernel_tolerance = 0.0_wp
     end if
   end subroutine read_efg_card
+
+  !> The EFG card of a meshfree shell section (ELFORM 41) into `section`: DX DY ISPLINE IDILA
+  !> IEBT IDIM.
+  subroutine read_efg_shell_card(deck, card, section, log, warnings)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(inout) :: card
+    type(section_t), intent(inout) :: section
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    integer :: k, kernel, dilation_basis, boundary_treatment, domain_integration
+    real(wp) :: support_scale(2)
+
+    do k = 1, 2
+      call get_real(deck, card, k, support_names(k), support_scale(k), log)
+    end do
+    call get_integer(deck, card, 3, "ISPLINE", kernel, log)
+    call get_integer(deck, card, 4, "IDILA", dilation_basis, log)
+    call get_integer(deck, card, 5, "IEBT", boundary_treatment, log, default=boundary_coupled)
+    call get_integer(deck, card, 6, "IDIM", domain_integration, log, &
+                     default=integration_local_boundary)
+    if (card%failed) return
+
+    do k = 1, 2
+      if (support_scale(k) == 0.0_wp) then
+        support_scale(k) = default_shell_support_scale
+      else if (support_scale(k) <= 1.0_wp) then
+        call card_problem(deck, log, card, support_names(k), support_names(k)//" must be "// &
+          "greater than 1: at 1.0 a vertex weight vanishes on the cell's far corner; found "// &
+          real_text(support_scale(k))//" (blank or 0 means 1.1)")
+      end if
+    end do
+    section%support_scale(1:2) = support_scale
+    section%support_scale(3) = support_scale(1)
+
+    select case (kernel)
+    case (kernel_cubic_box, kernel_quadratic_box)
+      section%kernel = kernel
+    case (kernel_cubic_sphere)
+      section%kernel = kernel
+      ! a circle has one radius, scaled by DX
+      if (support_scale(2) /= support_scale(1)) call warn_if_set(deck, card, 2, "DY", &
+        "a circular support (ISPLINE 2) has one radius, scaled by DX", warnings)
+    case default
+      call card_problem(deck, log, card, "ISPLINE", "must be 0 (cubic spline, box support), "// &
+        "1 (quadratic spline, box support) or 2 (cubic spline, circular support), found "// &
+        integer_text(kernel))
+    end select
+
+    select case (dilation_basis)
+    case (0)
+      section%dilation_basis = dilation_basis
+    case (1)
+      call card_problem(deck, log, card, "IDILA", "IDILA 1 (support size from the "// &
+        "surrounding nodes) is not available: crashfree sizes each particle's support from "// &
+        "the nodes that share a shell with it (IDILA 0); leave IDILA blank or 0")
+    case default
+      call card_problem(deck, log, card, "IDILA", "must be 0 (support size from the "// &
+        "background elements), found "//integer_text(dilation_basis))
+    end select
+
+    if (boundary_treatment == boundary_coupled) then
+      section%boundary_treatment = boundary_treatment
+    else
+      call card_problem(deck, log, card, "IEBT", "essential boundary treatment "// &
+        integer_text(boundary_treatment)//" is not available for meshfree shells; crashfree "// &
+        "has IEBT 3 (coupled FE/EFG: the nodes on the part's boundary keep FE functions), the "// &
+        "default for a blank field"//zero_note(boundary_treatment))
+    end if
+
+    if (domain_integration == integration_local_boundary) then
+      section%domain_integration = domain_integration
+    else
+      call card_problem(deck, log, card, "IDIM", "domain integration "// &
+        integer_text(domain_integration)//" is not available for meshfree shells; crashfree "// &
+        "has IDIM 1 (local boundary integration on sub-cells, with one transverse shear point "// &
+        "per cell), the default for a blank field"//zero_note(domain_integration))
+    end if
+    section%kernel_tolerance = 0.0_wp
+  end subroutine read_efg_shell_card
 
   !> Card 3 of *SECTION_SOLID_EFG: IPS STIME IKEN SF CMID IBR DS ECUT. Each field belongs to a
   !> feature crashfree does not have (pressure smoothing, stabilized EFG, the maximum-entropy

@@ -11,8 +11,8 @@ module deck_parts_sections
   use deck_fields, only: card_t, open_card, next_line, require_card, next_definition, &
                          has_data, get_integer, get_real, card_problem, warn_if_set, line_title, &
                          card_is_empty, field_is_blank
-  use deck_efg_cards, only: read_efg_card, read_efg_options_card, elform_efg, &
-                            elform_adaptive_efg
+  use deck_efg_cards, only: read_efg_card, read_efg_options_card, read_efg_shell_card, &
+                            elform_efg, elform_adaptive_efg
   use deck_input, only: deck_input_t
   implicit none
   private
@@ -184,7 +184,9 @@ contains
   !> *SECTION_SHELL (with _TITLE: a title line before each section). Sections repeat until the
   !> next keyword; each is two cards:
   !> card 1 SECID ELFORM SHRF NIP PROPT QR/IRID ICOMP SETYP, card 2 T1 T2 T3 T4 NLOC MAREA IDOF
-  !> EDGSET. Only what the Belytschko-Tsay shell models is accepted: ELFORM 2 (0 or blank: 2), Gauss
+  !> EDGSET, and with ELFORM 41 (the meshfree EFG shell) the EFG card DX DY ISPLINE IDILA IEBT
+  !> IDIM (read_efg_shell_card). Only what the Belytschko-Tsay shell and the meshfree shell
+  !> model is accepted: ELFORM 2 (0 or blank: 2) or 41 (42, the global EFG shell, is refused), Gauss
   !> integration through the thickness (QR/IRID 0) with 1-10 points, no composite angles
   !> (ICOMP 0), the mid surface as reference (NLOC 0) and no non-structural mass (MAREA 0,
   !> rejected rather than ignored since it would change the mass). T2-T4 blank or 0 take T1,
@@ -222,9 +224,7 @@ contains
         if (.not. card%failed) then
           if (section%id <= 0) call card_problem(deck, log, card, "SECID", "section id must "// &
                                                  "be > 0, found "//integer_text(section%id))
-          if (section%element_formulation /= 2) call card_problem(deck, log, card, "ELFORM", &
-            "shell formulation "//integer_text(section%element_formulation)//" is not "// &
-            "available; ELFORM 2 (Belytschko-Tsay) is the one shell crashfree has")
+          call check_shell_formulation(deck, log, card, section%element_formulation)
           if (section%shear_factor < 0.0_wp) call card_problem(deck, log, card, "SHRF", &
             "shear factor must be > 0 (0 or blank: 1.0; 5/6 is usual), found "// &
             real_text(section%shear_factor))
@@ -275,8 +275,39 @@ contains
       do k = 1, angle_cards
         if (.not. next_line(deck, block, line, .false.)) exit
       end do
+      ! the EFG card of a meshfree shell (and of ELFORM 42, refused on card 1, read over so that
+      ! the next section is read in place)
+      associate (section => input%model%sections(n))
+        if (section%element_formulation == elform_efg .or. &
+            section%element_formulation == elform_adaptive_efg) then
+          if (.not. require_card(deck, block, line, standard_widths, card, log, "the EFG card "// &
+              "(DX DY ISPLINE IDILA IEBT IDIM) of section "//integer_text(section%id), "DX")) exit
+          call read_efg_shell_card(deck, card, section, log, warnings)
+        end if
+      end associate
     end do
   end subroutine read_shell_sections
+
+  !> ELFORM of a shell section: 2 (Belytschko-Tsay) and 41 (meshfree EFG shell, LS-DYNA's local
+  !> approach for crash).
+  subroutine check_shell_formulation(deck, log, card, formulation)
+    type(deck_t), intent(in) :: deck
+    type(problem_log_t), intent(inout) :: log
+    type(card_t), intent(inout) :: card
+    integer, intent(in) :: formulation
+
+    select case (formulation)
+    case (2, elform_efg)
+    case (elform_adaptive_efg)
+      call card_problem(deck, log, card, "ELFORM", "the global meshfree shell (ELFORM 42, "// &
+        "LS-DYNA's EFG shell for metal forming) is not available; use ELFORM 41 (meshfree "// &
+        "EFG shell, local approach) or 2 (Belytschko-Tsay)")
+    case default
+      call card_problem(deck, log, card, "ELFORM", "shell formulation "// &
+        integer_text(formulation)//" is not available; crashfree has ELFORM 2 "// &
+        "(Belytschko-Tsay) and 41 (meshfree EFG shell)")
+    end select
+  end subroutine check_shell_formulation
 
   !> ELFORM of a solid section: 1 and 2 (finite elements) and 41 (EFG); 41 only under
   !> *SECTION_SOLID_EFG.

@@ -38,6 +38,7 @@ module efg_group
     procedure :: exchange_state
     procedure :: failure_text
     procedure :: to_physical
+    procedure :: forces_to_generalized
   end type efg_group_t
 
 contains
@@ -249,6 +250,29 @@ contains
       call transform_to_physical(self%parts(k), field, physical)
     end do
   end subroutine to_physical
+
+  !> The transpose of to_physical for forces (contact on physical positions): a particle's own
+  !> entry is replaced by what the rows give it, its physical force goes to the nodes of its row
+  !> with the row's weights, particle by particle (a fixed order).
+  subroutine forces_to_generalized(self, physical, generalized)
+    class(efg_group_t), intent(in) :: self
+    real(wp), intent(in) :: physical(:, :)
+    real(wp), intent(inout) :: generalized(:, :)
+    integer :: k, j, n
+    do k = 1, size(self%parts)
+      associate (geometry => self%parts(k)%geometry)
+        do j = 1, size(geometry%particles)
+          generalized(:, geometry%particles(j)) = 0.0_wp
+        end do
+        do j = 1, size(geometry%particles)
+          do n = geometry%transform_offsets(j), geometry%transform_offsets(j + 1) - 1
+            generalized(:, geometry%transform_node(n)) = generalized(:, geometry%transform_node(n)) &
+              + geometry%transform_value(n)*physical(:, geometry%particles(j))
+          end do
+        end do
+      end associate
+    end do
+  end subroutine forces_to_generalized
 
   !> Particles, their dofs and the set-up time of the shape functions as well (set, not added:
   !> called before and after the run).

@@ -98,6 +98,10 @@ module element_group
     procedure :: failure_text
     !> Optional: transform a nodal field from solver values to physical ones (meshfree parts).
     procedure :: to_physical
+    !> Optional (meshfree parts): the transpose of to_physical for forces. `physical` holds forces
+    !> on the physical values; `generalized` holds the same on entry and gets A^T f at the
+    !> group's interior particles (the contact phase: contact on physical positions).
+    procedure :: forces_to_generalized
     !> Optional: the element whose density mass scaling raised most, and the factor.
     procedure :: most_scaled
     !> For kinds whose blocks report a step, critical element and failed element each: the
@@ -234,6 +238,12 @@ contains
     real(wp), intent(in) :: field(:, :)
     real(wp), intent(inout) :: physical(:, :)
   end subroutine to_physical
+
+  subroutine forces_to_generalized(self, physical, generalized)
+    class(element_group_t), intent(in) :: self
+    real(wp), intent(in) :: physical(:, :)
+    real(wp), intent(inout) :: generalized(:, :)
+  end subroutine forces_to_generalized
 
   subroutine most_scaled(self, model, largest, element)
     class(element_group_t), intent(in) :: self

@@ -101,7 +101,8 @@ module model
   end type material_t
 
   !> EFG kernels (ISPLINE) and boundary treatments (IEBT) and domain integrations (IDIM).
-  integer, parameter, public :: kernel_cubic_box = 0, kernel_cubic_sphere = 2
+  !> The quadratic spline on a box support (ISPLINE 1) is read for meshfree shells only.
+  integer, parameter, public :: kernel_cubic_box = 0, kernel_quadratic_box = 1, kernel_cubic_sphere = 2
   integer, parameter, public :: boundary_full_transformation = 1, boundary_coupled = 3
   integer, parameter, public :: integration_local_boundary = 1, integration_gauss = 2
   !> Conventional EFG: 4x4x4 Gauss points per cell with direct MLS gradients (IDIM = 4, a
@@ -124,15 +125,19 @@ module model
     character(len=:), allocatable :: title
     integer :: kind = section_solid        !< section_solid or section_shell
     integer :: element_formulation = 1     !< ELFORM: 1 one-point, 2 fully integrated S/R, 41 EFG;
-                                           !< shells: 2 Belytschko-Tsay
+                                           !< shells: 2 Belytschko-Tsay, 41 meshfree (EFG) shell
     ! *SECTION_SHELL
     real(wp) :: shear_factor = 1.0_wp      !< SHRF: transverse shear correction (5/6 is usual)
     integer :: integration_points = 2      !< NIP through the thickness (1-10)
     real(wp) :: thickness(4) = 0.0_wp      !< T1-T4 at the element's nodes (T2-T4 default T1)
     real(wp) :: reference_surface = 0.0_wp !< NLOC: 0 mid surface, 1 top, -1 bottom
     ! EFG card (ELFORM 41), meaningful only for meshfree sections
-    real(wp) :: support_scale(3) = 1.01_wp !< DX, DY, DZ: normalized support (> 1)
-    integer :: kernel = kernel_cubic_box   !< ISPLINE: 0 cubic spline, box; 2 cubic spline, sphere
+    !> DX, DY, DZ: normalized support (> 1). Meshfree shells (*SECTION_SHELL ELFORM 41) use
+    !> DX and DY, in the directions e1 and e2 of each cell's frame; their DZ is DX (not used).
+    real(wp) :: support_scale(3) = 1.01_wp
+    !> ISPLINE: 0 cubic spline, box; 1 quadratic spline, box (shells); 2 cubic spline, sphere
+    !> (shells: a circle in the surface)
+    integer :: kernel = kernel_cubic_box
     integer :: dilation_basis = 0          !< IDILA (0: from the nodes sharing an element)
     real(wp) :: kernel_tolerance = 0.0_wp  !< TOLDEF: 0 Lagrangian kernel (the only one built)
     integer :: boundary_treatment = boundary_coupled        !< IEBT: 3 coupled FE/EFG, 1 full transformation

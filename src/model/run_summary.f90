@@ -25,6 +25,10 @@ module run_summary
     integer :: fe_solids = 0, fe_shells = 0      !< fe_elements = fe_solids + fe_shells + fe_beams
     integer :: fe_beams = 0                      !< beam elements (beam_group)
     real(wp) :: fe_beam_s = 0.0_wp               !< seconds of the beams' force calls
+    ! meshfree shells (efg_shell_group): background cells, interior particles, their dofs
+    ! (translations and rotations of the part's nodes), set-up and force-call seconds
+    integer :: efg_shell_cells = 0, efg_shell_particles = 0, dofs_efg_shell = 0
+    real(wp) :: efg_shell_setup_s = 0.0_wp, efg_shell_s = 0.0_wp
     integer :: failed_beams = 0                  !< beams failed by their material (*MAT_SPOTWELD)
     ! FE solids folded inside out at a corner (checked at each state)
     integer :: tangled_solids = 0                !< at the last state

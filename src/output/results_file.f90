@@ -1350,12 +1350,14 @@ contains
     type(results_file_t), intent(in) :: results
     type(run_summary_t), intent(in) :: summary
     type(error_t), allocatable, intent(inout) :: error
-    character(len=*), parameter :: second_names(9) = [character(len=11) :: "wall_s", &
-      "fe_solid_s", "fe_shell_s", "efg_s", "contact_s", "output_s", "setup_s", "efg_setup_s", "fe_beam_s"]
-    character(len=*), parameter :: count_names(10) = [character(len=13) :: "cycles", "threads", &
-      "fe_elements", "efg_particles", "dofs_total", "dofs_efg", "fe_solids", "fe_shells", "fe_beams", "failed_beams"]
-    real(wp) :: seconds(9)
-    integer :: counts(10), entry, status
+    character(len=*), parameter :: second_names(11) = [character(len=17) :: "wall_s", &
+      "fe_solid_s", "fe_shell_s", "efg_s", "contact_s", "output_s", "setup_s", "efg_setup_s", "fe_beam_s", &
+      "efg_shell_s", "efg_shell_setup_s"]
+    character(len=*), parameter :: count_names(13) = [character(len=19) :: "cycles", "threads", &
+      "fe_elements", "efg_particles", "dofs_total", "dofs_efg", "fe_solids", "fe_shells", "fe_beams", "failed_beams", &
+      "efg_shell_cells", "efg_shell_particles", "dofs_efg_shell"]
+    real(wp) :: seconds(11)
+    integer :: counts(13), entry, status
     integer(hid_t) :: group_id
 
     call create_group_path(results%file_id, "/timing", error)
@@ -1366,10 +1368,12 @@ contains
       return
     end if
     seconds = [summary%wall_s, summary%fe_solid_s, summary%fe_shell_s, summary%efg_s, &
-               summary%contact_s, summary%output_s, summary%setup_s, summary%efg_setup_s, summary%fe_beam_s]
+               summary%contact_s, summary%output_s, summary%setup_s, summary%efg_setup_s, summary%fe_beam_s, &
+               summary%efg_shell_s, summary%efg_shell_setup_s]
     counts = [summary%cycles, summary%threads, summary%fe_elements, summary%efg_particles, &
               summary%dofs_total, summary%dofs_efg, summary%fe_solids, summary%fe_shells, &
-              summary%fe_beams, summary%failed_beams]
+              summary%fe_beams, summary%failed_beams, summary%efg_shell_cells, summary%efg_shell_particles, &
+              summary%dofs_efg_shell]
     do entry = 1, size(seconds)
       call write_real_attribute(group_id, "/timing", trim(second_names(entry)), seconds(entry), &
                                 error)

@@ -2,9 +2,9 @@
 !> (the registration point of a new kind), sets up their masses, computes the internal forces
 !> of all of them and gathers what the engine needs from their headers.
 !>
-!> Order is part of the results: groups are visited solids, shells, meshfree parts, beams, always, so
-!> a node shared by several kinds receives their forces in the same order on every run, and the
-!> smallest stable step goes to the first group on a tie.
+!> Order is part of the results: groups are visited solids, shells, meshfree parts, meshfree
+!> shells, beams, always, so a node shared by several kinds receives their forces in the same
+!> order on every run, and the smallest stable step goes to the first group on a tie.
 module element_groups
   use kinds, only: wp
   use error_handling, only: error_t
@@ -14,6 +14,7 @@ module element_groups
   use solid_group, only: new_solid_group
   use shell_group, only: new_shell_group
   use efg_group, only: new_efg_group
+  use efg_shell_group, only: new_efg_shell_group
   use beam_group, only: new_beam_group
   use wall_clock, only: start_phase, stop_phase
   implicit none
@@ -38,6 +39,9 @@ contains
     call new_shell_group(model, group)
     call add(group)
     call new_efg_group(model, group, error)
+    if (allocated(error)) return
+    call add(group)
+    call new_efg_shell_group(model, group, error)
     if (allocated(error)) return
     call add(group)
     call new_beam_group(model, group)

@@ -353,17 +353,52 @@ contains
   end subroutine advance_positions
 
   !> Penalty contact forces at t^{n+1} and their energy (initial penetrations are reported once).
+  !> Meshfree particles take part with their physical values: the contacts see x = X + A d and
+  !> A v, and their forces f on those come back to the generalized unknowns as A^T f (the
+  !> groups' to_physical and forces_to_generalized; consistent, and momentum is kept because the
+  !> rows of A sum to one). Contact energy is the work on the physical motion, which A^T makes
+  !> the same as on the generalized one.
   subroutine contact_forces(model, state, step)
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(inout) :: state
     real(wp), intent(in) :: step
     real(wp) :: work
+    integer :: k
     if (size(state%contacts) == 0) return
-    call compute_contact_forces(model, state%contacts, state%time, step, state%nodes%coordinates, &
-                                state%nodes%velocity, state%nodes%mass, state%nodes%contact_force, work)
+    if (.not. any(state%nodes%is_particle)) then
+      call compute_contact_forces(model, state%contacts, state%time, step, state%nodes%coordinates, &
+                                  state%nodes%velocity, state%nodes%mass, state%nodes%contact_force, work)
+    else
+      call physical_contact_values(state)
+      call compute_contact_forces(model, state%contacts, state%time, step, state%contact_coordinates, &
+                                  state%contact_velocity, state%nodes%mass, state%nodes%contact_force, work)
+      state%contact_physical_force = state%nodes%contact_force
+      do k = 1, size(state%groups)
+        call state%groups(k)%group%forces_to_generalized(state%contact_physical_force, state%nodes%contact_force)
+      end do
+    end if
     state%energy%contact = state%energy%contact + work
     call report_initial_penetrations(model, state%contacts, state%time)
   end subroutine contact_forces
+
+  !> The physical positions and velocities of every node for the contacts: the solver's values,
+  !> with the meshfree groups' interior particles transformed (to_physical).
+  subroutine physical_contact_values(state)
+    type(explicit_state_t), intent(inout) :: state
+    integer :: k
+    associate (nodes => state%nodes)
+      if (.not. allocated(state%contact_coordinates)) &
+        allocate (state%contact_coordinates(3, nodes%count), state%contact_velocity(3, nodes%count), &
+                  state%contact_physical_force(3, nodes%count))
+      state%contact_coordinates = nodes%displacement
+      state%contact_velocity = nodes%velocity
+      do k = 1, size(state%groups)
+        call state%groups(k)%group%to_physical(nodes%displacement, state%contact_coordinates)
+        call state%groups(k)%group%to_physical(nodes%velocity, state%contact_velocity)
+      end do
+      state%contact_coordinates = nodes%reference + state%contact_coordinates
+    end associate
+  end subroutine physical_contact_values
 
   !> Nodal loads at t^{n+1} and their work over the second half of the step.
   subroutine external_forces(model, state, step)

@@ -78,6 +78,10 @@ module explicit_state
     logical, allocatable :: solid_eroded(:), shell_eroded(:)
     logical :: eroded_this_cycle = .false.
     integer :: eroded_count = 0
+    !> Contact on physical values (explicit_solver's contact phase, models with meshfree
+    !> particles): the positions and velocities the contacts see and their forces on them,
+    !> (3, nodes) each, allocated at the first contact phase and reused
+    real(wp), allocatable :: contact_coordinates(:, :), contact_velocity(:, :), contact_physical_force(:, :)
     ! bookkeeping
     real(wp), allocatable :: chunk_sums(:, :)            !< (5, chunks of nodes): scratch of the fixed-order
                                                          !< sums (fixed_order_sum), allocated once

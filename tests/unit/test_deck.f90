@@ -10,7 +10,7 @@ program test_deck
   use error_handling, only: error_t, error_list_t
   use text_format, only: integer_text
   use model, only: model_t, formulation_fe, formulation_efg, motion_displacement, motion_velocity, &
-                   kernel_cubic_box, kernel_cubic_sphere, boundary_coupled, &
+                   kernel_cubic_box, kernel_cubic_sphere, kernel_quadratic_box, boundary_coupled, &
                    boundary_full_transformation, integration_local_boundary, integration_gauss, &
                    integration_gauss_conventional, formulation_rigid, section_shell, section_solid
   use material_laws, only: law_elastic, law_plastic_kinematic, law_honeycomb, &
@@ -65,6 +65,8 @@ program test_deck
   call test_shell_rotations_on_solids()
   call test_shell_errors()
   call test_shell_section_errors()
+  call test_efg_shell_sections()
+  call test_efg_shell_section_errors()
   call test_line_table_beyond_2_gib()
   call test_keyword_suggestions()
   call test_known_keywords_are_read()
@@ -1590,8 +1592,8 @@ contains
     type(model_t) :: model
     type(error_list_t) :: warnings
     call read_bad("shell_elform.k", plate_replaced(18, "1,16"), [character(len=300) :: &
-      "@:18: *SECTION_SHELL: field ELFORM: shell formulation 16 is not available; ELFORM 2 "// &
-      "(Belytschko-Tsay) is the one shell crashfree has"], message_lines=1)
+      "@:18: *SECTION_SHELL: field ELFORM: shell formulation 16 is not available; crashfree "// &
+      "has ELFORM 2 (Belytschko-Tsay) and 41 (meshfree EFG shell)"], message_lines=1)
     call read_bad("shell_nip.k", plate_replaced(18, "1,2,0.8333,11"), [character(len=300) :: &
       "@:18: *SECTION_SHELL: field NIP: integration points through the thickness must be "// &
       "1-10 (0 or blank: 2), found 11"], message_lines=1)
@@ -1627,6 +1629,99 @@ contains
       index(warnings%text, "shell_warnings.k:19: *SECTION_SHELL: field EDGSET: ignored "// &
       "(seatbelt shells are not available)") > 0, warnings%text)
   end subroutine test_shell_section_errors
+
+  !> The plate deck with its shell section given by `section` (lines 22 on: *SECTION_SHELL,
+  !> card 1, card 2, the EFG card ...) instead of lines 17-19 (comments there).
+  function plate_with_section(section) result(lines)
+    character(len=*), intent(in) :: section(:)
+    character(len=line_length), allocatable :: lines(:)
+    lines = plate_deck(section)
+    lines(17:19) = "$"
+  end function plate_with_section
+
+  !> *SECTION_SHELL ELFORM 41 and its EFG card DX DY ISPLINE IDILA IEBT IDIM: blank fields take
+  !> DX = DY = 1.1 (LS-DYNA's default for the shell card), the cubic spline on a box, IDILA 0,
+  !> IEBT 3, IDIM 1; the part becomes meshfree; the next section is read in place.
+  subroutine test_efg_shell_sections()
+    type(model_t) :: model
+    type(error_list_t) :: warnings
+    call read_good("efg_shell_defaults.k", plate_with_section([character(len=line_length) :: &
+      "*SECTION_SHELL", "1,41,0.8333,3", "1.5", "", &                          ! 22-25
+      "*SECTION_SHELL", "2,41", "1.0", "1.5,1.3,1,0,3,1", &                   ! 26-29
+      "*SECTION_SHELL_TITLE", "disk", "3,41", "2.0", "1.4,0.0,2", &           ! 30-34
+      "*SECTION_SHELL", "4", "1.0"]), model, warnings)                         ! 35-37
+    if (.not. allocated(model%sections)) return
+    if (size(model%sections) /= 4) then
+      call check(suite, "efg shell: four sections", .false.)
+      return
+    end if
+    associate (defaults => model%sections(1), given => model%sections(2), &
+               disk => model%sections(3), fe => model%sections(4))
+      call check(suite, "efg shell: ELFORM 41 kept", defaults%kind == section_shell .and. &
+                 defaults%element_formulation == 41 .and. given%element_formulation == 41)
+      call check_close(suite, "efg shell: blank DX DY are 1.1", defaults%support_scale(1:2), &
+                       [1.1_wp, 1.1_wp], thr=0.0_wp)
+      call check(suite, "efg shell: blank ISPLINE IDILA IEBT IDIM", &
+                 defaults%kernel == kernel_cubic_box .and. defaults%dilation_basis == 0 .and. &
+                 defaults%boundary_treatment == boundary_coupled .and. &
+                 defaults%domain_integration == integration_local_boundary)
+      call check_close(suite, "efg shell: the FE cards still read", &
+                       [defaults%thickness(1), defaults%shear_factor], [1.5_wp, 0.8333_wp], &
+                       thr=0.0_wp)
+      call check(suite, "efg shell: NIP still read", defaults%integration_points == 3)
+      call check_close(suite, "efg shell: DX DY given", given%support_scale(1:2), &
+                       [1.5_wp, 1.3_wp], thr=0.0_wp)
+      call check(suite, "efg shell: ISPLINE 1 is the quadratic spline", &
+                 given%kernel == kernel_quadratic_box)
+      call check(suite, "efg shell: ISPLINE 2 is the circle", disk%kernel == kernel_cubic_sphere &
+                 .and. disk%title == "disk")
+      call check_close(suite, "efg shell: circle DX, DY 0 is 1.1", disk%support_scale(1:2), &
+                       [1.4_wp, 1.1_wp], thr=0.0_wp)
+      call check(suite, "efg shell: the next section in place", fe%id == 4 .and. &
+                 fe%element_formulation == 2)
+    end associate
+    call check(suite, "efg shell: no warning for blank fields", warnings%count == 0, warnings%text)
+    call check(suite, "efg shell: the part is meshfree", model%parts(1)%section == 1 .and. &
+               model%parts(1)%formulation == formulation_efg)
+
+    call read_good("efg_shell_circle_dy.k", plate_with_section([character(len=line_length) :: &
+      "*SECTION_SHELL", "1,41", "1.5", "1.4,1.2,2"]), model, warnings)
+    call check(suite, "efg shell: DY of a circle warned", warnings%count == 1 .and. &
+      index(warnings%text, "efg_shell_circle_dy.k:25: *SECTION_SHELL: field DY: ignored (a "// &
+      "circular support (ISPLINE 2) has one radius, scaled by DX)") > 0, warnings%text)
+  end subroutine test_efg_shell_sections
+
+  !> Every value of the shell's EFG card that crashfree does not build is an error naming its
+  !> field and line; ELFORM 42 is refused on card 1 and its EFG card read over.
+  subroutine test_efg_shell_section_errors()
+    call read_bad("efg_shell_values.k", plate_with_section([character(len=line_length) :: &
+      "*SECTION_SHELL", "1,41", "1.5", "0.9,1.0,3,1,1,2", &                   ! 22-25
+      "*SECTION_SHELL", "2,42", "1.5", "1.5,1.5", &                           ! 26-29
+      "*SECTION_SHELL", "3,41", "1.5", ",,,2,0,0"]), [character(len=300) :: &    ! 30-33
+      "@:25: *SECTION_SHELL: field DX: DX must be greater than 1: at 1.0 a vertex weight "// &
+      "vanishes on the cell's far corner; found 0.9 (blank or 0 means 1.1)", &
+      "@:25: *SECTION_SHELL: field DY: DY must be greater than 1", &
+      "@:25: *SECTION_SHELL: field ISPLINE: must be 0 (cubic spline, box support), 1 "// &
+      "(quadratic spline, box support) or 2 (cubic spline, circular support), found 3", &
+      "@:25: *SECTION_SHELL: field IDILA: IDILA 1 (support size from the surrounding nodes) "// &
+      "is not available", &
+      "@:25: *SECTION_SHELL: field IEBT: essential boundary treatment 1 is not available for "// &
+      "meshfree shells; crashfree has IEBT 3", &
+      "@:25: *SECTION_SHELL: field IDIM: domain integration 2 is not available for meshfree "// &
+      "shells; crashfree has IDIM 1", &
+      "@:27: *SECTION_SHELL: field ELFORM: the global meshfree shell (ELFORM 42, LS-DYNA's "// &
+      "EFG shell for metal forming) is not available; use ELFORM 41", &
+      "@:33: *SECTION_SHELL: field IDILA: must be 0 (support size from the background "// &
+      "elements), found 2", &
+      "@:33: *SECTION_SHELL: field IEBT: essential boundary treatment 0 is not available for "// &
+      "meshfree shells", "0 is not a default here: leave the field blank", &
+      "@:33: *SECTION_SHELL: field IDIM: domain integration 0 is not available"], &
+      message_lines=10)
+    call read_bad("efg_shell_missing_card.k", [character(len=line_length) :: &
+      plate_with_section([character(len=line_length) :: "*SECTION_SHELL", "1,41", "1.5"])], &
+      [character(len=300) :: "@:24: *SECTION_SHELL: field DX: the EFG card (DX DY ISPLINE "// &
+      "IDILA IEBT IDIM) of section 1 is missing"], message_lines=1)
+  end subroutine test_efg_shell_section_errors
 
   ! ---------------------------------------------------------------- line table, keyword names
 
