@@ -149,7 +149,17 @@ def summarize(run: dict) -> dict:
                                    "internal_peak", "hourglass", "kinetic", "kinetic_start", "contact_energy",
                                    "worst_jacobian_run", "path")}
     s["cpu_per_ms"] = run["cpu"] / run["end_time"] if run["end_time"] > 0 else np.nan
-    s["efg_share"] = run["dofs_efg"] / run["dofs_total"] if run["dofs_total"] else 0.0
+    # meshfree share of the dofs, two ways: every node of a meshfree part (3 dofs, 3 more on a
+    # shell node; a node of a meshfree solid and shell counted once), as the generator prints
+    # it; and the interior particles only (the Gamma nodes keep FE functions)
+    mesh = run["mesh"]
+    efg_parts = [int(p) for p, f in zip(mesh["part_ids"], mesh["formulations"]) if f == "efg"]
+    solid_nodes = set(np.unique(mesh["connectivity"][np.isin(mesh["solid_part_ids"], efg_parts)]).tolist())
+    shell_nodes = set(np.unique(run["shells"][np.isin(run["shell_parts"], efg_parts)]).tolist())
+    total = max(run["dofs_total"], 1)
+    s["efg_share"] = (3 * len(solid_nodes | shell_nodes) + 3 * len(shell_nodes)) / total
+    timing = run["timing"]
+    s["particle_share"] = (3 * int(timing.get("efg_particles", 0)) + 6 * int(timing.get("efg_shell_particles", 0))) / total
     s["hourglass_ratio"] = run["hourglass"] / run["internal"] if run["internal"] else np.nan
     k = int(np.argmax(run["force"]))
     s["peak_force"], s["peak_time"] = float(run["force"][k]), float(run["time"][k])
@@ -157,9 +167,10 @@ def summarize(run: dict) -> dict:
     s["impulse"] = float(np.trapezoid(run["force"], run["time"]))
     s["door_dv"] = float(run["door_velocity"][-1] - run["door_velocity"][0])
     s.update(quality(run, run["last"][1]))
-    timing = run["timing"]
+    # efg_s holds both meshfree kinds; efg_shell_s the shells' share of it
     phases = {"FE solids": timing.get("fe_solid_s", 0.0), "FE shells": timing.get("fe_shell_s", 0.0),
-              "meshfree": timing.get("efg_s", 0.0), "contact": timing.get("contact_s", 0.0),
+              "meshfree solids": timing.get("efg_s", 0.0) - timing.get("efg_shell_s", 0.0),
+              "meshfree shells": timing.get("efg_shell_s", 0.0), "contact": timing.get("contact_s", 0.0),
               "output": timing.get("output_s", 0.0)}
     wall = float(timing.get("wall_s", np.nan))
     phases["other"] = wall - sum(phases.values())
@@ -273,7 +284,8 @@ def table(summaries, labels) -> str:
             ("end time reached (ms)", lambda s: f"{s['end_time']:.2f}"),
             ("cycles", lambda s: f"{s['cycles']}"),
             ("CPU (s), per simulated ms", lambda s: f"{s['cpu']:.1f} ({s['cpu_source']}), {s['cpu_per_ms']:.2f}"),
-            ("meshfree dofs / model dofs", lambda s: f"{s['dofs_efg']} / {s['dofs_total']} = {100 * s['efg_share']:.1f}%"),
+            ("meshfree share of the dofs: nodes of meshfree parts; interior particles",
+             lambda s: f"{100 * s['efg_share']:.1f}%; {100 * s['particle_share']:.1f}% (of {s['dofs_total']})"),
             ("energy ratio at the end (min, max)",
              lambda s: f"{s['energy_ratio']:.4f} ({s['energy_ratio_min']:.4f}, {s['energy_ratio_max']:.4f})"),
             ("kinetic energy start / end (J)", lambda s: f"{s['kinetic_start']:.0f} / {s['kinetic']:.0f}"),
@@ -289,8 +301,9 @@ def table(summaries, labels) -> str:
              lambda s: "-" if np.isnan(s["min_jacobian"]) else f"{s['min_jacobian']:.2f} ({s['min_jacobian_element']})"),
             ("worst corner Jacobian ratio over the run (solver)", lambda s: f"{s['worst_jacobian_run']:.2f}"),
             ("smallest jacket shell area A/A0, end", lambda s: f"{s['min_jacket_area']:.3f}"),
-            ("seconds: FE solids / FE shells / meshfree / contact / other",
-             lambda s: " / ".join(f"{s['phases'][k]:.1f}" for k in ("FE solids", "FE shells", "meshfree", "contact"))
+            ("seconds (/timing): FE solids / FE shells / meshfree solids / meshfree shells / contact / other",
+             lambda s: " / ".join(f"{s['phases'][k]:.1f}" for k in ("FE solids", "FE shells", "meshfree solids",
+                                                                      "meshfree shells", "contact"))
              + f" / {s['phases']['other'] + s['phases']['output']:.1f}"),
             ("message", lambda s: s["message"] or "-")]
     lines = ["| | " + " | ".join(labels) + " |", "|---|" + "---|" * len(labels)]

@@ -223,12 +223,13 @@ class Mesh:
 
     def dof_counts(self, efg_parts) -> dict:
         """Degrees of freedom as the solver counts them in /timing: 3 translations per node and 3
-        rotations more per shell node (dofs_total); 3 per node of a meshfree solid part and 6 per
-        node of a meshfree shell part (dofs_efg; a node in both counts its 6 once). Rigid bodies
-        count as their nodes, as the solver's count does."""
+        rotations more per deformable shell node (dofs_total); 3 per node of a meshfree solid part and 6 per
+        node of a meshfree shell part (a node in both counts its 6 once). The nodes of the rigid
+        door count their translations only, as the solver's count does."""
         shell_nodes = set()
-        for _, _, corners in self.shells:
-            shell_nodes.update(corners)
+        for _, pid, corners in self.shells:
+            if pid != PART_DOOR:          # the rigid door's nodes have no rotational dofs
+                shell_nodes.update(corners)
         efg_solid = self.part_nodes([p for p in efg_parts if p in PART_FOAMS])
         efg_shell = self.part_nodes([p for p in efg_parts if p == PART_JACKET])
         efg = 3 * len(efg_solid | efg_shell) + 3 * len(efg_shell)
