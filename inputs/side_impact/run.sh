@@ -6,6 +6,7 @@
 #   inputs/side_impact/run.sh                  # the shipped decks, NCPU=1, into results/side_impact
 #   REPEAT=3 inputs/side_impact/run.sh         # the timing study: medians of 3 runs each
 #   DECKS="fe coupled" inputs/side_impact/run.sh   # only some of the decks
+#   DECK_DIR=DIR inputs/side_impact/run.sh     # decks written elsewhere by the generator (e.g. --end-time 10)
 #
 # The user CPU seconds of each run go to cpu_seconds.txt beside its results (the machine may be
 # shared: CPU time, not wall time, is what the ratio compares); all of them, with the simulated
@@ -16,7 +17,7 @@ ncpu=${NCPU:-1}
 repeat=${REPEAT:-1}
 output=${OUTPUT:-results/side_impact}
 python=${PYTHON:-python3}
-decks=inputs/side_impact
+decks=${DECK_DIR:-inputs/side_impact}
 names=${DECKS:-fe ribs_efg coupled}
 mkdir -p "$output"
 run() {   # run NAME
