@@ -314,7 +314,7 @@ def write_deck(mesh: Mesh, path: Path, args, deck: str):
            "*CONTROL_TERMINATION", card(end),
            "*CONTROL_TIMESTEP", "$   DTINIT    TSSFAC", card(0.0, args.tssfac),
            "*CONTROL_HOURGLASS", "$      IHQ        QH", card(args.ihq, args.qh),
-           "*CONTROL_ENERGY", "$     HGEN      RWEN    SLNTEN", card(2, 2, 2),
+           "*CONTROL_ENERGY", "$     HGEN      RWEN", card(2, 2),
            "*DATABASE_GLSTAT", card(end / 600),
            "*DATABASE_MATSUM", card(end / 600),
            "*DATABASE_RCFORC", card(end / 600),
