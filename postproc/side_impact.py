@@ -143,6 +143,16 @@ def quality(run: dict, displacement) -> dict:
     return result
 
 
+def moving_mean(time, values, window: float) -> np.ndarray:
+    """Centred moving mean over `window` (ms) of a uniformly sampled history."""
+    step = float(np.median(np.diff(time))) if len(time) > 1 else window
+    n = max(1, int(round(window / step)))
+    if n < 2 or len(values) <= n:
+        return np.asarray(values, float)
+    padded = np.pad(np.asarray(values, float), (n // 2, n - 1 - n // 2), mode="edge")
+    return np.convolve(padded, np.ones(n) / n, mode="valid")
+
+
 def summarize(run: dict) -> dict:
     s = {key: run[key] for key in ("status", "message", "end_time", "cycles", "cpu", "cpu_source", "dofs_total",
                                    "dofs_efg", "energy_ratio", "energy_ratio_min", "energy_ratio_max", "internal",
@@ -163,6 +173,11 @@ def summarize(run: dict) -> dict:
     s["hourglass_ratio"] = run["hourglass"] / run["internal"] if run["internal"] else np.nan
     k = int(np.argmax(run["force"]))
     s["peak_force"], s["peak_time"] = float(run["force"][k]), float(run["time"][k])
+    # the force chatters (the rigid door knocks light jacket nodes ahead of it): the peak of its
+    # 1 ms moving mean is the measure to compare
+    mean = moving_mean(run["time"], run["force"], 1.0)
+    k = int(np.argmax(mean))
+    s["peak_mean_force"], s["peak_mean_time"] = float(mean[k]), float(run["time"][k])
     # impulse of the contact on the door (trapezoidal rule) against the door's momentum change
     s["impulse"] = float(np.trapezoid(run["force"], run["time"]))
     s["door_dv"] = float(run["door_velocity"][-1] - run["door_velocity"][0])
@@ -187,12 +202,12 @@ def plot_force(runs, summaries, labels, output: Path):
     fig, ax = plt.subplots(figsize=(7.5, 4.4))
     for run, s, label in zip(runs, summaries, labels):
         ending = "" if "normal" in s["status"] else f", stops at {s['end_time']:.1f} ms"
-        ax.plot(run["time"], run["force"], lw=1.1, label=f"{label} (peak {s['peak_force']:.1f} kN at "
-                                                         f"{s['peak_time']:.1f} ms{ending})")
+        ax.plot(run["time"], run["force"], lw=0.8, label=f"{label} (1 ms mean: peak {s['peak_mean_force']:.1f} kN "
+                                                         f"at {s['peak_mean_time']:.1f} ms{ending})")
         if "normal" not in s["status"]:
             ax.plot(run["time"][-1], run["force"][-1], "x", color=ax.lines[-1].get_color(), ms=9)
     ax.set_xlabel("time (ms)")
-    ax.set_ylabel("force door - thorax (kN)")
+    ax.set_ylabel("force door - thorax (kN), samples")
     ax.set_title("Side-impact dummy component test: contact force (Fig. 17 analog)")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
@@ -292,7 +307,8 @@ def table(summaries, labels) -> str:
             ("internal energy end (peak) (J)", lambda s: f"{s['internal']:.0f} ({s['internal_peak']:.0f})"),
             ("hourglass energy (J), / internal", lambda s: f"{s['hourglass']:.1f}, {100 * s['hourglass_ratio']:.1f}%"),
             ("contact energy (J)", lambda s: f"{s['contact_energy']:.1f}"),
-            ("peak force (kN) at (ms)", lambda s: f"{s['peak_force']:.2f} at {s['peak_time']:.2f}"),
+            ("peak force (kN) at (ms): of the 1 ms mean; of the samples",
+             lambda s: f"{s['peak_mean_force']:.2f} at {s['peak_mean_time']:.2f}; {s['peak_force']:.2f} at {s['peak_time']:.2f}"),
             ("contact impulse / door mass x velocity change (kN ms)",
              lambda s: f"{s['impulse']:.1f} / {s['door_mass'] * s['door_dv']:.1f}"),
             ("smallest V/V0 of an FE foam solid (element), end",
