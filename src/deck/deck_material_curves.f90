@@ -2,6 +2,7 @@
 !> - the laws with curve slots (*MAT_HONEYCOMB, *MAT_MODIFIED_HONEYCOMB, *MAT_LOW_DENSITY_FOAM,
 !>   *MAT_PIECEWISE_LINEAR_PLASTICITY): their curve ids resolved to copies of the curves kept in
 !>   the material (so that the law kernels get them through the material dispatch);
+!> - *MAT_MOONEY-RIVLIN_RUBBER with LCID1: A and B fitted to the test curve;
 !> - each part's section against the element families its law takes: shells, solids, meshfree
 !>   (*MAT_NULL: shells only), and the hexahedron formulations ELFORM 1, 2 and 41 for the laws
 !>   that need them (the crushable honeycombs and foam).
@@ -9,7 +10,9 @@ module deck_material_curves
   use kinds, only: wp
   use model, only: model_t, material_t, section_shell, section_beam, piecewise_hardening_curve
   use material_laws, only: law_table, find_law, law_keyword_name, law_curve_field, law_piecewise_linear, &
-                           law_null
+                           law_null, law_mooney_rivlin
+  use material_rubber, only: mooney_rivlin_fit
+  use deck_materials, only: mooney_rivlin_check
   use deck_problems, only: problem_log_t
   use text_format, only: integer_text, real_text
   use deck_lexer, only: deck_t
@@ -62,10 +65,39 @@ contains
             integer_text(material%curve_ids(k))//" of material "//integer_text(material%id)// &
             " is not defined"//missing)
         end do
+        if (material%law == law_mooney_rivlin .and. material%curve_ids(1) > 0) then
+          if (allocated(material%curves(1)%abscissa)) call fit_mooney_rivlin(deck, material, line, log)
+        end if
       end associate
     end do
     call check_part_laws(deck, model, material_lines, part_lines, log)
   end subroutine resolve_material_curves
+
+  !> *MAT_MOONEY-RIVLIN_RUBBER with LCID1: A and B by least squares on its uniaxial test curve
+  !> (force against change of gauge length; stretch 1 + dL / SGL, nominal stress F / (SW ST));
+  !> material_rubber's mooney_rivlin_fit), then the checks of the reader on them.
+  subroutine fit_mooney_rivlin(deck, material, line, log)
+    type(deck_t), intent(in) :: deck
+    type(material_t), intent(inout) :: material
+    integer, intent(in) :: line
+    type(problem_log_t), intent(inout) :: log
+    logical :: fitted
+    character(len=:), allocatable :: field, problem
+    associate (curve => material%curves(1), dimensions => material%specimen_dimensions)
+      if (.not. all(dimensions > 0.0_wp)) return         ! reported by the reader
+      call mooney_rivlin_fit(1.0_wp + curve%abscissa/dimensions(1), curve%ordinate/(dimensions(2)*dimensions(3)), &
+                             material%mooney_rivlin_a, material%mooney_rivlin_b, fitted)
+      if (.not. fitted) then
+        call located_problem(deck, log, line, "LCID1", "curve "//integer_text(curve%id)//" of material "// &
+          integer_text(material%id)//" needs points at two or more different changes of gauge length "// &
+          "(besides 0) to fit A and B")
+        return
+      end if
+      call mooney_rivlin_check(material, field, problem)
+      if (len(problem) > 0) call located_problem(deck, log, line, "LCID1", "A and B fitted to curve "// &
+        integer_text(curve%id)//" of material "//integer_text(material%id)//": "//problem)
+    end associate
+  end subroutine fit_mooney_rivlin
 
   !> The LCSS yield curve and the LCSR scale factors of *MAT_024 must stay positive.
   subroutine check_positive_curve(deck, material, law, slot, line, log)

@@ -31,6 +31,7 @@ module deck_materials
   public :: read_modified_honeycomb_materials, read_low_density_foam_materials
   public :: read_piecewise_linear_materials, read_null_materials, append_material
   public :: read_mooney_rivlin_materials, read_blatz_ko_materials, read_viscoelastic_materials
+  public :: mooney_rivlin_check
 
   !> Poisson's ratio of *MAT_BLATZ-KO_RUBBER (LS-DYNA Theory Manual, Material Model 7).
   real(wp), parameter, public :: blatz_ko_poissons_ratio = 0.463_wp
@@ -560,11 +561,13 @@ contains
   end subroutine read_low_density_foam_materials
 
   !> *MAT_MOONEY-RIVLIN_RUBBER: C1 MID RO PR A B REF; C2 (optional at the end of the keyword)
-  !> SGL SW ST LCID1 DATA LCID2 BSTART TRAMP. E and PR of the material are set to the
-  !> small-strain moduli (E = 2 G (1 + PR), G = 2 (A + B)) for the time step, the hourglass and
-  !> transverse shear stiffness and the contact stiffness. Not built, so rejected when given: the
-  !> fit of A and B to a test curve (LCID1), the viscoelastic relaxation curve (LCID2, BSTART,
-  !> TRAMP) and the reference geometry (REF).
+  !> SGL SW ST LCID1 DATA LCID2 BSTART TRAMP. With LCID1 > 0, A and B are fitted to the uniaxial
+  !> test curve (force against change of gauge length of a SGL x SW x ST specimen) by the
+  !> cross-check once the curve is resolved (deck_material_curves); else they are taken from card
+  !> 1. E and PR of the material are set to the small-strain moduli (E = 2 G (1 + PR),
+  !> G = 2 (A + B)) for the time step, the hourglass and transverse shear stiffness and the
+  !> contact stiffness. Not built, so rejected when given: DATA other than uniaxial, the
+  !> viscoelastic relaxation curve (LCID2, BSTART, TRAMP) and the reference geometry (REF).
   subroutine read_mooney_rivlin_materials(deck, block, keyword, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block
@@ -572,10 +575,12 @@ contains
     type(deck_input_t), intent(inout) :: input
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
-    type(card_t) :: card
-    integer :: line, n
-    real(wp) :: lowest_ratio, value
-    character(len=:), allocatable :: title
+    type(card_t) :: card, first_card
+    integer :: line, n, curve, test_curve, k
+    real(wp) :: value
+    logical :: more
+    character(len=:), allocatable :: title, field, problem
+    character(len=3), parameter :: specimen_fields(3) = ["SGL", "SW ", "ST "]
 
     line = 0
     do while (next_definition(deck, block, keyword%title, line, standard_widths, card, title, &
@@ -594,41 +599,86 @@ contains
                                                   "> 0, found "//integer_text(material%id))
           if (material%density <= 0.0_wp) call card_problem(deck, log, card, "RO", "density must "// &
             "be > 0, found "//shown(card, 2, material%density))
-          if (.not. material%mooney_rivlin_a + material%mooney_rivlin_b > 0.0_wp) then
-            call card_problem(deck, log, card, "A", "the shear modulus 2 (A + B) must be > 0, found A = "// &
-              real_text(material%mooney_rivlin_a)//", B = "//real_text(material%mooney_rivlin_b))
-          else if (material%poissons_ratio >= 0.5_wp) then
-            call card_problem(deck, log, card, "PR", "Poisson's ratio must be < 0.5 (0.49 to 0.495 are "// &
-              "usual for rubber), found "//shown(card, 3, material%poissons_ratio))
-          else
-            ! D >= 0 (the volumetric term convex, sigma_33 = 0 solvable in shells) needs
-            ! PR >= (2 A + 5 B) / (5 A + 11 B)
-            lowest_ratio = (2.0_wp*material%mooney_rivlin_a + 5.0_wp*material%mooney_rivlin_b)/ &
-                           (5.0_wp*material%mooney_rivlin_a + 11.0_wp*material%mooney_rivlin_b)
-            if (material%poissons_ratio < lowest_ratio) call card_problem(deck, log, card, "PR", &
-              "Poisson's ratio must lie in ["//real_text(lowest_ratio)//", 0.5) for these A and B (below, "// &
-              "the volumetric term D (I3 - 1)^2 has D < 0); rubber is nearly incompressible (0.49 to "// &
-              "0.495), found "//shown(card, 3, material%poissons_ratio))
-          end if
-          material%youngs_modulus = 4.0_wp*(material%mooney_rivlin_a + material%mooney_rivlin_b)* &
-                                    (1.0_wp + material%poissons_ratio)
+          if (material%poissons_ratio >= 0.5_wp) call card_problem(deck, log, card, "PR", "Poisson's ratio "// &
+            "must be < 0.5 (0.49 to 0.495 are usual for rubber), found "//shown(card, 3, material%poissons_ratio))
         end if
-        if (.not. next_line(deck, block, line, .false.)) exit
-        call open_card(deck, block, line, standard_widths, card, log)
-        call require_zero(deck, card, 4, "LCID1", "fitting A and B to a uniaxial test curve is not "// &
-                          "available; give A and B", log)
-        call warn_if_set(deck, card, 1, "SGL", "specimen gauge length: used only with LCID1", warnings)
-        call warn_if_set(deck, card, 2, "SW", "specimen width: used only with LCID1", warnings)
-        call warn_if_set(deck, card, 3, "ST", "specimen thickness: used only with LCID1", warnings)
-        call get_real(deck, card, 5, "DATA", value, log)
-        call warn_if_set(deck, card, 5, "DATA", "used only with LCID1", warnings)
-        call require_zero(deck, card, 6, "LCID2", "viscoelastic relaxation of this rubber is not available "// &
-                          "(use *MAT_VISCOELASTIC for a viscoelastic part)", log)
-        call require_zero(deck, card, 7, "BSTART", "used only with LCID2, which is not available", log)
-        call require_zero(deck, card, 8, "TRAMP", "used only with LCID2, which is not available", log)
+        first_card = card
+        test_curve = 0
+        more = next_line(deck, block, line, .false.)
+        if (more) then
+          call open_card(deck, block, line, standard_widths, card, log)
+          do k = 1, 3
+            call get_real(deck, card, k, trim(specimen_fields(k)), material%specimen_dimensions(k), log)
+          end do
+          call get_integer(deck, card, 4, "LCID1", test_curve, log)
+          call get_real(deck, card, 5, "DATA", value, log)
+          if (.not. card%failed) then
+            if (test_curve < 0) call card_problem(deck, log, card, "LCID1", "curve id must be >= 0 (0: A and B "// &
+              "from card 1), found "//integer_text(test_curve))
+            if (test_curve > 0) then
+              do k = 1, 3
+                if (.not. material%specimen_dimensions(k) > 0.0_wp) call card_problem(deck, log, card, &
+                  trim(specimen_fields(k)), "the specimen's gauge length, width and thickness must be > 0 with "// &
+                  "LCID1, found "//shown(card, k, material%specimen_dimensions(k)))
+              end do
+              if (value /= 0.0_wp .and. value /= 1.0_wp) call card_problem(deck, log, card, "DATA", "must be "// &
+                "blank, 0 or 1 (uniaxial test data, the only fit built), found "//real_text(value))
+              call warn_if_set(deck, first_card, 4, "A", "fitted to LCID1", warnings)
+              call warn_if_set(deck, first_card, 5, "B", "fitted to LCID1", warnings)
+            else
+              call warn_if_set(deck, card, 1, "SGL", "specimen gauge length: used only with LCID1", warnings)
+              call warn_if_set(deck, card, 2, "SW", "specimen width: used only with LCID1", warnings)
+              call warn_if_set(deck, card, 3, "ST", "specimen thickness: used only with LCID1", warnings)
+              call warn_if_set(deck, card, 5, "DATA", "used only with LCID1", warnings)
+            end if
+          end if
+          call get_integer(deck, card, 6, "LCID2", curve, log)
+          if (curve /= 0 .and. .not. card%failed) call card_problem(deck, log, card, "LCID2", "must be blank "// &
+            "or 0, found "//integer_text(curve)//": viscoelastic relaxation of this rubber is not available "// &
+            "(use *MAT_VISCOELASTIC for a viscoelastic part)")
+          call require_zero(deck, card, 7, "BSTART", "used only with LCID2, which is not available", log)
+          call require_zero(deck, card, 8, "TRAMP", "used only with LCID2, which is not available", log)
+        end if
+        material%curve_ids = [max(test_curve, 0)]
+        if (test_curve == 0 .and. .not. first_card%failed) then
+          call mooney_rivlin_check(material, field, problem)
+          if (len(problem) > 0) call card_problem(deck, log, first_card, field, problem)
+        end if
       end associate
+      if (.not. more) exit
     end do
   end subroutine read_mooney_rivlin_materials
+
+  !> The checks of Mooney-Rivlin's A, B and PR (`problem` empty when they pass; `field` names
+  !> the field to blame) and, when they pass, its E = 2 G (1 + PR), G = 2 (A + B). Shared by the
+  !> reader and, for A and B fitted to LCID1, the cross-check (deck_material_curves).
+  subroutine mooney_rivlin_check(material, field, problem)
+    type(material_t), intent(inout) :: material
+    character(len=:), allocatable, intent(out) :: field, problem
+    real(wp) :: lowest_ratio
+    field = "A"
+    problem = ""
+    if (.not. material%mooney_rivlin_a + material%mooney_rivlin_b > 0.0_wp) then
+      problem = "the shear modulus 2 (A + B) must be > 0, found A = "//real_text(material%mooney_rivlin_a)// &
+                ", B = "//real_text(material%mooney_rivlin_b)
+      return
+    end if
+    if (material%poissons_ratio >= 0.5_wp) return    ! reported by the reader
+    ! D >= 0 (the volumetric term convex, sigma_33 = 0 solvable in shells) needs
+    ! PR >= (2 A + 5 B) / (5 A + 11 B)
+    lowest_ratio = (2.0_wp*material%mooney_rivlin_a + 5.0_wp*material%mooney_rivlin_b)/ &
+                   (5.0_wp*material%mooney_rivlin_a + 11.0_wp*material%mooney_rivlin_b)
+    if (material%poissons_ratio < lowest_ratio) then
+      field = "PR"
+      problem = "Poisson's ratio must lie in ["//real_text(lowest_ratio)//", 0.5) for A = "// &
+        real_text(material%mooney_rivlin_a)//", B = "//real_text(material%mooney_rivlin_b)//" (below, the "// &
+        "volumetric term D (I3 - 1)^2 has D < 0); rubber is nearly incompressible (0.49 to 0.495), found "// &
+        real_text(material%poissons_ratio)
+      return
+    end if
+    material%youngs_modulus = 4.0_wp*(material%mooney_rivlin_a + material%mooney_rivlin_b)* &
+                              (1.0_wp + material%poissons_ratio)
+  end subroutine mooney_rivlin_check
 
   !> *MAT_BLATZ-KO_RUBBER: MID RO G REF, one card per material. Poisson's ratio is 0.463 (the
   !> law's); E = 2 G (1 + 0.463) is kept for the time step and the element stiffnesses.

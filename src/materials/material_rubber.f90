@@ -35,7 +35,7 @@ module material_rubber
   private
 
   public :: rubber_update, rubber_plane_stress_update, rubber_cauchy_stress
-  public :: rubber_plane_stress_thickness, mooney_rivlin_constants
+  public :: rubber_plane_stress_thickness, mooney_rivlin_constants, mooney_rivlin_fit
 
   !> The two rubbers (the `form` argument).
   integer, parameter, public :: rubber_mooney_rivlin = 1, rubber_blatz_ko = 2
@@ -56,6 +56,38 @@ contains
     constants(4) = (a*(5.0_wp*poissons_ratio - 2.0_wp) + b*(11.0_wp*poissons_ratio - 5.0_wp))/ &
                    (2.0_wp*(1.0_wp - 2.0_wp*poissons_ratio))
   end function mooney_rivlin_constants
+
+  !> Least-squares A and B of Mooney-Rivlin from a uniaxial test: `stretch` lambda_i and nominal
+  !> stress `nominal` P_i (force over the undeformed section), fitted to the incompressible
+  !> uniaxial curve P = 2 (lambda - lambda^-2) (A + B / lambda), which is linear in A and B: the
+  !> 2x2 normal equations. Points at lambda = 1 carry no information and are skipped. `fitted`
+  !> is false when fewer than two distinct stretches remain (singular normal equations).
+  pure subroutine mooney_rivlin_fit(stretch, nominal, a, b, fitted)
+    real(wp), intent(in) :: stretch(:), nominal(:)
+    real(wp), intent(out) :: a, b
+    logical, intent(out) :: fitted
+    real(wp) :: normal(2, 2), right(2), first, second, determinant_of_normal
+    integer :: k
+    normal = 0.0_wp
+    right = 0.0_wp
+    do k = 1, size(stretch)
+      if (.not. stretch(k) > 0.0_wp) cycle
+      first = 2.0_wp*(stretch(k) - 1.0_wp/stretch(k)**2)
+      second = first/stretch(k)
+      normal(1, 1) = normal(1, 1) + first*first
+      normal(1, 2) = normal(1, 2) + first*second
+      normal(2, 2) = normal(2, 2) + second*second
+      right(1) = right(1) + first*nominal(k)
+      right(2) = right(2) + second*nominal(k)
+    end do
+    determinant_of_normal = normal(1, 1)*normal(2, 2) - normal(1, 2)**2
+    fitted = determinant_of_normal > 1.0e-12_wp*max(normal(1, 1)*normal(2, 2), tiny(1.0_wp))
+    a = 0.0_wp
+    b = 0.0_wp
+    if (.not. fitted) return
+    a = (normal(2, 2)*right(1) - normal(1, 2)*right(2))/determinant_of_normal
+    b = (normal(1, 1)*right(2) - normal(1, 2)*right(1))/determinant_of_normal
+  end subroutine mooney_rivlin_fit
 
   !> Cauchy stress of left Cauchy-Green tensor `b` (3x3). `constants`: Mooney-Rivlin A, B, C, D;
   !> Blatz-Ko G, beta = 1 / (1 - 2 nu) (the rest unused).

@@ -8,12 +8,15 @@
 !>   2 D_xy dt), in the local frame;
 !> - stress (block_size, 3): sigma_xx, sigma_yy, sigma_xy in the same frame (sigma_zz = 0);
 !> - history (block_size, plane_stress_history_count(material)), the law's own layout; tensor
-!>   history (the back stress of law 3) lives in the same corotational frame as the stress and
-!>   so needs no rotation;
+!>   history lives in the same corotational frame as the stress. When the element turns its
+!>   stress about the normal (the material spin), it calls rotate_plane_stress_history, which
+!>   turns the rubbers' b and the viscoelastic branch (the back stress of law 3 is left as it is);
 !> - thickness_strain_increment (block_size): d eps_zz making sigma_zz = 0.
 !>
 !> Laws: *MAT_ELASTIC (1), *MAT_PLASTIC_KINEMATIC (3: history eps_p, beta_xx, beta_yy, beta_xy),
-!> *MAT_PIECEWISE_LINEAR_PLASTICITY (24: history eps_p) and *MAT_NULL (9: no stress, no
+!> *MAT_PIECEWISE_LINEAR_PLASTICITY (24: history eps_p), *MAT_VISCOELASTIC (6: h_xx, h_yy, h_zz,
+!> h_xy), *MAT_BLATZ-KO_RUBBER (7) and *MAT_MOONEY-RIVLIN_RUBBER (27: b_xx - 1, b_yy - 1, b_xy,
+!> b_zz - 1; material_rubber) and *MAT_NULL (9: no stress, no
 !> thickness change, so that a null shell keeps the thickness its contact uses). Any other law
 !> has no plane-stress kernel: plane_stress_history_count returns -1, and the caller (the
 !> deck check of shell parts) must reject it; update_plane_stress_block stops on it.

@@ -85,7 +85,7 @@ module material_laws
     material_law_t(code=law_blatz_ko, name="BLATZ-KO_RUBBER", solids=.true., shells=.true., meshfree=.true., &
                    history_count=6, shell_history_count=4), &
     material_law_t(code=law_mooney_rivlin, name="MOONEY-RIVLIN_RUBBER", solids=.true., shells=.true., &
-                   meshfree=.true., history_count=6, shell_history_count=4)]
+                   meshfree=.true., history_count=6, shell_history_count=4, curve_fields="LCID1", curve_card=2)]
 
 contains
 

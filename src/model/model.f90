@@ -89,6 +89,9 @@ module model
     ! *MAT_MOONEY-RIVLIN_RUBBER (PR above; E holds the small-strain 2 G (1 + nu), G = 2 (A + B))
     real(wp) :: mooney_rivlin_a = 0.0_wp    !< A
     real(wp) :: mooney_rivlin_b = 0.0_wp    !< B
+    !> SGL SW ST: gauge length, width and thickness of the test specimen of LCID1 (whose curve
+    !> gives the force against the change of gauge length; A and B are then fitted to it)
+    real(wp) :: specimen_dimensions(3) = 0.0_wp
     ! *MAT_VISCOELASTIC (E, PR above hold the instantaneous moduli from BULK and G0)
     real(wp) :: long_term_shear_modulus = 0.0_wp !< GI
     real(wp) :: decay_constant = 0.0_wp     !< BETA: G(t) = GI + (G0 - GI) exp(-BETA t)

@@ -1574,7 +1574,8 @@ contains
       "*DEFINE_CURVE", fixed([character(len=8) :: "12"], 10), "0.0,0.0", "0.5,0.2"]), &
       [character(len=300) :: "@:16: *PART: field MID: part 1: material 3 has no shell "// &
       "(plane-stress) formulation; shell sections take *MAT_ELASTIC, *MAT_PLASTIC_KINEMATIC, "// &
-      "*MAT_PIECEWISE_LINEAR_PLASTICITY, *MAT_NULL or *MAT_RIGID"], message_lines=1)
+      "*MAT_PIECEWISE_LINEAR_PLASTICITY, *MAT_NULL, *MAT_RIGID, *MAT_VISCOELASTIC, *MAT_BLATZ-KO_RUBBER or "// &
+      "*MAT_MOONEY-RIVLIN_RUBBER"], message_lines=1)
     call read_bad("shell_static.k", plate_deck([character(len=line_length) :: &
       "*CONTROL_IMPLICIT_GENERAL", "1"]), [character(len=300) :: "@:12: *ELEMENT_SHELL: field "// &
       "EID: the linear static analysis (*CONTROL_IMPLICIT_GENERAL IMFLAG = 1) takes solid "// &

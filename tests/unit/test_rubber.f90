@@ -22,7 +22,8 @@ program test_rubber
   use plane_stress_dispatch, only: update_plane_stress_block, plane_stress_history_count, &
                                    rotate_plane_stress_history
   use material_rubber, only: rubber_cauchy_stress, rubber_plane_stress_update, rubber_mooney_rivlin, &
-                             rubber_blatz_ko, mooney_rivlin_constants, rubber_thickness_tolerance
+                             mooney_rivlin_constants, rubber_thickness_tolerance, &
+                             mooney_rivlin_fit
   use testing, only: test_suite_t, check, check_close, finish_suite
   implicit none
 
@@ -53,6 +54,7 @@ program test_rubber
   call test_shell_objectivity(mooney_rivlin(0.49_wp), "Mooney-Rivlin")
   call test_viscoelastic_solid_relaxation()
   call test_viscoelastic_shell()
+  call test_mooney_rivlin_fit()
   call finish_suite(suite)
 
 contains
@@ -243,6 +245,7 @@ contains
       expected = expected_nominal(material, [axial, expected_lateral, expected_lateral])
       worst = max(worst, abs(nominal - expected)/max(abs(expected), 1.0e-3_wp*scale))
     end do
+    write (*, '(a)') "  "//name//": worst relative error of the nominal stress "//real_text(worst)
     call check(suite, name//": nominal stress within 1% of the analytical curve", worst < 0.01_wp, &
                "worst relative error "//real_text(worst))
     call check(suite, name//": (and within 1e-6: the b update is exact for a stretch)", worst < 1.0e-6_wp, &
@@ -302,6 +305,7 @@ contains
       worst = max(worst, abs(stress(1, 1)*stretch*thickness - expected)/abs(expected))
       worst = max(worst, abs(stress(1, 3))/abs(stress(1, 1)))
     end do
+    write (*, '(a)') "  "//name//": worst relative error of the nominal stress "//real_text(worst)
     call check(suite, name//": nominal stress within 1% of the analytical curve, sigma_zz = 0", worst < 0.01_wp, &
                "worst relative error "//real_text(worst))
     call check(suite, name//": (and within 1e-6)", worst < 1.0e-6_wp, "worst relative error "//real_text(worst))
@@ -328,6 +332,8 @@ contains
       worst_biaxial = max(worst_biaxial, abs(expected_nominal(material, [stretch, stretch, lateral]) - classical)/ &
                           abs(classical))
     end do
+    write (*, '(a)') "  Mooney-Rivlin PR 0.4995 against the incompressible curves: uniaxial "// &
+      real_text(worst_uniaxial)//", equibiaxial "//real_text(worst_biaxial)
     call check(suite, "Mooney-Rivlin PR 0.4995: uniaxial curve within 1% of the incompressible one", &
                worst_uniaxial < 0.01_wp, "worst relative error "//real_text(worst_uniaxial))
     call check(suite, "Mooney-Rivlin PR 0.4995: equibiaxial curve within 1% of the incompressible one", &
@@ -381,6 +387,7 @@ contains
       worst = max(worst, abs(stress(1, 1)*lateral*thickness - expected)/max(abs(expected), 1.0e-3_wp*scale))
       worst_thickness = max(worst_thickness, abs(thickness - expected_lateral))
     end do
+    write (*, '(a)') "  "//name//": worst relative error of the nominal stress "//real_text(worst)
     call check(suite, name//": nominal stress within 1% of the analytical curve", worst < 0.01_wp, &
                "worst relative error "//real_text(worst))
     call check(suite, name//": (and within 1e-6)", worst < 1.0e-6_wp, "worst relative error "//real_text(worst))
@@ -443,6 +450,7 @@ contains
       worst = max(worst, abs(stress(1, 1)*stretch*thickness - expected)/abs(expected))
       worst = max(worst, abs(stress(1, 1) - stress(1, 2))/abs(stress(1, 1)))
     end do
+    write (*, '(a)') "  "//name//": worst relative error of the nominal stress "//real_text(worst)
     call check(suite, name//": nominal stress within 1% of the analytical curve", worst < 0.01_wp, &
                "worst relative error "//real_text(worst))
     call check(suite, name//": (and within 1e-6)", worst < 1.0e-6_wp, "worst relative error "//real_text(worst))
@@ -632,6 +640,25 @@ contains
                worst < 1.0e-12_wp .and. worst_zz < 1.0e-12_wp, &
                "in-plane "//real_text(worst)//", sigma_zz "//real_text(worst_zz))
   end subroutine test_viscoelastic_shell
+
+  !> LCID1's least-squares fit: exact incompressible uniaxial data (stretch 0.7 to 2.5, a point at
+  !> stretch 1 included) give A and B back to 1e-12; one stretch only is not enough.
+  subroutine test_mooney_rivlin_fit()
+    real(wp) :: stretch(13), nominal(13), a, b
+    logical :: fitted
+    integer :: k
+    do k = 1, 13
+      stretch(k) = 0.7_wp + 0.15_wp*real(k - 1, wp)
+      if (k == 3) stretch(k) = 1.0_wp
+      nominal(k) = 2.0_wp*(stretch(k) - stretch(k)**(-2))*(mooney_a + mooney_b/stretch(k))
+    end do
+    call mooney_rivlin_fit(stretch, nominal, a, b, fitted)
+    call check(suite, "Mooney-Rivlin fit: fitted", fitted)
+    call check_close(suite, "Mooney-Rivlin fit: A and B recovered (1e-12)", [a, b], [mooney_a, mooney_b], &
+                     rel=1.0e-12_wp)
+    call mooney_rivlin_fit([1.0_wp, 1.5_wp, 1.5_wp], [0.0_wp, 1.0_wp, 1.0_wp], a, b, fitted)
+    call check(suite, "Mooney-Rivlin fit: one stretch besides 1 is not enough", .not. fitted)
+  end subroutine test_mooney_rivlin_fit
 
   function rotation_matrix(axis, angle) result(r)
     real(wp), intent(in) :: axis(3), angle
