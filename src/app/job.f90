@@ -191,6 +191,13 @@ contains
         "% of the dofs; set-up ", summary%efg_setup_s, " s"
       write (*, '(a)') trim(line)
     end if
+    if (summary%efg_shell_cells > 0) then
+      write (line, '(a,i0,a,i0,a,f0.1,a,f0.3,a)') "meshfree shells: ", summary%efg_shell_cells, " cells, ", &
+        summary%efg_shell_particles, " interior particles, ", &
+        100.0_wp*real(summary%dofs_efg_shell, wp)/real(summary%dofs_total, wp), "% of the dofs; set-up ", &
+        summary%efg_shell_setup_s, " s"
+      write (*, '(a)') trim(line)
+    end if
     if (state%added_mass > 0.0_wp) then
       ! (es: the percentage of a huge DT2MS does not fit a fixed format)
       write (line, '(a,es12.5,a,es10.3,a)') "mass scaling: added mass ", state%added_mass, " (", &
@@ -213,10 +220,11 @@ contains
       ", wall time "//format_duration(summary%wall_s)
     write (*, '(a)') trim(line)
     write (line, '(a,f9.3,a,f9.3,a,f9.3,a,f9.3,a,f9.3,a,f9.3,a,f9.3)') "  seconds: setup", summary%setup_s, &
-      "  solids", summary%fe_solid_s, "  shells", summary%fe_shell_s, "  meshfree", summary%efg_s, "  contact", &
+      "  solids", summary%fe_solid_s, "  shells", summary%fe_shell_s, "  meshfree", summary%efg_s + summary%efg_shell_s, &
+      "  contact", &
       summary%contact_s, "  output", summary%output_s, "  other", &
-      max(0.0_wp, summary%wall_s - summary%setup_s - summary%fe_solid_s - summary%fe_shell_s - summary%efg_s - &
-          summary%contact_s - summary%output_s - summary%fe_beam_s)
+      max(0.0_wp, summary%wall_s - summary%setup_s - summary%fe_solid_s - summary%fe_shell_s - summary%efg_s &
+          - summary%efg_shell_s - summary%contact_s - summary%output_s - summary%fe_beam_s)
     write (*, '(a)') trim(line)
     if (.not. static .and. summary%cycles > 0 .and. summary%fe_solids > 0) then
       per_element = 1.0e9_wp*summary%fe_solid_s/(real(summary%cycles, wp)*real(summary%fe_solids, wp))
@@ -237,6 +245,11 @@ contains
     if (.not. static .and. summary%cycles > 0 .and. summary%efg_particles > 0) then
       per_element = 1.0e9_wp*summary%efg_s/(real(summary%cycles, wp)*real(summary%efg_particles, wp))
       write (line, '(a,f0.1,a)') "  meshfree: ", per_element, " ns per interior particle per cycle"
+      write (*, '(a)') trim(line)
+    end if
+    if (.not. static .and. summary%cycles > 0 .and. summary%efg_shell_cells > 0) then
+      per_element = 1.0e9_wp*summary%efg_shell_s/(real(summary%cycles, wp)*real(summary%efg_shell_cells, wp))
+      write (line, '(a,f0.1,a)') "  meshfree shells: ", per_element, " ns per cell per cycle"
       write (*, '(a)') trim(line)
     end if
     write (*, '(a)') "  results: "//options%output_dir//"/"//options%job_id//".h5 (and .xdmf for ParaView)"

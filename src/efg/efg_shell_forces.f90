@@ -3,8 +3,8 @@
 !> corners (Wu, Guo, Wang & Botkin 2004, "A mesh-free analysis of shell structures", 8th Int.
 !> LS-DYNA Users Conference: Lagrangian MLS functions on the undeformed surface, co-rotational
 !> update as in the Belytschko-Tsay shell, stabilized conforming (sub-cell) integration of the
-!> membrane and bending strains, one-point transverse shear per background cell against
-!> locking). The geometry (pairs, smoothed gradients, shear point, masses, transformation) comes
+!> membrane and bending strains) with an assumed-strain transverse shear on the cells' physical
+!> corner values (below). The geometry (pairs, smoothed gradients, masses, transformation) comes
 !> from the set-up (efg_shell_part); this module is the per-cycle work on it.
 !>
 !> Per background cell c: the current frame E = shell_cell_frame of its current corners, the
@@ -23,19 +23,23 @@
 !> the material spin (half into the mid-step frame, half into the end frame, as
 !> shell_block's rotate_with_material). Resultants N, M per unit current length; the point's
 !> forces and moments are the transposes, W J N g_I and W J (M-moments), J = det F.
-!> Transverse shear at the cell's shear point (Psi_I, b^s_I at the centre): 2 d_xz = sum
-!> g^s_1 vl_z + Psi wl_y, 2 d_yz = sum g^s_2 vl_z - Psi wl_x, elastic with SHRF G, uniform
-!> through the thickness as in shell_block.
+!> Transverse shear (docs/efg_shells.md says why not from the meshfree functions): on the
+!> physical values of the cell's corners (a particle corner through its transformation row),
+!> MITC4 on a quadrilateral (Bathe & Dvorkin 1985: covariant shear at the edge midpoints,
+!> interpolated to the four sub-cell points), the FE triangle's edge-based constant shear on a
+!> triangle (shell_triangle); a Kirchhoff mode has no shear on any mesh. Elastic with SHRF G,
+!> uniform through the thickness as in shell_block; forces and moments onto the physical corners
+!> are handed to the nodes through the rows (A^T).
 !>
 !> Energies are the exact work of the nodal forces and moments (element_work's add_force_work,
-!> as efg_forces and shell_block). Their power needs no pair loop: with the sums Vb, Wb of a
-!> point, the power of any forces given by (E, G, W J N, W J M) is W J (N : L + M : k); the
-!> forces of the last call (kept per point) against this step's velocities complete the last
-!> step's work.
+!> as efg_forces and shell_block). Their power needs no pair loop: a point's forces and moments
+!> are f_I = P b_I and m_I = Q b_I (P, Q: 3 x 2 per point), so their power is P : Vb + Q : Wb
+!> (= W J (N : L + M : k)); the forces of the last call (kept per point) against this step's
+!> velocities complete the last step's work.
 !>
 !> Blocks are runs of whole cells, at most block_size membrane/bending points each (a lane per
-!> point for the materials; the block's cells and their shear points go with it). Blocks are
-!> coloured by the nodes of their pairs and corners, so the blocks of one colour share no node:
+!> point for the materials; the block's cells go with it). Blocks are coloured by the nodes of
+!> their pairs, corners and corner rows, so the blocks of one colour share no node:
 !> colours one after another, the blocks of a colour in parallel, each node receives its
 !> contributions in the same order for any thread count.
 module efg_shell_forces
@@ -49,6 +53,7 @@ module efg_shell_forces
   use element_work, only: add_force_work
   use gauss_legendre, only: gauss_legendre_rule
   use shell_block, only: max_shell_points
+  use shell_triangle, only: triangle_shear_operator
   implicit none
   private
 
@@ -66,11 +71,11 @@ module efg_shell_forces
     real(wp), allocatable :: stress(:, :, :)
     !> Plane-stress history (block_size, count, NIP).
     real(wp), allocatable :: history(:, :, :)
-    !> Transverse shear stress zx, yz of each cell lane (elastic, the same at every thickness point).
+    !> Transverse shear stress zx, yz of each point lane (elastic, the same at every thickness point).
     real(wp) :: shear_stress(block_size, 2) = 0.0_wp
     real(wp) :: internal_energy(block_size) = 0.0_wp   !< per point lane: membrane and bending work
     real(wp) :: force_power(block_size) = 0.0_wp
-    real(wp) :: shear_energy(block_size) = 0.0_wp      !< per cell lane: transverse shear work
+    real(wp) :: shear_energy(block_size) = 0.0_wp      !< per cell lane: transverse shear work (its points')
     real(wp) :: shear_power(block_size) = 0.0_wp
     real(wp) :: previous_time_step = 0.0_wp
   end type efg_shell_block_t
@@ -88,13 +93,21 @@ module efg_shell_forces
     !> Per cell, from the last call: frame(:, a, c) = e_a at the end of the step, current area.
     real(wp), allocatable :: cell_frame(:, :, :)
     real(wp), allocatable :: cell_area(:)
-    !> Per point, the forces of the last call: G = F^-T (2, 2), W J N and W J M (3 each).
-    real(wp), allocatable :: point_inverse(:, :, :)
+    !> Per point, the resultants of the last call times the point's current area, W J N and
+    !> W J M (local xx, yy, xy), and its forces and moments on a pair (I, b_I): global
+    !> f_I = P b_I, m_I = Q b_I with P, Q (3, 2) (forces_of_point).
     real(wp), allocatable :: point_membrane(:, :)
     real(wp), allocatable :: point_moment(:, :)
-    !> Per cell, the shear forces of the last call: G^s (2, 2) and A J_s Q (Q_zx, Q_yz).
-    real(wp), allocatable :: shear_inverse(:, :, :)
-    real(wp), allocatable :: shear_resultant(:, :)
+    real(wp), allocatable :: point_force(:, :, :)
+    real(wp), allocatable :: point_couple(:, :, :)
+    !> The physical values of each cell's corners (transverse shear): corner k = 4 (c - 1) + L
+    !> of cell c is sum over corner_offsets(k) : corner_offsets(k+1)-1 of corner_weight times the
+    !> solver's value at corner_node (a particle's transformation row; a Gamma node itself).
+    integer, allocatable :: corner_offsets(:), corner_node(:)
+    real(wp), allocatable :: corner_weight(:)
+    !> Per cell, the transverse shear forces (1-3) and moments (4-6) of the last call on its
+    !> physical corners (global; (6, 4, cells)).
+    real(wp), allocatable :: corner_force(:, :, :)
     type(gather_list_t) :: block_colours          !< colour -> blocks; blocks of one colour share no node
     real(wp), allocatable :: block_time_step(:)
     integer, allocatable :: block_critical_cell(:), block_failed_cell(:)
@@ -158,14 +171,15 @@ contains
     allocate (solver%cell_frame(3, 3, cell_count), solver%cell_area(cell_count))
     solver%cell_frame = geometry%cell_frame
     solver%cell_area = geometry%cell_area
-    allocate (solver%point_inverse(2, 2, point_count), solver%point_membrane(3, point_count), &
-              solver%point_moment(3, point_count), solver%shear_inverse(2, 2, cell_count), &
-              solver%shear_resultant(2, cell_count))
-    solver%point_inverse = 0.0_wp
+    allocate (solver%point_membrane(3, point_count), solver%point_moment(3, point_count), &
+              solver%point_force(3, 2, point_count), solver%point_couple(3, 2, point_count), &
+              solver%corner_force(6, 4, cell_count))
     solver%point_membrane = 0.0_wp
     solver%point_moment = 0.0_wp
-    solver%shear_inverse = 0.0_wp
-    solver%shear_resultant = 0.0_wp
+    solver%point_force = 0.0_wp
+    solver%point_couple = 0.0_wp
+    solver%corner_force = 0.0_wp
+    call set_up_corner_rows(geometry, solver%cell_nodes, size(model%coordinates, 2), solver)
     allocate (solver%block_time_step(block_count), solver%block_critical_cell(block_count), &
               solver%block_failed_cell(block_count))
     solver%block_time_step = huge(1.0_wp)
@@ -221,8 +235,56 @@ contains
     end do
   end function points_of_cell
 
-  !> Colours the blocks by the nodes of their points' pairs, their shear pairs and their cells'
-  !> corners (each node listed once per block).
+  !> The corner rows (physical corner values for the transverse shear): a particle corner takes
+  !> its transformation row, a Gamma corner itself with weight 1.
+  subroutine set_up_corner_rows(geometry, cell_nodes, node_count, solver)
+    type(efg_shell_part_t), intent(in) :: geometry
+    integer, intent(in) :: cell_nodes(:, :), node_count
+    type(efg_shell_solver_t), intent(inout) :: solver
+    integer, allocatable :: particle_of(:)
+    integer :: c, corner, j, k, count, node, corner_count
+    allocate (particle_of(node_count))
+    particle_of = 0
+    do j = 1, size(geometry%particles)
+      particle_of(geometry%particles(j)) = j
+    end do
+    corner_count = 4*size(geometry%cells)
+    count = 0
+    do c = 1, size(geometry%cells)
+      do corner = 1, 4
+        j = particle_of(cell_nodes(corner, c))
+        if (j == 0) then
+          count = count + 1
+        else
+          count = count + geometry%transform_offsets(j + 1) - geometry%transform_offsets(j)
+        end if
+      end do
+    end do
+    allocate (solver%corner_offsets(corner_count + 1), solver%corner_node(count), solver%corner_weight(count))
+    count = 0
+    do c = 1, size(geometry%cells)
+      do corner = 1, 4
+        solver%corner_offsets(4*(c - 1) + corner) = count + 1
+        node = cell_nodes(corner, c)
+        j = particle_of(node)
+        if (j == 0) then
+          count = count + 1
+          solver%corner_node(count) = node
+          solver%corner_weight(count) = 1.0_wp
+        else
+          do k = geometry%transform_offsets(j), geometry%transform_offsets(j + 1) - 1
+            count = count + 1
+            solver%corner_node(count) = geometry%transform_node(k)
+            solver%corner_weight(count) = geometry%transform_value(k)
+          end do
+        end if
+      end do
+    end do
+    solver%corner_offsets(corner_count + 1) = count + 1
+  end subroutine set_up_corner_rows
+
+  !> Colours the blocks by the nodes of their points' pairs, their cells' corner rows and their
+  !> cells' corners (each node listed once per block).
   subroutine colour_shell_blocks(node_count, solver)
     integer, intent(in) :: node_count
     type(efg_shell_solver_t), intent(inout) :: solver
@@ -230,7 +292,7 @@ contains
     integer :: b, k, c, count
     associate (geometry => solver%geometry)
       allocate (offsets(size(solver%blocks) + 1), listed_by(node_count), &
-                block_nodes(size(geometry%pair_node) + size(geometry%shear_node) + 4*size(geometry%cells)))
+                block_nodes(size(geometry%pair_node) + size(solver%corner_node) + 4*size(geometry%cells)))
       listed_by = 0
       count = 0
       do b = 1, size(solver%blocks)
@@ -240,8 +302,8 @@ contains
             call list_node(geometry%pair_node(k))
           end do
           do c = block%first_cell, block%first_cell + block%cell_count - 1
-            do k = geometry%shear_offsets(c), geometry%shear_offsets(c + 1) - 1
-              call list_node(geometry%shear_node(k))
+            do k = solver%corner_offsets(4*(c - 1) + 1), solver%corner_offsets(4*c + 1) - 1
+              call list_node(solver%corner_node(k))
             end do
             do k = 1, 4
               call list_node(solver%cell_nodes(k, c))
@@ -327,14 +389,15 @@ contains
           call compute_shell_block(material, solver%geometry, solver%cell_nodes, solver%density, &
                                    solver%shear_factor, solver%thickness_points, solver%point_height, &
                                    solver%point_weight, solver%blocks(b), coordinates, velocity, angular_velocity, &
-                                   dt, solver%cell_frame, solver%cell_area, solver%point_inverse, &
-                                   solver%point_membrane, solver%point_moment, solver%shear_inverse, &
-                                   solver%shear_resultant, solver%block_time_step(b), solver%block_critical_cell(b), &
+                                   dt, solver%cell_frame, solver%cell_area, solver%point_membrane, &
+                                   solver%point_moment, solver%point_force, solver%point_couple, solver%corner_offsets, &
+                                   solver%corner_node, solver%corner_weight, solver%corner_force, &
+                                   solver%block_time_step(b), solver%block_critical_cell(b), &
                                    solver%block_failed_cell(b))
           call add_block_forces(solver%geometry, solver%cell_nodes, solver%blocks(b), solver%cell_frame, &
-                                solver%cell_area, solver%point_inverse, solver%point_membrane, solver%point_moment, &
-                                solver%shear_inverse, solver%shear_resultant, internal_force, internal_moment, &
-                                normal_sum, area_sum)
+                                solver%cell_area, solver%point_force, solver%point_couple, solver%corner_offsets, &
+                                solver%corner_node, solver%corner_weight, solver%corner_force, internal_force, &
+                                internal_moment, normal_sum, area_sum)
         end do
         !$omp end parallel do
       end do
@@ -346,8 +409,9 @@ contains
   !> Allocates nothing.
   subroutine compute_shell_block(material, geometry, cell_nodes, density, shear_factor, thickness_points, &
                                  point_height, point_weight, block, coordinates, velocity, angular_velocity, dt, &
-                                 cell_frame, cell_area, point_inverse, point_membrane, point_moment, shear_inverse, &
-                                 shear_resultant, critical_time_step, critical_cell, failed_cell)
+                                 cell_frame, cell_area, point_membrane, point_moment, point_force, point_couple, &
+                                 corner_offsets, corner_node, corner_weight, corner_force, critical_time_step, &
+                                 critical_cell, failed_cell)
     type(material_t), intent(in) :: material
     type(efg_shell_part_t), intent(in) :: geometry
     integer, intent(in) :: cell_nodes(:, :), thickness_points
@@ -355,20 +419,25 @@ contains
     type(efg_shell_block_t), intent(inout) :: block
     real(wp), intent(in), contiguous :: coordinates(:, :), velocity(:, :), angular_velocity(:, :)
     real(wp), intent(in) :: dt
-    real(wp), intent(inout) :: cell_frame(:, :, :), cell_area(:), point_inverse(:, :, :), point_membrane(:, :)
-    real(wp), intent(inout) :: point_moment(:, :), shear_inverse(:, :, :), shear_resultant(:, :)
+    real(wp), intent(inout) :: cell_frame(:, :, :), cell_area(:), point_membrane(:, :), point_moment(:, :)
+    real(wp), intent(inout) :: point_force(:, :, :), point_couple(:, :, :)
+    integer, intent(in) :: corner_offsets(:), corner_node(:)
+    real(wp), intent(in) :: corner_weight(:)
+    real(wp), intent(inout) :: corner_force(:, :, :)
     real(wp), intent(out) :: critical_time_step
     integer, intent(out) :: critical_cell, failed_cell
     real(wp) :: mid_frame(3, 3, block_size), end_frame(3, 3, block_size), first_turn(block_size)
     real(wp) :: second_turn(block_size), spin(block_size), jacobian(block_size), thickness(block_size)
     real(wp) :: membrane(block_size, 3), curvature(block_size, 3), increment(block_size, 3)
     real(wp) :: thickness_increment(block_size), old_power(block_size), new_power(block_size)
-    real(wp) :: velocity_sum(3, 2, block_size), rotation_sum(3, 2, block_size)
-    real(wp) :: shear_velocity(3, 2), shear_rotation(3), corners(3, 4), corner_velocity(3, 4)
+    real(wp) :: velocity_sum(3, 2, block_size), rotation_sum(3, 2, block_size), end_inverse(2, 2, block_size)
+    real(wp) :: corners(3, 4), corner_velocity(3, 4), node_velocity(3, 4), physical_velocity(3, 4)
+    real(wp) :: physical_rotation(3, 4), operator(2, 4, 3, 4), corner_values(4, 3), corner_local(4, 3), area_scale
     real(wp) :: position_sum(3, 2), inverse(2, 2), rate(2, 2), bend(2, 2), determinant
-    real(wp) :: shear_modulus, height, angle, c, s, first, second, gamma(2), resultant(6), weight, arm
-    real(wp) :: area, longest, wave_speed, cell_step, shear_jacobian, local_z(2)
-    integer :: nel, i, g, cell, lane, point, corner, k, node
+    real(wp) :: shear_modulus, height, gamma(2), transverse(2), resultant(6), weight, arm
+    real(wp) :: area, longest, wave_speed, cell_step
+    integer :: nel, i, g, cell, lane, point, corner, k, first_point
+    logical :: triangle
 
     nel = block%point_count
     failed_cell = 0
@@ -432,9 +501,9 @@ contains
       curvature(i, :) = [bend(2, 1), -bend(1, 2), bend(2, 2) - bend(1, 1)]
       ! half the material's spin over the step (the stress turns with it: module comment)
       spin(i) = 0.25_wp*dt*(rate(2, 1) - rate(1, 2))
-      old_power(i) = point_power(cell_frame(:, :, cell), point_inverse(:, :, g), point_membrane(:, g), &
-                                 point_moment(:, g), velocity_sum(:, :, i), rotation_sum(:, :, i))
-      call in_plane_inverse(end_frame(:, :, lane), position_sum, point_inverse(:, :, g), jacobian(i))
+      ! the power of the last call's forces f_I = P b_I, m_I = Q b_I: P : Vb + Q : Wb
+      old_power(i) = sum(point_force(:, :, g)*velocity_sum(:, :, i)) + sum(point_couple(:, :, g)*rotation_sum(:, :, i))
+      call in_plane_inverse(end_frame(:, :, lane), position_sum, end_inverse(:, :, i), jacobian(i))
       if (.not. jacobian(i) > 0.0_wp .and. failed_cell == 0) failed_cell = cell
     end do
 
@@ -467,50 +536,55 @@ contains
       resultant = geometry%point_area(g)*jacobian(i)*resultant
       point_membrane(:, g) = resultant(1:3)
       point_moment(:, g) = resultant(4:6)
-      new_power(i) = point_power(end_frame(:, :, lane), point_inverse(:, :, g), point_membrane(:, g), &
-                                 point_moment(:, g), velocity_sum(:, :, i), rotation_sum(:, :, i))
+      call forces_of_point(end_frame(:, :, lane), end_inverse(:, :, i), resultant, point_force(:, :, g), &
+                           point_couple(:, :, g))
+      new_power(i) = sum(point_force(:, :, g)*velocity_sum(:, :, i)) + sum(point_couple(:, :, g)*rotation_sum(:, :, i))
     end do
     call add_force_work(nel, dt, block%previous_time_step, old_power, new_power, block%force_power, &
                         block%internal_energy)
 
-    ! transverse shear at each cell's shear point
+    ! transverse shear: assumed strain on the cells' physical corner values (module comment)
     do lane = 1, block%cell_count
       cell = block%first_cell + lane - 1
-      position_sum = 0.0_wp
-      shear_velocity = 0.0_wp
-      shear_rotation = 0.0_wp
-      do k = geometry%shear_offsets(cell), geometry%shear_offsets(cell + 1) - 1
-        node = geometry%shear_node(k)
-        position_sum(:, 1) = position_sum(:, 1) + coordinates(:, node)*geometry%shear_gradient(1, k)
-        position_sum(:, 2) = position_sum(:, 2) + coordinates(:, node)*geometry%shear_gradient(2, k)
-        shear_velocity(:, 1) = shear_velocity(:, 1) + velocity(:, node)*geometry%shear_gradient(1, k)
-        shear_velocity(:, 2) = shear_velocity(:, 2) + velocity(:, node)*geometry%shear_gradient(2, k)
-        shear_rotation = shear_rotation + angular_velocity(:, node)*geometry%shear_value(k)
+      triangle = cell_nodes(3, cell) == cell_nodes(4, cell)
+      do corner = 1, 4
+        corners(:, corner) = coordinates(:, cell_nodes(corner, cell))
+        node_velocity(:, corner) = velocity(:, cell_nodes(corner, cell))
+        physical_velocity(:, corner) = 0.0_wp
+        physical_rotation(:, corner) = 0.0_wp
+        do k = corner_offsets(4*(cell - 1) + corner), corner_offsets(4*(cell - 1) + corner + 1) - 1
+          physical_velocity(:, corner) = physical_velocity(:, corner) + corner_weight(k)*velocity(:, corner_node(k))
+          physical_rotation(:, corner) = physical_rotation(:, corner) + corner_weight(k)*angular_velocity(:, corner_node(k))
+        end do
       end do
-      old_power(lane) = shear_power(cell_frame(:, :, cell), shear_inverse(:, :, cell), shear_resultant(:, cell), &
-                                    shear_velocity, shear_rotation)
-      call in_plane_inverse(mid_frame(:, :, lane), position_sum - 0.5_wp*dt*shear_velocity, inverse, determinant)
-      rate = local_gradient(mid_frame(:, :, lane), shear_velocity, inverse)
-      local_z = [dot_product(mid_frame(:, 3, lane), shear_velocity(:, 1)), &
-                 dot_product(mid_frame(:, 3, lane), shear_velocity(:, 2))]
-      gamma = matmul(inverse, local_z) + [dot_product(mid_frame(:, 2, lane), shear_rotation), &
-                                          -dot_product(mid_frame(:, 1, lane), shear_rotation)]
-      ! the shear stress (zx, yz) turns as an in-plane vector, with the spin at the shear point
-      angle = 0.25_wp*dt*(rate(2, 1) - rate(1, 2))
-      do k = 1, 2
-        c = cos(angle + merge(first_turn(lane), second_turn(lane), k == 1))
-        s = sin(angle + merge(first_turn(lane), second_turn(lane), k == 1))
-        first = block%shear_stress(lane, 1)
-        second = block%shear_stress(lane, 2)
-        block%shear_stress(lane, 1) = c*first - s*second
-        block%shear_stress(lane, 2) = s*first + c*second
-        if (k == 1) block%shear_stress(lane, :) = block%shear_stress(lane, :) + shear_factor*shear_modulus*dt*gamma
+      old_power(lane) = sum(corner_force(1:3, :, cell)*physical_velocity) + sum(corner_force(4:6, :, cell)*physical_rotation)
+      ! rates on the mid-step corners and frame
+      call shear_operator(mid_frame(:, :, lane), corners - 0.5_wp*dt*node_velocity, triangle, operator)
+      call local_corner_values(mid_frame(:, :, lane), physical_velocity, physical_rotation, corner_values)
+      first_point = first_point_in_block(geometry, block, cell)
+      do point = 1, merge(3, 4, triangle)
+        i = first_point + point - 1
+        gamma = shear_rate(operator(:, :, :, point), corner_values)
+        call rotate_shear_stress(block, i, spin(i) + first_turn(lane))
+        block%shear_stress(i, :) = block%shear_stress(i, :) + shear_factor*shear_modulus*dt*gamma
+        call rotate_shear_stress(block, i, spin(i) + second_turn(lane))
       end do
-      call in_plane_inverse(end_frame(:, :, lane), position_sum, shear_inverse(:, :, cell), shear_jacobian)
-      shear_resultant(:, cell) = geometry%cell_area(cell)*shear_jacobian*geometry%cell_thickness(cell) &
-                                 *block%shear_stress(lane, :)
-      new_power(lane) = shear_power(end_frame(:, :, lane), shear_inverse(:, :, cell), shear_resultant(:, cell), &
-                                    shear_velocity, shear_rotation)
+      ! forces on the end-of-step corners: the transposes, times each point's current area
+      call shear_operator(end_frame(:, :, lane), corners, triangle, operator)
+      area_scale = cell_area(cell)/geometry%cell_area(cell)
+      corner_local = 0.0_wp
+      do point = 1, merge(3, 4, triangle)
+        i = first_point + point - 1
+        transverse = geometry%point_area(block%first_point + i - 1)*area_scale*geometry%cell_thickness(cell) &
+                     *block%shear_stress(i, :)
+        corner_local = corner_local + transverse(1)*operator(1, :, :, point) + transverse(2)*operator(2, :, :, point)
+      end do
+      do corner = 1, 4
+        corner_force(1:3, corner, cell) = corner_local(corner, 1)*end_frame(:, 3, lane)
+        corner_force(4:6, corner, cell) = corner_local(corner, 2)*end_frame(:, 1, lane) &
+                                          + corner_local(corner, 3)*end_frame(:, 2, lane)
+      end do
+      new_power(lane) = sum(corner_force(1:3, :, cell)*physical_velocity) + sum(corner_force(4:6, :, cell)*physical_rotation)
       cell_frame(:, :, cell) = end_frame(:, :, lane)
     end do
     call add_force_work(block%cell_count, dt, block%previous_time_step, old_power, new_power, block%shear_power, &
@@ -581,26 +655,143 @@ contains
     end do
   end function local_gradient
 
-  !> Power of a point's forces and moments given by (frame, G, W J N, W J M) against the
-  !> velocities and angular velocities whose pair sums are Vb and Wb: W J (N : L + M : k).
-  pure real(wp) function point_power(frame, inverse, membrane, moment, velocity_sum, rotation_sum)
-    real(wp), intent(in) :: frame(3, 3), inverse(2, 2), membrane(3), moment(3), velocity_sum(3, 2), rotation_sum(3, 2)
-    real(wp) :: rate(2, 2), bend(2, 2)
-    rate = local_gradient(frame, velocity_sum, inverse)
-    bend = local_gradient(frame, rotation_sum, inverse)
-    point_power = membrane(1)*rate(1, 1) + membrane(2)*rate(2, 2) + membrane(3)*(rate(1, 2) + rate(2, 1)) &
-                  + moment(1)*bend(2, 1) - moment(2)*bend(1, 2) + moment(3)*(bend(2, 2) - bend(1, 1))
-  end function point_power
+  !> The first lane of a cell's points in its block.
+  pure integer function first_point_in_block(geometry, block, cell) result(lane)
+    type(efg_shell_part_t), intent(in) :: geometry
+    type(efg_shell_block_t), intent(in) :: block
+    integer, intent(in) :: cell
+    do lane = 1, block%point_count
+      if (geometry%point_cell(block%first_point + lane - 1) == cell) return
+    end do
+    lane = 0
+  end function first_point_in_block
 
-  !> Power of a cell's shear forces (frame, G^s, A J Q) against the velocities (pair sum over
-  !> the shear gradients) and angular velocities (sum of Psi w).
-  pure real(wp) function shear_power(frame, inverse, resultant, velocity_sum, rotation)
-    real(wp), intent(in) :: frame(3, 3), inverse(2, 2), resultant(2), velocity_sum(3, 2), rotation(3)
-    real(wp) :: local_z(2), gamma(2)
-    local_z = [dot_product(frame(:, 3), velocity_sum(:, 1)), dot_product(frame(:, 3), velocity_sum(:, 2))]
-    gamma = matmul(inverse, local_z) + [dot_product(frame(:, 2), rotation), -dot_product(frame(:, 1), rotation)]
-    shear_power = resultant(1)*gamma(1) + resultant(2)*gamma(2)
-  end function shear_power
+  !> Local corner values (v_z, w_x, w_y) of the physical corner velocities and angular velocities.
+  pure subroutine local_corner_values(frame, velocity, rotation, values)
+    real(wp), intent(in) :: frame(3, 3), velocity(3, 4), rotation(3, 4)
+    real(wp), intent(out) :: values(4, 3)
+    integer :: corner
+    do corner = 1, 4
+      values(corner, 1) = dot_product(frame(:, 3), velocity(:, corner))
+      values(corner, 2) = dot_product(frame(:, 1), rotation(:, corner))
+      values(corner, 3) = dot_product(frame(:, 2), rotation(:, corner))
+    end do
+  end subroutine local_corner_values
+
+  !> (2 d_xz, 2 d_yz) of one point from its operator and the local corner values.
+  pure function shear_rate(operator, values) result(gamma)
+    real(wp), intent(in) :: operator(2, 4, 3), values(4, 3)
+    real(wp) :: gamma(2)
+    gamma(1) = sum(operator(1, :, :)*values)
+    gamma(2) = sum(operator(2, :, :)*values)
+  end function shear_rate
+
+  !> The transverse shear operator of a cell at its membrane/bending points:
+  !> (2 d_xz, 2 d_yz) at point p = sum over corners L and local dofs (v_z, w_x, w_y) of
+  !> operator(:, L, dof, p) times the corner's value. A quadrilateral takes MITC4 (Bathe &
+  !> Dvorkin 1985): the covariant shear at the midpoint of each edge (i, j),
+  !> gamma_e = (w_j - w_i)/2 + g_x (th_y,i + th_y,j)/2 - g_y (th_x,i + th_x,j)/2 with
+  !> g = (x_j - x_i)/2, interpolated linearly across the cell (gamma_xi between edges 1-2 and 4-3,
+  !> gamma_eta between edges 1-4 and 2-3) to the sub-cell points (+-1/2, +-1/2) and turned into
+  !> Cartesian components with the point's Jacobian. A Kirchhoff mode (w quadratic, theta its
+  !> gradient) gives zero at every edge midpoint of any quadrilateral. A triangle (corner 4 =
+  !> corner 3) takes the edge-based constant shear of the FE triangle (shell_triangle) at its
+  !> three points.
+  pure subroutine shear_operator(frame, corners, triangle, operator)
+    real(wp), intent(in) :: frame(3, 3), corners(3, 4)
+    logical, intent(in) :: triangle
+    real(wp), intent(out) :: operator(2, 4, 3, 4)
+    real(wp), parameter :: point_xi(4) = [-0.5_wp, 0.5_wp, 0.5_wp, -0.5_wp]
+    real(wp), parameter :: point_eta(4) = [-0.5_wp, -0.5_wp, 0.5_wp, 0.5_wp]
+    real(wp) :: xl(4), yl(4), vz_weight(3, 2), wx_weight(3, 2), wy_weight(3, 2)
+    real(wp) :: edge_a(4, 3), edge_b(4, 3), edge_c(4, 3), edge_d(4, 3), along_xi(4, 3), along_eta(4, 3)
+    real(wp) :: x_xi, y_xi, x_eta, y_eta, determinant, xi, eta
+    integer :: corner, point
+    do corner = 1, 4
+      xl(corner) = dot_product(frame(:, 1), corners(:, corner) - corners(:, 1))
+      yl(corner) = dot_product(frame(:, 2), corners(:, corner) - corners(:, 1))
+    end do
+    operator = 0.0_wp
+    if (triangle) then
+      call triangle_shear_operator(xl(1:3), yl(1:3), vz_weight, wx_weight, wy_weight)
+      do point = 1, 3
+        do corner = 1, 3
+          operator(:, corner, 1, point) = vz_weight(corner, :)
+          operator(:, corner, 2, point) = wx_weight(corner, :)
+          operator(:, corner, 3, point) = wy_weight(corner, :)
+        end do
+      end do
+      return
+    end if
+    ! tying points A (edge 1-2), B (2-3), C (4-3), D (1-4), along xi for A, C and eta for B, D
+    edge_a = edge_operator(1, 2)
+    edge_b = edge_operator(2, 3)
+    edge_c = edge_operator(4, 3)
+    edge_d = edge_operator(1, 4)
+    do point = 1, 4
+      xi = point_xi(point)
+      eta = point_eta(point)
+      along_xi = 0.5_wp*(1.0_wp - eta)*edge_a + 0.5_wp*(1.0_wp + eta)*edge_c
+      along_eta = 0.5_wp*(1.0_wp - xi)*edge_d + 0.5_wp*(1.0_wp + xi)*edge_b
+      x_xi = 0.25_wp*((1.0_wp - eta)*(xl(2) - xl(1)) + (1.0_wp + eta)*(xl(3) - xl(4)))
+      y_xi = 0.25_wp*((1.0_wp - eta)*(yl(2) - yl(1)) + (1.0_wp + eta)*(yl(3) - yl(4)))
+      x_eta = 0.25_wp*((1.0_wp - xi)*(xl(4) - xl(1)) + (1.0_wp + xi)*(xl(3) - xl(2)))
+      y_eta = 0.25_wp*((1.0_wp - xi)*(yl(4) - yl(1)) + (1.0_wp + xi)*(yl(3) - yl(2)))
+      determinant = x_xi*y_eta - y_xi*x_eta
+      if (determinant == 0.0_wp) cycle
+      ! [gamma_xi, gamma_eta] = J [gamma_x, gamma_y], J = [[x_xi, y_xi], [x_eta, y_eta]]
+      operator(1, :, :, point) = (y_eta*along_xi - y_xi*along_eta)/determinant
+      operator(2, :, :, point) = (-x_eta*along_xi + x_xi*along_eta)/determinant
+    end do
+  contains
+    !> Weights of the covariant shear at the midpoint of edge (i, j) on the corner values.
+    pure function edge_operator(i, j) result(weights)
+      integer, intent(in) :: i, j
+      real(wp) :: weights(4, 3), gx, gy
+      gx = 0.5_wp*(xl(j) - xl(i))
+      gy = 0.5_wp*(yl(j) - yl(i))
+      weights = 0.0_wp
+      weights(i, 1) = -0.5_wp
+      weights(j, 1) = 0.5_wp
+      weights(i, 2) = -0.5_wp*gy
+      weights(j, 2) = -0.5_wp*gy
+      weights(i, 3) = 0.5_wp*gx
+      weights(j, 3) = 0.5_wp*gx
+    end function edge_operator
+  end subroutine shear_operator
+
+  !> Turn lane i's transverse shear stress (zx, yz) as an in-plane vector by `angle`.
+  pure subroutine rotate_shear_stress(block, i, angle)
+    type(efg_shell_block_t), intent(inout) :: block
+    integer, intent(in) :: i
+    real(wp), intent(in) :: angle
+    real(wp) :: c, s, first, second
+    c = cos(angle)
+    s = sin(angle)
+    first = block%shear_stress(i, 1)
+    second = block%shear_stress(i, 2)
+    block%shear_stress(i, 1) = c*first - s*second
+    block%shear_stress(i, 2) = s*first + c*second
+  end subroutine rotate_shear_stress
+
+  !> A point's forces and moments on its pairs as global f_I = P b_I and m_I = Q b_I, from the
+  !> end frame, G = F^-T and the resultants times W J (N: xx, yy, xy; M: xx, yy, xy): with
+  !> g_I = G b_I the local force is (N g_I) and the local moment about e1, e2 is
+  !> (-M_xy g_1 - M_yy g_2, M_xx g_1 + M_xy g_2), the transposes of the rates (module comment).
+  pure subroutine forces_of_point(frame, inverse, resultant, force, couple)
+    real(wp), intent(in) :: frame(3, 3), inverse(2, 2), resultant(6)
+    real(wp), intent(out) :: force(3, 2), couple(3, 2)
+    real(wp) :: local_force(2, 2), local_couple(2, 2)
+    integer :: c
+    do c = 1, 2
+      local_force(1, c) = resultant(1)*inverse(1, c) + resultant(3)*inverse(2, c)
+      local_force(2, c) = resultant(3)*inverse(1, c) + resultant(2)*inverse(2, c)
+      local_couple(1, c) = -resultant(6)*inverse(1, c) - resultant(5)*inverse(2, c)
+      local_couple(2, c) = resultant(4)*inverse(1, c) + resultant(6)*inverse(2, c)
+      force(:, c) = local_force(1, c)*frame(:, 1) + local_force(2, c)*frame(:, 2)
+      couple(:, c) = local_couple(1, c)*frame(:, 1) + local_couple(2, c)*frame(:, 2)
+    end do
+  end subroutine forces_of_point
 
   !> Turn lane i's stresses (every thickness point) by `angle` (components kept in a frame that
   !> turned by phi while the material turned by psi turn by psi - phi: shell_block's
@@ -626,53 +817,44 @@ contains
   !> The block's forces and moments into the nodes: point by point, pair by pair (a node
   !> appears once among a point's pairs), then cell by cell its shear pairs and its corners'
   !> normal and area sums.
-  subroutine add_block_forces(geometry, cell_nodes, block, cell_frame, cell_area, point_inverse, point_membrane, &
-                              point_moment, shear_inverse, shear_resultant, internal_force, internal_moment, &
-                              normal_sum, area_sum)
+  subroutine add_block_forces(geometry, cell_nodes, block, cell_frame, cell_area, point_force, point_couple, &
+                              corner_offsets, corner_node, corner_weight, corner_force, internal_force, &
+                              internal_moment, normal_sum, area_sum)
     type(efg_shell_part_t), intent(in) :: geometry
     integer, intent(in) :: cell_nodes(:, :)
     type(efg_shell_block_t), intent(in) :: block
-    real(wp), intent(in) :: cell_frame(:, :, :), cell_area(:), point_inverse(:, :, :), point_membrane(:, :)
-    real(wp), intent(in) :: point_moment(:, :), shear_inverse(:, :, :), shear_resultant(:, :)
+    real(wp), intent(in) :: cell_frame(:, :, :), cell_area(:), point_force(:, :, :), point_couple(:, :, :)
+    integer, intent(in) :: corner_offsets(:), corner_node(:)
+    real(wp), intent(in) :: corner_weight(:), corner_force(:, :, :)
     real(wp), intent(inout) :: internal_force(:, :), internal_moment(:, :), normal_sum(:, :), area_sum(:)
-    real(wp) :: e1(3), e2(3), e3(3), g1, g2, n1, n2, m1, m2, transverse
+    real(wp) :: p(3, 2), q(3, 2), b1, b2, weight
     integer :: gp, k, node, cell, corner
     do gp = block%first_point, block%first_point + block%point_count - 1
-      cell = geometry%point_cell(gp)
-      e1 = cell_frame(:, 1, cell)
-      e2 = cell_frame(:, 2, cell)
-      associate (inverse => point_inverse(:, :, gp), membrane => point_membrane(:, gp), moment => point_moment(:, gp))
-        do k = geometry%point_offsets(gp), geometry%point_offsets(gp + 1) - 1
-          node = geometry%pair_node(k)
-          g1 = inverse(1, 1)*geometry%pair_gradient(1, k) + inverse(1, 2)*geometry%pair_gradient(2, k)
-          g2 = inverse(2, 1)*geometry%pair_gradient(1, k) + inverse(2, 2)*geometry%pair_gradient(2, k)
-          n1 = membrane(1)*g1 + membrane(3)*g2
-          n2 = membrane(3)*g1 + membrane(2)*g2
-          m1 = -moment(2)*g2 - moment(3)*g1
-          m2 = moment(1)*g1 + moment(3)*g2
-          internal_force(:, node) = internal_force(:, node) + (n1*e1 + n2*e2)
-          internal_moment(:, node) = internal_moment(:, node) + (m1*e1 + m2*e2)
-        end do
-      end associate
+      p = point_force(:, :, gp)
+      q = point_couple(:, :, gp)
+      do k = geometry%point_offsets(gp), geometry%point_offsets(gp + 1) - 1
+        node = geometry%pair_node(k)
+        b1 = geometry%pair_gradient(1, k)
+        b2 = geometry%pair_gradient(2, k)
+        internal_force(:, node) = internal_force(:, node) + (p(:, 1)*b1 + p(:, 2)*b2)
+        internal_moment(:, node) = internal_moment(:, node) + (q(:, 1)*b1 + q(:, 2)*b2)
+      end do
     end do
     do cell = block%first_cell, block%first_cell + block%cell_count - 1
-      e1 = cell_frame(:, 1, cell)
-      e2 = cell_frame(:, 2, cell)
-      e3 = cell_frame(:, 3, cell)
-      associate (inverse => shear_inverse(:, :, cell), q => shear_resultant(:, cell))
-        do k = geometry%shear_offsets(cell), geometry%shear_offsets(cell + 1) - 1
-          node = geometry%shear_node(k)
-          g1 = inverse(1, 1)*geometry%shear_gradient(1, k) + inverse(1, 2)*geometry%shear_gradient(2, k)
-          g2 = inverse(2, 1)*geometry%shear_gradient(1, k) + inverse(2, 2)*geometry%shear_gradient(2, k)
-          transverse = q(1)*g1 + q(2)*g2
-          internal_force(:, node) = internal_force(:, node) + transverse*e3
-          internal_moment(:, node) = internal_moment(:, node) + geometry%shear_value(k)*(q(1)*e2 - q(2)*e1)
+      ! the shear forces on the physical corners, through each corner's row (A^T)
+      do corner = 1, 4
+        if (corner == 4 .and. cell_nodes(4, cell) == cell_nodes(3, cell)) cycle
+        do k = corner_offsets(4*(cell - 1) + corner), corner_offsets(4*(cell - 1) + corner + 1) - 1
+          node = corner_node(k)
+          weight = corner_weight(k)
+          internal_force(:, node) = internal_force(:, node) + weight*corner_force(1:3, corner, cell)
+          internal_moment(:, node) = internal_moment(:, node) + weight*corner_force(4:6, corner, cell)
         end do
-      end associate
+      end do
       do corner = 1, 4
         if (corner == 4 .and. cell_nodes(4, cell) == cell_nodes(3, cell)) cycle
         node = cell_nodes(corner, cell)
-        normal_sum(:, node) = normal_sum(:, node) + cell_area(cell)*e3
+        normal_sum(:, node) = normal_sum(:, node) + cell_area(cell)*cell_frame(:, 3, cell)
         area_sum(node) = area_sum(node) + cell_area(cell)
       end do
     end do
@@ -758,7 +940,7 @@ contains
             if (geometry%point_cell(block%first_point + i - 1) /= c) cycle
             area = geometry%point_area(block%first_point + i - 1)
             do point = 1, solver%thickness_points
-              local = [block%stress(i, :, point), block%shear_stress(lane, 2), block%shear_stress(lane, 1)]
+              local = [block%stress(i, :, point), block%shear_stress(i, 2), block%shear_stress(i, 1)]
               mean = mean + solver%point_weight(point)*area*local
               mean_strain = mean_strain + solver%point_weight(point)*area*point_strain(i, point)
               peak_strain = max(peak_strain, point_strain(i, point))

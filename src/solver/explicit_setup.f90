@@ -100,7 +100,8 @@ contains
 
   !> Things the user should know before the run starts, one per line (empty: nothing):
   !> conditions and loads on interior particles of meshfree parts act on generalized
-  !> displacements, and mass scaling leaves meshfree parts alone.
+  !> displacements, mass scaling leaves meshfree parts alone, and rigid walls act on the
+  !> generalized positions of meshfree particles.
   function set_up_warnings(model, state) result(text)
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(in) :: state
@@ -126,6 +127,15 @@ contains
       if (len(text) > 0) text = text//new_line('a')
       text = text//"warning: mass scaling (DT2MS) applies to finite elements only; meshfree parts keep their density"
     end if
+    ! meshfree shells (efg_shell_group): walls see their particles' generalized positions
+    do k = 1, size(model%walls)
+      if (.not. allocated(model%walls(k)%nodes)) cycle
+      if (.not. any(state%nodes%is_particle(model%walls(k)%nodes))) cycle
+      if (len(text) > 0) text = text//new_line('a')
+      text = text//"warning: rigid wall "//trim(integer_text(model%walls(k)%id))//" tracks interior particles "// &
+        "of meshfree parts: it acts on their generalized positions, not their physical ones (a contact with a "// &
+        "rigid part does)"
+    end do
   contains
     subroutine note_particle(node)
       integer, intent(in) :: node

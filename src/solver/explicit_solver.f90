@@ -385,18 +385,22 @@ contains
   !> with the meshfree groups' interior particles transformed (to_physical).
   subroutine physical_contact_values(state)
     type(explicit_state_t), intent(inout) :: state
-    integer :: k
+    integer :: k, node
     associate (nodes => state%nodes)
       if (.not. allocated(state%contact_coordinates)) &
         allocate (state%contact_coordinates(3, nodes%count), state%contact_velocity(3, nodes%count), &
                   state%contact_physical_force(3, nodes%count))
-      state%contact_coordinates = nodes%displacement
+      ! other nodes keep the solver's values exactly; a particle's displacement becomes its position
+      state%contact_coordinates = nodes%coordinates
       state%contact_velocity = nodes%velocity
       do k = 1, size(state%groups)
         call state%groups(k)%group%to_physical(nodes%displacement, state%contact_coordinates)
         call state%groups(k)%group%to_physical(nodes%velocity, state%contact_velocity)
       end do
-      state%contact_coordinates = nodes%reference + state%contact_coordinates
+      do node = 1, nodes%count
+        if (nodes%is_particle(node)) &
+          state%contact_coordinates(:, node) = nodes%reference(:, node) + state%contact_coordinates(:, node)
+      end do
     end associate
   end subroutine physical_contact_values
 

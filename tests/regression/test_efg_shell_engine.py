@@ -204,3 +204,21 @@ def test_drop_on_a_free_rigid_plate_keeps_the_momentum(tmp_path, run_deck):
     plate_mass, rigid_mass = DENSITY * SIDE * SIDE * 2.0, DENSITY * 60.0 * 60.0 * 2.0
     elastic = 2.0 * plate_mass / (plate_mass + rigid_mass) * 3.0
     assert rigid_velocity[0, 2] == 0.0 and rigid_velocity[-1, 2] < -0.5 * elastic
+
+
+def test_walls_and_failure_criteria_on_meshfree_shells_are_announced(tmp_path, run_deck):
+    """What meshfree shells do not do is said before the run: a rigid wall tracking their
+    interior particles acts on generalized positions; their material's failure strain does not
+    erode them (the deck check's warning for every meshfree part)."""
+    deck = drop_deck(tmp_path / "announced.k", end_time=0.01)
+    text = deck.read_text()
+    text = text.replace("*MAT_ELASTIC\n" + fields(1, DENSITY, YOUNGS, POISSON),
+                        "*MAT_PLASTIC_KINEMATIC\n" + fields(1, DENSITY, YOUNGS, POISSON, 0.25, 0.0, 0.0) + "\n" +
+                        fields(0.0, 0.0, 0.3) + "\n*RIGIDWALL_PLANAR\n" + fields(0) + "\n" +
+                        fields(0.0, 0.0, -10.0, 0.0, 0.0, 1.0))
+    deck.write_text(text)
+    run = run_deck(deck)
+    assert run.status == 0, run.stdout + run.stderr
+    assert ("warning: rigid wall 1 tracks interior particles of meshfree parts: it acts on their generalized "
+            "positions") in run.stderr
+    assert "the failure criteria of material 1 are ignored for part 1: meshfree (EFG) parts do not erode" in run.stderr
