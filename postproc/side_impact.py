@@ -182,14 +182,18 @@ def summarize(run: dict) -> dict:
     s["impulse"] = float(np.trapezoid(run["force"], run["time"]))
     s["door_dv"] = float(run["door_velocity"][-1] - run["door_velocity"][0])
     s.update(quality(run, run["last"][1]))
-    # efg_s holds both meshfree kinds; efg_shell_s the shells' share of it
     phases = {"FE solids": timing.get("fe_solid_s", 0.0), "FE shells": timing.get("fe_shell_s", 0.0),
-              "meshfree solids": timing.get("efg_s", 0.0) - timing.get("efg_shell_s", 0.0),
+              "meshfree solids": timing.get("efg_s", 0.0),
               "meshfree shells": timing.get("efg_shell_s", 0.0), "contact": timing.get("contact_s", 0.0),
               "output": timing.get("output_s", 0.0)}
     wall = float(timing.get("wall_s", np.nan))
     phases["other"] = wall - sum(phases.values())
     s["phases"] = phases
+    # the cycle's phases (wall seconds): internal forces, and what of it no group timer holds
+    internal = float(timing.get("phase_internal_forces_s", np.nan))
+    groups = sum(phases[k] for k in ("FE solids", "FE shells", "meshfree solids", "meshfree shells"))
+    s["phase_internal"], s["phase_internal_untimed"] = internal, internal - groups
+    s["phase_contact"] = float(timing.get("phase_contact_s", np.nan))
     s["wall"] = wall
     return s
 
@@ -321,6 +325,9 @@ def table(summaries, labels) -> str:
              lambda s: " / ".join(f"{s['phases'][k]:.1f}" for k in ("FE solids", "FE shells", "meshfree solids",
                                                                       "meshfree shells", "contact"))
              + f" / {s['phases']['other'] + s['phases']['output']:.1f}"),
+            ("phase seconds: internal forces (not in a group timer) / contact / wall",
+             lambda s: f"{s['phase_internal']:.1f} ({s['phase_internal_untimed']:.1f}) / {s['phase_contact']:.1f} / "
+                       f"{s['wall']:.1f}"),
             ("message", lambda s: s["message"] or "-")]
     lines = ["| | " + " | ".join(labels) + " |", "|---|" + "---|" * len(labels)]
     for name, value in rows:
