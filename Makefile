@@ -4,6 +4,8 @@
 #                   coupled FE/EFG, about 2 min on one core), plot and tabulate (ODB_FE=1: run fe.k too)
 #   make taylor     the same for the Taylor bar
 #   make vehicle    the same for the vehicle front structure (inputs/vehicle_front; 8 min on 2 threads, NCPU=2)
+#   make side-impact  the side-impact dummy component test (inputs/side_impact): fe.k, ribs_efg.k
+#                   and coupled.k, then their force plot, sections and table (REPEAT=3: timing study)
 #   make test       install what is missing, build, layer check, unit tests (debug build) and
 #                   regression tests
 #   make layers     check that each folder of src/ uses only the folders below it
@@ -117,6 +119,12 @@ test: deps
 vehicle: deps
 	@$(MAKE) --no-print-directory all
 	@bash tools/run_vehicle_front.sh
+
+# The side-impact dummy component test (inputs/side_impact, docs/examples/side_impact.md).
+.PHONY: side-impact
+side-impact: deps
+	@$(MAKE) --no-print-directory all
+	@bash inputs/side_impact/run.sh
 
 bench: deps
 	@$(MAKE) --no-print-directory all
