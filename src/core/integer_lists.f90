@@ -5,7 +5,7 @@ module integer_lists
   implicit none
   private
 
-  public :: reserve_integers, reserve_integer_columns, append_integer
+  public :: reserve_integers, reserve_integer_columns, append_integer, sorted_position, sort_short_list
 
 contains
 
@@ -58,4 +58,43 @@ contains
     first_capacity = 16
     if (present(minimum)) first_capacity = minimum
   end function first_capacity
+
+  !> Position of `value` in the ascending list (0 if absent), by bisection.
+  pure integer function sorted_position(list, value)
+    integer, intent(in) :: list(:), value
+    integer :: low, high, middle
+
+    sorted_position = 0
+    low = 1
+    high = size(list)
+    do while (low <= high)
+      middle = (low + high)/2
+      if (list(middle) == value) then
+        sorted_position = middle
+        return
+      else if (list(middle) < value) then
+        low = middle + 1
+      else
+        high = middle - 1
+      end if
+    end do
+  end function sorted_position
+
+  !> Sort a short list ascending in place (insertion sort: the lists here hold a few dozen
+  !> entries, mostly in order already).
+  pure subroutine sort_short_list(values)
+    integer, intent(inout) :: values(:)
+    integer :: i, j, held
+
+    do i = 2, size(values)
+      held = values(i)
+      j = i - 1
+      do while (j >= 1)
+        if (values(j) <= held) exit
+        values(j + 1) = values(j)
+        j = j - 1
+      end do
+      values(j + 1) = held
+    end do
+  end subroutine sort_short_list
 end module integer_lists

@@ -30,6 +30,7 @@
 !> trilinear functions.
 module efg_shape_functions
   use kinds, only: wp
+  use integer_lists, only: sorted_position, sort_short_list
   use efg_kernel, only: kernel_weights, kernel_weight_gradient
   use efg_cell_geometry, only: trilinear_functions, trilinear_natural_derivatives, cell_jacobian, inverse_3, &
                                mean_edge_length
@@ -128,7 +129,7 @@ contains
       gamma_count = gamma_count + 1
       gamma_vertices(gamma_count) = cell_nodes(a)
     end do
-    call sort_small(gamma_vertices(1:gamma_count))
+    call sort_short_list(gamma_vertices(1:gamma_count))
 
     ! merge the two ascending lists (particle numbers ascend with their node indices)
     context%node_count = gamma_count + candidate_count
@@ -154,11 +155,11 @@ contains
 
     do a = 1, 8
       node = cell_nodes(a)
-      context%vertex_local(a) = local_position(context%nodes(1:context%node_count), node)
+      context%vertex_local(a) = sorted_position(context%nodes(1:context%node_count), node)
       context%vertex_particle(a) = 0
       if (context%vertex_is_particle(a)) then
         ! an interior vertex always covers its cell, so it is among the candidates
-        context%vertex_particle(a) = local_position(context%candidates(1:candidate_count), &
+        context%vertex_particle(a) = sorted_position(context%candidates(1:candidate_count), &
                                                     supports%particle_of_node(node))
       end if
     end do
@@ -359,42 +360,7 @@ contains
     end do
   end function forward_solve
 
-  !> Position of `value` in the ascending list (0 if absent).
-  pure integer function local_position(list, value)
-    integer, intent(in) :: list(:), value
-    integer :: low, high, middle
 
-    local_position = 0
-    low = 1
-    high = size(list)
-    do while (low <= high)
-      middle = (low + high)/2
-      if (list(middle) == value) then
-        local_position = middle
-        return
-      else if (list(middle) < value) then
-        low = middle + 1
-      else
-        high = middle - 1
-      end if
-    end do
-  end function local_position
-
-  pure subroutine sort_small(values)
-    integer, intent(inout) :: values(:)
-    integer :: i, j, held
-
-    do i = 2, size(values)
-      held = values(i)
-      j = i - 1
-      do while (j >= 1)
-        if (values(j) <= held) exit
-        values(j + 1) = values(j)
-        j = j - 1
-      end do
-      values(j + 1) = held
-    end do
-  end subroutine sort_small
 
   !> Room for `count` candidate particles (and count + 8 local nodes); arrays only grow, so one
   !> context can be reused for every cell of a thread.

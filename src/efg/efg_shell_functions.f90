@@ -23,6 +23,7 @@
 !> R11^T and one product with Q (dormqr); the residual |sum_I Psi_I p(xi_I) - b| is returned.
 module efg_shell_functions
   use kinds, only: wp
+  use integer_lists, only: sorted_position, sort_short_list
   use efg_kernel, only: kernel_weight
   use efg_shell_part, only: shell_cell_frame
   use efg_shell_supports, only: shell_supports_t, corner_count
@@ -148,7 +149,7 @@ contains
       gamma_count = gamma_count + 1
       gamma_corners(gamma_count) = cell_nodes(a)
     end do
-    call sort_small(gamma_corners(1:gamma_count))
+    call sort_short_list(gamma_corners(1:gamma_count))
 
     ! merge the two ascending lists (particle numbers ascend with their node indices)
     context%node_count = gamma_count + candidate_count
@@ -172,7 +173,7 @@ contains
       end if
     end do
     do a = 1, 4
-      context%corner_local(a) = local_position(context%nodes(1:context%node_count), cell_nodes(a))
+      context%corner_local(a) = sorted_position(context%nodes(1:context%node_count), cell_nodes(a))
     end do
   end subroutine prepare_shell_cell
 
@@ -264,42 +265,7 @@ contains
     residual = maxval(abs(reproduced - moment))
   end subroutine evaluate_shell_functions
 
-  !> Position of `value` in the ascending list (0 if absent).
-  pure integer function local_position(list, value)
-    integer, intent(in) :: list(:), value
-    integer :: low, high, middle
 
-    local_position = 0
-    low = 1
-    high = size(list)
-    do while (low <= high)
-      middle = (low + high)/2
-      if (list(middle) == value) then
-        local_position = middle
-        return
-      else if (list(middle) < value) then
-        low = middle + 1
-      else
-        high = middle - 1
-      end if
-    end do
-  end function local_position
-
-  pure subroutine sort_small(values)
-    integer, intent(inout) :: values(:)
-    integer :: i, j, held
-
-    do i = 2, size(values)
-      held = values(i)
-      j = i - 1
-      do while (j >= 1)
-        if (values(j) <= held) exit
-        values(j + 1) = values(j)
-        j = j - 1
-      end do
-      values(j + 1) = held
-    end do
-  end subroutine sort_small
 
   !> Room for `count` candidate particles (and count + 4 local nodes); arrays only grow.
   subroutine ensure_size(context, count)
