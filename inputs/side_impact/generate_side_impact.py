@@ -369,7 +369,8 @@ def main(argv=None):
     parser.add_argument("--end-time", type=float, default=60.0, help="termination time (ms)")
     parser.add_argument("--states", type=int, default=30, help="number of state intervals")
     parser.add_argument("--dx", type=float, default=1.2, help="EFG solids: normalized support DX = DY = DZ")
-    parser.add_argument("--shell-dx", type=float, default=1.5, help="EFG shells: normalized support DX = DY")
+    parser.add_argument("--shell-dx", type=float, default=1.1,
+                        help="EFG shells: normalized support DX = DY (LS-DYNA's default 1.1; wider supports stiffen the curved jacket)")
     parser.add_argument("--ihq", type=int, default=1, help="hourglass type of the FE solids")
     parser.add_argument("--qh", type=float, default=0.1, help="hourglass coefficient")
     parser.add_argument("--tssfac", type=float, default=0.9, help="time step scale factor")

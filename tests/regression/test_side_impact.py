@@ -114,7 +114,7 @@ def test_decks_differ_only_in_the_foam_and_jacket_sections(decks):
     assert ribs.count("*SECTION_SOLID_EFG") == 1 and coupled.count("*SECTION_SOLID_EFG") == 1
     jacket = coupled.split("meshfree jacket\n")[1].splitlines()
     assert int(jacket[1][10:20]) == 41            # *SECTION_SHELL ELFORM 41 ...
-    assert jacket[5].split()[:2] == ["1.5", "1.5"]  # ... and its EFG card DX DY
+    assert jacket[5].split()[:2] == ["1.1", "1.1"]  # ... and its EFG card DX DY
     for text in (fe, ribs, coupled):
         assert "*INCLUDE\nmesh.k" in text and text.count("*CONTACT_AUTOMATIC") == 2
 
