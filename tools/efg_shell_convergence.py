@@ -149,7 +149,7 @@ def section(cantilever, strip, formulations, command, tests):
         "",
         "Both EFG columns follow the FE column in the cantilever (their transverse shear is an assumed "
         "strain on the cells' physical corner values, MITC4-like, which brings the FE shell's "
-        "-1/(4 n^2)): the EFG shell is not more accurate than FE here, against the issue's expectation "
+        "-1/(4 n^2)): the EFG shell is not more accurate than FE here "
         "(before that shear, with one MLS shear point per cell, DX 1.5 gave -0.75% at 5 x 2 and "
         "-0.13% at 10 x 2). The EFG strip periods settle 0.4% below Euler-Bernoulli at 40 x 2 while "
         "FE's reach it; but FE with more cells across the width goes there too (40 x 4: 0.99639, "
