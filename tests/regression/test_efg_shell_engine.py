@@ -206,6 +206,79 @@ def test_drop_on_a_free_rigid_plate_keeps_the_momentum(tmp_path, run_deck):
     assert rigid_velocity[0, 2] == 0.0 and rigid_velocity[-1, 2] < -0.5 * elastic
 
 
+def struck_surface_deck(path, speed=3.0, end_time=0.4):
+    """The meshfree plate as the contact SURFACE: the EFG plate (40 x 40 mm, 8 x 8 irregular
+    cells, 2 mm, moving up at `speed`) strikes a free rigid plate above it (20 x 20 mm, 4 x 4 FE
+    shells, centred); *CONTACT_AUTOMATIC_NODES_TO_SURFACE with the rigid plate's nodes as the
+    secondary side and the EFG part as the segments, so the segments' corners (mostly interior
+    particles) are at their physical positions and the segment forces go back as A^T f. The
+    rigid nodes start 0.5 mm above the EFG plate's upper contact surface (its half thickness above
+    the mid-surface)."""
+    thickness = 2.0
+    nodes, shells = plate_mesh((8, 8), (SIDE, SIDE), perturbation=0.2, seed=9)
+    nodes = round_to_node_card(nodes)
+    rigid_nodes, rigid_shells = plate_mesh((4, 4), (20.0, 20.0))
+    rigid_nodes = round_to_node_card(rigid_nodes + [10.0, 10.0, 0.5 * thickness + 0.5])
+    count = len(nodes)
+    return write_deck(
+        path,
+        "*TITLE\nrigid plate struck by a meshfree plate",
+        "*CONTROL_TERMINATION\n" + fields(end_time),
+        "*DATABASE_GLSTAT\n" + fields(end_time / 200),
+        "*DATABASE_BINARY_D3PLOT\n" + fields(end_time / 4),
+        "*PART\nmeshfree plate\n" + fields(1, 1, 1),
+        "*SECTION_SHELL\n" + fields(1, 41, f"{5 / 6:10.7f}", 3) + "\n" + fields(thickness, thickness, thickness,
+                                                                             thickness) + "\n" + fields(1.5, 1.5),
+        "*MAT_ELASTIC\n" + fields(1, DENSITY, YOUNGS, POISSON),
+        "*PART\nrigid plate\n" + fields(2, 2, 2),
+        "*SECTION_SHELL\n" + fields(2, 2, 1.0, 2) + "\n" + fields(thickness, thickness, thickness, thickness),
+        "*MAT_RIGID\n" + fields(2, DENSITY, YOUNGS, POISSON) + "\n" + fields(0.0, 0.0, 0.0) + "\n" + fields(0.0),
+        "*CONTACT_AUTOMATIC_NODES_TO_SURFACE_ID\n" + fields(5) + "strike\n" + fields(2, 1, 4, 3) + "\n" +
+        fields(0.0) + "\n" + fields(0.1, 0.1),
+        "*SET_NODE_LIST_GENERATE\n" + fields(1) + "\n" + fields(1, count),
+        "*SET_NODE_LIST_GENERATE\n" + fields(2) + "\n" + fields(count + 1, count + len(rigid_nodes)),
+        nodes_card(np.vstack([nodes, rigid_nodes])),
+        shells_card(shells, part_id=1) + "\n" +
+        "\n".join(shells_card(rigid_shells, part_id=2, first_id=len(shells) + 1,
+                              first_node_id=count + 1).splitlines()[1:]),
+        "*INITIAL_VELOCITY\n" + fields(1) + "\n" + fields(0.0, 0.0, speed),
+    )
+
+
+def test_meshfree_plate_as_contact_surface_keeps_the_momentum(tmp_path, run_deck):
+    """The other side of the contact: the EFG part gives the segments, a rigid plate's nodes
+    strike them. Total momentum stays at its initial value (1e-9 relative), the total energy
+    within 1e-5, the rigid plate is pushed up (faster than half the speed of an elastic impact of
+    its mass on the EFG plate's, 2 m1 / (m1 + m2) v), and no rigid node passes the EFG plate's
+    physical upper surface (its mid-surface at the rigid plate's nodes plus half the thickness)
+    by more than a tenth of the thickness at any output state."""
+    run = run_deck(struck_surface_deck(tmp_path / "struck.k"))
+    assert run.status == 0, run.stdout + run.stderr
+    with run.open() as results:
+        glstat = glstat_of(results)
+        rigid_velocity = results["history/rbdout/2"]["velocity"][...]
+        coordinates = results["mesh/nodes/coordinates"][...]
+        gaps = []
+        for name in sorted(results["states"]):
+            current = coordinates + results["states"][name]["displacement"][...]
+            meshfree, rigid = current[:81], current[81:]
+            # the EFG plate's physical mid-surface height under the rigid plate: the mean of the
+            # nodes within its footprint (the plate stays nearly flat; bending is small)
+            under = (meshfree[:, 0] > 10.0) & (meshfree[:, 0] < 30.0) & (meshfree[:, 1] > 10.0) & \
+                    (meshfree[:, 1] < 30.0)
+            gaps.append(rigid[:, 2].min() - (meshfree[under, 2].max() + 1.0))
+    momentum = glstat["momentum"]
+    assert np.abs(momentum - momentum[0]).max() <= 1e-9 * np.abs(momentum[0]).max()
+    total = glstat["total_energy"]
+    assert np.abs(total / total[0] - 1.0).max() < 1e-5
+    plate_mass, rigid_mass = DENSITY * SIDE * SIDE * 2.0, DENSITY * 20.0 * 20.0 * 2.0
+    elastic = 2.0 * plate_mass / (plate_mass + rigid_mass) * 3.0
+    print(f"rigid plate final speed {rigid_velocity[-1, 2]:.4f} (elastic {elastic:.4f}); smallest gap "
+          f"{min(gaps):.4f} mm")
+    assert rigid_velocity[0, 2] == 0.0 and rigid_velocity[-1, 2] > 0.5 * elastic
+    assert min(gaps) > -0.2
+
+
 def test_walls_and_failure_criteria_on_meshfree_shells_are_announced(tmp_path, run_deck):
     """What meshfree shells do not do is said before the run: a rigid wall tracking their
     interior particles acts on generalized positions; their material's failure strain does not
