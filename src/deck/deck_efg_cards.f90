@@ -41,6 +41,12 @@ module deck_efg_cards
 
   character(len=2), parameter :: support_names(3) = ["DX", "DY", "DZ"]
 
+  !> The widest normalized support read: the set-up's pair lists grow with the square (shells)
+  !> or cube (solids) of the support, and a support of many element neighbour distances makes
+  !> every particle cover most of the part (a 40 x 40 shell plate at DX 1e29 needed 870 MB).
+  !> LS-DYNA's manuals suggest values between 1.0 and 2.0.
+  real(wp), parameter :: widest_support_scale = 4.0_wp
+
 contains
 
   !> The EFG card into `section`: DX DY DZ ISPLINE IDILA IEBT IDIM TOLDEF.
@@ -71,6 +77,8 @@ contains
         call card_problem(deck, log, card, support_names(k), support_names(k)//" must be "// &
           "greater than 1: at 1.0 a vertex weight vanishes on the cell's far corner; found "// &
           real_text(support_scale(k))//" (blank or 0 means 1.01)")
+      else if (support_scale(k) > widest_support_scale) then
+        call card_problem(deck, log, card, support_names(k), too_wide_text(support_names(k), support_scale(k)))
       end if
     end do
     section%support_scale = support_scale
@@ -164,6 +172,8 @@ contains
         call card_problem(deck, log, card, support_names(k), support_names(k)//" must be "// &
           "greater than 1: at 1.0 a vertex weight vanishes on the cell's far corner; found "// &
           real_text(support_scale(k))//" (blank or 0 means 1.1)")
+      else if (support_scale(k) > widest_support_scale) then
+        call card_problem(deck, log, card, support_names(k), too_wide_text(support_names(k), support_scale(k)))
       end if
     end do
     section%support_scale(1:2) = support_scale
@@ -278,4 +288,12 @@ contains
     real(wp), intent(in) :: value, expected
     is_value = abs(value - expected) <= 1.0e-9_wp*abs(expected)
   end function is_value
+  !> The message for a normalized support above widest_support_scale.
+  function too_wide_text(name, value) result(text)
+    character(len=*), intent(in) :: name
+    real(wp), intent(in) :: value
+    character(len=:), allocatable :: text
+    text = name//" must be at most "//trim(real_text(widest_support_scale))//" (the support in element "// &
+      "neighbour distances; 1.0 to 2.0 is usual, and wider supports cover most of the part); found "//real_text(value)
+  end function too_wide_text
 end module deck_efg_cards

@@ -99,17 +99,24 @@ contains
   end subroutine set_up_rigid_state
 
   !> Things the user should know before the run starts, one per line (empty: nothing):
-  !> conditions and loads on interior particles of meshfree parts act on generalized
-  !> displacements, mass scaling leaves meshfree parts alone, rigid walls act on the
-  !> generalized positions of meshfree particles, and wide supports stiffen curved meshfree
-  !> shells.
+  !> segment loads are applied by the static analysis only; conditions and loads on interior
+  !> particles of meshfree parts act on generalized displacements, and so does an initial
+  !> velocity field that is not linear across a meshfree part; mass scaling leaves meshfree
+  !> parts alone, rigid walls act on the generalized positions of meshfree particles, and wide
+  !> supports stiffen curved meshfree shells.
   function set_up_warnings(model, state) result(text)
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(in) :: state
     character(len=:), allocatable :: text
     integer :: count, first, k
     text = ""
+    if (allocated(model%segment_loads)) then
+      if (size(model%segment_loads) > 0) text = "warning: the deck's "//trim(integer_text(size(model%segment_loads)))// &
+        " segment load(s) (*LOAD_SEGMENT, _SET, _NONUNIFORM) are applied by the linear static analysis "// &
+        "(*CONTROL_IMPLICIT_GENERAL) only: this explicit run does not apply them"
+    end if
     if (.not. any(state%nodes%is_particle)) return
+    call note_initial_velocities()
     count = 0
     first = 0
     do k = 1, size(model%spcs)
@@ -121,9 +128,12 @@ contains
     do k = 1, size(model%loads)
       call note_particle(model%loads(k)%node)
     end do
-    if (count > 0) text = "warning: "//trim(integer_text(count))//" constraint(s) or load(s) act on interior "// &
-      "particles of meshfree parts (node "//trim(integer_text(model%node_ids(first)))//" first): they act on "// &
-      "generalized displacements, not on the nodes' own motion; put them on the parts' surfaces"
+    if (count > 0) then
+      if (len(text) > 0) text = text//new_line('a')
+      text = text//"warning: "//trim(integer_text(count))//" constraint(s) or load(s) act on interior "// &
+        "particles of meshfree parts (node "//trim(integer_text(model%node_ids(first)))//" first): they act on "// &
+        "generalized displacements, not on the nodes' own motion; put them on the parts' surfaces"
+    end if
     if (model%mass_scaled_time_step /= 0.0_wp) then
       if (len(text) > 0) text = text//new_line('a')
       text = text//"warning: mass scaling (DT2MS) applies to finite elements only; meshfree parts keep their density"
@@ -142,6 +152,37 @@ contains
         "rigid part does)"
     end do
   contains
+    !> Initial velocities are given to the solver's values, which at interior particles are
+    !> generalized: the physical initial velocity is A v, equal to the deck's for a uniform or
+    !> linear field (a translation, a rotation) only. Warn, naming the first node, when A v
+    !> differs from the deck's velocity at a particle.
+    subroutine note_initial_velocities()
+      real(wp), allocatable :: physical(:, :)
+      real(wp) :: scale
+      integer :: group, node, worst
+      if (.not. allocated(model%initial_velocity)) return
+      scale = maxval(abs(model%initial_velocity))
+      if (scale <= 0.0_wp) return
+      physical = model%initial_velocity
+      do group = 1, size(state%groups)
+        call state%groups(group)%group%to_physical(model%initial_velocity, physical)
+      end do
+      worst = 0
+      do node = 1, size(physical, 2)
+        if (.not. state%nodes%is_particle(node)) cycle
+        if (maxval(abs(physical(:, node) - model%initial_velocity(:, node))) > 1.0e-9_wp*scale) then
+          worst = node
+          exit
+        end if
+      end do
+      if (worst == 0) return
+      if (len(text) > 0) text = text//new_line('a')
+      text = text//"warning: the initial velocities are not a uniform or linear field across a meshfree part: "// &
+        "at interior particles they set generalized velocities, so the physical initial velocity differs (node "// &
+        trim(integer_text(model%node_ids(worst)))//" first); give meshfree parts a uniform or rotational "// &
+        "initial velocity"
+    end subroutine note_initial_velocities
+
     !> A meshfree shell part with DX or DY above 1.2 whose neighbouring cells (sharing a node)
     !> turn by more than 2 degrees: wide supports span several facets of a curved surface in each
     !> cell's plane, which stiffens it (membrane locking; docs/efg_shells.md: a quarter ring at

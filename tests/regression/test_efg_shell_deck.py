@@ -52,6 +52,8 @@ def test_meshfree_shell_section_is_read_and_its_part_is_meshfree(tmp_path, run_d
 def test_every_efg_card_value_not_built_is_refused_with_its_line_and_field(tmp_path, run_deck):
     cases = [
         (fields(0.9), "field DX: DX must be greater than 1"),
+        (fields(1.5, 1e29), "field DY: DY must be at most 4.0 (the support in element neighbour distances; 1.0 to "
+                            "2.0 is usual, and wider supports cover most of the part); found 1.0e29"),
         (fields(None, None, 3), "field ISPLINE: must be 0 (cubic spline, box support), 1 (quadratic spline, box "
                                 "support) or 2 (cubic spline, circular support), found 3"),
         (fields(None, None, None, 1), "field IDILA: IDILA 1 (support size from the surrounding nodes) is not "

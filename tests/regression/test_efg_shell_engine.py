@@ -297,6 +297,33 @@ def test_walls_and_failure_criteria_on_meshfree_shells_are_announced(tmp_path, r
     assert "the failure criteria of material 1 are ignored for part 1: meshfree (EFG) parts do not erode" in run.stderr
 
 
+def test_initial_velocities_and_segment_loads_are_announced(tmp_path, run_deck):
+    """The stretch deck's initial velocity field is linear, so at every interior particle the
+    physical velocity A v equals the deck's: no warning. Give one interior node (41, the plate's
+    centre) a different velocity and the run says that the initial velocities are not a uniform or
+    linear field across a meshfree part, naming the first particle whose physical velocity differs
+    (22, a particle whose functions reach node 41). A *LOAD_SEGMENT in an explicit run
+    is said to be applied by the static analysis only."""
+    deck = stretch_deck(tmp_path / "linear.k", end_time=0.001)
+    run = run_deck(deck, jobid="linear")
+    assert run.status == 0, run.stdout + run.stderr
+    assert "initial velocities" not in run.stderr and "segment load" not in run.stderr
+    text = deck.read_text().splitlines()
+    centre = next(k for k, line in enumerate(text) if line.startswith(f"{41:20d}") and "e" in line[20:])
+    text[centre] = f"{41:20d}{0.0:20.13e}{0.0:20.13e}{1.0:20.13e}"
+    text.insert(text.index("*END") if "*END" in text else len(text),
+                "*LOAD_SEGMENT\n" + fields(1, 1.0e-6, 0.0, 1, 2, 11, 10))
+    changed = tmp_path / "changed.k"
+    changed.write_text("\n".join(text) + "\n")
+    run = run_deck(changed, jobid="changed")
+    assert run.status == 0, run.stdout + run.stderr
+    assert ("warning: the initial velocities are not a uniform or linear field across a meshfree part: at interior "
+            "particles they set generalized velocities, so the physical initial velocity differs (node 22 first)"
+            ) in run.stderr
+    assert ("warning: the deck's 1 segment load(s) (*LOAD_SEGMENT, _SET, _NONUNIFORM) are applied by the linear "
+            "static analysis (*CONTROL_IMPLICIT_GENERAL) only: this explicit run does not apply them") in run.stderr
+
+
 def test_spot_weld_on_meshfree_shells_fails_by_their_plastic_strain(tmp_path, run_deck):
     """The lap joint of test_spot_welds with meshfree strips (ELFORM 41, DX 1.5; the weld's nodes
     stay Gamma nodes): with EP = 0.002 the weld fails by the plastic strain of the cells around
