@@ -1421,6 +1421,20 @@ contains
         call located_problem(deck, log, input%shell_lines(element), "N1-N4", name// &
           " has no area: its corners coincide or lie on one line")
       end do
+      ! a meshfree shell cell is split into sub-cells at its centre: a concave quadrilateral has
+      ! one of no or negative area
+      do element = 1, input%shell_count
+        part = model%shell_part(element)
+        if (part <= 0) cycle
+        if (model%parts(part)%formulation /= formulation_efg) cycle
+        corner = concave_corner(model%coordinates(:, model%shell_nodes(:, element)))
+        if (corner == 0) cycle
+        call located_problem(deck, log, input%shell_lines(element), "N1-N4", "shell "// &
+          integer_text(model%shell_ids(element))//" of meshfree part "//integer_text(model%parts(part)%id)// &
+          " is not convex at its corner N"//integer_text(corner)//" (node "// &
+          integer_text(model%node_ids(model%shell_nodes(corner, element)))//"): a meshfree shell cell "// &
+          "(ELFORM 41) must be a convex quadrilateral or a triangle")
+      end do
       do element = 1, input%solid_count
         do corner = 1, 8
           corners(:, corner) = model%coordinates(:, model%solid_nodes(corner, element))
@@ -1565,4 +1579,26 @@ contains
     real(wp) :: c(3)
     c = [a(2)*b(3) - a(3)*b(2), a(3)*b(1) - a(1)*b(3), a(1)*b(2) - a(2)*b(1)]
   end function cross_product
+
+  !> The first corner (1-4) at which a quadrilateral with corners x(3, 4) turns against its
+  !> normal (the cross product of the diagonals), or 0 for a convex one; triangles (corner 4
+  !> repeating corner 3) and cells with no area are left to the other checks.
+  pure integer function concave_corner(x)
+    real(wp), intent(in) :: x(3, 4)
+    real(wp) :: normal(3), incoming(3), outgoing(3), turn(3)
+    integer :: corner
+    concave_corner = 0
+    if (all(x(:, 4) == x(:, 3))) return
+    normal = cross_product(x(:, 3) - x(:, 1), x(:, 4) - x(:, 2))
+    if (norm2(normal) <= 0.0_wp) return
+    do corner = 1, 4
+      incoming = x(:, corner) - x(:, modulo(corner - 2, 4) + 1)
+      outgoing = x(:, modulo(corner, 4) + 1) - x(:, corner)
+      turn = cross_product(incoming, outgoing)
+      if (dot_product(turn, normal) <= 0.0_wp) then
+        concave_corner = corner
+        return
+      end if
+    end do
+  end function concave_corner
 end module deck_cross_check

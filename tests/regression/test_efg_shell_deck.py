@@ -79,3 +79,23 @@ def test_global_meshfree_shell_and_a_missing_efg_card_are_refused(tmp_path, run_
     assert run.status == 2
     assert ("missing.k:6: *SECTION_SHELL: field DX: the EFG card (DX DY ISPLINE IDILA IEBT IDIM) of section 1 "
             "is missing") in run.stderr, run.stderr
+
+
+def test_a_concave_meshfree_shell_cell_is_refused_with_its_line(tmp_path, run_deck):
+    """A meshfree cell is split into sub-cells at its centre, so a concave quadrilateral would have
+    a sub-cell of negative area: the deck check refuses it with the element's line, its corner
+    and node (an FE shell part with the same cell is accepted: the Belytschko-Tsay shell takes
+    it). The centre node of the 4 x 4 plate (node 13, at about (20, 20)) is pulled to (14, 14),
+    past the diagonal of shell 6, whose corner N3 it is."""
+    for elform, expected in [(41, 2), (2, 0)]:
+        deck = plate_deck(tmp_path / f"concave{elform}.k", fields(1.5, 1.5) if elform == 41 else None, elform=elform)
+        lines = deck.read_text().splitlines()
+        node_line = next(k for k, line in enumerate(lines) if line.startswith(f"{13:8d}"))
+        lines[node_line] = f"{13:8d}{14.0:16.6f}{14.0:16.6f}{0.0:16.6f}"
+        deck.write_text("\n".join(lines) + "\n")
+        run = run_deck(deck, jobid=f"concave{elform}")
+        assert run.status == expected, run.stdout + run.stderr
+        if elform == 41:
+            assert "*ELEMENT_SHELL: field N1-N4: shell 6 of meshfree part 1 is not convex at its corner N3 (node 13): " \
+                   "a meshfree shell cell (ELFORM 41) must be a convex quadrilateral or a triangle" in run.stderr, \
+                run.stderr
