@@ -1,11 +1,11 @@
 """Verification of the meshfree (EFG) shells, *SECTION_SHELL ELFORM 41, against the FE shells
-(Belytschko-Tsay, ELFORM 2) and analytical values (issue 14, section 1 "Verification"; the
+(Belytschko-Tsay, ELFORM 2) and analytical values (the verification list of docs/verification.md; the
 mesh-convergence table is tools/efg_shell_convergence.py, docs/verification.md "Meshfree
 shells"). Every case runs with both formulations where the FE value is a useful baseline.
 
 All runs are explicit (the linear static analysis takes no shells): a static value is read from
 a slowly driven run, and each test says what precision that allows. Decks: plate_decks.py. The
-EFG sections write DX = DY = 1.5 (the issue's and the paper's support; a blank field gives
+EFG sections write DX = DY = 1.5 (the paper's support; a blank field gives
 LS-DYNA's 1.1, at which the EFG shell is close to the FE shell: cantilever 5 x 2 0.98958 against
 FE 0.98951, see tools/efg_shell_convergence.py).
 
@@ -41,7 +41,7 @@ efgshell-forces, 97f2748, and their tests pass.)
    of the FE-only strip on the same mesh (whose own tail behind the pulse gives the scale).
 Besides, a cantilever whose cells are all split into triangles (FE triangles against EFG
 triangle cells) and a curved part, a quarter ring with an end load (against Castigliano). The
-mesh-convergence table (item 7 of the issue's list) is the tool's.
+mesh-convergence table is the tool's (tools/efg_shell_convergence.py).
 """
 from __future__ import annotations
 
@@ -257,7 +257,7 @@ def test_cantilever_plate_efg_tip_deflection_within_one_percent(tmp_path, run_de
                           "assumed-strain shear on the cells' corner values brings the FE shell's -1/(4 n^2); "
                           "with the cell-centre MLS shear it was 0.99250 at 5 x 2)", strict=True)
 def test_cantilever_plate_efg_more_accurate_than_fe(tmp_path, run_deck):
-    """The issue's claim at a moderate mesh, 5 x 2 cells (20 x 10 mm): EFG within 1% and closer
+    """The expectation at a moderate mesh, 5 x 2 cells (20 x 10 mm): EFG within 1% and closer
     to the analytical value than the FE shells on the same mesh (strict xfail: not met)."""
     efg = cantilever_ratio(run_deck, tmp_path / "efg.k", EFG, CANTILEVER_CELLS)
     fe = cantilever_ratio(run_deck, tmp_path / "fe.k", FE, CANTILEVER_CELLS)
