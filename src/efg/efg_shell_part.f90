@@ -12,8 +12,10 @@
 !> * membrane and bending points: one per sub-cell (4 per quadrilateral, 3 per triangle), with
 !>   smoothed gradients (local boundary integration over the sub-cell's edges) of every node's
 !>   function, in the cell's reference frame (components along e1 and e2);
-!> * one transverse shear point per cell (selective reduced integration), with the functions'
-!>   values and gradients at the cell centre.
+!> * one point per cell at its centre, with the functions' values and gradients there. The
+!>   explicit update takes its transverse shear from the cells' physical corner values instead
+!>   (an assumed strain, efg_shell_forces: the MLS w of a linear basis gives a Kirchhoff mode a
+!>   spurious shear); it uses these points' pairs only for the nodes' rotary-inertia areas.
 !> The points of one cell are consecutive and the cells come in ascending order.
 module efg_shell_part
   use kinds, only: wp
@@ -39,7 +41,7 @@ module efg_shell_part
     integer, allocatable :: point_offsets(:)     !< pairs of point g: point_offsets(g) : point_offsets(g+1)-1
     integer, allocatable :: pair_node(:)         !< node index of each pair, ascending within a point
     real(wp), allocatable :: pair_gradient(:, :) !< (2, pairs): smoothed gradient along e1, e2 of the cell
-    ! transverse shear points (one per cell, at its centre)
+    ! centre points (one per cell; rotary-inertia areas, see above)
     integer, allocatable :: shear_offsets(:)     !< pairs of cell c: shear_offsets(c) : shear_offsets(c+1)-1
     integer, allocatable :: shear_node(:)        !< node index of each pair, ascending within a cell
     real(wp), allocatable :: shear_value(:)      !< Psi_node at the cell centre
