@@ -53,13 +53,16 @@ module efg_shell_forces
   use element_work, only: add_force_work
   use gauss_legendre, only: gauss_legendre_rule
   use shell_block, only: max_shell_points
-  use shell_triangle, only: triangle_shear_operator
+  use shell_triangle, only: triangle_edge_fit
   implicit none
   private
 
   public :: efg_shell_block_t, efg_shell_solver_t, set_up_efg_shell_solver, compute_efg_shell_forces
   public :: efg_shell_cell_results, efg_shell_nodal_masses, transform_shell_to_physical, transpose_shell_to_generalized
   public :: efg_shell_rotary_factor, raise_corner_plastic_strain
+
+  !> Transverse shear stations of a cell: corners 1-4, midpoints 5-8 of the edges 1-2, 2-3, 3-4, 4-1.
+  integer, parameter :: stations_per_cell = 8
 
   !> Whole cells whose membrane/bending points fill at most block_size lanes, and their state.
   type :: efg_shell_block_t
@@ -100,14 +103,16 @@ module efg_shell_forces
     real(wp), allocatable :: point_moment(:, :)
     real(wp), allocatable :: point_force(:, :, :)
     real(wp), allocatable :: point_couple(:, :, :)
-    !> The physical values of each cell's corners (transverse shear): corner k = 4 (c - 1) + L
-    !> of cell c is sum over corner_offsets(k) : corner_offsets(k+1)-1 of corner_weight times the
-    !> solver's value at corner_node (a particle's transformation row; a Gamma node itself).
-    integer, allocatable :: corner_offsets(:), corner_node(:)
-    real(wp), allocatable :: corner_weight(:)
+    !> The physical values at each cell's stations (transverse shear): its corners 1-4 and the
+    !> midpoints 5-8 of its edges 1-2, 2-3, 3-4, 4-1. Station L of cell c, k = 8 (c - 1) + L, is
+    !> the sum over station_offsets(k) : station_offsets(k+1)-1 of station_weight times the
+    !> solver's value at station_node (a corner: a particle's transformation row, a Gamma node
+    !> itself; a midpoint: the functions there; empty for a triangle's midpoints).
+    integer, allocatable :: station_offsets(:), station_node(:)
+    real(wp), allocatable :: station_weight(:)
     !> Per cell, the transverse shear forces (1-3) and moments (4-6) of the last call on its
-    !> physical corners (global; (6, 4, cells)).
-    real(wp), allocatable :: corner_force(:, :, :)
+    !> stations' physical values (global; (6, stations_per_cell, cells)).
+    real(wp), allocatable :: station_force(:, :, :)
     type(gather_list_t) :: block_colours          !< colour -> blocks; blocks of one colour share no node
     real(wp), allocatable :: block_time_step(:)
     integer, allocatable :: block_critical_cell(:), block_failed_cell(:)
@@ -173,13 +178,13 @@ contains
     solver%cell_area = geometry%cell_area
     allocate (solver%point_membrane(3, point_count), solver%point_moment(3, point_count), &
               solver%point_force(3, 2, point_count), solver%point_couple(3, 2, point_count), &
-              solver%corner_force(6, 4, cell_count))
+              solver%station_force(6, stations_per_cell, cell_count))
     solver%point_membrane = 0.0_wp
     solver%point_moment = 0.0_wp
     solver%point_force = 0.0_wp
     solver%point_couple = 0.0_wp
-    solver%corner_force = 0.0_wp
-    call set_up_corner_rows(geometry, solver%cell_nodes, size(model%coordinates, 2), solver)
+    solver%station_force = 0.0_wp
+    call set_up_station_rows(geometry, solver%cell_nodes, size(model%coordinates, 2), solver)
     allocate (solver%block_time_step(block_count), solver%block_critical_cell(block_count), &
               solver%block_failed_cell(block_count))
     solver%block_time_step = huge(1.0_wp)
@@ -235,21 +240,22 @@ contains
     end do
   end function points_of_cell
 
-  !> The corner rows (physical corner values for the transverse shear): a particle corner takes
-  !> its transformation row, a Gamma corner itself with weight 1.
-  subroutine set_up_corner_rows(geometry, cell_nodes, node_count, solver)
+  !> The station rows (physical values for the transverse shear): a particle corner takes its
+  !> transformation row, a Gamma corner itself with weight 1, an edge midpoint the functions
+  !> there (the geometry's midpoint rows).
+  subroutine set_up_station_rows(geometry, cell_nodes, node_count, solver)
     type(efg_shell_part_t), intent(in) :: geometry
     integer, intent(in) :: cell_nodes(:, :), node_count
     type(efg_shell_solver_t), intent(inout) :: solver
     integer, allocatable :: particle_of(:)
-    integer :: c, corner, j, k, count, node, corner_count
+    integer :: c, corner, edge, j, k, count, node, station_count
     allocate (particle_of(node_count))
     particle_of = 0
     do j = 1, size(geometry%particles)
       particle_of(geometry%particles(j)) = j
     end do
-    corner_count = 4*size(geometry%cells)
-    count = 0
+    station_count = stations_per_cell*size(geometry%cells)
+    count = size(geometry%midpoint_node)
     do c = 1, size(geometry%cells)
       do corner = 1, 4
         j = particle_of(cell_nodes(corner, c))
@@ -260,30 +266,38 @@ contains
         end if
       end do
     end do
-    allocate (solver%corner_offsets(corner_count + 1), solver%corner_node(count), solver%corner_weight(count))
+    allocate (solver%station_offsets(station_count + 1), solver%station_node(count), solver%station_weight(count))
     count = 0
     do c = 1, size(geometry%cells)
       do corner = 1, 4
-        solver%corner_offsets(4*(c - 1) + corner) = count + 1
+        solver%station_offsets(stations_per_cell*(c - 1) + corner) = count + 1
         node = cell_nodes(corner, c)
         j = particle_of(node)
         if (j == 0) then
           count = count + 1
-          solver%corner_node(count) = node
-          solver%corner_weight(count) = 1.0_wp
+          solver%station_node(count) = node
+          solver%station_weight(count) = 1.0_wp
         else
           do k = geometry%transform_offsets(j), geometry%transform_offsets(j + 1) - 1
             count = count + 1
-            solver%corner_node(count) = geometry%transform_node(k)
-            solver%corner_weight(count) = geometry%transform_value(k)
+            solver%station_node(count) = geometry%transform_node(k)
+            solver%station_weight(count) = geometry%transform_value(k)
           end do
         end if
       end do
+      do edge = 1, 4
+        solver%station_offsets(stations_per_cell*(c - 1) + 4 + edge) = count + 1
+        do k = geometry%midpoint_offsets(4*(c - 1) + edge), geometry%midpoint_offsets(4*(c - 1) + edge + 1) - 1
+          count = count + 1
+          solver%station_node(count) = geometry%midpoint_node(k)
+          solver%station_weight(count) = geometry%midpoint_value(k)
+        end do
+      end do
     end do
-    solver%corner_offsets(corner_count + 1) = count + 1
-  end subroutine set_up_corner_rows
+    solver%station_offsets(station_count + 1) = count + 1
+  end subroutine set_up_station_rows
 
-  !> Colours the blocks by the nodes of their points' pairs, their cells' corner rows and their
+  !> Colours the blocks by the nodes of their points' pairs, their cells' station rows and their
   !> cells' corners (each node listed once per block).
   subroutine colour_shell_blocks(node_count, solver)
     integer, intent(in) :: node_count
@@ -292,7 +306,7 @@ contains
     integer :: b, k, c, count
     associate (geometry => solver%geometry)
       allocate (offsets(size(solver%blocks) + 1), listed_by(node_count), &
-                block_nodes(size(geometry%pair_node) + size(solver%corner_node) + 4*size(geometry%cells)))
+                block_nodes(size(geometry%pair_node) + size(solver%station_node) + 4*size(geometry%cells)))
       listed_by = 0
       count = 0
       do b = 1, size(solver%blocks)
@@ -302,8 +316,9 @@ contains
             call list_node(geometry%pair_node(k))
           end do
           do c = block%first_cell, block%first_cell + block%cell_count - 1
-            do k = solver%corner_offsets(4*(c - 1) + 1), solver%corner_offsets(4*c + 1) - 1
-              call list_node(solver%corner_node(k))
+            do k = solver%station_offsets(stations_per_cell*(c - 1) + 1), &
+                   solver%station_offsets(stations_per_cell*c + 1) - 1
+              call list_node(solver%station_node(k))
             end do
             do k = 1, 4
               call list_node(solver%cell_nodes(k, c))
@@ -390,13 +405,13 @@ contains
                                    solver%shear_factor, solver%thickness_points, solver%point_height, &
                                    solver%point_weight, solver%blocks(b), coordinates, velocity, angular_velocity, &
                                    dt, solver%cell_frame, solver%cell_area, solver%point_membrane, &
-                                   solver%point_moment, solver%point_force, solver%point_couple, solver%corner_offsets, &
-                                   solver%corner_node, solver%corner_weight, solver%corner_force, &
+                                   solver%point_moment, solver%point_force, solver%point_couple, solver%station_offsets, &
+                                   solver%station_node, solver%station_weight, solver%station_force, &
                                    solver%block_time_step(b), solver%block_critical_cell(b), &
                                    solver%block_failed_cell(b))
           call add_block_forces(solver%geometry, solver%cell_nodes, solver%blocks(b), solver%cell_frame, &
-                                solver%cell_area, solver%point_force, solver%point_couple, solver%corner_offsets, &
-                                solver%corner_node, solver%corner_weight, solver%corner_force, internal_force, &
+                                solver%cell_area, solver%point_force, solver%point_couple, solver%station_offsets, &
+                                solver%station_node, solver%station_weight, solver%station_force, internal_force, &
                                 internal_moment, normal_sum, area_sum)
         end do
         !$omp end parallel do
@@ -410,7 +425,7 @@ contains
   subroutine compute_shell_block(material, geometry, cell_nodes, density, shear_factor, thickness_points, &
                                  point_height, point_weight, block, coordinates, velocity, angular_velocity, dt, &
                                  cell_frame, cell_area, point_membrane, point_moment, point_force, point_couple, &
-                                 corner_offsets, corner_node, corner_weight, corner_force, critical_time_step, &
+                                 station_offsets, station_node, station_weight, station_force, critical_time_step, &
                                  critical_cell, failed_cell)
     type(material_t), intent(in) :: material
     type(efg_shell_part_t), intent(in) :: geometry
@@ -421,9 +436,9 @@ contains
     real(wp), intent(in) :: dt
     real(wp), intent(inout) :: cell_frame(:, :, :), cell_area(:), point_membrane(:, :), point_moment(:, :)
     real(wp), intent(inout) :: point_force(:, :, :), point_couple(:, :, :)
-    integer, intent(in) :: corner_offsets(:), corner_node(:)
-    real(wp), intent(in) :: corner_weight(:)
-    real(wp), intent(inout) :: corner_force(:, :, :)
+    integer, intent(in) :: station_offsets(:), station_node(:)
+    real(wp), intent(in) :: station_weight(:)
+    real(wp), intent(inout) :: station_force(:, :, :)
     real(wp), intent(out) :: critical_time_step
     integer, intent(out) :: critical_cell, failed_cell
     real(wp) :: mid_frame(3, 3, block_size), end_frame(3, 3, block_size), first_turn(block_size)
@@ -431,13 +446,15 @@ contains
     real(wp) :: membrane(block_size, 3), curvature(block_size, 3), increment(block_size, 3)
     real(wp) :: thickness_increment(block_size), old_power(block_size), new_power(block_size)
     real(wp) :: velocity_sum(3, 2, block_size), rotation_sum(3, 2, block_size), end_inverse(2, 2, block_size)
-    real(wp) :: corners(3, 4), corner_velocity(3, 4), node_velocity(3, 4), physical_velocity(3, 4)
-    real(wp) :: physical_rotation(3, 4), shear_weights(2, 4, 3, 4), corner_values(4, 3), corner_local(4, 3)
+    real(wp) :: corners(3, 4), corner_velocity(3, 4), node_velocity(3, 4)
+    real(wp) :: physical_velocity(3, stations_per_cell), physical_rotation(3, stations_per_cell)
+    real(wp) :: shear_weights(2, stations_per_cell, 3, 4), station_values(stations_per_cell, 3)
+    real(wp) :: station_local(stations_per_cell, 3)
     real(wp) :: area_scale
     real(wp) :: position_sum(3, 2), inverse(2, 2), rate(2, 2), bend(2, 2), determinant
     real(wp) :: shear_modulus, height, gamma(2), transverse(2), resultant(6), weight, arm
     real(wp) :: area, longest, wave_speed, cell_step
-    integer :: nel, i, g, cell, lane, point, corner, k, first_point
+    integer :: nel, i, g, cell, lane, point, corner, k, first_point, station
     logical :: triangle
 
     nel = block%point_count
@@ -551,21 +568,25 @@ contains
       do corner = 1, 4
         corners(:, corner) = coordinates(:, cell_nodes(corner, cell))
         node_velocity(:, corner) = velocity(:, cell_nodes(corner, cell))
-        physical_velocity(:, corner) = 0.0_wp
-        physical_rotation(:, corner) = 0.0_wp
-        do k = corner_offsets(4*(cell - 1) + corner), corner_offsets(4*(cell - 1) + corner + 1) - 1
-          physical_velocity(:, corner) = physical_velocity(:, corner) + corner_weight(k)*velocity(:, corner_node(k))
-          physical_rotation(:, corner) = physical_rotation(:, corner) + corner_weight(k)*angular_velocity(:, corner_node(k))
+      end do
+      do station = 1, stations_per_cell
+        physical_velocity(:, station) = 0.0_wp
+        physical_rotation(:, station) = 0.0_wp
+        do k = station_offsets(stations_per_cell*(cell - 1) + station), &
+               station_offsets(stations_per_cell*(cell - 1) + station + 1) - 1
+          physical_velocity(:, station) = physical_velocity(:, station) + station_weight(k)*velocity(:, station_node(k))
+          physical_rotation(:, station) = physical_rotation(:, station) + &
+                                          station_weight(k)*angular_velocity(:, station_node(k))
         end do
       end do
-      old_power(lane) = sum(corner_force(1:3, :, cell)*physical_velocity) + sum(corner_force(4:6, :, cell)*physical_rotation)
+      old_power(lane) = sum(station_force(1:3, :, cell)*physical_velocity) + sum(station_force(4:6, :, cell)*physical_rotation)
       ! rates on the mid-step corners and frame
       call shear_operator(mid_frame(:, :, lane), corners - 0.5_wp*dt*node_velocity, triangle, shear_weights)
-      call local_corner_values(mid_frame(:, :, lane), physical_velocity, physical_rotation, corner_values)
+      call local_station_values(mid_frame(:, :, lane), physical_velocity, physical_rotation, station_values)
       first_point = first_point_in_block(geometry, block, cell)
       do point = 1, merge(3, 4, triangle)
         i = first_point + point - 1
-        gamma = shear_rate(shear_weights(:, :, :, point), corner_values)
+        gamma = shear_rate(shear_weights(:, :, :, point), station_values)
         call rotate_shear_stress(block, i, spin(i) + first_turn(lane))
         block%shear_stress(i, :) = block%shear_stress(i, :) + shear_factor*shear_modulus*dt*gamma
         call rotate_shear_stress(block, i, spin(i) + second_turn(lane))
@@ -573,20 +594,20 @@ contains
       ! forces on the end-of-step corners: the transposes, times each point's current area
       call shear_operator(end_frame(:, :, lane), corners, triangle, shear_weights)
       area_scale = cell_area(cell)/geometry%cell_area(cell)
-      corner_local = 0.0_wp
+      station_local = 0.0_wp
       do point = 1, merge(3, 4, triangle)
         i = first_point + point - 1
         transverse = geometry%point_area(block%first_point + i - 1)*area_scale*geometry%cell_thickness(cell) &
                      *block%shear_stress(i, :)
-        corner_local = corner_local + transverse(1)*shear_weights(1, :, :, point) &
-                       + transverse(2)*shear_weights(2, :, :, point)
+        station_local = station_local + transverse(1)*shear_weights(1, :, :, point) &
+                        + transverse(2)*shear_weights(2, :, :, point)
       end do
-      do corner = 1, 4
-        corner_force(1:3, corner, cell) = corner_local(corner, 1)*end_frame(:, 3, lane)
-        corner_force(4:6, corner, cell) = corner_local(corner, 2)*end_frame(:, 1, lane) &
-                                          + corner_local(corner, 3)*end_frame(:, 2, lane)
+      do station = 1, stations_per_cell
+        station_force(1:3, station, cell) = station_local(station, 1)*end_frame(:, 3, lane)
+        station_force(4:6, station, cell) = station_local(station, 2)*end_frame(:, 1, lane) &
+                                            + station_local(station, 3)*end_frame(:, 2, lane)
       end do
-      new_power(lane) = sum(corner_force(1:3, :, cell)*physical_velocity) + sum(corner_force(4:6, :, cell)*physical_rotation)
+      new_power(lane) = sum(station_force(1:3, :, cell)*physical_velocity) + sum(station_force(4:6, :, cell)*physical_rotation)
       cell_frame(:, :, cell) = end_frame(:, :, lane)
     end do
     call add_force_work(block%cell_count, dt, block%previous_time_step, old_power, new_power, block%shear_power, &
@@ -668,21 +689,21 @@ contains
     lane = 0
   end function first_point_in_block
 
-  !> Local corner values (v_z, w_x, w_y) of the physical corner velocities and angular velocities.
-  pure subroutine local_corner_values(frame, velocity, rotation, values)
-    real(wp), intent(in) :: frame(3, 3), velocity(3, 4), rotation(3, 4)
-    real(wp), intent(out) :: values(4, 3)
-    integer :: corner
-    do corner = 1, 4
-      values(corner, 1) = dot_product(frame(:, 3), velocity(:, corner))
-      values(corner, 2) = dot_product(frame(:, 1), rotation(:, corner))
-      values(corner, 3) = dot_product(frame(:, 2), rotation(:, corner))
+  !> Local station values (v_z, w_x, w_y) of the physical velocities and angular velocities.
+  pure subroutine local_station_values(frame, velocity, rotation, values)
+    real(wp), intent(in) :: frame(3, 3), velocity(3, stations_per_cell), rotation(3, stations_per_cell)
+    real(wp), intent(out) :: values(stations_per_cell, 3)
+    integer :: station
+    do station = 1, stations_per_cell
+      values(station, 1) = dot_product(frame(:, 3), velocity(:, station))
+      values(station, 2) = dot_product(frame(:, 1), rotation(:, station))
+      values(station, 3) = dot_product(frame(:, 2), rotation(:, station))
     end do
-  end subroutine local_corner_values
+  end subroutine local_station_values
 
-  !> (2 d_xz, 2 d_yz) of one point from its shear_weights and the local corner values.
+  !> (2 d_xz, 2 d_yz) of one point from its shear_weights and the local station values.
   pure function shear_rate(shear_weights, values) result(gamma)
-    real(wp), intent(in) :: shear_weights(2, 4, 3), values(4, 3)
+    real(wp), intent(in) :: shear_weights(2, stations_per_cell, 3), values(stations_per_cell, 3)
     real(wp) :: gamma(2)
     gamma(1) = sum(shear_weights(1, :, :)*values)
     gamma(2) = sum(shear_weights(2, :, :)*values)
@@ -702,11 +723,12 @@ contains
   pure subroutine shear_operator(frame, corners, triangle, shear_weights)
     real(wp), intent(in) :: frame(3, 3), corners(3, 4)
     logical, intent(in) :: triangle
-    real(wp), intent(out) :: shear_weights(2, 4, 3, 4)
+    real(wp), intent(out) :: shear_weights(2, stations_per_cell, 3, 4)
     real(wp), parameter :: point_xi(4) = [-0.5_wp, 0.5_wp, 0.5_wp, -0.5_wp]
     real(wp), parameter :: point_eta(4) = [-0.5_wp, -0.5_wp, 0.5_wp, 0.5_wp]
-    real(wp) :: xl(4), yl(4), vz_weight(3, 2), wx_weight(3, 2), wy_weight(3, 2)
-    real(wp) :: edge_a(4, 3), edge_b(4, 3), edge_c(4, 3), edge_d(4, 3), along_xi(4, 3), along_eta(4, 3)
+    real(wp) :: xl(4), yl(4)
+    real(wp) :: edge_a(stations_per_cell, 3), edge_b(stations_per_cell, 3), edge_c(stations_per_cell, 3)
+    real(wp) :: edge_d(stations_per_cell, 3), along_xi(stations_per_cell, 3), along_eta(stations_per_cell, 3)
     real(wp) :: x_xi, y_xi, x_eta, y_eta, determinant, xi, eta
     integer :: corner, point
     do corner = 1, 4
@@ -715,21 +737,17 @@ contains
     end do
     shear_weights = 0.0_wp
     if (triangle) then
-      call triangle_shear_operator(xl(1:3), yl(1:3), vz_weight, wx_weight, wy_weight)
-      do point = 1, 3
-        do corner = 1, 3
-          shear_weights(:, corner, 1, point) = vz_weight(corner, :)
-          shear_weights(:, corner, 2, point) = wx_weight(corner, :)
-          shear_weights(:, corner, 3, point) = wy_weight(corner, :)
-        end do
+      call triangle_shear_weights(xl(1:3), yl(1:3), shear_weights(:, :, :, 1))
+      do point = 2, 3
+        shear_weights(:, :, :, point) = shear_weights(:, :, :, 1)
       end do
       return
     end if
     ! tying points A (edge 1-2), B (2-3), C (4-3), D (1-4), along xi for A, C and eta for B, D
-    edge_a = edge_operator(1, 2)
-    edge_b = edge_operator(2, 3)
-    edge_c = edge_operator(4, 3)
-    edge_d = edge_operator(1, 4)
+    edge_a = edge_operator(1, 2, 5)
+    edge_b = edge_operator(2, 3, 6)
+    edge_c = edge_operator(4, 3, 7)
+    edge_d = edge_operator(1, 4, 8)
     do point = 1, 4
       xi = point_xi(point)
       eta = point_eta(point)
@@ -746,21 +764,49 @@ contains
       shear_weights(2, :, :, point) = (-x_eta*along_xi + x_xi*along_eta)/determinant
     end do
   contains
-    !> Weights of the covariant shear at the midpoint of edge (i, j) on the corner values.
-    pure function edge_operator(i, j) result(weights)
-      integer, intent(in) :: i, j
-      real(wp) :: weights(4, 3), gx, gy
+    !> Weights of the covariant shear of edge (i, j), averaged along the edge, on the station
+    !> values: (w_j - w_i)/2 - the edge average of theta . (e3 x g), the rotations' average by
+    !> Simpson's rule on the corners i, j and the edge's midpoint station m.
+    pure function edge_operator(i, j, m) result(weights)
+      integer, intent(in) :: i, j, m
+      real(wp) :: weights(stations_per_cell, 3), gx, gy
       gx = 0.5_wp*(xl(j) - xl(i))
       gy = 0.5_wp*(yl(j) - yl(i))
       weights = 0.0_wp
       weights(i, 1) = -0.5_wp
       weights(j, 1) = 0.5_wp
-      weights(i, 2) = -0.5_wp*gy
-      weights(j, 2) = -0.5_wp*gy
-      weights(i, 3) = 0.5_wp*gx
-      weights(j, 3) = 0.5_wp*gx
+      weights([i, j], 2) = -gy/6.0_wp
+      weights(m, 2) = -4.0_wp*gy/6.0_wp
+      weights([i, j], 3) = gx/6.0_wp
+      weights(m, 3) = 4.0_wp*gx/6.0_wp
     end function edge_operator
   end subroutine shear_operator
+
+  !> The constant transverse shear of a triangle cell (corners 1-3, midpoint stations 5, 6, 7 of
+  !> its edges 1-2, 2-3, 3-1): the FE triangle's edge-based operator (shell_triangle: the shear
+  !> along each edge at its middle, least-squares fitted), with each edge's mean rotation taken
+  !> by Simpson's rule on its corners and its midpoint station instead of its corners' mean.
+  pure subroutine triangle_shear_weights(xl, yl, weights)
+    real(wp), intent(in) :: xl(3), yl(3)
+    real(wp), intent(out) :: weights(2, stations_per_cell, 3)
+    real(wp) :: tangent(2, 3), length(3), fit(2, 3)
+    integer :: edge, first, second, middle
+    call triangle_edge_fit(xl, yl, tangent, length, fit)
+    weights = 0.0_wp
+    do edge = 1, 3
+      first = edge
+      second = modulo(edge, 3) + 1
+      middle = 4 + edge
+      weights(:, first, 1) = weights(:, first, 1) - fit(:, edge)/length(edge)
+      weights(:, second, 1) = weights(:, second, 1) + fit(:, edge)/length(edge)
+      weights(:, first, 3) = weights(:, first, 3) + tangent(1, edge)*fit(:, edge)/6.0_wp
+      weights(:, second, 3) = weights(:, second, 3) + tangent(1, edge)*fit(:, edge)/6.0_wp
+      weights(:, middle, 3) = weights(:, middle, 3) + 4.0_wp*tangent(1, edge)*fit(:, edge)/6.0_wp
+      weights(:, first, 2) = weights(:, first, 2) - tangent(2, edge)*fit(:, edge)/6.0_wp
+      weights(:, second, 2) = weights(:, second, 2) - tangent(2, edge)*fit(:, edge)/6.0_wp
+      weights(:, middle, 2) = weights(:, middle, 2) - 4.0_wp*tangent(2, edge)*fit(:, edge)/6.0_wp
+    end do
+  end subroutine triangle_shear_weights
 
   !> Turn lane i's transverse shear stress (zx, yz) as an in-plane vector by `angle`.
   pure subroutine rotate_shear_stress(block, i, angle)
@@ -822,17 +868,17 @@ contains
   !> appears once among a point's pairs), then cell by cell its shear pairs and its corners'
   !> normal and area sums.
   subroutine add_block_forces(geometry, cell_nodes, block, cell_frame, cell_area, point_force, point_couple, &
-                              corner_offsets, corner_node, corner_weight, corner_force, internal_force, &
+                              station_offsets, station_node, station_weight, station_force, internal_force, &
                               internal_moment, normal_sum, area_sum)
     type(efg_shell_part_t), intent(in) :: geometry
     integer, intent(in) :: cell_nodes(:, :)
     type(efg_shell_block_t), intent(in) :: block
     real(wp), intent(in) :: cell_frame(:, :, :), cell_area(:), point_force(:, :, :), point_couple(:, :, :)
-    integer, intent(in) :: corner_offsets(:), corner_node(:)
-    real(wp), intent(in) :: corner_weight(:), corner_force(:, :, :)
+    integer, intent(in) :: station_offsets(:), station_node(:)
+    real(wp), intent(in) :: station_weight(:), station_force(:, :, :)
     real(wp), intent(inout) :: internal_force(:, :), internal_moment(:, :), normal_sum(:, :), area_sum(:)
     real(wp) :: p(3, 2), q(3, 2), b1, b2, weight
-    integer :: gp, k, node, cell, corner
+    integer :: gp, k, node, cell, corner, station
     do gp = block%first_point, block%first_point + block%point_count - 1
       p = point_force(:, :, gp)
       q = point_couple(:, :, gp)
@@ -845,14 +891,15 @@ contains
       end do
     end do
     do cell = block%first_cell, block%first_cell + block%cell_count - 1
-      ! the shear forces on the physical corners, through each corner's row (A^T)
-      do corner = 1, 4
-        if (corner == 4 .and. cell_nodes(4, cell) == cell_nodes(3, cell)) cycle
-        do k = corner_offsets(4*(cell - 1) + corner), corner_offsets(4*(cell - 1) + corner + 1) - 1
-          node = corner_node(k)
-          weight = corner_weight(k)
-          internal_force(:, node) = internal_force(:, node) + weight*corner_force(1:3, corner, cell)
-          internal_moment(:, node) = internal_moment(:, node) + weight*corner_force(4:6, corner, cell)
+      ! the shear forces on the stations' physical values, through each station's row (A^T)
+      do station = 1, stations_per_cell
+        if (station == 4 .and. cell_nodes(4, cell) == cell_nodes(3, cell)) cycle
+        do k = station_offsets(stations_per_cell*(cell - 1) + station), &
+               station_offsets(stations_per_cell*(cell - 1) + station + 1) - 1
+          node = station_node(k)
+          weight = station_weight(k)
+          internal_force(:, node) = internal_force(:, node) + weight*station_force(1:3, station, cell)
+          internal_moment(:, node) = internal_moment(:, node) + weight*station_force(4:6, station, cell)
         end do
       end do
       do corner = 1, 4

@@ -415,7 +415,7 @@ contains
     call exchange_restart(store, path//"/point_moment", solver%point_moment, error)
     call exchange_restart(store, path//"/point_force", solver%point_force, error)
     call exchange_restart(store, path//"/point_couple", solver%point_couple, error)
-    call exchange_restart(store, path//"/corner_force", solver%corner_force, error)
+    call exchange_restart(store, path//"/station_force", solver%station_force, error)
     call exchange_restart(store, path//"/block_time_step", solver%block_time_step, error)
     call exchange_restart(store, path//"/block_critical_cell", solver%block_critical_cell, error)
     call exchange_restart(store, path//"/block_failed_cell", solver%block_failed_cell, error)

@@ -46,6 +46,14 @@ module efg_shell_part
     integer, allocatable :: shear_node(:)        !< node index of each pair, ascending within a cell
     real(wp), allocatable :: shear_value(:)      !< Psi_node at the cell centre
     real(wp), allocatable :: shear_gradient(:, :) !< (2, pairs): its gradient along e1, e2 of the cell
+    ! edge midpoints of the cells (transverse shear, efg_shell_forces): the physical value at the
+    ! midpoint of edge e (corner e to the next corner; a triangle's edge 3 goes back to corner 1
+    ! and its row 4 is empty) of cell c is the sum over midpoint_offsets(4 (c - 1) + e) :
+    ! midpoint_offsets(4 (c - 1) + e + 1) - 1 of midpoint_value times the solver's value at
+    ! midpoint_node
+    integer, allocatable :: midpoint_offsets(:)
+    integer, allocatable :: midpoint_node(:)
+    real(wp), allocatable :: midpoint_value(:)
     ! row-sum lumped mass: m(node) += density * mass_volume(k) (sum over points of Psi W t)
     integer, allocatable :: mass_node(:)         !< node indices (each node of the part once)
     real(wp), allocatable :: mass_volume(:)

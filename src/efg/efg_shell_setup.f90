@@ -64,6 +64,9 @@ module efg_shell_setup
     real(wp), allocatable :: shear_gradient(:, :)
     integer, allocatable :: mass_node(:)
     real(wp), allocatable :: mass_volume(:)
+    integer :: midpoint_count(4) = 0               !< entries of each edge midpoint's row
+    integer, allocatable :: midpoint_node(:)
+    real(wp), allocatable :: midpoint_value(:)
     integer :: row_count = 0
     integer, allocatable :: row_particle(:)
     integer, allocatable :: row_length(:)
@@ -188,7 +191,8 @@ contains
       ! a degenerate or inverted cell is reported by the caller
       allocate (result%pair_count(corners), result%pair_node(0), result%pair_gradient(2, 0), result%shear_node(0), &
                 result%shear_value(0), result%shear_gradient(2, 0), result%mass_node(0), result%mass_volume(0), &
-                result%row_particle(0), result%row_length(0), result%row_node(0), result%row_value(0))
+                result%row_particle(0), result%row_length(0), result%row_node(0), result%row_value(0), &
+                result%midpoint_node(0), result%midpoint_value(0))
       result%pair_count = 0
       return
     end if
@@ -229,6 +233,27 @@ contains
       result%shear_value(total) = values(pair)
       result%shear_gradient(:, total) = cell_gradient(:, pair)
     end do
+
+    ! the edge midpoints (the transverse shear's edge averages, Simpson's rule): edge e from
+    ! corner e to the next one (a triangle's third edge back to corner 1; its fourth row empty)
+    allocate (row_node(4*n), row_value(4*n))
+    row_total = 0
+    result%midpoint_count = 0
+    do e = 1, corners
+      point = 0.5_wp*(parametric(:, e) + parametric(:, modulo(e, corners) + 1))
+      call evaluate_shell_functions(context, point, planar, values, rank, residual)
+      call note_point(result, rank, residual)
+      do pair = 1, n
+        if (values(pair) == 0.0_wp) cycle
+        row_total = row_total + 1
+        result%midpoint_count(e) = result%midpoint_count(e) + 1
+        row_node(row_total) = context%nodes(pair)
+        row_value(row_total) = values(pair)
+      end do
+    end do
+    result%midpoint_node = row_node(1:row_total)
+    result%midpoint_value = row_value(1:row_total)
+    deallocate (row_node, row_value)
 
     result%mass_node = pack(context%nodes(1:n), mass_volume /= 0.0_wp)
     result%mass_volume = pack(mass_volume, mass_volume /= 0.0_wp)
@@ -313,7 +338,8 @@ contains
     type(shell_supports_t), intent(in) :: supports
     type(cell_result_t), intent(in) :: results(:)
     type(efg_shell_part_t), intent(inout) :: geometry
-    integer :: cell_count, point_count, pair_total, shear_total, k, g, point, offset, shear, j, row
+    integer :: cell_count, point_count, pair_total, shear_total, k, g, point, offset, shear, j, row, e
+    integer :: midpoint_total, midpoint
     integer, allocatable :: node_slot(:), row_start(:), row_size(:), row_owner(:), row_position(:)
     real(wp), allocatable :: mass(:)
 
@@ -321,10 +347,12 @@ contains
     point_count = 0
     pair_total = 0
     shear_total = 0
+    midpoint_total = 0
     do k = 1, cell_count
       point_count = point_count + size(results(k)%point_area)
       pair_total = pair_total + size(results(k)%pair_node)
       shear_total = shear_total + size(results(k)%shear_node)
+      midpoint_total = midpoint_total + size(results(k)%midpoint_node)
     end do
     allocate (geometry%cell_frame(3, 3, cell_count), geometry%cell_area(cell_count), &
               geometry%cell_thickness(cell_count), geometry%point_cell(point_count), &
@@ -358,6 +386,23 @@ contains
       shear = shear + j
     end do
     geometry%shear_offsets(cell_count + 1) = shear
+
+    ! edge midpoint rows, 4 per cell in cell order
+    allocate (geometry%midpoint_offsets(4*cell_count + 1), geometry%midpoint_node(midpoint_total), &
+              geometry%midpoint_value(midpoint_total))
+    midpoint = 1
+    do k = 1, cell_count
+      offset = 1
+      do e = 1, 4
+        geometry%midpoint_offsets(4*(k - 1) + e) = midpoint
+        j = results(k)%midpoint_count(e)
+        geometry%midpoint_node(midpoint:midpoint + j - 1) = results(k)%midpoint_node(offset:offset + j - 1)
+        geometry%midpoint_value(midpoint:midpoint + j - 1) = results(k)%midpoint_value(offset:offset + j - 1)
+        offset = offset + j
+        midpoint = midpoint + j
+      end do
+    end do
+    geometry%midpoint_offsets(4*cell_count + 1) = midpoint
 
     ! row-sum masses: each node of the part once, ascending
     allocate (node_slot(size(supports%particle_of_node)), mass(size(supports%nodes)))

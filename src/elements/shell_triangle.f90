@@ -20,7 +20,7 @@ module shell_triangle
   implicit none
   private
 
-  public :: triangle_shear_operator
+  public :: triangle_shear_operator, triangle_edge_fit
 
 contains
 
@@ -31,26 +31,9 @@ contains
     ! (assumed shape: callers pass a lane's row of the block arrays without copying it)
     real(wp), intent(in) :: xl(:), yl(:)
     real(wp), intent(out) :: vz_weight(3, 2), wx_weight(3, 2), wy_weight(3, 2)
-    real(wp) :: tangent(2, 3), length(3), a11, a22, a12, determinant, fit(2, 3)
+    real(wp) :: tangent(2, 3), length(3), fit(2, 3)
     integer :: edge, first, second
-    do edge = 1, 3
-      first = edge
-      second = modulo(edge, 3) + 1
-      tangent(:, edge) = [xl(second) - xl(first), yl(second) - yl(first)]
-      length(edge) = max(norm2(tangent(:, edge)), tiny(1.0_wp))
-      tangent(:, edge) = tangent(:, edge)/length(edge)
-    end do
-    a11 = sum(tangent(1, :)**2)
-    a22 = sum(tangent(2, :)**2)
-    a12 = sum(tangent(1, :)*tangent(2, :))
-    ! three edge directions of a triangle with area span the plane: A is positive definite (a
-    ! flat triangle is reported by the caller; it keeps finite weights)
-    determinant = max(a11*a22 - a12*a12, tiny(1.0_wp))
-    ! fit(:, k) = A^-1 t_k: what edge k's strain adds to the constant shear
-    do edge = 1, 3
-      fit(1, edge) = (a22*tangent(1, edge) - a12*tangent(2, edge))/determinant
-      fit(2, edge) = (a11*tangent(2, edge) - a12*tangent(1, edge))/determinant
-    end do
+    call triangle_edge_fit(xl, yl, tangent, length, fit)
     vz_weight = 0.0_wp
     wx_weight = 0.0_wp
     wy_weight = 0.0_wp
@@ -65,4 +48,30 @@ contains
       wx_weight(second, :) = wx_weight(second, :) - 0.5_wp*tangent(2, edge)*fit(:, edge)
     end do
   end subroutine triangle_shear_operator
+
+  !> The edges of a triangle (edge k from corner k to the next): unit tangents, lengths, and
+  !> fit(:, k) = A^-1 t_k, what edge k's shear strain adds to the least-squares constant shear.
+  pure subroutine triangle_edge_fit(xl, yl, tangent, length, fit)
+    real(wp), intent(in) :: xl(:), yl(:)
+    real(wp), intent(out) :: tangent(2, 3), length(3), fit(2, 3)
+    real(wp) :: a11, a22, a12, determinant
+    integer :: edge, first, second
+    do edge = 1, 3
+      first = edge
+      second = modulo(edge, 3) + 1
+      tangent(:, edge) = [xl(second) - xl(first), yl(second) - yl(first)]
+      length(edge) = max(norm2(tangent(:, edge)), tiny(1.0_wp))
+      tangent(:, edge) = tangent(:, edge)/length(edge)
+    end do
+    a11 = sum(tangent(1, :)**2)
+    a22 = sum(tangent(2, :)**2)
+    a12 = sum(tangent(1, :)*tangent(2, :))
+    ! three edge directions of a triangle with area span the plane: A is positive definite (a
+    ! flat triangle is reported by the caller; it keeps finite weights)
+    determinant = max(a11*a22 - a12*a12, tiny(1.0_wp))
+    do edge = 1, 3
+      fit(1, edge) = (a22*tangent(1, edge) - a12*tangent(2, edge))/determinant
+      fit(2, edge) = (a11*tangent(2, edge) - a12*tangent(1, edge))/determinant
+    end do
+  end subroutine triangle_edge_fit
 end module shell_triangle

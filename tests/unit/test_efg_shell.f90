@@ -407,6 +407,41 @@ contains
     call check(suite, label//": transformation rows sum to 1", transform_sum < tight, real_text(transform_sum))
     if (flat) call check(suite, label//": transformation rows reproduce the particle's position", &
                          transform_position < tight, real_text(transform_position))
+
+    ! edge midpoint rows (the transverse shear's Simpson rule): sum to 1, reproduce the midpoint
+    block
+      real(wp) :: midpoint_sum, midpoint_position, corner_mid(3)
+      integer :: c, e, row, corners
+      midpoint_sum = 0.0_wp
+      midpoint_position = 0.0_wp
+      call check(suite, label//": four edge midpoint rows per cell", &
+                 size(geometry%midpoint_offsets) == 4*size(geometry%cells) + 1)
+      do c = 1, size(geometry%cells)
+        corners = merge(3, 4, model%shell_nodes(3, geometry%cells(c)) == model%shell_nodes(4, geometry%cells(c)))
+        do e = 1, 4
+          row = 4*(c - 1) + e
+          if (e > corners) then
+            call check(suite, label//": a triangle's fourth midpoint row is empty", &
+                       geometry%midpoint_offsets(row + 1) == geometry%midpoint_offsets(row))
+            cycle
+          end if
+          position = 0.0_wp
+          do k = geometry%midpoint_offsets(row), geometry%midpoint_offsets(row + 1) - 1
+            position = position + geometry%midpoint_value(k)*model%coordinates(:, geometry%midpoint_node(k))
+          end do
+          midpoint_sum = max(midpoint_sum, abs(sum(geometry%midpoint_value(geometry%midpoint_offsets(row): &
+                                                                            geometry%midpoint_offsets(row + 1) - 1)) - 1.0_wp))
+          corner_mid = 0.5_wp*(model%coordinates(:, model%shell_nodes(e, geometry%cells(c))) + &
+                               model%coordinates(:, model%shell_nodes(modulo(e, corners) + 1, geometry%cells(c))))
+          midpoint_position = max(midpoint_position, norm2(position - corner_mid))
+        end do
+      end do
+      write (*, '(a)') "efg_shell: "//label//": edge midpoint rows: sum - 1 "//trim(real_text(midpoint_sum))// &
+        ", position "//trim(real_text(midpoint_position))
+      call check(suite, label//": edge midpoint rows sum to 1", midpoint_sum < tight, real_text(midpoint_sum))
+      if (flat) call check(suite, label//": edge midpoint rows reproduce the midpoint", midpoint_position < tight, &
+                           real_text(midpoint_position))
+    end block
   end subroutine check_part
 
   !> The linear field of cell c's plane at `position`: c + g . y, y the projection on e1, e2.
