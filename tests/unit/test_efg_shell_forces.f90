@@ -189,6 +189,18 @@ contains
     end do
     geometry%point_offsets(4*cell_count + 1) = 16*cell_count + 1
     geometry%shear_offsets(cell_count + 1) = 4*cell_count + 1
+    ! edge midpoints: bilinear functions, half of each end corner
+    allocate (geometry%midpoint_offsets(4*cell_count + 1), geometry%midpoint_node(8*cell_count), &
+              geometry%midpoint_value(8*cell_count))
+    do c = 1, cell_count
+      do corner = 1, 4
+        k = 4*(c - 1) + corner
+        geometry%midpoint_offsets(k) = 2*k - 1
+        geometry%midpoint_node(2*k - 1:2*k) = [model%shell_nodes(corner, c), model%shell_nodes(modulo(corner, 4) + 1, c)]
+        geometry%midpoint_value(2*k - 1:2*k) = 0.5_wp
+      end do
+    end do
+    geometry%midpoint_offsets(4*cell_count + 1) = 8*cell_count + 1
   end subroutine all_gamma_part
 
   !> The local point of a cell with corners (xl, yl) at parametric coordinates.
