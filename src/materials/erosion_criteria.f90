@@ -10,6 +10,7 @@
 module erosion_criteria
   use kinds, only: wp
   use model, only: material_t
+  use small_tensors, only: determinant3
   implicit none
   private
 
@@ -93,7 +94,7 @@ contains
       shifted(2, 2) = shifted(2, 2) - mean
       shifted(3, 3) = shifted(3, 3) - mean
       shifted = shifted/p
-      r = 0.5_wp*determinant_3(shifted)
+      r = 0.5_wp*determinant3(shifted)
       r = max(-1.0_wp, min(1.0_wp, r))
       phi = acos(r)/3.0_wp
       e1 = mean + 2.0_wp*p*cos(phi)
@@ -117,9 +118,4 @@ contains
     smallest = 0.5_wp*log(max(mean - radius, tiny(1.0_wp)))
   end subroutine principal_log_strains_2d
 
-  pure real(wp) function determinant_3(a)
-    real(wp), intent(in) :: a(3, 3)
-    determinant_3 = a(1, 1)*(a(2, 2)*a(3, 3) - a(2, 3)*a(3, 2)) - a(1, 2)*(a(2, 1)*a(3, 3) - a(2, 3)*a(3, 1)) &
-                    + a(1, 3)*(a(2, 1)*a(3, 2) - a(2, 2)*a(3, 1))
-  end function determinant_3
 end module erosion_criteria

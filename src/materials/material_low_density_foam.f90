@@ -23,6 +23,7 @@
 module material_low_density_foam
   use kinds, only: wp, block_size
   use curves, only: curve_t, curve_value
+  use small_tensors, only: symmetric_matrix, symmetric_components, midpoint_update, symmetric_eigen
   implicit none
   private
 
@@ -32,8 +33,6 @@ module material_low_density_foam
   ! zz xy yz zx), then e_max.
   integer, parameter, public :: foam_left_cauchy_green_first_slot = 1
   integer, parameter, public :: foam_largest_compression_slot = 7
-
-  integer, parameter :: jacobi_sweeps = 12
 
 contains
 
@@ -55,19 +54,18 @@ contains
     real(wp), intent(in) :: strain_increment(block_size, 6)
     real(wp), intent(inout) :: stress(block_size, 6)
     real(wp), intent(inout), contiguous :: history(:, :)
-    real(wp) :: identity(3, 3), half_step(3, 3), update(3, 3), b(3, 3), vectors(3, 3), values(3)
+    real(wp) :: update(3, 3), b(3, 3), vectors(3, 3), values(3)
     real(wp) :: stretch(3), nominal_strain(3), nominal_stress(3), cauchy(3), largest, compression, factor
-    real(wp) :: result(3, 3), lane(6)
+    real(wp) :: lane(6)
     integer :: i, k
 
-    identity = reshape([1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [3, 3])
     do i = 1, nel
+      ! (the rows are copied to contiguous lanes once)
       lane = strain_increment(i, :)
-      half_step = 0.5_wp*unpacked(lane)
-      update = matmul(inverse3(identity - half_step), identity + half_step)
+      update = midpoint_update(symmetric_matrix(lane))
       lane = history(i, 1:6)
-      b = matmul(update, matmul(unpacked(lane), transpose(update)))
-      history(i, 1:6) = packed(b)
+      b = matmul(matmul(update, symmetric_matrix(lane)), transpose(update))
+      history(i, 1:6) = symmetric_components(b)
       call symmetric_eigen(b, values, vectors)
       stretch = sqrt(max(values, tiny(1.0_wp)))
       nominal_strain = stretch - 1.0_wp
@@ -87,79 +85,17 @@ contains
       cauchy(1) = nominal_stress(1)/(stretch(2)*stretch(3))
       cauchy(2) = nominal_stress(2)/(stretch(3)*stretch(1))
       cauchy(3) = nominal_stress(3)/(stretch(1)*stretch(2))
-      result = 0.0_wp
+      ! sum_k cauchy_k n_k n_k^T, packed (xx yy zz xy yz zx)
+      lane = 0.0_wp
       do k = 1, 3
-        result = result + cauchy(k)*spread(vectors(:, k), 2, 3)*spread(vectors(:, k), 1, 3)
+        lane(1) = lane(1) + cauchy(k)*vectors(1, k)*vectors(1, k)
+        lane(2) = lane(2) + cauchy(k)*vectors(2, k)*vectors(2, k)
+        lane(3) = lane(3) + cauchy(k)*vectors(3, k)*vectors(3, k)
+        lane(4) = lane(4) + cauchy(k)*vectors(1, k)*vectors(2, k)
+        lane(5) = lane(5) + cauchy(k)*vectors(2, k)*vectors(3, k)
+        lane(6) = lane(6) + cauchy(k)*vectors(3, k)*vectors(1, k)
       end do
-      stress(i, :) = packed(result) + damping*damping_modulus*strain_increment(i, :)
+      stress(i, :) = lane + damping*damping_modulus*strain_increment(i, :)
     end do
   end subroutine low_density_foam_update
-
-  !> Eigenvalues and eigenvectors (columns) of a symmetric 3x3 matrix by cyclic Jacobi
-  !> rotations (converges quadratically; a fixed sweep count keeps the kernel branch-light).
-  pure subroutine symmetric_eigen(matrix, values, vectors)
-    real(wp), intent(in) :: matrix(3, 3)
-    real(wp), intent(out) :: values(3), vectors(3, 3)
-    real(wp) :: a(3, 3), theta, t, c, s, rotation(3, 3), scale
-    integer :: sweep, p, q
-    a = matrix
-    vectors = 0.0_wp
-    vectors(1, 1) = 1.0_wp
-    vectors(2, 2) = 1.0_wp
-    vectors(3, 3) = 1.0_wp
-    scale = max(maxval(abs(matrix)), tiny(1.0_wp))
-    do sweep = 1, jacobi_sweeps
-      if (abs(a(1, 2)) + abs(a(2, 3)) + abs(a(1, 3)) <= 1.0e-15_wp*scale) exit
-      do p = 1, 2
-        do q = p + 1, 3
-          if (abs(a(p, q)) <= 1.0e-300_wp) cycle
-          theta = (a(q, q) - a(p, p))/(2.0_wp*a(p, q))
-          t = sign(1.0_wp, theta)/(abs(theta) + sqrt(theta*theta + 1.0_wp))
-          c = 1.0_wp/sqrt(t*t + 1.0_wp)
-          s = t*c
-          rotation = 0.0_wp
-          rotation(1, 1) = 1.0_wp
-          rotation(2, 2) = 1.0_wp
-          rotation(3, 3) = 1.0_wp
-          rotation(p, p) = c
-          rotation(q, q) = c
-          rotation(p, q) = s
-          rotation(q, p) = -s
-          a = matmul(transpose(rotation), matmul(a, rotation))
-          vectors = matmul(vectors, rotation)
-        end do
-      end do
-    end do
-    values = [a(1, 1), a(2, 2), a(3, 3)]
-  end subroutine symmetric_eigen
-
-  pure function inverse3(m) result(inverse)
-    real(wp), intent(in) :: m(3, 3)
-    real(wp) :: inverse(3, 3), determinant
-    inverse(1, 1) = m(2, 2)*m(3, 3) - m(2, 3)*m(3, 2)
-    inverse(1, 2) = m(1, 3)*m(3, 2) - m(1, 2)*m(3, 3)
-    inverse(1, 3) = m(1, 2)*m(2, 3) - m(1, 3)*m(2, 2)
-    inverse(2, 1) = m(2, 3)*m(3, 1) - m(2, 1)*m(3, 3)
-    inverse(2, 2) = m(1, 1)*m(3, 3) - m(1, 3)*m(3, 1)
-    inverse(2, 3) = m(1, 3)*m(2, 1) - m(1, 1)*m(2, 3)
-    inverse(3, 1) = m(2, 1)*m(3, 2) - m(2, 2)*m(3, 1)
-    inverse(3, 2) = m(1, 2)*m(3, 1) - m(1, 1)*m(3, 2)
-    inverse(3, 3) = m(1, 1)*m(2, 2) - m(1, 2)*m(2, 1)
-    determinant = m(1, 1)*inverse(1, 1) + m(1, 2)*inverse(2, 1) + m(1, 3)*inverse(3, 1)
-    inverse = inverse/determinant
-  end function inverse3
-
-  pure function unpacked(tensor) result(matrix)
-    real(wp), intent(in) :: tensor(6)
-    real(wp) :: matrix(3, 3)
-    matrix = reshape([tensor(1), tensor(4), tensor(6), tensor(4), tensor(2), tensor(5), &
-                      tensor(6), tensor(5), tensor(3)], [3, 3])
-  end function unpacked
-
-  pure function packed(matrix) result(tensor)
-    real(wp), intent(in) :: matrix(3, 3)
-    real(wp) :: tensor(6)
-    tensor = [matrix(1, 1), matrix(2, 2), matrix(3, 3), 0.5_wp*(matrix(1, 2) + matrix(2, 1)), &
-              0.5_wp*(matrix(2, 3) + matrix(3, 2)), 0.5_wp*(matrix(3, 1) + matrix(1, 3))]
-  end function packed
 end module material_low_density_foam

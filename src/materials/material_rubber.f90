@@ -31,6 +31,7 @@
 !> below rubber_thickness_tolerance (2 to 3 iterations per step at explicit steps).
 module material_rubber
   use kinds, only: wp, block_size
+  use small_tensors, only: determinant3, symmetric_matrix, symmetric_components, midpoint_update
   implicit none
   private
 
@@ -98,7 +99,7 @@ contains
     real(wp) :: squared(3, 3), first, third, volume, derivative
     integer :: k
     squared = matmul(b, b)
-    third = max(determinant(b), tiny(1.0_wp))
+    third = max(determinant3(b), tiny(1.0_wp))
     volume = sqrt(third)
     if (form == rubber_mooney_rivlin) then
       first = b(1, 1) + b(2, 2) + b(3, 3)
@@ -124,18 +125,18 @@ contains
     integer :: i
     do i = 1, nel
       lane = strain_increment(i, :)
-      update = midpoint_update(unpacked(lane))
+      update = midpoint_update(symmetric_matrix(lane))
       lane = history(i, 1:6)
-      b = unpacked(lane)
+      b = symmetric_matrix(lane)
       b(1, 1) = b(1, 1) + 1.0_wp
       b(2, 2) = b(2, 2) + 1.0_wp
       b(3, 3) = b(3, 3) + 1.0_wp
       b = matmul(update, matmul(b, transpose(update)))
-      stress(i, :) = packed(rubber_cauchy_stress(form, constants, b))
+      stress(i, :) = symmetric_components(rubber_cauchy_stress(form, constants, b))
       b(1, 1) = b(1, 1) - 1.0_wp
       b(2, 2) = b(2, 2) - 1.0_wp
       b(3, 3) = b(3, 3) - 1.0_wp
-      history(i, 1:6) = packed(b)
+      history(i, 1:6) = symmetric_components(b)
     end do
   end subroutine rubber_update
 
@@ -277,53 +278,4 @@ contains
     thickness = x
   end subroutine rubber_plane_stress_thickness
 
-  !> M = (I - L/2)^-1 (I + L/2) for a 3x3 increment L.
-  pure function midpoint_update(increment) result(update)
-    real(wp), intent(in) :: increment(3, 3)
-    real(wp) :: update(3, 3)
-    real(wp) :: minus(3, 3), plus(3, 3)
-    integer :: k
-    minus = -0.5_wp*increment
-    plus = 0.5_wp*increment
-    do k = 1, 3
-      minus(k, k) = minus(k, k) + 1.0_wp
-      plus(k, k) = plus(k, k) + 1.0_wp
-    end do
-    update = matmul(inverse3(minus), plus)
-  end function midpoint_update
-
-  pure real(wp) function determinant(m)
-    real(wp), intent(in) :: m(3, 3)
-    determinant = m(1, 1)*(m(2, 2)*m(3, 3) - m(2, 3)*m(3, 2)) - m(1, 2)*(m(2, 1)*m(3, 3) - m(2, 3)*m(3, 1)) &
-                  + m(1, 3)*(m(2, 1)*m(3, 2) - m(2, 2)*m(3, 1))
-  end function determinant
-
-  pure function inverse3(m) result(inverse)
-    real(wp), intent(in) :: m(3, 3)
-    real(wp) :: inverse(3, 3)
-    inverse(1, 1) = m(2, 2)*m(3, 3) - m(2, 3)*m(3, 2)
-    inverse(1, 2) = m(1, 3)*m(3, 2) - m(1, 2)*m(3, 3)
-    inverse(1, 3) = m(1, 2)*m(2, 3) - m(1, 3)*m(2, 2)
-    inverse(2, 1) = m(2, 3)*m(3, 1) - m(2, 1)*m(3, 3)
-    inverse(2, 2) = m(1, 1)*m(3, 3) - m(1, 3)*m(3, 1)
-    inverse(2, 3) = m(1, 3)*m(2, 1) - m(1, 1)*m(2, 3)
-    inverse(3, 1) = m(2, 1)*m(3, 2) - m(2, 2)*m(3, 1)
-    inverse(3, 2) = m(1, 2)*m(3, 1) - m(1, 1)*m(3, 2)
-    inverse(3, 3) = m(1, 1)*m(2, 2) - m(1, 2)*m(2, 1)
-    inverse = inverse/determinant(m)
-  end function inverse3
-
-  pure function unpacked(tensor) result(matrix)
-    real(wp), intent(in) :: tensor(6)
-    real(wp) :: matrix(3, 3)
-    matrix = reshape([tensor(1), tensor(4), tensor(6), tensor(4), tensor(2), tensor(5), &
-                      tensor(6), tensor(5), tensor(3)], [3, 3])
-  end function unpacked
-
-  pure function packed(matrix) result(tensor)
-    real(wp), intent(in) :: matrix(3, 3)
-    real(wp) :: tensor(6)
-    tensor = [matrix(1, 1), matrix(2, 2), matrix(3, 3), 0.5_wp*(matrix(1, 2) + matrix(2, 1)), &
-              0.5_wp*(matrix(2, 3) + matrix(3, 2)), 0.5_wp*(matrix(3, 1) + matrix(1, 3))]
-  end function packed
 end module material_rubber
