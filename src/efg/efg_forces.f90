@@ -36,6 +36,7 @@ module efg_forces
   use material_dispatch, only: material_history_count, initialize_material_history, update_material_block, &
                                rotate_material_history, material_plastic_strain
   use objective_rotation, only: incremental_rotation, rotate_symmetric_tensors
+  use small_tensors, only: symmetric_matrix
   use hex8_geometry, only: deformation_increments
   use element_time_step, only: bulk_viscosity_pressure, solid_element_time_steps
   !$ use omp_lib, only: omp_get_max_threads
@@ -407,15 +408,10 @@ contains
     real(wp), intent(out) :: point_stress(9)
     real(wp) :: cauchy(3, 3), inverse(3, 3), scale
     integer :: i, j
-    cauchy(1, 1) = stress(1) - bulk_viscosity
-    cauchy(2, 2) = stress(2) - bulk_viscosity
-    cauchy(3, 3) = stress(3) - bulk_viscosity
-    cauchy(1, 2) = stress(4)
-    cauchy(2, 1) = stress(4)
-    cauchy(2, 3) = stress(5)
-    cauchy(3, 2) = stress(5)
-    cauchy(3, 1) = stress(6)
-    cauchy(1, 3) = stress(6)
+    cauchy = symmetric_matrix(stress)
+    do i = 1, 3
+      cauchy(i, i) = cauchy(i, i) - bulk_viscosity
+    end do
     call invert(deformation, jacobian, inverse)
     scale = volume*jacobian
     ! (sigma F^-T)_ij = sum_k sigma_ik (F^-1)_jk; stored column-major

@@ -243,13 +243,8 @@ contains
       point = 0.5_wp*(parametric(:, e) + parametric(:, modulo(e, corners) + 1))
       call evaluate_shell_functions(context, point, planar, values, rank, residual)
       call note_point(result, rank, residual)
-      do pair = 1, n
-        if (values(pair) == 0.0_wp) cycle
-        row_total = row_total + 1
-        result%midpoint_count(e) = result%midpoint_count(e) + 1
-        row_node(row_total) = context%nodes(pair)
-        row_value(row_total) = values(pair)
-      end do
+      result%midpoint_count(e) = count(values(1:n) /= 0.0_wp)
+      call append_row(context%nodes, values, n, row_node, row_value, row_total)
     end do
     result%midpoint_node = row_node(1:row_total)
     result%midpoint_value = row_value(1:row_total)
@@ -271,17 +266,28 @@ contains
       call note_point(result, rank, residual)
       result%row_count = result%row_count + 1
       result%row_particle(result%row_count) = particle
-      result%row_length(result%row_count) = count(values /= 0.0_wp)
-      do pair = 1, n
-        if (values(pair) == 0.0_wp) cycle
-        row_total = row_total + 1
-        row_node(row_total) = context%nodes(pair)
-        row_value(row_total) = values(pair)
-      end do
+      result%row_length(result%row_count) = count(values(1:n) /= 0.0_wp)
+      call append_row(context%nodes, values, n, row_node, row_value, row_total)
     end do
     result%row_node = row_node(1:row_total)
     result%row_value = row_value(1:row_total)
   end subroutine process_cell
+
+  !> Append the non-zero values(1:n) and their nodes to a row list that holds `total` entries.
+  pure subroutine append_row(nodes, values, n, row_node, row_value, total)
+    integer, intent(in) :: nodes(:), n
+    real(wp), intent(in) :: values(:)
+    integer, intent(inout) :: row_node(:)
+    real(wp), intent(inout) :: row_value(:)
+    integer, intent(inout) :: total
+    integer :: pair
+    do pair = 1, n
+      if (values(pair) == 0.0_wp) cycle
+      total = total + 1
+      row_node(total) = nodes(pair)
+      row_value(total) = values(pair)
+    end do
+  end subroutine append_row
 
   !> Counts a rank-deficient moment matrix and keeps the worst residual.
   subroutine note_point(result, rank, residual)
