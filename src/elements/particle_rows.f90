@@ -97,7 +97,7 @@ contains
     real(wp), intent(out) :: residual
     integer, intent(out) :: iterations
     real(wp), allocatable :: diagonal(:), b(:), x(:), r(:), r_hat(:), p(:), v(:), s(:), t(:), p_hat(:), s_hat(:)
-    real(wp) :: scale, rho, rho_new, alpha, omega, beta, limit, check(3)
+    real(wp) :: scale, rho, rho_new, alpha, omega, beta, limit, check(3), denominator
     integer :: n, row, k, component, iteration, column
     converged = .true.
     residual = 0.0_wp
@@ -131,7 +131,9 @@ contains
           if (rows%row_of_node(rows%node(k)) == 0) b(row) = b(row) - rows%value(k)*field(component, rows%node(k))
         end do
       end do
-      x = b
+      do row = 1, n
+        x(row) = target(component, rows%particle(row))
+      end do
       call multiply(x, r)
       r = b - r
       if (maxval(abs(r)) <= limit) then
@@ -152,7 +154,9 @@ contains
         p = r + beta*(p - omega*v)
         p_hat = p/diagonal
         call multiply(p_hat, v)
-        alpha = rho_new/dot_product(r_hat, v)
+        denominator = dot_product(r_hat, v)
+        if (denominator == 0.0_wp) exit   ! breakdown: the final check reports the residual
+        alpha = rho_new/denominator
         s = r - alpha*v
         if (maxval(abs(s)) <= limit) then
           x = x + alpha*p_hat
@@ -198,10 +202,15 @@ contains
       residual = 0.0_wp
       do i = 1, n
         check = row_value(rows, i, field) - target(:, rows%particle(i))
-        residual = max(residual, maxval(abs(check)))
+        if (any(check /= check)) then
+          residual = huge(1.0_wp)
+        else
+          residual = max(residual, maxval(abs(check)))
+        end if
       end do
       if (scale > 0.0_wp) residual = residual/scale
-      converged = residual <= tolerance
+      ! (a NaN residual, from a breakdown, is no convergence)
+      converged = residual <= tolerance .and. residual == residual
     end subroutine known_part_check
   end subroutine solve_particle_rows
 end module particle_rows
