@@ -32,7 +32,8 @@ module planar_rigid_walls
   public :: initialise_wall_states, enforce_planar_walls, apply_wall_friction, add_row_impulse, &
             particle_sweep_limit
 
-  !> Sweeps over a wall's particles in one step at most (each usually needs one or two).
+  !> Sweeps over a wall's particles in one step at most (the tests need up to 28; what is left
+  !> after the last stays).
   integer, parameter :: particle_sweep_limit = 200
 
 contains
@@ -140,7 +141,7 @@ contains
   !> normal velocity that lands it on the wall; a particle pushed off the wall by its neighbours'
   !> corrections gives back what it received (never more). Friction acts on each correction's
   !> tangential physical velocity as on a node's. Sweeps until the largest correction of a sweep
-  !> moves a particle by less than 1e-12 of the model's size (round-off).
+  !> moves a particle by less than 1e-12 max(1, |wall point|) (round-off).
   subroutine hold_particles(wall, rows, state, dt, average_dt, wall_start, wall_point, reference, displacement, &
                             acceleration, mass, velocity, total_impulse, energy_removed)
     type(rigid_wall_t), intent(in) :: wall
