@@ -148,7 +148,24 @@ contains
     real(wp) :: position(3), physical_velocity(3), end_point(3), relative(3), height, normal(3), depth
     real(wp) :: new_velocity(3), weight, largest, tolerance
     integer :: sweep, k, row
+    logical :: near
     tolerance = 1.0e-12_wp*max(1.0_wp, wall%radius)
+    ! most steps no particle comes near the cylinder: find out in parallel (a logical, the same
+    ! answer for any thread count), and only then take the particles one by one
+    near = .false.
+    !$omp parallel do schedule(static) default(shared) private(k, row, position, physical_velocity, end_point, &
+    !$omp relative, height) reduction(.or.:near)
+    do k = 1, size(particle_rows)
+      row = particle_rows(k)
+      position = reference(:, rows%particle(row)) + row_value(rows, row, displacement)
+      physical_velocity = row_value(rows, row, velocity)
+      end_point = position + physical_velocity*dt
+      relative = end_point - tail_end
+      height = dot_product(relative, wall%normal)
+      if (dot_product(relative, relative) - height**2 < outside_squared) near = .true.
+    end do
+    !$omp end parallel do
+    if (.not. near) return
     do sweep = 1, particle_sweep_limit
       largest = 0.0_wp
       do k = 1, size(particle_rows)

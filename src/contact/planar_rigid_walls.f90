@@ -153,10 +153,24 @@ contains
     real(wp) :: normal(3), position(3), physical_velocity(3), gap, start_gap, weight, received, change
     real(wp) :: new_velocity(3), largest, tolerance, no_work
     integer :: sweep, k, row
+    logical :: crossing
     normal = wall%normal
     tolerance = 1.0e-12_wp*max(1.0_wp, norm2(wall_point))
     state%particle_impulse = 0.0_wp
     no_work = 0.0_wp
+    ! most steps no particle comes near the wall: find out in parallel (a logical, the same
+    ! answer for any thread count), and only then take the particles one by one
+    crossing = .false.
+    !$omp parallel do schedule(static) default(shared) private(k, row, position, physical_velocity) &
+    !$omp reduction(.or.:crossing)
+    do k = 1, size(state%particle_rows)
+      row = state%particle_rows(k)
+      position = reference(:, rows%particle(row)) + row_value(rows, row, displacement)
+      physical_velocity = row_value(rows, row, velocity)
+      if (dot_product(position + physical_velocity*dt - wall_point, normal) < 0.0_wp) crossing = .true.
+    end do
+    !$omp end parallel do
+    if (.not. crossing) return
     do sweep = 1, particle_sweep_limit
       largest = 0.0_wp
       do k = 1, size(state%particle_rows)
