@@ -11,9 +11,13 @@ particle I is X_I + sum_J A_IJ u_J. Checked here:
   give identical results;
 - a meshfree shell plate thrown at a wall with a dome of speeds (its interior particles meet
   the wall first, and the motion is not a linear field): the same checks;
+- a restart dump written while particles rest on the wall continues the run bit for bit;
 - initial velocities with a quadratic profile across a meshfree solid block and a meshfree
   shell plate: the physical velocities at t = 0 equal the deck's to 1e-10.
 """
+import shutil
+
+import h5py
 import numpy as np
 
 from deck_writer import (block_mesh, boundary_node_mask, efg_section, fields, node_list_set, nodes_card, plate_mesh,
@@ -305,3 +309,27 @@ def test_quadratic_initial_velocity_is_physical(tmp_path, run_deck):
         print(f"{name}: largest difference of the physical initial velocity {error:.3e} (relative)")
         assert error < 1e-10
         assert "initial velocities" not in run.stderr
+
+
+def test_restart_while_particles_rest_on_the_wall(tmp_path):
+    """The plate thrown at the wall (in contact from cycle 47 to 89), continued on 2 threads from
+    the dumps of cycles 80 (particles on the wall) and 160: the results file of the uninterrupted
+    run, bit for bit (the sweeps keep nothing from step to step)."""
+    from test_restart import assert_same, contents, restart, run_fresh
+    deck, _, _ = plate_deck(tmp_path / "plate.k", end_time=0.12)
+    text = deck.read_text().replace("*DATABASE_GLSTAT", "*DATABASE_BINARY_D3DUMP\n" + fields(40) + "\n*DATABASE_GLSTAT")
+    deck.write_text(text)
+    run_fresh(deck, tmp_path / "one", ncpu=1)
+    reference = contents(tmp_path / "one" / "results.h5")
+    with h5py.File(tmp_path / "one" / "results.h5", "r") as results:
+        touched = results["history/rwforc/4/force"][...]
+    dumps = sorted(p.name for p in (tmp_path / "one").glob("d3dump*"))
+    assert len(dumps) >= 4, dumps
+    assert touched[80, 2] != 0.0, "the second dump (cycle 80) must be written during the contact"
+    for dump in dumps[1:4:2]:
+        target = tmp_path / f"restart_{dump}"
+        shutil.copytree(tmp_path / "one", target)
+        process = restart(target / dump, 2)
+        assert process.returncode == 0, process.stdout + process.stderr
+        assert_same(reference, contents(target / "results.h5"), f"continued from {dump}")
+    print(f"dumps {dumps}; wall force in {np.count_nonzero(touched[:, 2])} of {len(touched)} cycles")
