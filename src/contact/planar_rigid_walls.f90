@@ -18,7 +18,8 @@
 !> (rows sum to one: the total is P). Particles share nodes J, so a correction moves its
 !> neighbours too: the particles are corrected one after the other in the order of the wall's
 !> node list, in sweeps, each particle keeping the normal impulse it has received in the step
-!> non-negative (projected Gauss-Seidel), until no particle moves by more than round-off. The
+!> non-negative and its friction impulse within the Coulomb cone (projected Gauss-Seidel),
+!> until no particle moves by more than round-off. The
 !> order is fixed and the sweeps serial: the same result for any thread count. The impulses
 !> on the generalized values give the wall force and energy exactly as a node's.
 module planar_rigid_walls
@@ -54,8 +55,10 @@ contains
       else
         allocate (states(w)%particle_rows(0))
       end if
-      allocate (states(w)%particle_impulse(size(states(w)%particle_rows)))
+      allocate (states(w)%particle_impulse(size(states(w)%particle_rows)), &
+                states(w)%particle_friction(3, size(states(w)%particle_rows)))
       states(w)%particle_impulse = 0.0_wp
+      states(w)%particle_friction = 0.0_wp
     end do
   end subroutine initialise_wall_states
 
@@ -139,8 +142,10 @@ contains
   !> The tracked meshfree particles of one planar wall (projected Gauss-Seidel, see above): each
   !> particle whose physical position would end the step behind the wall gets the physical
   !> normal velocity that lands it on the wall; a particle pushed off the wall by its neighbours'
-  !> corrections gives back what it received (never more). Friction acts on each correction's
-  !> tangential physical velocity as on a node's. Sweeps until the largest correction of a sweep
+  !> corrections gives back what it received (never more). Friction: the tangential impulse of
+  !> the step that stops the particle's tangential physical velocity, kept within FRIC times its
+  !> normal impulse (the Coulomb cone; a single node's rule, apply_wall_friction, for one
+  !> correction), corrected in the same sweeps. Sweeps until the largest correction of a sweep
   !> moves a particle by less than 1e-12 max(1, |wall point|) (round-off).
   subroutine hold_particles(wall, rows, state, dt, average_dt, wall_start, wall_point, reference, displacement, &
                             acceleration, mass, velocity, total_impulse, energy_removed)
@@ -151,12 +156,13 @@ contains
     real(wp), intent(in) :: reference(:, :), displacement(:, :), acceleration(:, :), mass(:)
     real(wp), intent(inout) :: velocity(:, :), total_impulse(3), energy_removed
     real(wp) :: normal(3), position(3), physical_velocity(3), gap, start_gap, weight, received, change
-    real(wp) :: new_velocity(3), largest, tolerance, no_work
+    real(wp) :: largest, tolerance, no_work, now_received, impulse(3), friction(3), limit, moved
     integer :: sweep, k, row
     logical :: crossing
     normal = wall%normal
     tolerance = 1.0e-12_wp*max(1.0_wp, norm2(wall_point))
     state%particle_impulse = 0.0_wp
+    state%particle_friction = 0.0_wp
     no_work = 0.0_wp
     ! most steps no particle comes near the wall: find out in parallel (a logical, the same
     ! answer for any thread count), and only then take the particles one by one
@@ -200,14 +206,29 @@ contains
         if (weight <= 0.0_wp) cycle
         ! the normal speed change that lands it on the wall, kept to a non-negative impulse
         change = max(-gap/dt, -received*weight)
-        if (sweep > 1 .and. abs(change)*dt <= tolerance) cycle
-        if (change == 0.0_wp) cycle
-        largest = max(largest, abs(change)*dt)
-        state%particle_impulse(k) = received + change/weight
-        new_velocity = physical_velocity + change*normal
-        call apply_wall_friction(wall%friction, normal, physical_velocity, new_velocity)
-        call add_row_impulse(rows, row, (new_velocity - physical_velocity)/weight, [0.0_wp, 0.0_wp, 0.0_wp], &
-                             average_dt, acceleration, mass, velocity, total_impulse, energy_removed, no_work)
+        now_received = received + change/weight
+        impulse = (change/weight)*normal
+        ! friction: the tangential impulse that stops its tangential physical velocity, kept
+        ! within FRIC times the normal impulse (FRIC >= 1: no sliding, no limit; none once it
+        ! has left the wall)
+        friction = state%particle_friction(:, k)
+        if (wall%friction > 0.0_wp) then
+          friction = friction - (physical_velocity - dot_product(physical_velocity, normal)*normal)/weight
+          if (wall%friction < 1.0_wp) then
+            limit = wall%friction*now_received
+            if (norm2(friction) > limit) friction = friction*(limit/norm2(friction))
+          else if (now_received <= 0.0_wp) then
+            friction = 0.0_wp
+          end if
+          impulse = impulse + (friction - state%particle_friction(:, k))
+        end if
+        moved = norm2(impulse)*weight*dt
+        if (moved == 0.0_wp .or. (sweep > 1 .and. moved <= tolerance)) cycle
+        largest = max(largest, moved)
+        state%particle_impulse(k) = now_received
+        state%particle_friction(:, k) = friction
+        call add_row_impulse(rows, row, impulse, [0.0_wp, 0.0_wp, 0.0_wp], average_dt, acceleration, mass, velocity, &
+                             total_impulse, energy_removed, no_work)
       end do
       if (largest <= tolerance) exit
     end do

@@ -21,5 +21,6 @@ module wall_state
     !> Scratch of one step: the normal impulse each of those particles has received (planar
     !> walls; -1: left alone in this step, as a node that started behind the wall)
     real(wp), allocatable :: particle_impulse(:)
+    real(wp), allocatable :: particle_friction(:, :)   !< (3, particles) their friction impulse of the step
   end type wall_state_t
 end module wall_state

@@ -5,7 +5,7 @@ The interior particles of meshfree parts carry generalized values; the physical 
 particle I is X_I + sum_J A_IJ u_J. Checked here:
 
 - a meshfree solid block whose interior particles (the wall's node set) hit a stationary planar
-  wall (also with friction), struck by a moving wall with a mass, and falling on a cylinder: no physical position of a tracked
+  wall (also with Coulomb friction and without sliding), struck by a moving wall with a mass, and falling on a cylinder: no physical position of a tracked
   node passes the wall by more than round-off, the impulse of the wall force history (rwforc)
   equals the change of momentum (1e-6), the energy balance closes within 1%; 1 and 2 threads
   give identical results;
@@ -177,6 +177,30 @@ def test_block_particles_slide_on_a_wall_with_friction(tmp_path, run_deck):
     print(f"tangential / normal impulse {ratio:.4f} (x part {impulse[0]:.4e}, along the motion)")
     assert impulse[0] > 0.0 and 0.05 < ratio <= 0.3 * (1.0 + 1e-9)
     assert min(position[particles - 1, 2].min() - wall_z for _, position in positions) > -1e-9
+
+
+def test_block_particles_stick_to_a_wall_without_sliding(tmp_path, run_deck):
+    """The oblique throw with FRIC 1 (no sliding): a particle whose physical position is on the
+    wall in two consecutive states (0.3 us apart, about one cycle) has not slid along it by more
+    than 1e-10 mm."""
+    wall_z = 1.5
+    wall = ("*RIGIDWALL_PLANAR_ID\n" + fields(3) + "sticky floor\n" + fields(1) + "\n" +
+            fields(0.0, 0.0, wall_z, 0.0, 0.0, wall_z + 1.0, 1.0))
+    deck, nodes, particles = block_deck(tmp_path / "stick.k", wall, initial=np.tile([10.0, 0.0, -20.0], (125, 1)),
+                                        interval=0.0003, end_time=0.15)
+    run = run_deck(deck)
+    assert run.status == 0, run.stdout + run.stderr
+    with run.open() as results:
+        positions = [position[particles - 1] for _, position in physical_positions(results)]
+    slides = []
+    for before, after in zip(positions, positions[1:]):
+        resting = (np.abs(before[:, 2] - wall_z) < 1e-9) & (np.abs(after[:, 2] - wall_z) < 1e-9)
+        if resting.any():
+            slides.append(np.abs(after[resting, :2] - before[resting, :2]).max())
+    print(f"{len(slides)} pairs of states with particles resting on the wall; largest slide "
+          f"{max(slides) if slides else float('nan'):.3e} mm")
+    assert len(slides) > 5
+    assert max(slides) < 1e-10
 
 
 def test_block_particles_struck_by_a_moving_wall(tmp_path, run_deck):
