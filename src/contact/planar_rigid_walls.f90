@@ -259,8 +259,8 @@ contains
       total_impulse = total_impulse + node_impulse
       node_work = dot_product(node_impulse, wall_velocity)
       work = work + node_work
-      energy_removed = energy_removed + node_work &
-                       - 0.5_wp*dot_product(node_impulse, velocity(:, node) + previous - average_dt*acceleration(:, node))
+      energy_removed = energy_removed + node_work - 0.5_wp*dot_product(node_impulse, velocity(:, node) + previous &
+                                                                       - average_dt*acceleration(:, node))
     end do
   end subroutine add_row_impulse
 

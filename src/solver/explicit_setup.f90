@@ -95,10 +95,11 @@ contains
                              converged, residual, iterations)
     if (.not. converged) then
       write (residual_text, '(es10.3)') residual
-      call make_error(error, "initial velocities (*INITIAL_VELOCITY...): the generalized velocities of the meshfree "// &
-                      "particles that give the deck's velocities were not found (BiCGSTAB on the transformation "// &
-                      "rows: relative residual "//trim(adjustl(residual_text))//" after "//integer_text(iterations)// &
-                      " iterations, wanted 1e-12); give meshfree parts a uniform or linear initial velocity field")
+      call make_error(error, "initial velocities (*INITIAL_VELOCITY...): the generalized velocities of the "// &
+                      "meshfree particles that give the deck's velocities were not found (BiCGSTAB on the "// &
+                      "transformation rows: relative residual "//trim(adjustl(residual_text))//" after "// &
+                      integer_text(iterations)//" iterations, wanted 1e-12); give meshfree parts a uniform or "// &
+                      "linear initial velocity field")
       return
     end if
     where (state%nodes%fixed) state%nodes%velocity = 0.0_wp

@@ -1,14 +1,15 @@
 """Rigid walls and initial velocities act on the physical motion of meshfree particles
-(docs/efg.md, docs/efg_shells.md, docs/solver.md "Rigid walls").
+(docs/efg.md, docs/efg_shells.md, docs/solver.md "Rigid walls and meshfree particles" and
+"Initial velocities").
 
 The interior particles of meshfree parts carry generalized values; the physical position of
 particle I is X_I + sum_J A_IJ u_J. Checked here:
 
 - a meshfree solid block whose interior particles (the wall's node set) hit a stationary planar
-  wall (also with Coulomb friction and without sliding), struck by a moving wall with a mass, and falling on a cylinder: no physical position of a tracked
-  node passes the wall by more than round-off, the impulse of the wall force history (rwforc)
-  equals the change of momentum (1e-6), the energy balance closes within 1%; 1 and 2 threads
-  give identical results;
+  wall (also with Coulomb friction and without sliding), are struck by a moving wall with a mass,
+  and fall on a cylinder: no physical position of a tracked node passes the wall by more than
+  round-off, the impulse of the wall force history (rwforc) equals the change of momentum
+  (1e-6), the energy balance closes within 1%; 1 and 2 threads give identical results;
 - a meshfree shell plate thrown at a wall with a dome of speeds (its interior particles meet
   the wall first, and the motion is not a linear field): the same checks;
 - a restart dump written while particles rest on the wall continues the run bit for bit;
@@ -142,7 +143,8 @@ def test_block_particles_stop_at_a_planar_wall(tmp_path, run_deck):
     lowest particle starts above z = 2.1): after contact no particle's physical position is
     below the wall by more than 1e-9 mm (on the old generalized treatment: by about 1e-2 mm)."""
     wall_z = 1.5
-    wall = "*RIGIDWALL_PLANAR_ID\n" + fields(3) + "floor\n" + fields(1) + "\n" + fields(0.0, 0.0, wall_z, 0.0, 0.0, wall_z + 1.0)
+    wall = ("*RIGIDWALL_PLANAR_ID\n" + fields(3) + "floor\n" + fields(1) + "\n" +
+            fields(0.0, 0.0, wall_z, 0.0, 0.0, wall_z + 1.0))
     deck, nodes, particles = block_deck(tmp_path / "block.k", wall)
     run = run_deck(deck)
     assert run.status == 0, run.stdout + run.stderr

@@ -70,7 +70,8 @@ contains
     call check_close(suite, "A x = target at every particle", largest/maxval(abs(target)), 0.0_wp, thr=1.0e-12_wp)
     call check(suite, "nodes that are no particles keep their values", &
                all(field(:, 1) == target(:, 1)) .and. all(field(:, 22) == target(:, 22)))
-    call check(suite, "the generalized values differ from the field", maxval(abs(field(:, 2:21) - target(:, 2:21))) > 0.1_wp)
+    call check(suite, "the generalized values differ from the field", &
+               maxval(abs(field(:, 2:21) - target(:, 2:21))) > 0.1_wp)
   end subroutine test_chain
 
   !> Two particles with the same row and different targets: no solution.
