@@ -21,12 +21,20 @@
 !> feeds it). The rigid-wall energy is what the walls took out, E - W (the energy dissipated by
 !> the inelastic constraint; for a stationary wall E = 0 and it is -W as for planar walls).
 !> The balance kinetic + internal + rigid-wall = initial + external work then closes.
+!>
+!> Interior particles of meshfree parts are held by their physical motion as by the planar
+!> walls (planar_rigid_walls): physical position and velocity from their rows, the correction
+!> along the surface normal made with the smallest change of the generalized velocities in the
+!> mass norm, particle after particle in the order of the wall's node list, in sweeps until no
+!> particle ends inside by more than round-off (a correction only pushes out: the surface normal
+!> changes from point to point, so no impulse is given back).
 module cylinder_walls
   use kinds, only: wp
   use curves, only: curve_t, curve_value
   use model, only: rigid_wall_t, wall_cylinder
   use wall_state, only: wall_state_t
-  use planar_rigid_walls, only: apply_wall_friction
+  use particle_rows, only: particle_rows_t, row_value, row_mass_weight
+  use planar_rigid_walls, only: apply_wall_friction, add_row_impulse, particle_sweep_limit
   implicit none
   private
 
@@ -41,12 +49,15 @@ contains
   !> holds v^{n+1/2} computed from `acceleration` a^n with the step `average_dt`. Returns the
   !> rigid-wall energy increment (energy dissipated) and the work the moving walls did on the
   !> nodes (external work).
-  subroutine enforce_cylinder_walls(walls, curves, states, time, dt, average_dt, coordinates, acceleration, &
-                                    mass, velocity, energy_removed, wall_work)
+  subroutine enforce_cylinder_walls(walls, curves, rows, states, time, dt, average_dt, reference, displacement, &
+                                    coordinates, acceleration, mass, velocity, energy_removed, wall_work)
     type(rigid_wall_t), intent(in) :: walls(:)
     type(curve_t), intent(in) :: curves(:)
+    type(particle_rows_t), intent(in) :: rows
     type(wall_state_t), intent(inout) :: states(:)
     real(wp), intent(in) :: time, dt, average_dt
+    real(wp), intent(in) :: reference(:, :)     !< X
+    real(wp), intent(in) :: displacement(:, :)  !< u^n (generalized at particles)
     real(wp), intent(in) :: coordinates(:, :)   !< x^n
     real(wp), intent(in) :: acceleration(:, :)  !< a^n
     real(wp), intent(in) :: mass(:)
@@ -90,6 +101,9 @@ contains
       outside_squared = (1.0_wp + 1.0e-8_wp)*walls(w)%radius**2
       do k = 1, size(walls(w)%nodes)
         node = walls(w)%nodes(k)
+        if (rows%count > 0) then
+          if (rows%row_of_node(node) > 0) cycle   ! particles: below
+        end if
         ! most tracked nodes are far from the cylinder: a test without square roots first
         end_point = coordinates(:, node) + velocity(:, node)*dt
         relative = end_point - tail_end
@@ -110,11 +124,72 @@ contains
         energy_removed = energy_removed + work - 0.5_wp*dot_product(impulse, velocity(:, node) + old_velocity &
                                                                     - average_dt*acceleration(:, node))
       end do
+      if (size(states(w)%particle_rows) > 0) &
+        call hold_particles(walls(w), rows, states(w)%particle_rows, dt, average_dt, tail_start, tail_end, &
+                            wall_velocity, outside_squared, reference, displacement, acceleration, mass, velocity, &
+                            total_impulse, energy_removed, wall_work)
       ! the wall receives the opposite impulse; its prescribed motion does not change
       states(w)%force = -total_impulse/dt
       states(w)%impulse = states(w)%impulse - total_impulse
     end do
   end subroutine enforce_cylinder_walls
+
+  !> The tracked meshfree particles of one cylinder (see above): sweeps in the list's order until
+  !> no particle would end the step inside by more than 1e-12 of the radius (round-off).
+  subroutine hold_particles(wall, rows, particle_rows, dt, average_dt, tail_start, tail_end, wall_velocity, &
+                            outside_squared, reference, displacement, acceleration, mass, velocity, total_impulse, &
+                            energy_removed, wall_work)
+    type(rigid_wall_t), intent(in) :: wall
+    type(particle_rows_t), intent(in) :: rows
+    integer, intent(in) :: particle_rows(:)
+    real(wp), intent(in) :: dt, average_dt, tail_start(3), tail_end(3), wall_velocity(3), outside_squared
+    real(wp), intent(in) :: reference(:, :), displacement(:, :), acceleration(:, :), mass(:)
+    real(wp), intent(inout) :: velocity(:, :), total_impulse(3), energy_removed, wall_work
+    real(wp) :: position(3), physical_velocity(3), end_point(3), relative(3), height, normal(3), depth
+    real(wp) :: new_velocity(3), weight, largest, tolerance
+    integer :: sweep, k, row
+    logical :: near
+    tolerance = 1.0e-12_wp*max(1.0_wp, wall%radius)
+    ! most steps no particle comes near the cylinder: find out in parallel (a logical, the same
+    ! answer for any thread count), and only then take the particles one by one
+    near = .false.
+    !$omp parallel do schedule(static) default(shared) private(k, row, position, physical_velocity, end_point, &
+    !$omp relative, height) reduction(.or.:near)
+    do k = 1, size(particle_rows)
+      row = particle_rows(k)
+      position = reference(:, rows%particle(row)) + row_value(rows, row, displacement)
+      physical_velocity = row_value(rows, row, velocity)
+      end_point = position + physical_velocity*dt
+      relative = end_point - tail_end
+      height = dot_product(relative, wall%normal)
+      if (dot_product(relative, relative) - height**2 < outside_squared) near = .true.
+    end do
+    !$omp end parallel do
+    if (.not. near) return
+    do sweep = 1, particle_sweep_limit
+      largest = 0.0_wp
+      do k = 1, size(particle_rows)
+        row = particle_rows(k)
+        position = reference(:, rows%particle(row)) + row_value(rows, row, displacement)
+        physical_velocity = row_value(rows, row, velocity)
+        end_point = position + physical_velocity*dt
+        relative = end_point - tail_end
+        height = dot_product(relative, wall%normal)
+        if (dot_product(relative, relative) - height**2 >= outside_squared) cycle
+        call surface_correction(wall, tail_start, tail_end, position, end_point, normal, depth)
+        if (depth <= 0.0_wp .or. (sweep > 1 .and. depth <= tolerance)) cycle
+        weight = row_mass_weight(rows, row, mass)
+        if (weight <= 0.0_wp) cycle
+        largest = max(largest, depth)
+        new_velocity = physical_velocity + (depth/dt)*normal - wall_velocity
+        call apply_wall_friction(wall%friction, normal, physical_velocity - wall_velocity, new_velocity)
+        new_velocity = new_velocity + wall_velocity
+        call add_row_impulse(rows, row, (new_velocity - physical_velocity)/weight, wall_velocity, average_dt, &
+                             acceleration, mass, velocity, total_impulse, energy_removed, wall_work)
+      end do
+      if (largest <= tolerance) exit
+    end do
+  end subroutine hold_particles
 
   !> Whether `end_point` lies inside the cylinder placed at `tail_end`; if so, the outward unit
   !> `normal` of the surface the node is pushed to and the `depth` to move along it (depth <= 0:

@@ -15,5 +15,12 @@ module wall_state
     real(wp) :: normal(3) = 0.0_wp           !< direction of its motion
     real(wp) :: force(3) = 0.0_wp            !< force on the wall in the last cycle
     real(wp) :: impulse(3) = 0.0_wp          !< impulse on the wall since the start of the run
+    !> The tracked nodes that are interior particles of meshfree parts: their rows (particle_rows),
+    !> in the order of the wall's node list (set up once, not part of a restart dump)
+    integer, allocatable :: particle_rows(:)
+    !> Scratch of one step: the normal impulse each of those particles has received (planar
+    !> walls; -1: left alone in this step, as a node that started behind the wall)
+    real(wp), allocatable :: particle_impulse(:)
+    real(wp), allocatable :: particle_friction(:, :)   !< (3, particles) their friction impulse of the step
   end type wall_state_t
 end module wall_state

@@ -12,6 +12,7 @@ module efg_group
   use model, only: model_t, formulation_efg, boundary_full_transformation, integration_gauss_conventional
   use nodal_state, only: nodal_state_t
   use element_group, only: element_group_t, element_results_t
+  use particle_rows, only: particle_rows_t, append_particle_rows
   use element_work, only: booked_energy, add_kinetic_energy
   use efg_part, only: efg_part_t
   use efg_setup, only: build_efg_part
@@ -39,6 +40,7 @@ module efg_group
     procedure :: failure_text
     procedure :: to_physical
     procedure :: forces_to_generalized
+    procedure :: add_particle_rows
   end type efg_group_t
 
 contains
@@ -250,6 +252,19 @@ contains
       call transform_to_physical(self%parts(k), field, physical)
     end do
   end subroutine to_physical
+
+  !> Each part's rows of eq. 16 (walls and initial velocities act on the physical values).
+  subroutine add_particle_rows(self, rows)
+    class(efg_group_t), intent(in) :: self
+    type(particle_rows_t), intent(inout) :: rows
+    integer :: k
+    do k = 1, size(self%parts)
+      associate (geometry => self%parts(k)%geometry)
+        call append_particle_rows(rows, geometry%particles, geometry%transform_offsets, geometry%transform_node, &
+                                  geometry%transform_value)
+      end associate
+    end do
+  end subroutine add_particle_rows
 
   !> The transpose of to_physical for forces (contact on physical positions): a particle's own
   !> entry is replaced by what the rows give it, its physical force goes to the nodes of its row

@@ -23,6 +23,7 @@ module efg_shell_group
   use model, only: model_t, formulation_efg
   use nodal_state, only: nodal_state_t
   use element_group, only: element_group_t, element_results_t
+  use particle_rows, only: particle_rows_t, append_particle_rows
   use element_work, only: booked_energy, add_kinetic_energy
   use efg_shell_part, only: efg_shell_part_t
   use efg_shell_setup, only: build_efg_shell_part
@@ -57,6 +58,7 @@ module efg_shell_group
     procedure :: failure_text
     procedure :: to_physical
     procedure :: forces_to_generalized
+    procedure :: add_particle_rows
     procedure :: thinnest
     procedure :: raise_nodal_plastic_strain
   end type efg_shell_group_t
@@ -335,6 +337,19 @@ contains
       call transform_shell_to_physical(self%parts(k), field, physical)
     end do
   end subroutine to_physical
+
+  !> Each part's rows of eq. 16 (walls and initial velocities act on the physical values).
+  subroutine add_particle_rows(self, rows)
+    class(efg_shell_group_t), intent(in) :: self
+    type(particle_rows_t), intent(inout) :: rows
+    integer :: k
+    do k = 1, size(self%parts)
+      associate (geometry => self%parts(k)%geometry)
+        call append_particle_rows(rows, geometry%particles, geometry%transform_offsets, geometry%transform_node, &
+                                  geometry%transform_value)
+      end associate
+    end do
+  end subroutine add_particle_rows
 
   subroutine forces_to_generalized(self, physical, generalized)
     class(efg_shell_group_t), intent(in) :: self

@@ -23,6 +23,7 @@ module element_group
   use run_summary, only: run_summary_t
   use error_handling, only: error_t
   use restart_file, only: restart_store_t
+  use particle_rows, only: particle_rows_t
   implicit none
   private
 
@@ -102,6 +103,9 @@ module element_group
     !> on the physical values; `generalized` holds the same on entry and gets A^T f at the
     !> group's interior particles (the contact phase: contact on physical positions).
     procedure :: forces_to_generalized
+    !> Optional (meshfree parts): append the transformation rows of its interior particles
+    !> (particle_rows), the rows of to_physical: the walls and the initial velocities use them.
+    procedure :: add_particle_rows
     !> Optional: the element whose density mass scaling raised most, and the factor.
     procedure :: most_scaled
     !> For kinds whose blocks report a step, critical element and failed element each: the
@@ -244,6 +248,11 @@ contains
     real(wp), intent(in) :: physical(:, :)
     real(wp), intent(inout) :: generalized(:, :)
   end subroutine forces_to_generalized
+
+  subroutine add_particle_rows(self, rows)
+    class(element_group_t), intent(in) :: self
+    type(particle_rows_t), intent(inout) :: rows
+  end subroutine add_particle_rows
 
   subroutine most_scaled(self, model, largest, element)
     class(element_group_t), intent(in) :: self

@@ -14,6 +14,7 @@ module explicit_setup
   use output_plan, only: plan_output
   use boundary_conditions, only: fixed_dof_mask, fixed_rotation_mask
   use planar_rigid_walls, only: initialise_wall_states
+  use particle_rows, only: start_particle_rows, solve_particle_rows
   use penalty_contact, only: set_up_contacts
   use rigid_bodies, only: set_up_rigid_bodies, add_node_masses
   use spot_weld_constraints, only: set_up_spot_welds
@@ -40,6 +41,7 @@ contains
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(inout) :: state
     type(error_t), allocatable, intent(out) :: error
+    integer :: k
 
     call allocate_nodal_state(state%nodes, model%coordinates, model%initial_velocity)
     allocate (state%free_acceleration(size(model%motions)))
@@ -56,8 +58,14 @@ contains
     call set_up_group_masses(model, state%groups, state%nodes, abs(model%mass_scaled_time_step), &
                              state%physical_mass, state%added_mass)
     state%nodes%rotational = any(state%nodes%rotary_inertia > 0.0_wp)
+    call start_particle_rows(state%rows, state%nodes%count)
+    do k = 1, size(state%groups)
+      call state%groups(k)%group%add_particle_rows(state%rows)
+    end do
+    call set_up_particle_velocities(model, state, error)
+    if (allocated(error)) return
     call set_up_rigid_state(model, state)
-    call initialise_wall_states(model%walls, state%walls)
+    call initialise_wall_states(model%walls, state%rows, state%walls)
     call set_up_contacts(model, state%nodes%is_particle, state%contacts, error)
     if (allocated(error)) return
     if (sum(state%nodes%mass) <= 0.0_wp) then
@@ -65,6 +73,37 @@ contains
       return
     end if
   end subroutine set_up_explicit_state
+
+  !> Initial velocities of meshfree parts: the solver's values at interior particles are
+  !> generalized, and the physical velocity there is A v (the rows). For a uniform or linear
+  !> field A v_deck = v_deck, but not for others: the particles get the generalized velocities v
+  !> with A v = v_deck (BiCGSTAB on the rows to 1e-12 of the largest particle speed), so that
+  !> every node starts with the deck's velocity. Dofs fixed by a support stay at rest.
+  subroutine set_up_particle_velocities(model, state, error)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(inout) :: state
+    type(error_t), allocatable, intent(out) :: error
+    real(wp), parameter :: tolerance = 1.0e-12_wp
+    integer, parameter :: iteration_limit = 2000
+    logical :: converged
+    real(wp) :: residual
+    integer :: iterations
+    character(len=16) :: residual_text
+    if (state%rows%count == 0 .or. .not. allocated(model%initial_velocity)) return
+    if (maxval(abs(model%initial_velocity)) <= 0.0_wp) return
+    call solve_particle_rows(state%rows, model%initial_velocity, tolerance, iteration_limit, state%nodes%velocity, &
+                             converged, residual, iterations)
+    if (.not. converged) then
+      write (residual_text, '(es10.3)') residual
+      call make_error(error, "initial velocities (*INITIAL_VELOCITY...): the generalized velocities of the "// &
+                      "meshfree particles that give the deck's velocities were not found (BiCGSTAB on the "// &
+                      "transformation rows: relative residual "//trim(adjustl(residual_text))//" after "// &
+                      integer_text(iterations)//" iterations, wanted 1e-12); give meshfree parts a uniform or "// &
+                      "linear initial velocity field")
+      return
+    end if
+    where (state%nodes%fixed) state%nodes%velocity = 0.0_wp
+  end subroutine set_up_particle_velocities
 
   !> *ELEMENT_MASS and the rigid bodies: their mass properties, stable step and initial motion
   !> (rigid_bodies), once the elements have lumped their masses.
@@ -100,10 +139,9 @@ contains
 
   !> Things the user should know before the run starts, one per line (empty: nothing):
   !> segment loads are applied by the static analysis only; conditions and loads on interior
-  !> particles of meshfree parts act on generalized displacements, and so does an initial
-  !> velocity field that is not linear across a meshfree part; mass scaling leaves meshfree
-  !> parts alone, rigid walls act on the generalized positions of meshfree particles, and wide
-  !> supports stiffen curved meshfree shells.
+  !> particles of meshfree parts act on generalized displacements; mass scaling leaves meshfree
+  !> parts alone, and wide supports stiffen curved meshfree shells. (Rigid walls and initial
+  !> velocities act on the particles' physical values: nothing to say.)
   function set_up_warnings(model, state) result(text)
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(in) :: state
@@ -116,7 +154,6 @@ contains
         "(*CONTROL_IMPLICIT_GENERAL) only: this explicit run does not apply them"
     end if
     if (.not. any(state%nodes%is_particle)) return
-    call note_initial_velocities()
     count = 0
     first = 0
     do k = 1, size(model%spcs)
@@ -142,47 +179,7 @@ contains
     do k = 1, size(model%parts)
       call note_curved_meshfree_shells(k)
     end do
-    ! meshfree shells (efg_shell_group): walls see their particles' generalized positions
-    do k = 1, size(model%walls)
-      if (.not. allocated(model%walls(k)%nodes)) cycle
-      if (.not. any(state%nodes%is_particle(model%walls(k)%nodes))) cycle
-      if (len(text) > 0) text = text//new_line('a')
-      text = text//"warning: rigid wall "//trim(integer_text(model%walls(k)%id))//" tracks interior particles "// &
-        "of meshfree parts: it acts on their generalized positions, not their physical ones (a contact with a "// &
-        "rigid part does)"
-    end do
   contains
-    !> Initial velocities are given to the solver's values, which at interior particles are
-    !> generalized: the physical initial velocity is A v, equal to the deck's for a uniform or
-    !> linear field (a translation, a rotation) only. Warn, naming the first node, when A v
-    !> differs from the deck's velocity at a particle.
-    subroutine note_initial_velocities()
-      real(wp), allocatable :: physical(:, :)
-      real(wp) :: scale
-      integer :: group, node, worst
-      if (.not. allocated(model%initial_velocity)) return
-      scale = maxval(abs(model%initial_velocity))
-      if (scale <= 0.0_wp) return
-      physical = model%initial_velocity
-      do group = 1, size(state%groups)
-        call state%groups(group)%group%to_physical(model%initial_velocity, physical)
-      end do
-      worst = 0
-      do node = 1, size(physical, 2)
-        if (.not. state%nodes%is_particle(node)) cycle
-        if (maxval(abs(physical(:, node) - model%initial_velocity(:, node))) > 1.0e-9_wp*scale) then
-          worst = node
-          exit
-        end if
-      end do
-      if (worst == 0) return
-      if (len(text) > 0) text = text//new_line('a')
-      text = text//"warning: the initial velocities are not a uniform or linear field across a meshfree part: "// &
-        "at interior particles they set generalized velocities, so the physical initial velocity differs (node "// &
-        trim(integer_text(model%node_ids(worst)))//" first); give meshfree parts a uniform or rotational "// &
-        "initial velocity"
-    end subroutine note_initial_velocities
-
     !> A meshfree shell part with DX or DY above 1.2 whose neighbouring cells (sharing a node)
     !> turn by more than 2 degrees: wide supports span several facets of a curved surface in each
     !> cell's plane, which stiffens it (membrane locking; docs/efg_shells.md: a quarter ring at

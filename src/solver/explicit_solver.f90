@@ -265,7 +265,8 @@ contains
     state%energy%external_work = state%energy%external_work + work
   end subroutine impose_constraints
 
-  !> Rigid walls stop the nodes that would pass them: the energy they take is the rigid-wall
+  !> Rigid walls stop the nodes that would pass them, meshfree particles by their physical
+  !> position and velocity (the rows of state%rows): the energy they take is the rigid-wall
   !> energy; a cylinder's prescribed motion does external work.
   subroutine enforce_walls(model, state, step, average_step)
     type(model_t), intent(in) :: model
@@ -273,12 +274,13 @@ contains
     real(wp), intent(in) :: step, average_step
     real(wp) :: work, cylinder_work
     if (size(model%walls) == 0) return
-    call enforce_planar_walls(model%walls, state%walls, state%time, step, average_step, state%nodes%coordinates, &
+    call enforce_planar_walls(model%walls, state%rows, state%walls, state%time, step, average_step, &
+                              state%nodes%reference, state%nodes%displacement, state%nodes%coordinates, &
                               state%nodes%acceleration, state%nodes%mass, state%nodes%velocity, work)
     state%energy%rigid_wall = state%energy%rigid_wall + work
-    call enforce_cylinder_walls(model%walls, model%curves, state%walls, state%time, step, average_step, &
-                                state%nodes%coordinates, state%nodes%acceleration, state%nodes%mass, &
-                                state%nodes%velocity, work, cylinder_work)
+    call enforce_cylinder_walls(model%walls, model%curves, state%rows, state%walls, state%time, step, average_step, &
+                                state%nodes%reference, state%nodes%displacement, state%nodes%coordinates, &
+                                state%nodes%acceleration, state%nodes%mass, state%nodes%velocity, work, cylinder_work)
     state%energy%rigid_wall = state%energy%rigid_wall + work
     state%energy%external_work = state%energy%external_work + cylinder_work
   end subroutine enforce_walls

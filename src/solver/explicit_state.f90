@@ -12,6 +12,7 @@ module explicit_state
   use tied_contact, only: tied_state_t
   use wall_state, only: wall_state_t
   use penalty_contact, only: contact_state_t
+  use particle_rows, only: particle_rows_t
   implicit none
   private
 
@@ -59,6 +60,9 @@ module explicit_state
     ! nodes and elements
     type(nodal_state_t) :: nodes
     type(group_holder_t), allocatable :: groups(:)
+    !> The transformation rows of every meshfree particle (set up once from the groups): walls
+    !> and initial velocities act on the physical values
+    type(particle_rows_t) :: rows
     real(wp), allocatable :: free_acceleration(:)        !< per prescribed motion: the acceleration the
                                                          !< forces would give its dof (for the support's work)
     ! rigid bodies (indexed like model%rigid_bodies); their nodes move with them
