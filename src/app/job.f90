@@ -23,6 +23,7 @@ module job
   use version, only: crashfree_version
   use stop_signals, only: catch_stop_signals
   use deck_signature, only: deck_source_t
+  use ascii_databases, only: write_ascii_databases
   use restart_control, only: restart_control_t, prepare_restart, check_restart_deck, set_up_restart_control, &
                              continue_restart_results, count_earlier_run
   use, intrinsic :: iso_fortran_env, only: error_unit
@@ -45,7 +46,7 @@ contains
     type(results_file_t) :: results
     type(run_summary_t) :: summary
     type(error_list_t) :: warnings
-    type(error_t), allocatable :: error, close_error
+    type(error_t), allocatable :: error, close_error, ascii_error
     character(len=:), allocatable :: warning_text
     real(wp) :: started
 
@@ -121,12 +122,17 @@ contains
       summary%message = ""
       exit_status = 0
     end if
+    ! LS-DYNA's ASCII files the deck asks for, from the histories of the whole run
+    if (.not. model%implicit_static) call write_ascii_databases(model, run%histories, settings%output_dir, &
+                                                                settings%job_id, ascii_error)
+    if (allocated(ascii_error)) exit_status = 1
     call close_results(results, summary, close_error)
     if (allocated(close_error)) exit_status = 1
     call print_summary(summary, settings, model%implicit_static)
     if (allocated(error)) write (error_unit, '(a)') "crashfree: error termination: "//error%message
     ! last: what the results file holds after a failed write
     if (allocated(close_error)) write (error_unit, '(a)') "crashfree: "//close_error%message
+    if (allocated(ascii_error)) write (error_unit, '(a)') "crashfree: "//ascii_error%message
   end subroutine run_job
 
   !> ncpu=, else OMP_NUM_THREADS (the OpenMP runtime reads it), else all cores; at most the
