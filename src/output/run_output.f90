@@ -99,7 +99,7 @@ contains
     interval = state%time - plan%last_rwforc_time
     do k = 1, size(plan%rwforc_series)
       force = 0.0_wp
-      if (interval > 0.0_wp) force = -(state%walls(k)%impulse - plan%wall_impulse(:, k))/interval
+      if (interval > 0.0_wp) force = 0.0_wp - (state%walls(k)%impulse - plan%wall_impulse(:, k))/interval   ! (+0, not -0)
       if (model%walls(k)%kind == wall_planar) then
         normal_force = dot_product(force, model%walls(k)%normal)
       else
@@ -123,7 +123,7 @@ contains
     do k = 1, size(plan%rcforc_series)
       force = 0.0_wp
       if (interval > 0.0_wp) force = (state%contacts(k)%impulse - plan%contact_impulse(:, k))/interval
-      call append_history_row(histories%series(plan%rcforc_series(k)), [state%time, force, -force])
+      call append_history_row(histories%series(plan%rcforc_series(k)), [state%time, force, 0.0_wp - force])
       plan%contact_impulse(:, k) = state%contacts(k)%impulse
     end do
     plan%last_rcforc_time = state%time
