@@ -1351,42 +1351,51 @@ contains
     integer(hid_t), intent(in) :: file_id
     type(run_summary_t), intent(in) :: summary
     type(error_t), allocatable, intent(inout) :: error
-    character(len=:), allocatable :: lines(:)
-    integer :: count, start, finish, k, longest, status
+    integer :: count, longest, status
     logical :: exists
     if (allocated(error)) return
-    count = 0
-    longest = 1
-    if (allocated(summary%warnings)) then
-      start = 1
-      do while (start <= len(summary%warnings))
-        finish = index(summary%warnings(start:), new_line("a"))
-        if (finish == 0) finish = len(summary%warnings) - start + 2
-        if (finish > 1) then
-          count = count + 1
-          longest = max(longest, finish - 1)
-        end if
-        start = start + finish
-      end do
-    end if
-    allocate (character(len=longest) :: lines(count))
-    if (count > 0) then
-      k = 0
-      start = 1
-      do while (start <= len(summary%warnings))
-        finish = index(summary%warnings(start:), new_line("a"))
-        if (finish == 0) finish = len(summary%warnings) - start + 2
-        if (finish > 1) then
-          k = k + 1
-          lines(k) = summary%warnings(start:start + finish - 2)
-        end if
-        start = start + finish
-      end do
-    end if
     call h5lexists_f(file_id, "/run/warnings", exists, status)
     if (status == 0 .and. exists) call h5ldelete_f(file_id, "/run/warnings", status)
-    call write_string_dataset(file_id, "/run/warnings", lines, error)
+    if (.not. allocated(summary%warnings)) then
+      call write_warning_lines(file_id, "", 0, 1, error)
+      return
+    end if
+    call split_lines(summary%warnings, count=count, longest=longest)
+    call write_warning_lines(file_id, summary%warnings, count, longest, error)
   end subroutine write_warnings
+
+  subroutine write_warning_lines(file_id, text, count, longest, error)
+    integer(hid_t), intent(in) :: file_id
+    character(len=*), intent(in) :: text
+    integer, intent(in) :: count, longest
+    type(error_t), allocatable, intent(inout) :: error
+    character(len=longest) :: lines(count)
+    integer :: ignored_count, ignored_longest
+    call split_lines(text, lines, ignored_count, ignored_longest)
+    call write_string_dataset(file_id, "/run/warnings", lines, error)
+  end subroutine write_warning_lines
+
+  !> The non-empty lines of `text` (split at new lines): how many, the longest, and (when
+  !> `lines` is given) the lines themselves.
+  subroutine split_lines(text, lines, count, longest)
+    character(len=*), intent(in) :: text
+    character(len=*), intent(out), optional :: lines(:)
+    integer, intent(out) :: count, longest
+    integer :: start, finish
+    count = 0
+    longest = 1
+    start = 1
+    do while (start <= len(text))
+      finish = index(text(start:), new_line("a"))
+      if (finish == 0) finish = len(text) - start + 2
+      if (finish > 1) then
+        count = count + 1
+        longest = max(longest, finish - 1)
+        if (present(lines)) lines(count) = text(start:start + finish - 2)
+      end if
+      start = start + finish
+    end do
+  end subroutine split_lines
 
   !> `/timing`: seconds per phase, the sizes that normalise them, and what the output wrote
   !> (`output_bytes`, `xdmf_writes`: see the module comment).
