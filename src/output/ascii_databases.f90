@@ -14,10 +14,18 @@ module ascii_databases
   use model, only: model_t
   use history_buffer, only: history_set_t, history_series_t
   use version, only: crashfree_version
+  use file_system, only: write_text_file
   implicit none
   private
 
-  public :: write_ascii_databases, lsdyna_file_path, c_exponential
+  public :: write_ascii_databases, lsdyna_file_path, c_exponential, text_buffer_t, add_line, start_database, &
+            finish_database
+
+  !> The text of a file being written, `text(1:length)`; lines are appended with add_line.
+  type :: text_buffer_t
+    character(len=:), allocatable :: text
+    integer :: length = 0
+  end type text_buffer_t
 
 contains
 
@@ -144,48 +152,67 @@ contains
     value_of = series%rows(position, row)
   end function value_of
 
-  subroutine open_database(path, model, unit, error)
-    character(len=*), intent(in) :: path
+  !> LS-DYNA's first two lines: the title, then the program, its version and the date.
+  subroutine start_database(model, out)
     type(model_t), intent(in) :: model
-    integer, intent(out) :: unit
-    type(error_t), allocatable, intent(out) :: error
-    integer :: status
-    character(len=256) :: message
+    type(text_buffer_t), intent(inout) :: out
     character(len=8) :: date
-    open (newunit=unit, file=path, status="replace", action="write", form="formatted", iostat=status, iomsg=message)
-    if (status /= 0) then
-      call make_error(error, "cannot write "//path//": "//trim(message))
-      return
-    end if
     call date_and_time(date=date)
-    ! LS-DYNA's first two lines: the title, then the program, its version and the date
     if (allocated(model%title)) then
-      write (unit, '(a)') " "//model%title(1:min(len(model%title), 72))
+      call add_line(out, " "//model%title(1:min(len(model%title), 72)))
     else
-      write (unit, '(a)') " "
+      call add_line(out, " ")
     end if
-    write (unit, '(a)') "                         crashfree (version "//crashfree_version//")     date "// &
-      date(5:6)//"/"//date(7:8)//"/"//date(1:4)
-  end subroutine open_database
+    call add_line(out, "                         crashfree (version "//crashfree_version//")     date "// &
+      date(5:6)//"/"//date(7:8)//"/"//date(1:4))
+  end subroutine start_database
 
-  subroutine close_database(unit, path, error)
-    integer, intent(in) :: unit
+  !> Append one line (and its new line) to `out`, doubling the buffer when it is full.
+  subroutine add_line(out, line)
+    type(text_buffer_t), intent(inout) :: out
+    character(len=*), intent(in) :: line
+    character(len=:), allocatable :: grown
+    integer :: needed
+    needed = out%length + len(line) + 1
+    if (.not. allocated(out%text)) allocate (character(len=max(4096, needed)) :: out%text)
+    if (needed > len(out%text)) then
+      allocate (character(len=max(2*len(out%text), needed)) :: grown)
+      grown(1:out%length) = out%text(1:out%length)
+      call move_alloc(grown, out%text)
+    end if
+    out%text(out%length + 1:needed) = line//new_line("a")
+    out%length = needed
+  end subroutine add_line
+
+  !> The whole text to `path` through C's stdio (file_system's write_text_file), which reports
+  !> a full disk; gfortran's formatted writes would cut the file short without a word.
+  subroutine finish_database(out, path, error)
+    type(text_buffer_t), intent(in) :: out
     character(len=*), intent(in) :: path
     type(error_t), allocatable, intent(out) :: error
-    integer :: status
-    character(len=256) :: message
-    close (unit, iostat=status, iomsg=message)
-    if (status /= 0) call make_error(error, "cannot write "//path//": "//trim(message))
-  end subroutine close_database
+    integer :: mark
+    if (allocated(out%text)) then
+      call write_text_file(path, out%text(1:out%length), error)
+    else
+      call write_text_file(path, "", error)
+    end if
+    if (.not. allocated(error)) return
+    ! "...: no space left on device", as the results file's messages say it
+    mark = index(error%message, ": ", back=.true.) + 2
+    if (mark > 2 .and. mark <= len(error%message)) then
+      if (error%message(mark:mark) >= "A" .and. error%message(mark:mark) <= "Z") &
+        error%message(mark:mark) = achar(iachar(error%message(mark:mark)) + 32)
+    end if
+  end subroutine finish_database
 
   !> A glstat line: the label padded with dots to 31 characters after a blank, then %14.5E.
-  subroutine glstat_line(unit, label, value)
-    integer, intent(in) :: unit
+  subroutine glstat_line(out, label, value)
+    type(text_buffer_t), intent(inout) :: out
     character(len=*), intent(in) :: label
     real(wp), intent(in) :: value
     character(len=32) :: padded
     padded = " "//label//repeat(".", 31)
-    write (unit, '(a)') padded//c_exponential(value, 14, 5)
+    call add_line(out, padded//c_exponential(value, 14, 5))
   end subroutine glstat_line
 
   !> glstat: per sample " dt of cycle" with the cycle number, then LS-DYNA's lines.
@@ -194,66 +221,64 @@ contains
     type(history_set_t), intent(in) :: histories
     character(len=*), intent(in) :: path
     type(error_t), allocatable, intent(out) :: error
-    type(error_t), allocatable :: close_error
-    integer :: unit, s, row
+    type(text_buffer_t) :: out
+    integer :: s, row
     character(len=32) :: cycle_text
     s = series_index(histories, "glstat")
     if (s == 0) return
-    call open_database(path, model, unit, error)
-    if (allocated(error)) return
+    call start_database(model, out)
     associate (series => histories%series(s))
       do row = 1, series%count
         write (cycle_text, '(i8)') nint(value_of(series, "cycle", row))
-        write (unit, '(a)') ""
-        write (unit, '(a)') ""
-        write (unit, '(a)') " dt of cycle"//trim(cycle_text)
-        write (unit, '(a)') ""
-        call glstat_line(unit, "time", value_of(series, "time", row))
-        call glstat_line(unit, "time step", value_of(series, "time_step", row))
-        call glstat_line(unit, "kinetic energy", value_of(series, "kinetic_energy", row))
-        call glstat_line(unit, "internal energy", value_of(series, "internal_energy", row))
-        if (size(model%walls) > 0) call glstat_line(unit, "stonewall energy", value_of(series, "rigid_wall_energy", row))
-        call glstat_line(unit, "spring and damper energy", value_of(series, "spring_damper_energy", row))
-        call glstat_line(unit, "hourglass energy ", value_of(series, "hourglass_energy", row))
-        call glstat_line(unit, "system damping energy", value_of(series, "system_damping_energy", row))
-        call glstat_line(unit, "sliding interface energy", value_of(series, "contact_energy", row))
-        call glstat_line(unit, "external work", value_of(series, "external_work", row))
-        call glstat_line(unit, "eroded kinetic energy", value_of(series, "eroded_kinetic_energy", row))
-        call glstat_line(unit, "eroded internal energy", value_of(series, "eroded_internal_energy", row))
-        call glstat_line(unit, "eroded hourglass energy", value_of(series, "eroded_hourglass_energy", row))
-        call glstat_line(unit, "total energy", value_of(series, "total_energy", row))
-        call glstat_line(unit, "total energy / initial energy", value_of(series, "energy_ratio", row))
-        call glstat_line(unit, "energy ratio w/o eroded energy", value_of(series, "energy_ratio_without_eroded", row))
-        call glstat_line(unit, "global x velocity", value_of(series, "global_velocity", row, 1))
-        call glstat_line(unit, "global y velocity", value_of(series, "global_velocity", row, 2))
-        call glstat_line(unit, "global z velocity", value_of(series, "global_velocity", row, 3))
-        write (unit, '(a)') ""
-        write (unit, '(a)') ""
-        call glstat_line(unit, "added mass", value_of(series, "added_mass", row))
-        call glstat_line(unit, "percentage increase", value_of(series, "percent_mass_increase", row))
+        call add_line(out, "")
+        call add_line(out, "")
+        call add_line(out, " dt of cycle"//trim(cycle_text))
+        call add_line(out, "")
+        call glstat_line(out, "time", value_of(series, "time", row))
+        call glstat_line(out, "time step", value_of(series, "time_step", row))
+        call glstat_line(out, "kinetic energy", value_of(series, "kinetic_energy", row))
+        call glstat_line(out, "internal energy", value_of(series, "internal_energy", row))
+        if (size(model%walls) > 0) call glstat_line(out, "stonewall energy", value_of(series, "rigid_wall_energy", row))
+        call glstat_line(out, "spring and damper energy", value_of(series, "spring_damper_energy", row))
+        call glstat_line(out, "hourglass energy ", value_of(series, "hourglass_energy", row))
+        call glstat_line(out, "system damping energy", value_of(series, "system_damping_energy", row))
+        call glstat_line(out, "sliding interface energy", value_of(series, "contact_energy", row))
+        call glstat_line(out, "external work", value_of(series, "external_work", row))
+        call glstat_line(out, "eroded kinetic energy", value_of(series, "eroded_kinetic_energy", row))
+        call glstat_line(out, "eroded internal energy", value_of(series, "eroded_internal_energy", row))
+        call glstat_line(out, "eroded hourglass energy", value_of(series, "eroded_hourglass_energy", row))
+        call glstat_line(out, "total energy", value_of(series, "total_energy", row))
+        call glstat_line(out, "total energy / initial energy", value_of(series, "energy_ratio", row))
+        call glstat_line(out, "energy ratio w/o eroded energy", value_of(series, "energy_ratio_without_eroded", row))
+        call glstat_line(out, "global x velocity", value_of(series, "global_velocity", row, 1))
+        call glstat_line(out, "global y velocity", value_of(series, "global_velocity", row, 2))
+        call glstat_line(out, "global z velocity", value_of(series, "global_velocity", row, 3))
+        call add_line(out, "")
+        call add_line(out, "")
+        call glstat_line(out, "added mass", value_of(series, "added_mass", row))
+        call glstat_line(out, "percentage increase", value_of(series, "percent_mass_increase", row))
       end do
     end associate
-    call close_database(unit, path, close_error)
-    if (allocated(close_error)) call move_alloc(close_error, error)
+    call finish_database(out, path, error)
   end subroutine write_glstat
 
   !> The legend of part, wall or contact titles LS-DYNA writes after the header.
-  subroutine write_legend(unit, ids, titles)
-    integer, intent(in) :: unit
+  subroutine write_legend(out, ids, titles)
+    type(text_buffer_t), intent(inout) :: out
     integer, intent(in) :: ids(:)
     character(len=*), intent(in) :: titles(:)
     integer :: k
     character(len=9) :: id_text
     if (all(len_trim(titles) == 0)) return
-    write (unit, '(a)') ""
-    write (unit, '(a)') "{BEGIN LEGEND"
-    write (unit, '(a)') " Entity #        Title"
+    call add_line(out, "")
+    call add_line(out, "{BEGIN LEGEND")
+    call add_line(out, " Entity #        Title")
     do k = 1, size(ids)
       write (id_text, '(i9)') ids(k)
-      write (unit, '(a)') id_text//"     "//trim(titles(k))
+      call add_line(out, id_text//"     "//trim(titles(k)))
     end do
-    write (unit, '(a)') "{END LEGEND}"
-    write (unit, '(a)') ""
+    call add_line(out, "{END LEGEND}")
+    call add_line(out, "")
   end subroutine write_legend
 
   !> matsum: per sample "time =", then per part its energies, momentum, rigid-body velocity,
@@ -263,11 +288,11 @@ contains
     type(history_set_t), intent(in) :: histories
     character(len=*), intent(in) :: path
     type(error_t), allocatable, intent(out) :: error
-    type(error_t), allocatable :: close_error
     integer, allocatable :: part_series(:)
     character(len=70), allocatable :: titles(:)
     character(len=16) :: id_text
-    integer :: unit, k, row, rows
+    type(text_buffer_t) :: out
+    integer :: k, row, rows
     allocate (part_series(size(model%parts)), titles(size(model%parts)))
     rows = huge(1)
     do k = 1, size(model%parts)
@@ -279,13 +304,12 @@ contains
       if (allocated(model%parts(k)%title)) titles(k) = model%parts(k)%title
     end do
     if (size(model%parts) == 0) return
-    call open_database(path, model, unit, error)
-    if (allocated(error)) return
-    call write_legend(unit, model%parts%id, titles)
+    call start_database(model, out)
+    call write_legend(out, model%parts%id, titles)
     do row = 1, rows
-      write (unit, '(a)') ""
-      write (unit, '(a)') ""
-      write (unit, '(a)') " time ="//c_exponential(histories%series(part_series(1))%rows(1, row), 13, 4)
+      call add_line(out, "")
+      call add_line(out, "")
+      call add_line(out, " time ="//c_exponential(histories%series(part_series(1))%rows(1, row), 13, 4))
       do k = 1, size(model%parts)
         associate (series => histories%series(part_series(k)))
           if (model%parts(k)%id < 100000) then
@@ -293,23 +317,22 @@ contains
           else
             write (id_text, '(i8)') model%parts(k)%id
           end if
-          write (unit, '(a)') " mat.#="//id_text(1:8)//"          inten="// &
+          call add_line(out, " mat.#="//id_text(1:8)//"          inten="// &
             c_exponential(value_of(series, "internal_energy", row), 13, 4)//"     kinen="// &
-            c_exponential(value_of(series, "kinetic_energy", row), 13, 4)
-          write (unit, '(a)') " x-mom="//c_exponential(value_of(series, "momentum", row, 1), 13, 4)// &
+            c_exponential(value_of(series, "kinetic_energy", row), 13, 4))
+          call add_line(out, " x-mom="//c_exponential(value_of(series, "momentum", row, 1), 13, 4)// &
             "     y-mom="//c_exponential(value_of(series, "momentum", row, 2), 13, 4)// &
-            "     z-mom="//c_exponential(value_of(series, "momentum", row, 3), 13, 4)
-          write (unit, '(a)') " x-rbv="//c_exponential(value_of(series, "rigid_body_velocity", row, 1), 13, 4)// &
+            "     z-mom="//c_exponential(value_of(series, "momentum", row, 3), 13, 4))
+          call add_line(out, " x-rbv="//c_exponential(value_of(series, "rigid_body_velocity", row, 1), 13, 4)// &
             "     y-rbv="//c_exponential(value_of(series, "rigid_body_velocity", row, 2), 13, 4)// &
-            "     z-rbv="//c_exponential(value_of(series, "rigid_body_velocity", row, 3), 13, 4)
-          write (unit, '(a)') "                         hgeng="// &
+            "     z-rbv="//c_exponential(value_of(series, "rigid_body_velocity", row, 3), 13, 4))
+          call add_line(out, "                         hgeng="// &
             c_exponential(value_of(series, "hourglass_energy", row), 13, 4)//"     +mass="// &
-            c_exponential(value_of(series, "mass", row), 13, 4)
+            c_exponential(value_of(series, "mass", row), 13, 4))
         end associate
       end do
     end do
-    call close_database(unit, path, close_error)
-    if (allocated(close_error)) call move_alloc(close_error, error)
+    call finish_database(out, path, error)
   end subroutine write_matsum
 
   !> nodout: per sample the "n o d a l   p r i n t   o u t" block, one line per history node.
@@ -318,12 +341,12 @@ contains
     type(history_set_t), intent(in) :: histories
     character(len=*), intent(in) :: path
     type(error_t), allocatable, intent(out) :: error
-    type(error_t), allocatable :: close_error
     integer, allocatable :: node_series(:)
     character(len=16) :: id_text
     character(len=9) :: node_text
     character(len=8) :: cycle_text
-    integer :: unit, k, j, row, rows, node
+    type(text_buffer_t) :: out
+    integer :: k, j, row, rows, node
     character(len=:), allocatable :: line
     if (.not. allocated(model%output%history_nodes)) return
     if (size(model%output%history_nodes) == 0) return
@@ -335,20 +358,19 @@ contains
       if (node_series(k) == 0) return
       rows = min(rows, histories%series(node_series(k))%count)
     end do
-    call open_database(path, model, unit, error)
-    if (allocated(error)) return
+    call start_database(model, out)
     do row = 1, rows
       associate (first => histories%series(node_series(1)))
         write (cycle_text, '(i8)') nint(value_of(first, "cycle", row))
-        write (unit, '(a)') ""
-        write (unit, '(a)') ""
-        write (unit, '(a)') ""
-        write (unit, '(a)') " n o d a l   p r i n t   o u t   f o r   t i m e  s t e p"//cycle_text// &
-          "                              ( at time"//c_exponential(first%rows(1, row), 12, 5)//" )"
+        call add_line(out, "")
+        call add_line(out, "")
+        call add_line(out, "")
+        call add_line(out, " n o d a l   p r i n t   o u t   f o r   t i m e  s t e p"//cycle_text// &
+          "                              ( at time"//c_exponential(first%rows(1, row), 12, 5)//" )")
       end associate
-      write (unit, '(a)') ""
-      write (unit, '(a)') " nodal point  x-disp     y-disp      z-disp      x-vel       y-vel       z-vel      "// &
-        "x-accl      y-accl      z-accl      x-coor      y-coor      z-coor"
+      call add_line(out, "")
+      call add_line(out, " nodal point  x-disp     y-disp      z-disp      x-vel       y-vel       z-vel      "// &
+        "x-accl      y-accl      z-accl      x-coor      y-coor      z-coor")
       do k = 1, size(node_series)
         node = model%output%history_nodes(k)
         associate (series => histories%series(node_series(k)))
@@ -366,12 +388,11 @@ contains
           do j = 1, 3
             line = line//c_exponential(model%coordinates(j, node) + value_of(series, "displacement", row, j), 12, 4)
           end do
-          write (unit, '(a)') line
+          call add_line(out, line)
         end associate
       end do
     end do
-    call close_database(unit, path, close_error)
-    if (allocated(close_error)) call move_alloc(close_error, error)
+    call finish_database(out, path, error)
   end subroutine write_nodout
 
   !> rwforc: one line per sample and wall: time, wall id, normal force, x, y, z force (the
@@ -381,12 +402,12 @@ contains
     type(history_set_t), intent(in) :: histories
     character(len=*), intent(in) :: path
     type(error_t), allocatable, intent(out) :: error
-    type(error_t), allocatable :: close_error
     integer, allocatable :: wall_series(:)
     character(len=70), allocatable :: titles(:)
     character(len=16) :: id_text
     character(len=8) :: wall_text
-    integer :: unit, k, j, row, rows
+    type(text_buffer_t) :: out
+    integer :: k, j, row, rows
     character(len=:), allocatable :: line
     allocate (wall_series(size(model%walls)), titles(size(model%walls)))
     rows = huge(1)
@@ -398,12 +419,11 @@ contains
       titles(k) = ""
       if (allocated(model%walls(k)%title)) titles(k) = model%walls(k)%title
     end do
-    call open_database(path, model, unit, error)
-    if (allocated(error)) return
-    call write_legend(unit, model%walls%id, titles)
-    write (unit, '(a)') ""
-    write (unit, '(a)') ""
-    write (unit, '(a)') "    time       wall#   normal-force    x-force        y-force        z-force"
+    call start_database(model, out)
+    call write_legend(out, model%walls%id, titles)
+    call add_line(out, "")
+    call add_line(out, "")
+    call add_line(out, "    time       wall#   normal-force    x-force        y-force        z-force")
     do row = 1, rows
       do k = 1, size(model%walls)
         associate (series => histories%series(wall_series(k)))
@@ -413,12 +433,11 @@ contains
           do j = 1, 3
             line = line//c_exponential(value_of(series, "force", row, j), 15, 6)
           end do
-          write (unit, '(a)') line
+          call add_line(out, line)
         end associate
       end do
     end do
-    call close_database(unit, path, close_error)
-    if (allocated(close_error)) call move_alloc(close_error, error)
+    call finish_database(out, path, error)
   end subroutine write_rwforc
 
   !> rcforc: per sample and contact a "slave" line (the force on SURFA) and a "master" line
@@ -429,12 +448,12 @@ contains
     type(history_set_t), intent(in) :: histories
     character(len=*), intent(in) :: path
     type(error_t), allocatable, intent(out) :: error
-    type(error_t), allocatable :: close_error
     integer, allocatable :: contact_series(:)
     character(len=70), allocatable :: titles(:)
     character(len=16) :: id_text
     character(len=11) :: contact_text
-    integer :: unit, k, row, rows
+    type(text_buffer_t) :: out
+    integer :: k, row, rows
     allocate (contact_series(size(model%contacts)), titles(size(model%contacts)))
     rows = huge(1)
     do k = 1, size(model%contacts)
@@ -445,27 +464,25 @@ contains
       titles(k) = ""
       if (allocated(model%contacts(k)%title)) titles(k) = model%contacts(k)%title
     end do
-    call open_database(path, model, unit, error)
-    if (allocated(error)) return
-    call write_legend(unit, model%contacts%id, titles)
+    call start_database(model, out)
+    call write_legend(out, model%contacts%id, titles)
     do row = 1, rows
       do k = 1, size(model%contacts)
         associate (series => histories%series(contact_series(k)))
           write (contact_text, '(i11)') model%contacts(k)%id
-          write (unit, '(a)') "  slave "//contact_text//" time"//c_exponential(series%rows(1, row), 12, 5)// &
+          call add_line(out, "  slave "//contact_text//" time"//c_exponential(series%rows(1, row), 12, 5)// &
             "  x "//c_exponential(value_of(series, "force", row, 1), 12, 5)// &
             "  y "//c_exponential(value_of(series, "force", row, 2), 12, 5)// &
             "  z "//c_exponential(value_of(series, "force", row, 3), 12, 5)// &
-            " mass "//c_exponential(0.0_wp, 12, 5)
-          write (unit, '(a)') "  master"//contact_text//" time"//c_exponential(series%rows(1, row), 12, 5)// &
+            " mass "//c_exponential(0.0_wp, 12, 5))
+          call add_line(out, "  master"//contact_text//" time"//c_exponential(series%rows(1, row), 12, 5)// &
             "  x "//c_exponential(value_of(series, "surfb_force", row, 1), 12, 5)// &
             "  y "//c_exponential(value_of(series, "surfb_force", row, 2), 12, 5)// &
             "  z "//c_exponential(value_of(series, "surfb_force", row, 3), 12, 5)// &
-            " mass "//c_exponential(0.0_wp, 12, 5)
+            " mass "//c_exponential(0.0_wp, 12, 5))
         end associate
       end do
     end do
-    call close_database(unit, path, close_error)
-    if (allocated(close_error)) call move_alloc(close_error, error)
+    call finish_database(out, path, error)
   end subroutine write_rcforc
 end module ascii_databases
