@@ -143,7 +143,8 @@ contains
     if (.not. model%implicit_static) then
       call write_ascii_databases(model, run%histories, settings%output_dir, settings%job_id, ascii_error)
       if (.not. allocated(ascii_error)) &
-        call write_d3hsp(model, run%state, run%histories, summary, settings%output_dir, settings%job_id, ascii_error)
+        call write_d3hsp(model, run%state, run%histories, initial_time_steps(run), summary, settings%output_dir, &
+                         settings%job_id, ascii_error)
     end if
     if (allocated(ascii_error)) exit_status = 1
     call close_results(results, summary, close_error)
@@ -162,6 +163,14 @@ contains
       end if
     end if
   end subroutine run_job
+
+  !> The d3hsp time step table the output recorded at cycle 0 ("" when it was not: a restart).
+  function initial_time_steps(run) result(text)
+    type(run_state_t), intent(in) :: run
+    character(len=:), allocatable :: text
+    text = ""
+    if (allocated(run%plan%initial_time_steps)) text = run%plan%initial_time_steps
+  end function initial_time_steps
 
   !> Print a warning or error on the terminal (standard error) after what standard output
   !> holds so far, so that a log of both reads in the order things happened, and keep it for

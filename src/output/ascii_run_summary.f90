@@ -51,10 +51,11 @@ contains
   end subroutine write_messag
 
   !> `d3hsp` (`JOB.d3hsp` with jobid=).
-  subroutine write_d3hsp(model, state, histories, summary, directory, job_id, error)
+  subroutine write_d3hsp(model, state, histories, initial_time_steps, summary, directory, job_id, error)
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(in) :: state
     type(history_set_t), intent(in) :: histories
+    character(len=*), intent(in) :: initial_time_steps   !< the table at cycle 0 ("" if not recorded)
     type(run_summary_t), intent(in) :: summary
     character(len=*), intent(in) :: directory, job_id
     type(error_t), allocatable, intent(out) :: error
@@ -69,7 +70,7 @@ contains
     if (allocated(model%deck_path)) call add_line(out, " input deck: "//model%deck_path)
     call write_controls(out, model)
     call write_parts(out, model, state)
-    call write_time_steps(out, model, state, histories)
+    call write_time_steps(out, model, state, histories, initial_time_steps)
     call add_line(out, "")
     write (cycles, '(i0)') summary%cycles
     call add_line(out, " cycles: "//trim(cycles)//", problem time "//trim(adjustl(c_exponential(summary%end_time, 12, 5))))
@@ -188,13 +189,14 @@ contains
   end subroutine write_parts
 
   !> The first time step (glstat's first row), and the smallest stable step of each element
-  !> kind with its element, from the last force call (LS-DYNA's table of the smallest steps,
-  !> here one row per element kind and the rigid bodies).
-  subroutine write_time_steps(out, model, state, histories)
+  !> kind with its element at the start (cycle 0) and at the last cycle (LS-DYNA's table of the
+  !> smallest steps, here one row per element kind and the rigid bodies).
+  subroutine write_time_steps(out, model, state, histories, initial_time_steps)
     type(text_buffer_t), intent(inout) :: out
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(in) :: state
     type(history_set_t), intent(in) :: histories
+    character(len=*), intent(in) :: initial_time_steps
     integer :: k, j
     character(len=200) :: line
     call add_line(out, "")
@@ -212,6 +214,13 @@ contains
     end do
     call control_line(out, "last stable time step (before TSSFAC)", real_field(state%stable_time_step))
     call add_line(out, "")
+    if (len(initial_time_steps) > 0) then
+      call add_line(out, " s m a l l e s t   t i m e   s t e p s   (by element kind, cycle 0)")
+      call add_line(out, " ----------------------------------------------------------------------")
+      call add_line(out, "      stable step  element")
+      call add_line(out, initial_time_steps(1:len(initial_time_steps) - 1))
+      call add_line(out, "")
+    end if
     call add_line(out, " s m a l l e s t   t i m e   s t e p s   (by element kind, last cycle)")
     call add_line(out, " ----------------------------------------------------------------------")
     call add_line(out, "      stable step  element")

@@ -14,6 +14,7 @@ module run_output
   use results_file, only: results_file_t, write_state
   use rigid_bodies, only: rigid_body_history_row
   use spot_weld_constraints, only: failed_weld_count
+  use ascii_databases, only: c_exponential
   implicit none
   private
 
@@ -37,6 +38,8 @@ contains
     logical :: glstat_due, matsum_due, nodout_due, states_due
     integer :: k
 
+    if (state%cycle == 0 .and. .not. allocated(plan%initial_time_steps)) &
+      call record_initial_time_steps(model, state, plan)
     glstat_due = clock_due(plan%glstat, state%time, last)
     matsum_due = clock_due(plan%matsum, state%time, last)
     if (glstat_due) then
@@ -82,6 +85,26 @@ contains
     ! the state and the history rows recorded since the previous one, as one commit
     if (states_due) call write_current_state(model, state, plan, histories, results, error)
   end subroutine write_due_output
+
+  !> The smallest stable step of each element kind at cycle 0 with its element, and the rigid
+  !> bodies' (d3hsp's time step table, which LS-DYNA writes at the start).
+  subroutine record_initial_time_steps(model, state, plan)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(in) :: state
+    type(output_plan_t), intent(inout) :: plan
+    integer :: k
+    plan%initial_time_steps = ""
+    do k = 1, size(state%groups)
+      associate (group => state%groups(k)%group)
+        if (group%critical_element <= 0) cycle
+        plan%initial_time_steps = plan%initial_time_steps//c_exponential(group%stable_time_step, 17, 5)//"  "// &
+                                  group%describe(model, group%critical_element)//new_line("a")
+      end associate
+    end do
+    if (size(state%rigid) > 0 .and. state%rigid_time_step < huge(1.0_wp)) &
+      plan%initial_time_steps = plan%initial_time_steps//c_exponential(state%rigid_time_step, 17, 5)// &
+                                "  rigid bodies"//new_line("a")
+  end subroutine record_initial_time_steps
 
   !> Wall force averaged over the sampling interval (impulse / interval), so that integrating
   !> the rwforc history gives the impulse exactly; at t = 0 the force of the first cycle is 0.
