@@ -73,7 +73,8 @@ contains
     call write_time_steps(out, model, state, histories, initial_time_steps)
     call add_line(out, "")
     write (cycles, '(i0)') summary%cycles
-    call add_line(out, " cycles: "//trim(cycles)//", problem time "//trim(adjustl(c_exponential(summary%end_time, 12, 5))))
+    call add_line(out, " cycles: "//trim(cycles)//", problem time "// &
+                  trim(adjustl(c_exponential(summary%end_time, 12, 5))))
     call add_line(out, "")
     call add_line(out, termination_line(summary))
     if (allocated(summary%message)) then
@@ -130,7 +131,8 @@ contains
     call control_line(out, "number of nodes", integer_field(size(model%node_ids)))
     call control_line(out, "number of solid elements", integer_field(size(model%solid_ids)))
     call control_line(out, "number of shell elements", integer_field(size(model%shell_ids)))
-    if (allocated(model%beam_ids)) call control_line(out, "number of beam elements", integer_field(size(model%beam_ids)))
+    if (allocated(model%beam_ids)) &
+      call control_line(out, "number of beam elements", integer_field(size(model%beam_ids)))
     call control_line(out, "number of parts", integer_field(size(model%parts)))
     call control_line(out, "number of rigid walls", integer_field(size(model%walls)))
     if (allocated(model%contacts)) call control_line(out, "number of contacts", integer_field(size(model%contacts)))

@@ -122,7 +122,8 @@ contains
     interval = state%time - plan%last_rwforc_time
     do k = 1, size(plan%rwforc_series)
       force = 0.0_wp
-      if (interval > 0.0_wp) force = 0.0_wp - (state%walls(k)%impulse - plan%wall_impulse(:, k))/interval   ! (+0, not -0)
+      ! (0 - x: a wall without force writes +0, not -0)
+      if (interval > 0.0_wp) force = 0.0_wp - (state%walls(k)%impulse - plan%wall_impulse(:, k))/interval
       if (model%walls(k)%kind == wall_planar) then
         normal_force = dot_product(force, model%walls(k)%normal)
       else
