@@ -24,7 +24,8 @@ CPU time: the run's user CPU seconds from `cpu_seconds.txt` beside its results f
 script wrote one (tools/run_default.sh, inputs/odb_component/run.sh), else the wall time of
 /timing (the same on an idle machine with ncpu=1).
 
-Force noise: the force is the cylinder's rwforc z component; its mean and peak are taken over the
+Force noise: the force is the crush force, minus the cylinder's rwforc z component (rwforc holds
+the force the wall exerts on the structure, LS-DYNA's sign, and the cylinder pushes down); its mean and peak are taken over the
 crush (from the first sample at 10% of the peak to the end). Noise is the r.m.s. of the force
 minus its moving average over 1 ms, relative to the mean (content above about 1 kHz), and the
 peak-to-mean ratio.
@@ -89,7 +90,7 @@ def load_run(path: Path) -> dict:
         last_time=float(glstat["time"][-1]),
         added_mass=float(glstat["added_mass"][-1]) if "added_mass" in glstat else 0.0,
         time_step_end=float(glstat["time_step"][-1]) if "time_step" in glstat else float("nan"),
-        time=np.asarray(rwforc["time"], float), force=np.asarray(rwforc["force"], float)[:, 2],
+        time=np.asarray(rwforc["time"], float), force=-np.asarray(rwforc["force"], float)[:, 2],
         energy_time=np.asarray(glstat["time"], float),
         internal_history=np.asarray(glstat["internal_energy"], float),
         hourglass_history=np.asarray(glstat["hourglass_energy"], float),

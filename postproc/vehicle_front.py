@@ -3,7 +3,7 @@
 
     python3 postproc/vehicle_front.py results/vehicle_front/results.h5 -o results/vehicle_front
 
-Reads `/history/rwforc/<wall>` (the force the nodes exert on the barrier, averaged over each
+Reads `/history/rwforc/<wall>` (the force the barrier exerts on the structure, LS-DYNA's sign, averaged over each
 output interval), `/history/rbdout/<body>` (the rear mass: the nodal rigid body that carries the
 lumped mass of the rest of the car), `/history/glstat` (energies, momentum) and `/timing`.
 
@@ -33,10 +33,9 @@ from generate_vehicle import PARTS  # noqa: E402  (the part names of the example
 
 
 def wall_history(results, wall: str = "1"):
-    """Time (ms) and the barrier's force on the structure (kN, (t,3)): rwforc holds the force
-    on the wall, the structure gets the opposite."""
+    """Time (ms) and the barrier's force on the structure (kN, (t,3)), as rwforc holds it."""
     history = cr.read_history(results, f"rwforc/{wall}")
-    return np.asarray(history["time"]), -np.asarray(history["force"])
+    return np.asarray(history["time"]), np.asarray(history["force"])
 
 
 def impulse(time: np.ndarray, force: np.ndarray) -> np.ndarray:

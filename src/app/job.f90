@@ -23,9 +23,11 @@ module job
   use version, only: crashfree_version
   use stop_signals, only: catch_stop_signals
   use deck_signature, only: deck_source_t
+  use ascii_databases, only: write_ascii_databases
+  use ascii_run_summary, only: write_d3hsp, write_messag
   use restart_control, only: restart_control_t, prepare_restart, check_restart_deck, set_up_restart_control, &
                              continue_restart_results, count_earlier_run
-  use, intrinsic :: iso_fortran_env, only: error_unit
+  use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
   !$ use omp_lib, only: omp_set_num_threads, omp_get_max_threads
   implicit none
   private
@@ -45,40 +47,50 @@ contains
     type(results_file_t) :: results
     type(run_summary_t) :: summary
     type(error_list_t) :: warnings
-    type(error_t), allocatable :: error, close_error
+    type(error_t), allocatable :: error, close_error, ascii_error
     character(len=:), allocatable :: warning_text
+    character(len=:), allocatable :: messages    !< every warning and error printed (messag)
+    character(len=:), allocatable :: warning_lines   !< the warnings among them (/run/warnings)
+    logical :: output_ready
     real(wp) :: started
 
     started = seconds_now()
     exit_status = 2
+    messages = ""
+    warning_lines = ""
+    output_ready = .false.
     ! r=: the deck, output directory and job of the dump unless given
     settings = options
     if (allocated(settings%restart_file)) &
       call prepare_restart(restart, settings%restart_file, settings%deck, settings%output_dir, settings%job_id, error)
     if (allocated(error)) then
-      write (error_unit, '(a)') "crashfree: "//error%message
+      call report("crashfree: "//error%message, messages)
       return
     end if
     summary%threads = select_threads(settings%threads)
     write (*, '(a)') "crashfree "//crashfree_version//": "//settings%deck//" on "//trim(count_text(summary%threads))// &
       " thread(s)"
+    flush (output_unit)
 
     call read_deck(settings%deck, model, warnings, error, settings%ignore_unknown, sources)
-    if (warnings%count > 0) write (error_unit, '(a)') warnings%text
+    if (warnings%count > 0) then
+      call report(warnings%text, messages)
+      warning_lines = warning_lines//warnings%text//new_line("a")
+    end if
     if (allocated(error)) then
-      write (error_unit, '(a)') error%message
-      write (error_unit, '(a)') "crashfree: the deck was rejected; nothing was run"
+      call report(error%message, messages)
+      call report("crashfree: the deck was rejected; nothing was run", messages)
       return
     end if
     if (restart%resuming) call check_restart_deck(restart, settings%deck, sources, error)
     if (.not. (model%implicit_static .or. allocated(error))) call set_up_run_state(model, run, error)
     if (allocated(error)) then
-      write (error_unit, '(a)') "crashfree: "//error%message
+      call report("crashfree: "//error%message, messages)
       return
     end if
     call make_directory(settings%output_dir, error)
     if (allocated(error)) then
-      write (error_unit, '(a)') "crashfree: "//error%message
+      call report("crashfree: "//error%message, messages)
       return
     end if
     if (restart%resuming) then
@@ -88,13 +100,18 @@ contains
       call open_results(results, settings%output_dir, settings%job_id, model, summary%threads, error)
     end if
     if (allocated(error)) then
-      write (error_unit, '(a)') "crashfree: "//error%message
+      call report("crashfree: "//error%message, messages)
       return
     end if
+    output_ready = .true.
     if (.not. model%implicit_static) then
       call describe_model(model, run%state, summary)
+      flush (output_unit)
       warning_text = set_up_warnings(model, run%state)
-      if (len(warning_text) > 0) write (error_unit, '(a)') warning_text
+      if (len(warning_text) > 0) then
+        call report(warning_text, messages)
+        warning_lines = warning_lines//warning_text//new_line("a")
+      end if
     end if
     summary%setup_s = seconds_now() - started
 
@@ -121,13 +138,51 @@ contains
       summary%message = ""
       exit_status = 0
     end if
+    summary%warnings = warning_lines
+    ! LS-DYNA's ASCII files the deck asks for, from the histories of the whole run, and d3hsp
+    if (.not. model%implicit_static) then
+      call write_ascii_databases(model, run%histories, settings%output_dir, settings%job_id, ascii_error)
+      if (.not. allocated(ascii_error)) &
+        call write_d3hsp(model, run%state, run%histories, initial_time_steps(run), summary, settings%output_dir, &
+                         settings%job_id, ascii_error)
+    end if
+    if (allocated(ascii_error)) exit_status = 1
     call close_results(results, summary, close_error)
     if (allocated(close_error)) exit_status = 1
     call print_summary(summary, settings, model%implicit_static)
-    if (allocated(error)) write (error_unit, '(a)') "crashfree: error termination: "//error%message
+    flush (output_unit)
+    if (allocated(error)) call report("crashfree: error termination: "//error%message, messages)
     ! last: what the results file holds after a failed write
-    if (allocated(close_error)) write (error_unit, '(a)') "crashfree: "//close_error%message
+    if (allocated(close_error)) call report("crashfree: "//close_error%message, messages)
+    if (allocated(ascii_error)) call report("crashfree: "//ascii_error%message, messages)
+    if (output_ready) then
+      call write_messag(settings%output_dir, settings%job_id, messages, summary, ascii_error)
+      if (allocated(ascii_error)) then
+        exit_status = max(exit_status, 1)
+        call report("crashfree: "//ascii_error%message, messages)
+      end if
+    end if
   end subroutine run_job
+
+  !> The d3hsp time step table the output recorded at cycle 0 ("" when it was not: a restart).
+  function initial_time_steps(run) result(text)
+    type(run_state_t), intent(in) :: run
+    character(len=:), allocatable :: text
+    text = ""
+    if (allocated(run%plan%initial_time_steps)) text = run%plan%initial_time_steps
+  end function initial_time_steps
+
+  !> Print a warning or error on the terminal (standard error) after what standard output
+  !> holds so far, so that a log of both reads in the order things happened, and keep it for
+  !> messag.
+  subroutine report(text, messages)
+    character(len=*), intent(in) :: text
+    character(len=:), allocatable, intent(inout) :: messages
+    flush (output_unit)
+    write (error_unit, '(a)') text
+    flush (error_unit)
+    messages = messages//text//new_line("a")
+  end subroutine report
 
   !> ncpu=, else OMP_NUM_THREADS (the OpenMP runtime reads it), else all cores; at most the
   !> processors this process may run on (a typing slip such as ncpu=1000 would otherwise run

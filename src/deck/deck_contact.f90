@@ -18,6 +18,7 @@ module deck_contact
                          card_problem, warn_if_set, id_heading, line_problem, located_problem, &
                          located_warning, keyword_label
   use deck_input, only: deck_input_t
+  use deck_database, only: read_binary_field
   use deck_contact_input, only: contact_entry_t
   use contact_surfaces, only: find_segment_owners, find_shell_owners
   implicit none
@@ -288,14 +289,16 @@ contains
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
-    integer :: line, interval_curve
+    integer :: line, interval_curve, binary
     real(wp) :: interval
     line = 0
     if (.not. require_card(deck, block, line, standard_widths, card, log, &
                            "card 1 (DT BINARY LCUR IOOPT)", "DT")) return
     call get_real(deck, card, 1, "DT", interval, log)
     call get_integer(deck, card, 3, "LCUR", interval_curve, log)
+    call read_binary_field(deck, card, log, binary)
     if (card%failed) return
+    input%model%output%rcforc_binary = binary
     if (interval < 0.0_wp) call card_problem(deck, log, card, "DT", "output interval must "// &
       "be >= 0 (0: no output), found "//real_text(interval))
     if (interval_curve /= 0) call card_problem(deck, log, card, "LCUR", "output intervals from a "// &

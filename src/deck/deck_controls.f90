@@ -324,8 +324,8 @@ contains
         "NPOPT NEECHO NREFUP IACCOP OPIFS IPNINT IKEDIT IFLUSH", &
         "IPRTF IERODE TET10S8 MSGMAX IPCURV GMDT IP1DBLT EOCS", &
         "TOLEV NEWLEG FRFREQ MINFO SOLSIG MSGFLG CDETOL"], &
-        "it controls LS-DYNA's printed output files (d3hsp, messag); crashfree reports on "// &
-        "standard output and writes results.h5", warnings)
+        "it chooses what LS-DYNA's d3hsp and messag hold; crashfree writes its own d3hsp summary "// &
+        "and messag (docs/output.md)", warnings)
     else if (index(name, "CONTROL_CPU") == 1) then
       call note_not_acted_upon(deck, block, [character(len=40) :: "CPUTIM IGLST"], &
         "no CPU-time limit; stop a run with SIGTERM, which writes a restart dump", warnings)

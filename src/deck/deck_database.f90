@@ -17,11 +17,12 @@ module deck_database
 
   public :: read_plot_output, read_glstat_output, read_matsum_output, read_nodout_output, read_rwforc_output
   public :: read_history_nodes, read_history_node_sets, read_d3dump_output, read_runrsf_output
-  public :: read_unused_output
+  public :: read_unused_output, read_rbdout_output, read_binary_field
 
   integer, parameter :: standard_widths(8) = 10
   !> The history outputs read by read_history_output.
-  integer, parameter :: history_glstat = 1, history_matsum = 2, history_nodout = 3, history_rwforc = 4
+  integer, parameter :: history_glstat = 1, history_matsum = 2, history_nodout = 3, history_rwforc = 4, &
+                        history_rbdout = 5
 
 contains
 
@@ -94,8 +95,20 @@ contains
     call read_history_output_card(deck, block, history_rwforc, input, log, warnings)
   end subroutine read_rwforc_output
 
-  !> *DATABASE_GLSTAT / _MATSUM / _NODOUT / _RWFORC: DT BINARY LCUR IOOPT (NODOUT: OPTION1
-  !> OPTION2 for nodouthf). BINARY is not used: every history goes to results.h5.
+  !> *DATABASE_RBDOUT: see read_history_output_card.
+  subroutine read_rbdout_output(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_history_output_card(deck, block, history_rbdout, input, log, warnings)
+  end subroutine read_rbdout_output
+
+  !> *DATABASE_GLSTAT / _MATSUM / _NODOUT / _RWFORC / _RBDOUT: DT BINARY LCUR IOOPT (NODOUT:
+  !> OPTION1 OPTION2 for nodouthf). BINARY chooses the files as LS-DYNA does (1 the ASCII
+  !> file, 2 binout, 3 both; 0 or blank 1); results.h5 holds every history whatever it says.
   subroutine read_history_output_card(deck, block, history, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block, history
@@ -103,28 +116,50 @@ contains
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
-    integer :: line, interval_curve
+    integer :: line, interval_curve, binary
     real(wp) :: interval
     line = 0
     if (.not. require_card(deck, block, line, standard_widths, card, log, &
                            "card 1 (DT BINARY LCUR IOOPT)", "DT")) return
     call get_real(deck, card, 1, "DT", interval, log)
     call get_integer(deck, card, 3, "LCUR", interval_curve, log)
+    call read_binary_field(deck, card, log, binary)
     if (card%failed) return
     call check_interval(deck, card, interval, interval_curve, log)
     select case (history)
     case (history_glstat)
       input%model%output%glstat_interval = interval
+      input%model%output%glstat_binary = binary
     case (history_matsum)
       input%model%output%matsum_interval = interval
+      input%model%output%matsum_binary = binary
     case (history_nodout)
       input%model%output%nodout_interval = interval
+      input%model%output%nodout_binary = binary
       input%nodout_line = line
       call warn_if_set(deck, card, 5, "OPTION1", "no high-frequency nodouthf output", warnings)
     case (history_rwforc)
       input%model%output%rwforc_interval = interval
+      input%model%output%rwforc_binary = binary
+    case (history_rbdout)
+      input%model%output%rbdout_interval = interval
+      input%model%output%rbdout_binary = binary
     end select
   end subroutine read_history_output_card
+
+  !> BINARY (field 2 of card 1 of a history database): 1 the ASCII file, 2 binout, 3 both;
+  !> 0 or blank is 1 (LS-DYNA's SMP default). Anything else is refused with its line.
+  subroutine read_binary_field(deck, card, log, binary)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(inout) :: card
+    type(problem_log_t), intent(inout) :: log
+    integer, intent(out) :: binary
+    call get_integer(deck, card, 2, "BINARY", binary, log)
+    if (card%failed) return
+    if (binary == 0) binary = 1
+    if (binary < 1 .or. binary > 3) call card_problem(deck, log, card, "BINARY", "must be 1 (ASCII file), "// &
+      "2 (binout) or 3 (both); 0 or blank is 1; found "//integer_text(binary))
+  end subroutine read_binary_field
 
   !> *DATABASE_BINARY_D3DUMP card 1: CYCL LCDT BEAM NPLTC PSETID (card 2: IOOPT);
   !> *DATABASE_BINARY_RUNRSF (`running`) card 1: CYCL NR BEAM NPLTC PSETID. CYCL is the number

@@ -48,7 +48,7 @@ module deck_keyword_table
     read_unused_control, read_sensor_definition
   use deck_database, only: read_plot_output, read_glstat_output, read_matsum_output, read_nodout_output, &
     read_rwforc_output, read_history_nodes, read_history_node_sets, read_d3dump_output, read_runrsf_output, &
-    read_unused_output
+    read_unused_output, read_rbdout_output
   use deck_rigid_bodies, only: read_rigid_materials, read_rigid_motions, read_nodal_rigid_bodies, &
     read_element_masses, read_spot_welds, read_generalized_spot_welds, read_extra_nodes, read_extra_node_sets, &
     read_rigid_body_merges
@@ -150,7 +150,7 @@ contains
       keyword_entry_t("DATABASE_SWFORC", reader=read_unused_output), &
       keyword_entry_t("DATABASE_JNTFORC", reader=read_unused_output), &
       keyword_entry_t("DATABASE_DEFORC", reader=read_unused_output), &
-      keyword_entry_t("DATABASE_RBDOUT", reader=read_unused_output), &
+      keyword_entry_t("DATABASE_RBDOUT", reader=read_rbdout_output), &
       keyword_entry_t("DATABASE_SBTOUT", reader=read_unused_output), &
       keyword_entry_t("DATABASE_NODFOR", reader=read_unused_output), &
       keyword_entry_t("DATABASE_ABSTAT", reader=read_unused_output), &

@@ -33,6 +33,7 @@ module efg_group
     procedure :: add_internal_forces
     procedure :: add_energies
     procedure :: add_part_energies
+    procedure :: add_part_momenta
     procedure :: element_results
     procedure :: describe
     procedure :: add_to_summary
@@ -212,6 +213,26 @@ contains
       end associate
     end do
   end subroutine add_part_energies
+
+  subroutine add_part_momenta(self, nodes, half_step, momentum, mass)
+    class(efg_group_t), intent(in) :: self
+    type(nodal_state_t), intent(in) :: nodes
+    real(wp), intent(in) :: half_step
+    real(wp), intent(inout) :: momentum(:, :), mass(:)
+    integer :: k, j, node
+    real(wp) :: particle_mass
+    do k = 1, size(self%parts)
+      associate (efg => self%parts(k), part => self%parts(k)%geometry%part)
+        do j = 1, size(efg%geometry%mass_node)
+          node = efg%geometry%mass_node(j)
+          particle_mass = efg%density*efg%geometry%mass_volume(j)
+          momentum(:, part) = momentum(:, part) + particle_mass*(nodes%velocity(:, node) + &
+                                                                 half_step*nodes%acceleration(:, node))
+          mass(part) = mass(part) + particle_mass
+        end do
+      end associate
+    end do
+  end subroutine add_part_momenta
 
   subroutine element_results(self, model, results)
     class(efg_group_t), intent(in) :: self

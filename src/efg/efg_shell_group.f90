@@ -51,6 +51,7 @@ module efg_shell_group
     procedure :: add_internal_forces
     procedure :: add_energies
     procedure :: add_part_energies
+    procedure :: add_part_momenta
     procedure :: element_results
     procedure :: describe
     procedure :: add_to_summary
@@ -296,6 +297,24 @@ contains
       end associate
     end do
   end subroutine add_part_energies
+
+  subroutine add_part_momenta(self, nodes, half_step, momentum, mass)
+    class(efg_shell_group_t), intent(in) :: self
+    type(nodal_state_t), intent(in) :: nodes
+    real(wp), intent(in) :: half_step
+    real(wp), intent(inout) :: momentum(:, :), mass(:)
+    integer :: k, j, node
+    do k = 1, size(self%parts)
+      associate (efg => self%parts(k), part => self%parts(k)%geometry%part)
+        do j = 1, size(efg%geometry%mass_node)
+          node = efg%geometry%mass_node(j)
+          momentum(:, part) = momentum(:, part) + self%masses(k)%mass(j)*(nodes%velocity(:, node) + &
+                                                                          half_step*nodes%acceleration(:, node))
+          mass(part) = mass(part) + self%masses(k)%mass(j)
+        end do
+      end associate
+    end do
+  end subroutine add_part_momenta
 
   !> Per cell, into the shell rows: the mean stress of its points, the peak point, plastic strains.
   subroutine element_results(self, model, results)

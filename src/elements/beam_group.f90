@@ -39,6 +39,7 @@ module beam_group
     procedure :: add_internal_forces
     procedure :: add_energies
     procedure :: add_part_energies
+    procedure :: add_part_momenta
     procedure :: element_results
     procedure :: describe
     procedure :: add_to_summary
@@ -245,6 +246,26 @@ contains
       end associate
     end do
   end subroutine add_part_energies
+
+  subroutine add_part_momenta(self, nodes, half_step, momentum, mass)
+    class(beam_group_t), intent(in) :: self
+    type(nodal_state_t), intent(in) :: nodes
+    real(wp), intent(in) :: half_step
+    real(wp), intent(inout) :: momentum(:, :), mass(:)
+    integer :: b, end, lane, node
+    do b = 1, size(self%blocks)
+      associate (beam => self%blocks(b))
+        do end = 1, 2
+          do lane = 1, beam%element_count
+            node = beam%nodes(lane, end)
+            momentum(:, beam%part) = momentum(:, beam%part) + self%nodal_mass(lane, b)* &
+                                     (nodes%velocity(:, node) + half_step*nodes%acceleration(:, node))
+            mass(beam%part) = mass(beam%part) + self%nodal_mass(lane, b)
+          end do
+        end do
+      end associate
+    end do
+  end subroutine add_part_momenta
 
   !> Per beam: the resultants N, Q_s, Q_t, T, M_s, M_t in its local axes, the largest plastic
   !> strain of its section points, and 1 for a failed beam (0 otherwise).

@@ -85,6 +85,8 @@ module element_group
     procedure(energy_interface), deferred :: add_energies
     !> Per part: internal, hourglass, and the kinetic energy of the nodal masses the group gave.
     procedure(part_energy_interface), deferred :: add_part_energies
+    !> Per part: the momentum and the mass of the nodal masses the group gave (matsum).
+    procedure(part_momentum_interface), deferred :: add_part_momenta
     !> Stresses and plastic strains of its elements for an output state.
     procedure(results_interface), deferred :: element_results
     !> "solid element 12 (part 3)"
@@ -176,6 +178,15 @@ module element_group
       real(wp), intent(in) :: average_step, step_correction
       real(wp), intent(inout) :: kinetic(:), internal(:), hourglass(:)
     end subroutine part_energy_interface
+
+    subroutine part_momentum_interface(self, nodes, half_step, momentum, mass)
+      import :: element_group_t, nodal_state_t, wp
+      class(element_group_t), intent(in) :: self
+      type(nodal_state_t), intent(in) :: nodes
+      real(wp), intent(in) :: half_step               !< half the step just taken: v^n = v^{n-1/2} + half_step a^n
+      real(wp), intent(inout) :: momentum(:, :)       !< (3, parts)
+      real(wp), intent(inout) :: mass(:)              !< (parts)
+    end subroutine part_momentum_interface
 
     subroutine results_interface(self, model, results)
       import :: element_group_t, model_t, element_results_t

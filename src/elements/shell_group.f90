@@ -38,6 +38,7 @@ module shell_group
     procedure :: add_internal_forces
     procedure :: add_energies
     procedure :: add_part_energies
+    procedure :: add_part_momenta
     procedure :: element_results
     procedure :: describe
     procedure :: add_to_summary
@@ -293,6 +294,26 @@ contains
       end associate
     end do
   end subroutine add_part_energies
+
+  subroutine add_part_momenta(self, nodes, half_step, momentum, mass)
+    class(shell_group_t), intent(in) :: self
+    type(nodal_state_t), intent(in) :: nodes
+    real(wp), intent(in) :: half_step
+    real(wp), intent(inout) :: momentum(:, :), mass(:)
+    integer :: b, corner, lane, node
+    do b = 1, size(self%blocks)
+      associate (shell => self%blocks(b))
+        do corner = 1, 4
+          do lane = 1, shell%element_count
+            node = shell%nodes(lane, corner)
+            momentum(:, shell%part) = momentum(:, shell%part) + self%corner_mass(lane, corner, b)* &
+                                      (nodes%velocity(:, node) + half_step*nodes%acceleration(:, node))
+            mass(shell%part) = mass(shell%part) + self%corner_mass(lane, corner, b)
+          end do
+        end do
+      end associate
+    end do
+  end subroutine add_part_momenta
 
   subroutine element_results(self, model, results)
     class(shell_group_t), intent(in) :: self

@@ -389,6 +389,16 @@ module model
     real(wp) :: nodout_interval = 0.0_wp
     real(wp) :: rwforc_interval = 0.0_wp
     real(wp) :: rcforc_interval = 0.0_wp     !< *DATABASE_RCFORC
+    real(wp) :: rbdout_interval = 0.0_wp     !< *DATABASE_RBDOUT
+    !> BINARY of *DATABASE_GLSTAT / _MATSUM / _NODOUT / _RWFORC / _RCFORC / _RBDOUT, as
+    !> LS-DYNA: 1 the ASCII file, 2 binout, 3 both (0 or blank: 1). The ASCII file is written
+    !> only when the keyword is in the deck (its interval > 0); results.h5 has every history.
+    integer :: glstat_binary = 1
+    integer :: matsum_binary = 1
+    integer :: nodout_binary = 1
+    integer :: rwforc_binary = 1
+    integer :: rcforc_binary = 1
+    integer :: rbdout_binary = 1
     integer :: dump_cycles = 0               !< *DATABASE_BINARY_D3DUMP CYCL (0: no periodic dumps)
     integer :: running_restart_cycles = 0    !< *DATABASE_BINARY_RUNRSF CYCL (0: none)
     integer :: running_restart_files = 1     !< *DATABASE_BINARY_RUNRSF NR, written in turn

@@ -13,6 +13,8 @@ module run_summary
   type :: run_summary_t
     character(len=:), allocatable :: status      !< status_normal or status_error
     character(len=:), allocatable :: message     !< empty, or the error message
+    !> every warning the run printed (deck, set-up), one per line as printed: /run/warnings
+    character(len=:), allocatable :: warnings
     real(wp) :: end_time = 0.0_wp                !< simulation time reached
     integer :: cycles = 0
     integer :: threads = 1

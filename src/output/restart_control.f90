@@ -178,6 +178,7 @@ contains
         end if
       end if
       if (allocated(failure)) then
+        flush (output_unit)   ! (after the progress lines printed so far, in a log of both)
         write (error_unit, '(a)') "crashfree: warning: no restart dump written at cycle "// &
           trim(integer_text(run%state%cycle))//": "//failure%message
         return

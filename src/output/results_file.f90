@@ -468,8 +468,8 @@ contains
     final_status = "running"
     if (.not. results%broken) then
       ! A full disk: the file keeps its states, and closing a flushed file writes nothing.
-      call reserve_space(results, metadata_reserve + 2_long_int*len(text_or_empty(summary%message)), &
-                         error)
+      call reserve_space(results, metadata_reserve + 2_long_int*len(text_or_empty(summary%message)) + &
+                         2_long_int*len(text_or_empty(summary%warnings)), error)
       if (allocated(error)) then
         error%message = error%message//" while writing the run status to "//results%h5_path
       else
@@ -1342,7 +1342,60 @@ contains
     call write_integer_attribute(group_id, "/run", "worst_corner_jacobian_element", &
                                  summary%worst_corner_jacobian_element, error)
     call h5gclose_f(group_id, status)
+    call write_warnings(file_id, summary, error)
   end subroutine write_run_end
+
+  !> `/run/warnings`: one string per warning line the run printed (an empty dataset when there
+  !> were none); a continued run replaces the earlier run's.
+  subroutine write_warnings(file_id, summary, error)
+    integer(hid_t), intent(in) :: file_id
+    type(run_summary_t), intent(in) :: summary
+    type(error_t), allocatable, intent(inout) :: error
+    integer :: count, longest, status
+    logical :: exists
+    if (allocated(error)) return
+    call h5lexists_f(file_id, "/run/warnings", exists, status)
+    if (status == 0 .and. exists) call h5ldelete_f(file_id, "/run/warnings", status)
+    if (.not. allocated(summary%warnings)) then
+      call write_warning_lines(file_id, "", 0, 1, error)
+      return
+    end if
+    call split_lines(summary%warnings, count=count, longest=longest)
+    call write_warning_lines(file_id, summary%warnings, count, longest, error)
+  end subroutine write_warnings
+
+  subroutine write_warning_lines(file_id, text, count, longest, error)
+    integer(hid_t), intent(in) :: file_id
+    character(len=*), intent(in) :: text
+    integer, intent(in) :: count, longest
+    type(error_t), allocatable, intent(inout) :: error
+    character(len=longest) :: lines(count)
+    integer :: ignored_count, ignored_longest
+    call split_lines(text, lines, ignored_count, ignored_longest)
+    call write_string_dataset(file_id, "/run/warnings", lines, error)
+  end subroutine write_warning_lines
+
+  !> The non-empty lines of `text` (split at new lines): how many, the longest, and (when
+  !> `lines` is given) the lines themselves.
+  subroutine split_lines(text, lines, count, longest)
+    character(len=*), intent(in) :: text
+    character(len=*), intent(out), optional :: lines(:)
+    integer, intent(out) :: count, longest
+    integer :: start, finish
+    count = 0
+    longest = 1
+    start = 1
+    do while (start <= len(text))
+      finish = index(text(start:), new_line("a"))
+      if (finish == 0) finish = len(text) - start + 2
+      if (finish > 1) then
+        count = count + 1
+        longest = max(longest, finish - 1)
+        if (present(lines)) lines(count) = text(start:start + finish - 2)
+      end if
+      start = start + finish
+    end do
+  end subroutine split_lines
 
   !> `/timing`: seconds per phase, the sizes that normalise them, and what the output wrote
   !> (`output_bytes`, `xdmf_writes`: see the module comment).

@@ -4,15 +4,17 @@
 module run_output
   use kinds, only: wp
   use error_handling, only: error_t
-  use model, only: model_t
+  use model, only: model_t, wall_planar
   use explicit_state, only: explicit_state_t, energy_totals_t
   use output_plan, only: output_plan_t, clock_due
   use history_buffer, only: history_set_t, append_history_row
   use element_groups, only: collect_element_results
-  use energy_balance, only: measured_energies, part_energies, total_energy, energy_ratio
+  use energy_balance, only: measured_energies, part_energies, part_momenta, total_energy, energy_ratio, &
+                            energy_ratio_without_eroded
   use results_file, only: results_file_t, write_state
   use rigid_bodies, only: rigid_body_history_row
   use spot_weld_constraints, only: failed_weld_count
+  use ascii_databases, only: c_exponential
   implicit none
   private
 
@@ -32,28 +34,37 @@ contains
     logical, intent(in) :: last
     type(error_t), allocatable, intent(out) :: error
     type(energy_totals_t) :: energy
+    real(wp) :: total_mass
     logical :: glstat_due, matsum_due, nodout_due, states_due
     integer :: k
 
+    if (state%cycle == 0 .and. .not. allocated(plan%initial_time_steps)) &
+      call record_initial_time_steps(model, state, plan)
     glstat_due = clock_due(plan%glstat, state%time, last)
     matsum_due = clock_due(plan%matsum, state%time, last)
     if (glstat_due) then
       energy = state%energy
       call measured_energies(model, state, scratch, energy)
+      ! glstat's global velocity: the momentum over the mass that carries it (physical and added)
+      total_mass = max(state%physical_mass + state%added_mass, tiny(1.0_wp))
       call append_history_row(histories%series(plan%glstat_series), [state%time, &
         merge(state%next_time_step, state%time_step, state%cycle == 0), &
         energy%kinetic, energy%internal, energy%hourglass, energy%contact, &
         energy%external_work, total_energy(energy), energy%rigid_wall, energy_ratio(energy), &
         state%added_mass, energy%momentum, energy%eroded_internal, energy%eroded_hourglass, &
-        energy%eroded_kinetic, real(state%eroded_count, wp)])
+        energy%eroded_kinetic, real(state%eroded_count, wp), 0.0_wp, 0.0_wp, energy_ratio_without_eroded(energy), &
+        100.0_wp*state%added_mass/max(state%physical_mass, tiny(1.0_wp)), energy%momentum/total_mass, &
+        real(state%cycle, wp), state%physical_mass])
       if (plan%weld_series > 0) call append_history_row(histories%series(plan%weld_series), &
                                                         [state%time, real(failed_weld_count(state%welds), wp)])
     end if
     if (matsum_due) then
       call part_energies(model, state, size(model%parts), plan%part_kinetic, plan%part_internal, plan%part_hourglass)
+      call part_momenta(model, state, size(model%parts), plan%part_momentum, plan%part_mass, plan%part_rigid_velocity)
       do k = 1, size(model%parts)
         call append_history_row(histories%series(plan%matsum_series(k)), [state%time, plan%part_kinetic(k), &
-                                plan%part_internal(k), plan%part_hourglass(k)])
+                                plan%part_internal(k), plan%part_hourglass(k), plan%part_momentum(:, k), &
+                                plan%part_rigid_velocity(:, k), plan%part_mass(k)])
       end do
     end if
     nodout_due = clock_due(plan%nodout, state%time, last)
@@ -63,37 +74,69 @@ contains
       do k = 1, size(plan%nodout_series)
         associate (node => model%output%history_nodes(k))
           call append_history_row(histories%series(plan%nodout_series(k)), [state%time, &
-            plan%node_displacement(:, node), plan%node_velocity(:, node), plan%node_acceleration(:, node)])
+            plan%node_displacement(:, node), plan%node_velocity(:, node), plan%node_acceleration(:, node), &
+            real(state%cycle, wp)])
         end associate
       end do
     end if
-    if (clock_due(plan%rwforc, state%time, last)) call record_wall_forces(state, plan, histories)
+    if (clock_due(plan%rwforc, state%time, last)) call record_wall_forces(model, state, plan, histories)
     if (clock_due(plan%rcforc, state%time, last)) call record_contact_forces(state, plan, histories)
     if (clock_due(plan%rbdout, state%time, last)) call record_rigid_bodies(model, state, plan, histories)
     ! the state and the history rows recorded since the previous one, as one commit
     if (states_due) call write_current_state(model, state, plan, histories, results, error)
   end subroutine write_due_output
 
+  !> The smallest stable step of each element kind at cycle 0 with its element, and the rigid
+  !> bodies' (d3hsp's time step table, which LS-DYNA writes at the start).
+  subroutine record_initial_time_steps(model, state, plan)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(in) :: state
+    type(output_plan_t), intent(inout) :: plan
+    integer :: k
+    plan%initial_time_steps = ""
+    do k = 1, size(state%groups)
+      associate (group => state%groups(k)%group)
+        if (group%critical_element <= 0) cycle
+        plan%initial_time_steps = plan%initial_time_steps//c_exponential(group%stable_time_step, 17, 5)//"  "// &
+                                  group%describe(model, group%critical_element)//new_line("a")
+      end associate
+    end do
+    if (size(state%rigid) > 0 .and. state%rigid_time_step < huge(1.0_wp)) &
+      plan%initial_time_steps = plan%initial_time_steps//c_exponential(state%rigid_time_step, 17, 5)// &
+                                "  rigid bodies"//new_line("a")
+  end subroutine record_initial_time_steps
+
   !> Wall force averaged over the sampling interval (impulse / interval), so that integrating
   !> the rwforc history gives the impulse exactly; at t = 0 the force of the first cycle is 0.
-  subroutine record_wall_forces(state, plan, histories)
+  !> LS-DYNA's sign: the force the wall exerts on the structure (the state's impulse is the
+  !> one the wall received); the normal force is its component along a planar wall's normal
+  !> (which points to the structure's side, so a wall pushing is positive), for a cylinder its
+  !> magnitude.
+  subroutine record_wall_forces(model, state, plan, histories)
+    type(model_t), intent(in) :: model
     type(explicit_state_t), intent(in) :: state
     type(output_plan_t), intent(inout) :: plan
     type(history_set_t), intent(inout) :: histories
     integer :: k
-    real(wp) :: interval, force(3)
+    real(wp) :: interval, force(3), normal_force
     interval = state%time - plan%last_rwforc_time
     do k = 1, size(plan%rwforc_series)
       force = 0.0_wp
-      if (interval > 0.0_wp) force = (state%walls(k)%impulse - plan%wall_impulse(:, k))/interval
-      call append_history_row(histories%series(plan%rwforc_series(k)), [state%time, force])
+      ! (0 - x: a wall without force writes +0, not -0)
+      if (interval > 0.0_wp) force = 0.0_wp - (state%walls(k)%impulse - plan%wall_impulse(:, k))/interval
+      if (model%walls(k)%kind == wall_planar) then
+        normal_force = dot_product(force, model%walls(k)%normal)
+      else
+        normal_force = norm2(force)
+      end if
+      call append_history_row(histories%series(plan%rwforc_series(k)), [state%time, force, normal_force])
       plan%wall_impulse(:, k) = state%walls(k)%impulse
     end do
     plan%last_rwforc_time = state%time
   end subroutine record_wall_forces
 
   !> Contact force on the SURFA side averaged over the sampling interval (impulse / interval),
-  !> as rwforc; at t = 0 the force is 0.
+  !> as rwforc, and on the SURFB side (the opposite: LS-DYNA's master line); at t = 0 both are 0.
   subroutine record_contact_forces(state, plan, histories)
     type(explicit_state_t), intent(in) :: state
     type(output_plan_t), intent(inout) :: plan
@@ -104,7 +147,7 @@ contains
     do k = 1, size(plan%rcforc_series)
       force = 0.0_wp
       if (interval > 0.0_wp) force = (state%contacts(k)%impulse - plan%contact_impulse(:, k))/interval
-      call append_history_row(histories%series(plan%rcforc_series(k)), [state%time, force])
+      call append_history_row(histories%series(plan%rcforc_series(k)), [state%time, force, 0.0_wp - force])
       plan%contact_impulse(:, k) = state%contacts(k)%impulse
     end do
     plan%last_rcforc_time = state%time

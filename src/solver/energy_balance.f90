@@ -9,7 +9,7 @@ module energy_balance
   implicit none
   private
 
-  public :: measured_energies, part_energies, total_energy, energy_ratio
+  public :: measured_energies, part_energies, part_momenta, total_energy, energy_ratio, energy_ratio_without_eroded
 
 contains
 
@@ -121,6 +121,37 @@ contains
     end do
   end subroutine part_energies
 
+  !> Momentum, mass and rigid-body velocity of each part (matsum; indexed like model%parts), at
+  !> the integer step as the glstat momentum. A node's momentum is shared among parts in
+  !> proportion to the mass each element gives it (as the kinetic energy). A rigid part has
+  !> its body's momentum, mass and velocity (a body of merged parts is reported under its
+  !> first part); the other parts' rigid-body velocity is 0, as LS-DYNA writes it.
+  subroutine part_momenta(model, state, part_count, momentum, mass, rigid_velocity)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(in) :: state
+    integer, intent(in) :: part_count
+    real(wp), intent(out) :: momentum(3, part_count), mass(part_count), rigid_velocity(3, part_count)
+    real(wp) :: body_kinetic, body_momentum(3), body_angular_momentum(3), body_velocity(3), half_step, average_step
+    integer :: b, k, part
+    momentum = 0.0_wp
+    mass = 0.0_wp
+    rigid_velocity = 0.0_wp
+    half_step = 0.5_wp*state%time_step
+    average_step = 0.5_wp*(state%time_step + state%next_time_step)
+    do k = 1, size(state%groups)
+      call state%groups(k)%group%add_part_momenta(state%nodes, half_step, momentum, mass)
+    end do
+    do b = 1, size(state%rigid)
+      part = model%rigid_bodies(b)%part
+      if (part == 0) cycle
+      call rigid_body_energy(model, b, state%rigid(b), state%nodes%acceleration, state%nodes%mass, half_step, &
+                             average_step, body_kinetic, body_momentum, body_angular_momentum, body_velocity)
+      momentum(:, part) = momentum(:, part) + body_momentum
+      mass(part) = mass(part) + state%rigid(b)%mass
+      rigid_velocity(:, part) = body_velocity
+    end do
+  end subroutine part_momenta
+
   !> Total energy: kinetic + internal + hourglass + contact + rigid-wall (energy the walls took)
   !> + the energy eroded elements took along.
   pure real(wp) function total_energy(energy)
@@ -140,4 +171,18 @@ contains
       energy_ratio = 1.0_wp
     end if
   end function energy_ratio
+
+  !> glstat's "energy ratio w/o eroded energy": the total without the energy eroded elements
+  !> took along, over (initial total + external work); below 1 once elements eroded.
+  pure real(wp) function energy_ratio_without_eroded(energy)
+    type(energy_totals_t), intent(in) :: energy
+    real(wp) :: reference
+    reference = energy%initial_total + energy%external_work
+    if (abs(reference) > tiny(1.0_wp)) then
+      energy_ratio_without_eroded = (total_energy(energy) - energy%eroded_internal - energy%eroded_hourglass &
+                                     - energy%eroded_kinetic)/reference
+    else
+      energy_ratio_without_eroded = 1.0_wp
+    end if
+  end function energy_ratio_without_eroded
 end module energy_balance

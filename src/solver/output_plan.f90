@@ -46,13 +46,21 @@ module output_plan
     real(wp), allocatable :: generalized_velocity(:, :) !< integer-step solver velocities (work array)
     real(wp), allocatable :: node_acceleration(:, :) !< physical accelerations (nodout)
     real(wp), allocatable :: part_kinetic(:), part_internal(:), part_hourglass(:)
+    real(wp), allocatable :: part_momentum(:, :), part_mass(:), part_rigid_velocity(:, :)   !< matsum
+    !> d3hsp's table of the smallest stable steps at cycle 0, one line per element kind (not
+    !> kept in restart dumps: a continued run's d3hsp has the last cycle's only)
+    character(len=:), allocatable :: initial_time_steps
   end type output_plan_t
 
-  character(len=32), parameter :: glstat_columns(16) = [character(len=32) :: "time", "time_step", &
+  ! the columns after eroded_elements came with LS-DYNA's glstat lines (appended, so that the
+  ! earlier ones keep their place)
+  character(len=32), parameter :: glstat_columns(23) = [character(len=32) :: "time", "time_step", &
     "kinetic_energy", "internal_energy", "hourglass_energy", "contact_energy", "external_work", &
     "total_energy", "rigid_wall_energy", "energy_ratio", "added_mass", "momentum", &
-    "eroded_internal_energy", "eroded_hourglass_energy", "eroded_kinetic_energy", "eroded_elements"]
-  integer, parameter :: glstat_widths(16) = [1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 3, 1, 1, 1, 1]
+    "eroded_internal_energy", "eroded_hourglass_energy", "eroded_kinetic_energy", "eroded_elements", &
+    "spring_damper_energy", "system_damping_energy", "energy_ratio_without_eroded", "percent_mass_increase", &
+    "global_velocity", "cycle", "physical_mass"]
+  integer, parameter :: glstat_widths(23) = [1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 3, 1, 1, 1, 1, 1, 1, 1, 1, 3, 1, 1]
 
 
 contains
@@ -83,7 +91,8 @@ contains
     do k = 1, size(model%parts)
       write (label, '(i0)') model%parts(k)%id
       call add_history_series(histories, "matsum/"//trim(label), [character(len=32) :: "time", &
-                              "kinetic_energy", "internal_energy", "hourglass_energy"], [1, 1, 1, 1], &
+                              "kinetic_energy", "internal_energy", "hourglass_energy", "momentum", &
+                              "rigid_body_velocity", "mass"], [1, 1, 1, 1, 3, 3, 1], &
                               capacity, plan%matsum_series(k))
     end do
     allocate (plan%nodout_series(0), plan%rwforc_series(0))
@@ -94,7 +103,7 @@ contains
       do k = 1, size(model%output%history_nodes)
         write (label, '(i0)') model%node_ids(model%output%history_nodes(k))
         call add_history_series(histories, "nodout/"//trim(label), [character(len=32) :: "time", &
-                                "displacement", "velocity", "acceleration"], [1, 3, 3, 3], capacity, &
+                                "displacement", "velocity", "acceleration", "cycle"], [1, 3, 3, 3, 1], capacity, &
                                 plan%nodout_series(k))
       end do
     end if
@@ -104,8 +113,8 @@ contains
       allocate (plan%rwforc_series(size(model%walls)))
       do k = 1, size(model%walls)
         write (label, '(i0)') model%walls(k)%id
-        call add_history_series(histories, "rwforc/"//trim(label), [character(len=32) :: "time", "force"], &
-                                [1, 3], capacity, plan%rwforc_series(k))
+        call add_history_series(histories, "rwforc/"//trim(label), [character(len=32) :: "time", "force", &
+                                "normal_force"], [1, 3, 1], capacity, plan%rwforc_series(k))
       end do
     end if
     ! swforc: how many spot welds have failed, at the glstat interval
@@ -123,15 +132,15 @@ contains
         allocate (plan%rcforc_series(size(model%contacts)))
         do k = 1, size(model%contacts)
           write (label, '(i0)') model%contacts(k)%id
-          call add_history_series(histories, "rcforc/"//trim(label), [character(len=32) :: "time", "force"], &
-                                  [1, 3], capacity, plan%rcforc_series(k))
+          call add_history_series(histories, "rcforc/"//trim(label), [character(len=32) :: "time", "force", &
+                                  "surfb_force"], [1, 3, 3], capacity, plan%rcforc_series(k))
         end do
       end if
     end if
-    ! rbdout: every rigid body, at the glstat interval
+    ! rbdout: every rigid body, at the *DATABASE_RBDOUT interval (else the glstat one)
     allocate (plan%rbdout_series(0))
     if (allocated(model%rigid_bodies)) then
-      call set_clock(plan%rbdout, 0.0_wp, plan%glstat%interval, size(model%rigid_bodies) > 0)
+      call set_clock(plan%rbdout, model%output%rbdout_interval, plan%glstat%interval, size(model%rigid_bodies) > 0)
       if (plan%rbdout%active) then
         capacity = expected_rows(model, plan%rbdout)
         deallocate (plan%rbdout_series)
@@ -176,6 +185,8 @@ contains
               plan%generalized_velocity(3, size(model%node_ids)), plan%node_acceleration(3, size(model%node_ids)))
     allocate (plan%part_kinetic(size(model%parts)), plan%part_internal(size(model%parts)), &
               plan%part_hourglass(size(model%parts)))
+    allocate (plan%part_momentum(3, size(model%parts)), plan%part_mass(size(model%parts)), &
+              plan%part_rigid_velocity(3, size(model%parts)))
   end subroutine plan_output
 
   subroutine set_clock(clock, interval, default_interval, active)

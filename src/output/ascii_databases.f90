@@ -1,0 +1,488 @@
+!> LS-DYNA's ASCII history files (glstat, matsum, nodout, rwforc, rcforc) written beside
+!> results.h5 from the run's histories, in LS-DYNA's layout (labels, column positions and
+!> number formats as LS-DYNA and its binout-to-ASCII translator write them), so that the
+!> parsers crash engineers already use read them. A file is written when the deck has its
+!> *DATABASE_<name> keyword with BINARY 1 or 3 (blank or 0: 1); results.h5 holds every history
+!> whatever BINARY says. The layouts are documented in docs/output.md.
+!>
+!> The files are written whole at the end of the run (normal or error termination) from the
+!> in-memory histories, so that a restart, which continues those histories, writes complete
+!> files too.
+module ascii_databases
+  use kinds, only: wp
+  use error_handling, only: error_t, make_error
+  use model, only: model_t
+  use history_buffer, only: history_set_t, history_series_t
+  use version, only: crashfree_version
+  use file_system, only: write_text_file
+  implicit none
+  private
+
+  public :: write_ascii_databases, lsdyna_file_path, c_exponential, text_buffer_t, add_line, start_database, &
+            finish_database
+
+  !> The text of a file being written, `text(1:length)`; lines are appended with add_line.
+  type :: text_buffer_t
+    character(len=:), allocatable :: text
+    integer :: length = 0
+  end type text_buffer_t
+
+contains
+
+  !> Every ASCII file the deck asks for, in `directory`, named as LS-DYNA names them
+  !> (`glstat`; with jobid=NAME `NAME.glstat`).
+  subroutine write_ascii_databases(model, histories, directory, job_id, error)
+    type(model_t), intent(in) :: model
+    type(history_set_t), intent(in) :: histories
+    character(len=*), intent(in) :: directory, job_id
+    type(error_t), allocatable, intent(out) :: error
+    if (wanted(model%output%glstat_interval, model%output%glstat_binary)) then
+      call write_glstat(model, histories, lsdyna_file_path(directory, job_id, "glstat"), error)
+      if (allocated(error)) return
+    end if
+    if (wanted(model%output%matsum_interval, model%output%matsum_binary)) then
+      call write_matsum(model, histories, lsdyna_file_path(directory, job_id, "matsum"), error)
+      if (allocated(error)) return
+    end if
+    if (wanted(model%output%nodout_interval, model%output%nodout_binary)) then
+      call write_nodout(model, histories, lsdyna_file_path(directory, job_id, "nodout"), error)
+      if (allocated(error)) return
+    end if
+    if (wanted(model%output%rwforc_interval, model%output%rwforc_binary) .and. size(model%walls) > 0) then
+      call write_rwforc(model, histories, lsdyna_file_path(directory, job_id, "rwforc"), error)
+      if (allocated(error)) return
+    end if
+    if (allocated(model%contacts)) then
+      if (wanted(model%output%rcforc_interval, model%output%rcforc_binary) .and. size(model%contacts) > 0) then
+        call write_rcforc(model, histories, lsdyna_file_path(directory, job_id, "rcforc"), error)
+        if (allocated(error)) return
+      end if
+    end if
+  end subroutine write_ascii_databases
+
+  !> `directory/name`, or `directory/JOB.name` when a job id other than the default was given
+  !> (LS-DYNA prefixes its files with jobid=).
+  function lsdyna_file_path(directory, job_id, name) result(path)
+    character(len=*), intent(in) :: directory, job_id, name
+    character(len=:), allocatable :: path
+    if (job_id == "results" .or. len_trim(job_id) == 0) then
+      path = directory//"/"//name
+    else
+      path = directory//"/"//trim(job_id)//"."//name
+    end if
+  end function lsdyna_file_path
+
+  !> A history database is in the deck (its interval > 0) and asks for the ASCII file.
+  logical function wanted(interval, binary)
+    real(wp), intent(in) :: interval
+    integer, intent(in) :: binary
+    wanted = interval > 0.0_wp .and. (binary == 1 .or. binary == 3)
+  end function wanted
+
+  !> A real as C's printf %<width>.<digits>E writes it (LS-DYNA's files are written so): a
+  !> two-digit exponent below 100, three above; right-justified in `width`.
+  function c_exponential(value, width, digits) result(text)
+    real(wp), intent(in) :: value
+    integer, intent(in) :: width, digits
+    character(len=width) :: text
+    character(len=64) :: buffer, format_text
+    integer :: mark
+    if (value /= value) then
+      text = adjustr("nan")
+      return
+    end if
+    if (abs(value) > huge(1.0_wp)) then
+      text = adjustr(merge("-inf", " inf", value < 0.0_wp))
+      return
+    end if
+    write (format_text, '(a,i0,a,i0,a)') "(es", digits + 8, ".", digits, "e3)"
+    write (buffer, format_text) value
+    buffer = adjustl(buffer)
+    mark = index(buffer, "E")
+    ! E+012 -> E+12 (C keeps at least two exponent digits)
+    if (mark > 0) then
+      if (buffer(mark + 2:mark + 2) == "0") buffer = buffer(1:mark + 1)//buffer(mark + 3:)
+    end if
+    if (len_trim(buffer) > width) then
+      text = trim(buffer)       ! (C widens the field; Fortran truncates: keep the leading part)
+    else
+      text = adjustr(buffer(1:width))
+    end if
+  end function c_exponential
+
+  !> The series of a history group, 0 when it was not recorded.
+  integer function series_index(histories, group)
+    type(history_set_t), intent(in) :: histories
+    character(len=*), intent(in) :: group
+    integer :: k
+    series_index = 0
+    do k = 1, histories%count
+      if (histories%series(k)%group == group) then
+        series_index = k
+        return
+      end if
+    end do
+  end function series_index
+
+  !> Position of a column's first component in a row (0: no such column).
+  integer function column(series, name)
+    type(history_series_t), intent(in) :: series
+    character(len=*), intent(in) :: name
+    integer :: k
+    column = 0
+    do k = 1, size(series%names)
+      if (series%names(k) == name) then
+        column = sum(series%widths(1:k - 1)) + 1
+        return
+      end if
+    end do
+  end function column
+
+  !> A column's value in row `row` (0 when the column does not exist).
+  real(wp) function value_of(series, name, row, component)
+    type(history_series_t), intent(in) :: series
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: row
+    integer, intent(in), optional :: component
+    integer :: position
+    value_of = 0.0_wp
+    position = column(series, name)
+    if (position == 0) return
+    if (present(component)) position = position + component - 1
+    value_of = series%rows(position, row)
+  end function value_of
+
+  !> LS-DYNA's first two lines: the title, then the program, its version and the date.
+  subroutine start_database(model, out)
+    type(model_t), intent(in) :: model
+    type(text_buffer_t), intent(inout) :: out
+    character(len=8) :: date
+    call date_and_time(date=date)
+    if (allocated(model%title)) then
+      call add_line(out, " "//model%title(1:min(len(model%title), 72)))
+    else
+      call add_line(out, " ")
+    end if
+    call add_line(out, "                         crashfree (version "//crashfree_version//")     date "// &
+      date(5:6)//"/"//date(7:8)//"/"//date(1:4))
+  end subroutine start_database
+
+  !> Append one line (and its new line) to `out`, doubling the buffer when it is full.
+  subroutine add_line(out, line)
+    type(text_buffer_t), intent(inout) :: out
+    character(len=*), intent(in) :: line
+    character(len=:), allocatable :: grown
+    integer :: needed
+    needed = out%length + len(line) + 1
+    if (.not. allocated(out%text)) allocate (character(len=max(4096, needed)) :: out%text)
+    if (needed > len(out%text)) then
+      allocate (character(len=max(2*len(out%text), needed)) :: grown)
+      grown(1:out%length) = out%text(1:out%length)
+      call move_alloc(grown, out%text)
+    end if
+    out%text(out%length + 1:needed) = line//new_line("a")
+    out%length = needed
+  end subroutine add_line
+
+  !> The whole text to `path` through C's stdio (file_system's write_text_file), which reports
+  !> a full disk; gfortran's formatted writes would cut the file short without a word.
+  subroutine finish_database(out, path, error)
+    type(text_buffer_t), intent(in) :: out
+    character(len=*), intent(in) :: path
+    type(error_t), allocatable, intent(out) :: error
+    integer :: mark
+    if (allocated(out%text)) then
+      call write_text_file(path, out%text(1:out%length), error)
+    else
+      call write_text_file(path, "", error)
+    end if
+    if (.not. allocated(error)) return
+    ! "...: no space left on device", as the results file's messages say it
+    mark = index(error%message, ": ", back=.true.) + 2
+    if (mark > 2 .and. mark <= len(error%message)) then
+      if (error%message(mark:mark) >= "A" .and. error%message(mark:mark) <= "Z") &
+        error%message(mark:mark) = achar(iachar(error%message(mark:mark)) + 32)
+    end if
+  end subroutine finish_database
+
+  !> A glstat line: the label padded with dots to 31 characters after a blank, then %14.5E.
+  subroutine glstat_line(out, label, value)
+    type(text_buffer_t), intent(inout) :: out
+    character(len=*), intent(in) :: label
+    real(wp), intent(in) :: value
+    character(len=32) :: padded
+    padded = " "//label//repeat(".", 31)
+    call add_line(out, padded//c_exponential(value, 14, 5))
+  end subroutine glstat_line
+
+  !> glstat: per sample " dt of cycle" with the cycle number, then LS-DYNA's lines.
+  subroutine write_glstat(model, histories, path, error)
+    type(model_t), intent(in) :: model
+    type(history_set_t), intent(in) :: histories
+    character(len=*), intent(in) :: path
+    type(error_t), allocatable, intent(out) :: error
+    type(text_buffer_t) :: out
+    integer :: s, row
+    character(len=32) :: cycle_text
+    s = series_index(histories, "glstat")
+    if (s == 0) return
+    call start_database(model, out)
+    associate (series => histories%series(s))
+      do row = 1, series%count
+        write (cycle_text, '(i8)') nint(value_of(series, "cycle", row))
+        call add_line(out, "")
+        call add_line(out, "")
+        call add_line(out, " dt of cycle"//trim(cycle_text))
+        call add_line(out, "")
+        call glstat_line(out, "time", value_of(series, "time", row))
+        call glstat_line(out, "time step", value_of(series, "time_step", row))
+        call glstat_line(out, "kinetic energy", value_of(series, "kinetic_energy", row))
+        call glstat_line(out, "internal energy", value_of(series, "internal_energy", row))
+        if (size(model%walls) > 0) call glstat_line(out, "stonewall energy", value_of(series, "rigid_wall_energy", row))
+        call glstat_line(out, "spring and damper energy", value_of(series, "spring_damper_energy", row))
+        call glstat_line(out, "hourglass energy ", value_of(series, "hourglass_energy", row))
+        call glstat_line(out, "system damping energy", value_of(series, "system_damping_energy", row))
+        call glstat_line(out, "sliding interface energy", value_of(series, "contact_energy", row))
+        call glstat_line(out, "external work", value_of(series, "external_work", row))
+        call glstat_line(out, "eroded kinetic energy", value_of(series, "eroded_kinetic_energy", row))
+        call glstat_line(out, "eroded internal energy", value_of(series, "eroded_internal_energy", row))
+        call glstat_line(out, "eroded hourglass energy", value_of(series, "eroded_hourglass_energy", row))
+        call glstat_line(out, "total energy", value_of(series, "total_energy", row))
+        call glstat_line(out, "total energy / initial energy", value_of(series, "energy_ratio", row))
+        call glstat_line(out, "energy ratio w/o eroded energy", value_of(series, "energy_ratio_without_eroded", row))
+        call glstat_line(out, "global x velocity", value_of(series, "global_velocity", row, 1))
+        call glstat_line(out, "global y velocity", value_of(series, "global_velocity", row, 2))
+        call glstat_line(out, "global z velocity", value_of(series, "global_velocity", row, 3))
+        call add_line(out, "")
+        call add_line(out, "")
+        call glstat_line(out, "added mass", value_of(series, "added_mass", row))
+        call glstat_line(out, "percentage increase", value_of(series, "percent_mass_increase", row))
+      end do
+    end associate
+    call finish_database(out, path, error)
+  end subroutine write_glstat
+
+  !> The legend of part, wall or contact titles LS-DYNA writes after the header.
+  subroutine write_legend(out, ids, titles)
+    type(text_buffer_t), intent(inout) :: out
+    integer, intent(in) :: ids(:)
+    character(len=*), intent(in) :: titles(:)
+    integer :: k
+    character(len=9) :: id_text
+    if (all(len_trim(titles) == 0)) return
+    call add_line(out, "")
+    call add_line(out, "{BEGIN LEGEND")
+    call add_line(out, " Entity #        Title")
+    do k = 1, size(ids)
+      write (id_text, '(i9)') ids(k)
+      call add_line(out, id_text//"     "//trim(titles(k)))
+    end do
+    call add_line(out, "{END LEGEND}")
+    call add_line(out, "")
+  end subroutine write_legend
+
+  !> matsum: per sample "time =", then per part its energies, momentum, rigid-body velocity,
+  !> hourglass energy and mass.
+  subroutine write_matsum(model, histories, path, error)
+    type(model_t), intent(in) :: model
+    type(history_set_t), intent(in) :: histories
+    character(len=*), intent(in) :: path
+    type(error_t), allocatable, intent(out) :: error
+    integer, allocatable :: part_series(:)
+    character(len=70), allocatable :: titles(:)
+    character(len=16) :: id_text
+    type(text_buffer_t) :: out
+    integer :: k, row, rows
+    allocate (part_series(size(model%parts)), titles(size(model%parts)))
+    rows = huge(1)
+    do k = 1, size(model%parts)
+      write (id_text, '(i0)') model%parts(k)%id
+      part_series(k) = series_index(histories, "matsum/"//trim(id_text))
+      if (part_series(k) == 0) return
+      rows = min(rows, histories%series(part_series(k))%count)
+      titles(k) = ""
+      if (allocated(model%parts(k)%title)) titles(k) = model%parts(k)%title
+    end do
+    if (size(model%parts) == 0) return
+    call start_database(model, out)
+    call write_legend(out, model%parts%id, titles)
+    do row = 1, rows
+      call add_line(out, "")
+      call add_line(out, "")
+      call add_line(out, " time ="//c_exponential(histories%series(part_series(1))%rows(1, row), 13, 4))
+      do k = 1, size(model%parts)
+        associate (series => histories%series(part_series(k)))
+          if (model%parts(k)%id < 100000) then
+            write (id_text, '(i5,3x)') model%parts(k)%id
+          else
+            write (id_text, '(i8)') model%parts(k)%id
+          end if
+          call add_line(out, " mat.#="//id_text(1:8)//"          inten="// &
+            c_exponential(value_of(series, "internal_energy", row), 13, 4)//"     kinen="// &
+            c_exponential(value_of(series, "kinetic_energy", row), 13, 4))
+          call add_line(out, " x-mom="//c_exponential(value_of(series, "momentum", row, 1), 13, 4)// &
+            "     y-mom="//c_exponential(value_of(series, "momentum", row, 2), 13, 4)// &
+            "     z-mom="//c_exponential(value_of(series, "momentum", row, 3), 13, 4))
+          call add_line(out, " x-rbv="//c_exponential(value_of(series, "rigid_body_velocity", row, 1), 13, 4)// &
+            "     y-rbv="//c_exponential(value_of(series, "rigid_body_velocity", row, 2), 13, 4)// &
+            "     z-rbv="//c_exponential(value_of(series, "rigid_body_velocity", row, 3), 13, 4))
+          call add_line(out, "                         hgeng="// &
+            c_exponential(value_of(series, "hourglass_energy", row), 13, 4)//"     +mass="// &
+            c_exponential(value_of(series, "mass", row), 13, 4))
+        end associate
+      end do
+    end do
+    call finish_database(out, path, error)
+  end subroutine write_matsum
+
+  !> nodout: per sample the "n o d a l   p r i n t   o u t" block, one line per history node.
+  subroutine write_nodout(model, histories, path, error)
+    type(model_t), intent(in) :: model
+    type(history_set_t), intent(in) :: histories
+    character(len=*), intent(in) :: path
+    type(error_t), allocatable, intent(out) :: error
+    integer, allocatable :: node_series(:)
+    character(len=16) :: id_text
+    character(len=9) :: node_text
+    character(len=8) :: cycle_text
+    type(text_buffer_t) :: out
+    integer :: k, j, row, rows, node
+    character(len=:), allocatable :: line
+    if (.not. allocated(model%output%history_nodes)) return
+    if (size(model%output%history_nodes) == 0) return
+    allocate (node_series(size(model%output%history_nodes)))
+    rows = huge(1)
+    do k = 1, size(node_series)
+      write (id_text, '(i0)') model%node_ids(model%output%history_nodes(k))
+      node_series(k) = series_index(histories, "nodout/"//trim(id_text))
+      if (node_series(k) == 0) return
+      rows = min(rows, histories%series(node_series(k))%count)
+    end do
+    call start_database(model, out)
+    do row = 1, rows
+      associate (first => histories%series(node_series(1)))
+        write (cycle_text, '(i8)') nint(value_of(first, "cycle", row))
+        call add_line(out, "")
+        call add_line(out, "")
+        call add_line(out, "")
+        call add_line(out, " n o d a l   p r i n t   o u t   f o r   t i m e  s t e p"//cycle_text// &
+          "                              ( at time"//c_exponential(first%rows(1, row), 12, 5)//" )")
+      end associate
+      call add_line(out, "")
+      call add_line(out, " nodal point  x-disp     y-disp      z-disp      x-vel       y-vel       z-vel      "// &
+        "x-accl      y-accl      z-accl      x-coor      y-coor      z-coor")
+      do k = 1, size(node_series)
+        node = model%output%history_nodes(k)
+        associate (series => histories%series(node_series(k)))
+          write (node_text, '(i9)') model%node_ids(node)
+          line = node_text//c_exponential(value_of(series, "displacement", row, 1), 13, 4)
+          do j = 2, 3
+            line = line//c_exponential(value_of(series, "displacement", row, j), 12, 4)
+          end do
+          do j = 1, 3
+            line = line//c_exponential(value_of(series, "velocity", row, j), 12, 4)
+          end do
+          do j = 1, 3
+            line = line//c_exponential(value_of(series, "acceleration", row, j), 12, 4)
+          end do
+          do j = 1, 3
+            line = line//c_exponential(model%coordinates(j, node) + value_of(series, "displacement", row, j), 12, 4)
+          end do
+          call add_line(out, line)
+        end associate
+      end do
+    end do
+    call finish_database(out, path, error)
+  end subroutine write_nodout
+
+  !> rwforc: one line per sample and wall: time, wall id, normal force, x, y, z force (the
+  !> force the wall exerts on the structure).
+  subroutine write_rwforc(model, histories, path, error)
+    type(model_t), intent(in) :: model
+    type(history_set_t), intent(in) :: histories
+    character(len=*), intent(in) :: path
+    type(error_t), allocatable, intent(out) :: error
+    integer, allocatable :: wall_series(:)
+    character(len=70), allocatable :: titles(:)
+    character(len=16) :: id_text
+    character(len=8) :: wall_text
+    type(text_buffer_t) :: out
+    integer :: k, j, row, rows
+    character(len=:), allocatable :: line
+    allocate (wall_series(size(model%walls)), titles(size(model%walls)))
+    rows = huge(1)
+    do k = 1, size(model%walls)
+      write (id_text, '(i0)') model%walls(k)%id
+      wall_series(k) = series_index(histories, "rwforc/"//trim(id_text))
+      if (wall_series(k) == 0) return
+      rows = min(rows, histories%series(wall_series(k))%count)
+      titles(k) = ""
+      if (allocated(model%walls(k)%title)) titles(k) = model%walls(k)%title
+    end do
+    call start_database(model, out)
+    call write_legend(out, model%walls%id, titles)
+    call add_line(out, "")
+    call add_line(out, "")
+    call add_line(out, "    time       wall#   normal-force    x-force        y-force        z-force")
+    do row = 1, rows
+      do k = 1, size(model%walls)
+        associate (series => histories%series(wall_series(k)))
+          write (wall_text, '(i8)') model%walls(k)%id
+          line = c_exponential(series%rows(1, row), 12, 5)//wall_text// &
+            c_exponential(value_of(series, "normal_force", row), 15, 6)
+          do j = 1, 3
+            line = line//c_exponential(value_of(series, "force", row, j), 15, 6)
+          end do
+          call add_line(out, line)
+        end associate
+      end do
+    end do
+    call finish_database(out, path, error)
+  end subroutine write_rwforc
+
+  !> rcforc: per sample and contact a "slave" line (the force on SURFA) and a "master" line
+  !> (on SURFB): time, x, y, z force and mass (0: the mass of the nodes in contact is not
+  !> measured).
+  subroutine write_rcforc(model, histories, path, error)
+    type(model_t), intent(in) :: model
+    type(history_set_t), intent(in) :: histories
+    character(len=*), intent(in) :: path
+    type(error_t), allocatable, intent(out) :: error
+    integer, allocatable :: contact_series(:)
+    character(len=70), allocatable :: titles(:)
+    character(len=16) :: id_text
+    character(len=11) :: contact_text
+    type(text_buffer_t) :: out
+    integer :: k, row, rows
+    allocate (contact_series(size(model%contacts)), titles(size(model%contacts)))
+    rows = huge(1)
+    do k = 1, size(model%contacts)
+      write (id_text, '(i0)') model%contacts(k)%id
+      contact_series(k) = series_index(histories, "rcforc/"//trim(id_text))
+      if (contact_series(k) == 0) return
+      rows = min(rows, histories%series(contact_series(k))%count)
+      titles(k) = ""
+      if (allocated(model%contacts(k)%title)) titles(k) = model%contacts(k)%title
+    end do
+    call start_database(model, out)
+    call write_legend(out, model%contacts%id, titles)
+    do row = 1, rows
+      do k = 1, size(model%contacts)
+        associate (series => histories%series(contact_series(k)))
+          write (contact_text, '(i11)') model%contacts(k)%id
+          call add_line(out, "  slave "//contact_text//" time"//c_exponential(series%rows(1, row), 12, 5)// &
+            "  x "//c_exponential(value_of(series, "force", row, 1), 12, 5)// &
+            "  y "//c_exponential(value_of(series, "force", row, 2), 12, 5)// &
+            "  z "//c_exponential(value_of(series, "force", row, 3), 12, 5)// &
+            " mass "//c_exponential(0.0_wp, 12, 5))
+          call add_line(out, "  master"//contact_text//" time"//c_exponential(series%rows(1, row), 12, 5)// &
+            "  x "//c_exponential(value_of(series, "surfb_force", row, 1), 12, 5)// &
+            "  y "//c_exponential(value_of(series, "surfb_force", row, 2), 12, 5)// &
+            "  z "//c_exponential(value_of(series, "surfb_force", row, 3), 12, 5)// &
+            " mass "//c_exponential(0.0_wp, 12, 5))
+        end associate
+      end do
+    end do
+    call finish_database(out, path, error)
+  end subroutine write_rcforc
+end module ascii_databases

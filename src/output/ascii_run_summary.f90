@@ -1,0 +1,242 @@
+!> LS-DYNA's run files beside results.h5: `d3hsp` (the model summary: controls, parts with
+!> their material, section, element counts and mass, the total mass, the time step
+!> information with the smallest stable steps by element kind, and the termination line) and
+!> `messag` (every warning and error the job printed, with file:line as the terminal showed
+!> them, and the termination line). Both are written at the end of the run (normal or error
+!> termination); the layout is in docs/output.md.
+module ascii_run_summary
+  use kinds, only: wp
+  use error_handling, only: error_t
+  use model, only: model_t
+  use material_laws, only: find_law, law_keyword_name
+  use explicit_state, only: explicit_state_t
+  use energy_balance, only: part_momenta
+  use run_summary, only: run_summary_t, status_normal
+  use history_buffer, only: history_set_t
+  use ascii_databases, only: lsdyna_file_path, c_exponential, text_buffer_t, add_line, finish_database
+  use version, only: crashfree_version
+  implicit none
+  private
+
+  public :: write_d3hsp, write_messag, termination_line
+
+contains
+
+  !> LS-DYNA's termination line, letters spaced as LS-DYNA writes it (scripts search for it).
+  function termination_line(summary) result(line)
+    type(run_summary_t), intent(in) :: summary
+    character(len=:), allocatable :: line
+    line = " E r r o r   t e r m i n a t i o n"
+    if (allocated(summary%status)) then
+      if (summary%status == status_normal) line = " N o r m a l    t e r m i n a t i o n"
+    end if
+  end function termination_line
+
+  !> `messag` (`JOB.messag` with jobid=): `messages` (one message per line, as printed), then
+  !> the termination line.
+  subroutine write_messag(directory, job_id, messages, summary, error)
+    character(len=*), intent(in) :: directory, job_id, messages
+    type(run_summary_t), intent(in) :: summary
+    type(error_t), allocatable, intent(out) :: error
+    type(text_buffer_t) :: out
+    call add_line(out, " crashfree (version "//crashfree_version//") messages")
+    call add_line(out, "")
+    if (len(messages) > 0) call add_line(out, messages)
+    call add_line(out, "")
+    call add_line(out, termination_line(summary))
+    if (allocated(summary%message)) then
+      if (len(summary%message) > 0) call add_line(out, " "//summary%message)
+    end if
+    call finish_database(out, lsdyna_file_path(directory, job_id, "messag"), error)
+  end subroutine write_messag
+
+  !> `d3hsp` (`JOB.d3hsp` with jobid=).
+  subroutine write_d3hsp(model, state, histories, initial_time_steps, summary, directory, job_id, error)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(in) :: state
+    type(history_set_t), intent(in) :: histories
+    character(len=*), intent(in) :: initial_time_steps   !< the table at cycle 0 ("" if not recorded)
+    type(run_summary_t), intent(in) :: summary
+    character(len=*), intent(in) :: directory, job_id
+    type(error_t), allocatable, intent(out) :: error
+    type(text_buffer_t) :: out
+    character(len=8) :: date
+    character(len=16) :: cycles
+    call date_and_time(date=date)
+    call add_line(out, " crashfree (version "//crashfree_version//")     date "//date(5:6)//"/"//date(7:8)//"/"// &
+      date(1:4))
+    call add_line(out, "")
+    if (allocated(model%title)) call add_line(out, " "//model%title)
+    if (allocated(model%deck_path)) call add_line(out, " input deck: "//model%deck_path)
+    call write_controls(out, model)
+    call write_parts(out, model, state)
+    call write_time_steps(out, model, state, histories, initial_time_steps)
+    call add_line(out, "")
+    write (cycles, '(i0)') summary%cycles
+    call add_line(out, " cycles: "//trim(cycles)//", problem time "// &
+                  trim(adjustl(c_exponential(summary%end_time, 12, 5))))
+    call add_line(out, "")
+    call add_line(out, termination_line(summary))
+    if (allocated(summary%message)) then
+      if (len(summary%message) > 0) call add_line(out, " "//summary%message)
+    end if
+    call finish_database(out, lsdyna_file_path(directory, job_id, "d3hsp"), error)
+  end subroutine write_d3hsp
+
+  !> One "label ..... value" line of the control section.
+  subroutine control_line(out, label, value)
+    type(text_buffer_t), intent(inout) :: out
+    character(len=*), intent(in) :: label, value
+    character(len=48) :: padded
+    padded = "   "//label//" "//repeat(".", 48)
+    call add_line(out, padded//" "//value)
+  end subroutine control_line
+
+  function real_field(value) result(text)
+    real(wp), intent(in) :: value
+    character(len=:), allocatable :: text
+    text = trim(adjustl(c_exponential(value, 12, 5)))
+  end function real_field
+
+  function integer_field(value) result(text)
+    integer, intent(in) :: value
+    character(len=:), allocatable :: text
+    character(len=16) :: buffer
+    write (buffer, '(i0)') value
+    text = trim(buffer)
+  end function integer_field
+
+  subroutine write_controls(out, model)
+    type(text_buffer_t), intent(inout) :: out
+    type(model_t), intent(in) :: model
+    call add_line(out, "")
+    call add_line(out, " c o n t r o l   i n f o r m a t i o n")
+    call add_line(out, "")
+    call control_line(out, "termination time (ENDTIM)", real_field(model%end_time))
+    call control_line(out, "termination cycle (ENDCYC)", integer_field(model%end_cycle))
+    call control_line(out, "time step scale factor (TSSFAC)", real_field(model%time_step_scale))
+    call control_line(out, "initial time step (DTINIT)", real_field(model%initial_time_step))
+    call control_line(out, "mass-scaled time step (DT2MS)", real_field(model%mass_scaled_time_step))
+    call control_line(out, "state interval (d3plot DT)", real_field(model%output%state_interval))
+    call control_line(out, "glstat interval, BINARY", real_field(model%output%glstat_interval)//", "// &
+                      integer_field(model%output%glstat_binary))
+    call control_line(out, "matsum interval, BINARY", real_field(model%output%matsum_interval)//", "// &
+                      integer_field(model%output%matsum_binary))
+    call control_line(out, "nodout interval, BINARY", real_field(model%output%nodout_interval)//", "// &
+                      integer_field(model%output%nodout_binary))
+    call control_line(out, "rwforc interval, BINARY", real_field(model%output%rwforc_interval)//", "// &
+                      integer_field(model%output%rwforc_binary))
+    call control_line(out, "rcforc interval, BINARY", real_field(model%output%rcforc_interval)//", "// &
+                      integer_field(model%output%rcforc_binary))
+    call control_line(out, "number of nodes", integer_field(size(model%node_ids)))
+    call control_line(out, "number of solid elements", integer_field(size(model%solid_ids)))
+    call control_line(out, "number of shell elements", integer_field(size(model%shell_ids)))
+    if (allocated(model%beam_ids)) &
+      call control_line(out, "number of beam elements", integer_field(size(model%beam_ids)))
+    call control_line(out, "number of parts", integer_field(size(model%parts)))
+    call control_line(out, "number of rigid walls", integer_field(size(model%walls)))
+    if (allocated(model%contacts)) call control_line(out, "number of contacts", integer_field(size(model%contacts)))
+  end subroutine write_controls
+
+  !> One line per part: id, material id and keyword, section id and ELFORM, its solids, shells
+  !> and beams, its mass (the nodal masses its elements give, a rigid part its body's), title;
+  !> then the totals.
+  subroutine write_parts(out, model, state)
+    type(text_buffer_t), intent(inout) :: out
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(in) :: state
+    real(wp), allocatable :: momentum(:, :), mass(:), rigid_velocity(:, :)
+    character(len=24) :: material_name
+    character(len=160) :: line
+    integer :: k, solids, shells, beams, row, section_id, formulation
+    allocate (momentum(3, size(model%parts)), mass(size(model%parts)), rigid_velocity(3, size(model%parts)))
+    call part_momenta(model, state, size(model%parts), momentum, mass, rigid_velocity)
+    call add_line(out, "")
+    call add_line(out, " p a r t   d e f i n i t i o n s")
+    call add_line(out, "")
+    call add_line(out, "     part id  material id  material                 section id  elform     solids" // &
+      "     shells      beams          mass  title")
+    do k = 1, size(model%parts)
+      associate (part => model%parts(k))
+        solids = count(model%solid_part == k)
+        shells = count(model%shell_part == k)
+        beams = 0
+        if (allocated(model%beam_part)) beams = count(model%beam_part == k)
+        material_name = ""
+        if (part%material > 0) then
+          row = find_law(model%materials(part%material)%law)
+          if (row > 0) material_name = law_keyword_name(row)
+        end if
+        section_id = 0
+        formulation = 0
+        if (part%section > 0) then
+          section_id = model%sections(part%section)%id
+          formulation = model%sections(part%section)%element_formulation
+        end if
+        write (line, '(i12,i13,2x,a24,i11,i8,3i11,a14)') part%id, part%material_id, material_name, section_id, &
+          formulation, solids, shells, beams, c_exponential(mass(k), 14, 5)
+        if (allocated(part%title)) then
+          call add_line(out, trim(line)//"  "//trim(part%title))
+        else
+          call add_line(out, trim(line))
+        end if
+      end associate
+    end do
+    call add_line(out, "")
+    call control_line(out, "total mass of the parts", real_field(sum(mass)))
+    call control_line(out, "physical mass of the model", real_field(state%physical_mass))
+    call control_line(out, "added mass (mass scaling)", real_field(state%added_mass))
+    call control_line(out, "percentage increase", real_field(100.0_wp*state%added_mass/ &
+                      max(state%physical_mass, tiny(1.0_wp))))
+  end subroutine write_parts
+
+  !> The first time step (glstat's first row), and the smallest stable step of each element
+  !> kind with its element at the start (cycle 0) and at the last cycle (LS-DYNA's table of the
+  !> smallest steps, here one row per element kind and the rigid bodies).
+  subroutine write_time_steps(out, model, state, histories, initial_time_steps)
+    type(text_buffer_t), intent(inout) :: out
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(in) :: state
+    type(history_set_t), intent(in) :: histories
+    character(len=*), intent(in) :: initial_time_steps
+    integer :: k, j
+    character(len=200) :: line
+    call add_line(out, "")
+    call add_line(out, " t i m e   s t e p   i n f o r m a t i o n")
+    call add_line(out, "")
+    do k = 1, histories%count
+      if (histories%series(k)%group /= "glstat") cycle
+      if (histories%series(k)%count == 0) cycle
+      do j = 1, size(histories%series(k)%names)
+        if (histories%series(k)%names(j) == "time_step") then
+          call control_line(out, "first time step", &
+                            real_field(histories%series(k)%rows(sum(histories%series(k)%widths(1:j - 1)) + 1, 1)))
+        end if
+      end do
+    end do
+    call control_line(out, "last stable time step (before TSSFAC)", real_field(state%stable_time_step))
+    call add_line(out, "")
+    if (len(initial_time_steps) > 0) then
+      call add_line(out, " s m a l l e s t   t i m e   s t e p s   (by element kind, cycle 0)")
+      call add_line(out, " ----------------------------------------------------------------------")
+      call add_line(out, "      stable step  element")
+      call add_line(out, initial_time_steps(1:len(initial_time_steps) - 1))
+      call add_line(out, "")
+    end if
+    call add_line(out, " s m a l l e s t   t i m e   s t e p s   (by element kind, last cycle)")
+    call add_line(out, " ----------------------------------------------------------------------")
+    call add_line(out, "      stable step  element")
+    do k = 1, size(state%groups)
+      associate (group => state%groups(k)%group)
+        if (group%critical_element <= 0) cycle
+        write (line, '(a)') c_exponential(group%stable_time_step, 17, 5)//"  "// &
+          group%describe(model, group%critical_element)
+        call add_line(out, trim(line))
+      end associate
+    end do
+    if (size(state%rigid) > 0 .and. state%rigid_time_step < huge(1.0_wp)) then
+      write (line, '(a)') c_exponential(state%rigid_time_step, 17, 5)//"  rigid bodies"
+      call add_line(out, trim(line))
+    end if
+  end subroutine write_time_steps
+end module ascii_run_summary

@@ -1,0 +1,323 @@
+"""LS-DYNA's ASCII databases (glstat, matsum, nodout, rwforc, rcforc), d3hsp and messag
+(docs/output.md, "LS-DYNA's ASCII files").
+
+A small reader here parses each file at LS-DYNA's fixed column positions (as LS-DYNA and its
+binout-to-ASCII translator write them); its values equal results.h5's to the printed
+precision. Physics: matsum's momentum of each part is sum m v of its nodes (the part's mass
+times its velocity for a block moving as a whole), a rigid part's rigid-body velocity is its
+velocity; rwforc has LS-DYNA's sign (a block moving in -x into a wall gets a force in +x) and
+its time integral is the block's momentum change; rcforc's two sides are opposite. messag has
+the warnings with file:line, d3hsp the parts and masses; BINARY=2 writes no ASCII file.
+"""
+import re
+import subprocess
+
+import numpy as np
+
+from deck_writer import block_mesh, fields, nodes_card, solids_card, write_deck
+from test_contact import head_on_deck
+
+DENSITY = 7.85e-6        # kg/mm^3
+SPEED = 50.0             # mm/ms
+BLOCK = (6.0, 5.0, 4.0)  # mm
+RIGID_SPEED = (-SPEED, 3.0, 0.0)
+
+
+def wall_deck(path, binary="", extra=""):
+    """A deformable block moving in -x into a planar wall at x = 0 (normal +x), and a rigid
+    block far behind it that never reaches the wall."""
+    block_nodes, block_elements = block_mesh((3, 2, 2), BLOCK, origin=(0.2, 0.0, 0.0))
+    rigid_nodes, rigid_elements = block_mesh((1, 1, 1), (2.0, 2.0, 2.0), origin=(40.0, 0.0, 0.0))
+    count = len(block_nodes)
+    return write_deck(
+        path,
+        "*TITLE\nblock into a wall, ascii databases",
+        "*CONTROL_TERMINATION\n" + fields(0.1),
+        "*DATABASE_GLSTAT\n" + fields(0.002, binary),
+        "*DATABASE_MATSUM\n" + fields(0.002, binary),
+        "*DATABASE_RWFORC\n" + fields(0.001, binary),
+        "*DATABASE_NODOUT\n" + fields(0.005, binary),
+        "*DATABASE_HISTORY_NODE\n" + fields(1, count, count + 1),
+        "*DATABASE_BINARY_D3PLOT\n" + fields(0.05),
+        "*DATABASE_SECFORC\n" + fields(0.001),
+        "*PART\nblock\n" + fields(1, 1, 1),
+        "*PART\nrigid block\n" + fields(2, 1, 2),
+        "*SECTION_SOLID\n" + fields(1, 1),
+        "*MAT_PLASTIC_KINEMATIC\n" + fields(1, DENSITY, 200.0, 0.3, 0.4, 1.0, 1.0) + "\n" + fields(0.0, 0.0),
+        "*MAT_RIGID\n" + fields(2, DENSITY, 200.0, 0.3) + "\n" + fields(0.0, 0.0, 0.0),
+        "*SET_NODE_LIST\n" + fields(1) + "\n" + "\n".join(
+            fields(*range(first, min(first + 8, count + 1))) for first in range(1, count + 1, 8)),
+        "*SET_NODE_LIST\n" + fields(2) + "\n" + "\n".join(
+            fields(*range(first, min(first + 8, count + 9))) for first in range(count + 1, count + 9, 8)),
+        "*INITIAL_VELOCITY\n" + fields(1) + "\n" + fields(-SPEED, 0.0, 0.0),
+        "*INITIAL_VELOCITY\n" + fields(2) + "\n" + fields(*RIGID_SPEED),
+        "*RIGIDWALL_PLANAR_ID\n" + fields(7) + "wall\n" + fields(0) + "\n" + fields(0.0, 0.0, 0.0, 1.0, 0.0, 0.0),
+        extra,
+        nodes_card(np.vstack([block_nodes, rigid_nodes])),
+        solids_card(block_elements, part_id=1) + "\n" +
+        "\n".join(solids_card(rigid_elements, part_id=2, first_id=len(block_elements) + 1,
+                              first_node_id=count + 1).splitlines()[1:]),
+    )
+
+
+def number(text):
+    return float(text.replace("D", "E"))
+
+
+def close(printed, exact, digits):
+    """A value printed with `digits` digits after the point of %E equals the exact one."""
+    return abs(printed - exact) <= 0.51 * 10.0 ** (-digits) * abs(exact) + 1e-300
+
+
+# ------------------------------------------------------------------ readers at fixed columns
+
+def read_glstat(path):
+    """[{label: value}] per sample; labels are columns 1-32 with the dots, values 33-46."""
+    samples = []
+    for line in path.read_text().splitlines():
+        if line.startswith(" dt of cycle"):
+            samples.append({"cycle": int(line[12:20])})
+        elif samples and len(line) >= 46 and line[1:32].rstrip(".").strip():
+            label = line[:32].rstrip(".").strip()
+            samples[-1][label] = number(line[32:46])
+    return samples
+
+
+def read_matsum(path):
+    """[(time, {part: {name: value}})]: " time =" then four lines per part."""
+    samples, part = [], None
+    for line in path.read_text().splitlines():
+        if line.startswith(" time ="):
+            samples.append((number(line[7:20]), {}))
+        elif line.startswith(" mat.#="):
+            part = int(line[7:15])
+            samples[-1][1][part] = {"inten": number(line[31:44]), "kinen": number(line[55:68])}
+        elif line.startswith(" x-mom=") or line.startswith(" x-rbv="):
+            kind = line[3:6]
+            samples[-1][1][part].update({"x" + kind: number(line[7:20]), "y" + kind: number(line[31:44]),
+                                         "z" + kind: number(line[55:68])})
+        elif line.startswith("                         hgeng="):
+            samples[-1][1][part].update({"hgeng": number(line[31:44]), "mass": number(line[55:68])})
+    return samples
+
+
+def read_rwforc(path):
+    """Rows (time, wall, normal, x, y, z) after the column header."""
+    lines = path.read_text().splitlines()
+    start = next(k for k, line in enumerate(lines) if line.startswith("    time       wall#")) + 1
+    return [(number(line[0:12]), int(line[12:20]), number(line[20:35]), number(line[35:50]),
+             number(line[50:65]), number(line[65:80])) for line in lines[start:] if line.strip()]
+
+
+def read_nodout(path):
+    """[(cycle, time, {node: 12 values})]: displacement, velocity, acceleration, coordinates."""
+    samples = []
+    for line in path.read_text().splitlines():
+        if line.startswith(" n o d a l   p r i n t   o u t"):
+            samples.append((int(line[58:66]), number(line[104:116]), {}))
+        elif samples and len(line) >= 154 and line[:9].strip().isdigit():
+            fields_at = [(9, 22)] + [(22 + 12 * k, 34 + 12 * k) for k in range(11)]
+            samples[-1][2][int(line[:9])] = [number(line[a:b]) for a, b in fields_at]
+    return samples
+
+
+def read_rcforc(path):
+    """Rows (side, contact, time, x, y, z, mass)."""
+    rows = []
+    for line in path.read_text().splitlines():
+        if line.startswith("  slave ") or line.startswith("  master"):
+            rows.append((line[2:8].strip(), int(line[8:19]), number(line[24:36]), number(line[40:52]),
+                         number(line[56:68]), number(line[72:84]), number(line[90:102])))
+    return rows
+
+
+# ------------------------------------------------------------------ tests
+
+def test_ascii_files_equal_results_and_physics(tmp_path, run_deck):
+    run = run_deck(wall_deck(tmp_path / "wall.k"))
+    assert run.status == 0, run.stdout + run.stderr
+    out = run.results.parent
+    with run.open() as results:
+        glstat = {key: results["history/glstat"][key][...] for key in results["history/glstat"]}
+        matsum = {part: {key: results[f"history/matsum/{part}"][key][...]
+                         for key in results[f"history/matsum/{part}"]} for part in (1, 2)}
+        wall = {key: results["history/rwforc/7"][key][...] for key in results["history/rwforc/7"]}
+        nodout = {node: {key: results[f"history/nodout/{node}"][key][...]
+                         for key in results[f"history/nodout/{node}"]} for node in (1,)}
+        warnings = [w.decode() for w in results["run/warnings"][...]]
+        coordinates = results["mesh/nodes/coordinates"][...]
+        node_ids = list(results["mesh/nodes/ids"][...])
+
+    # glstat: every sample, every line, to the printed precision
+    samples = read_glstat(out / "glstat")
+    assert len(samples) == len(glstat["time"])
+    names = {"time": "time", "time step": "time_step", "kinetic energy": "kinetic_energy",
+             "internal energy": "internal_energy", "hourglass energy": "hourglass_energy",
+             "sliding interface energy": "contact_energy", "external work": "external_work",
+             "total energy": "total_energy", "total energy / initial energy": "energy_ratio",
+             "energy ratio w/o eroded energy": "energy_ratio_without_eroded", "stonewall energy": "rigid_wall_energy",
+             "added mass": "added_mass", "percentage increase": "percent_mass_increase"}
+    for k, sample in enumerate(samples):
+        assert sample["cycle"] == glstat["cycle"][k]
+        for label, key in names.items():
+            assert close(sample[label], glstat[key][k], 5), (k, label, sample[label], glstat[key][k])
+        for axis, name in enumerate("xyz"):
+            assert close(sample[f"global {name} velocity"], glstat["global_velocity"][k][axis], 5)
+    # the way users' scripts commonly read glstat (label, dots, last word): the same values
+    loose = [dict() for _ in samples]
+    block = -1
+    for line in (out / "glstat").read_text().splitlines():
+        if re.match(r"\s*dt of cycle\s+\d+", line):
+            block += 1
+        match = re.match(r"\s*(.+?)\s*\.{3,}\s*(\S+)\s*$", line)
+        if match and block >= 0:
+            loose[block][match.group(1).strip()] = float(match.group(2))
+    # (LS-DYNA's two labels with fewer than three dots, the energy ratios, escape such scripts)
+    assert all(set(loose[k]) >= set(names) - {"total energy / initial energy", "energy ratio w/o eroded energy"}
+               for k in range(len(samples)))
+    assert all(loose[k][label] == samples[k][label] for k in range(len(samples)) for label in loose[k])
+    # global velocity is the momentum over the mass; at t = 0 the mass-weighted initial speeds
+    block_mass = DENSITY * np.prod(BLOCK)
+    rigid_mass = DENSITY * 8.0
+    expected = (block_mass * np.array([-SPEED, 0.0, 0.0]) + rigid_mass * np.array(RIGID_SPEED)) / (block_mass + rigid_mass)
+    assert np.allclose(glstat["global_velocity"][0], expected, rtol=1e-12, atol=1e-12)
+
+    # matsum: momentum = sum m v (part 1 at t = 0: its mass times -SPEED), the rigid part's
+    # rigid-body velocity is its velocity (no force acts on it), the deformable part's is 0
+    assert np.isclose(matsum[1]["mass"][0], block_mass, rtol=1e-12)
+    assert np.allclose(matsum[1]["momentum"][0], [-SPEED * block_mass, 0.0, 0.0], rtol=1e-12, atol=1e-15)
+    assert np.allclose(matsum[2]["rigid_body_velocity"], np.array(RIGID_SPEED)[None, :], rtol=1e-12)
+    assert np.allclose(matsum[2]["momentum"], rigid_mass * np.array(RIGID_SPEED)[None, :], rtol=1e-10)
+    assert np.all(matsum[1]["rigid_body_velocity"] == 0.0)
+    # the parts' momenta add up to glstat's
+    assert np.allclose(matsum[1]["momentum"] + matsum[2]["momentum"], glstat["momentum"],
+                       rtol=1e-10, atol=1e-12 * block_mass * SPEED)
+    parsed = read_matsum(out / "matsum")
+    assert len(parsed) == len(matsum[1]["time"])
+    for k, (time, parts) in enumerate(parsed):
+        assert close(time, matsum[1]["time"][k], 4)
+        for part in (1, 2):
+            values, exact = parts[part], matsum[part]
+            assert close(values["inten"], exact["internal_energy"][k], 4)
+            assert close(values["kinen"], exact["kinetic_energy"][k], 4)
+            assert close(values["hgeng"], exact["hourglass_energy"][k], 4)
+            assert close(values["mass"], exact["mass"][k], 4)
+            for axis, name in enumerate("xyz"):
+                assert close(values[name + "mom"], exact["momentum"][k][axis], 4)
+                assert close(values[name + "rbv"], exact["rigid_body_velocity"][k][axis], 4)
+
+    # rwforc: LS-DYNA's sign (the wall pushes the block in +x), normal force = x force here;
+    # the impulse (forces are interval averages) is the block's momentum change
+    rows = read_rwforc(out / "rwforc")
+    assert len(rows) == len(wall["time"])
+    for k, (time, wall_id, normal, fx, fy, fz) in enumerate(rows):
+        assert wall_id == 7 and close(time, wall["time"][k], 5)
+        assert close(normal, wall["normal_force"][k], 6)
+        for axis, value in enumerate((fx, fy, fz)):
+            assert close(value, wall["force"][k][axis], 6)
+    force = wall["force"]
+    assert force[:, 0].max() > 0.0 and force[:, 0].min() >= 0.0
+    assert np.allclose(wall["normal_force"], force[:, 0], rtol=1e-14, atol=0.0)
+    impulse = (force[1:] * np.diff(wall["time"])[:, None]).sum(axis=0)
+    block_momentum_change = matsum[1]["momentum"][-1] - matsum[1]["momentum"][0]
+    assert block_momentum_change[0] > 0.5 * SPEED * block_mass, "the wall must stop the block"
+    print(f"wall impulse {impulse[0]:.6e}, block momentum change {block_momentum_change[0]:.6e}")
+    assert abs(impulse[0] - block_momentum_change[0]) < 0.01 * abs(block_momentum_change[0])
+
+    # nodout: node 1's displacement, velocity, acceleration and coordinates
+    parsed = read_nodout(out / "nodout")
+    assert len(parsed) == len(nodout[1]["time"])
+    first = node_ids.index(1)
+    for k, (cycle, time, nodes) in enumerate(parsed):
+        assert cycle == nodout[1]["cycle"][k] and close(time, nodout[1]["time"][k], 5)
+        values = nodes[1]
+        exact = np.concatenate([nodout[1]["displacement"][k], nodout[1]["velocity"][k],
+                                nodout[1]["acceleration"][k], coordinates[first] + nodout[1]["displacement"][k]])
+        for printed, value in zip(values, exact):
+            assert close(printed, value, 4), (k, printed, value)
+
+    # messag and /run/warnings: the *DATABASE_SECFORC warning with its file:line
+    messag = (out / "messag").read_text()
+    line = next(k for k, text in enumerate((tmp_path / "wall.k").read_text().splitlines(), 1)
+                if text.startswith("*DATABASE_SECFORC"))
+    assert f"wall.k:{line}: *DATABASE_SECFORC" in messag
+    assert any(f"wall.k:{line}: *DATABASE_SECFORC" in warning for warning in warnings)
+    assert "N o r m a l    t e r m i n a t i o n" in messag
+
+    # d3hsp: the parts with their masses (equal to matsum's), the total, the termination
+    d3hsp = (out / "d3hsp").read_text()
+    part_lines = {int(text.split()[0]): text for text in d3hsp.splitlines()
+                  if text[:12].strip().isdigit() and "MAT_" in text}
+    assert set(part_lines) == {1, 2}
+    for part in (1, 2):
+        mass = number(part_lines[part][104:118])
+        assert close(mass, matsum[part]["mass"][0], 5), (part, mass)
+    assert "MAT_PLASTIC_KINEMATIC" in part_lines[1] and "MAT_RIGID" in part_lines[2]
+    assert "N o r m a l    t e r m i n a t i o n" in d3hsp
+    # the smallest steps at cycle 0 (solids, the rigid body): TSSFAC (0.9) times the smallest
+    # is the first step
+    lines = d3hsp.splitlines()
+    start = next(k for k, text in enumerate(lines) if "s m a l l e s t   t i m e   s t e p s   (by element kind, cycle 0)"
+                 in text) + 3
+    steps = []
+    while lines[start].strip():
+        steps.append(number(lines[start][0:17]))
+        start += 1
+    assert len(steps) == 2 and "rigid bodies" in lines[start - 1]
+    assert abs(0.9 * min(steps) - glstat["time_step"][0]) <= 1e-5 * glstat["time_step"][0]
+
+
+def test_contact_forces_both_sides(tmp_path, run_deck):
+    deck, *_ = head_on_deck(tmp_path / "head_on.k")
+    run = run_deck(deck)
+    assert run.status == 0, run.stdout + run.stderr
+    with run.open() as results:
+        history = {key: results["history/rcforc/5"][key][...] for key in results["history/rcforc/5"]}
+    rows = read_rcforc(run.results.parent / "rcforc")
+    slave = [row for row in rows if row[0] == "slave"]
+    master = [row for row in rows if row[0] == "master"]
+    assert len(slave) == len(master) == len(history["time"])
+    for k, (s, m) in enumerate(zip(slave, master)):
+        assert s[1] == m[1] == 5 and close(s[2], history["time"][k], 5)
+        for axis in range(3):
+            assert close(s[3 + axis], history["force"][k][axis], 5)
+            assert close(m[3 + axis], history["surfb_force"][k][axis], 5)
+    assert np.array_equal(history["surfb_force"], -history["force"])
+    assert np.abs(history["force"][:, 0]).max() > 0.0
+
+
+def test_binary_two_writes_no_ascii_file_and_jobid_prefixes(tmp_path, run_deck):
+    run = run_deck(wall_deck(tmp_path / "binout_only.k", binary=2))
+    assert run.status == 0, run.stdout + run.stderr
+    out = run.results.parent
+    for name in ("glstat", "matsum", "rwforc", "nodout"):
+        assert not (out / name).exists()
+    with run.open() as results:
+        assert len(results["history/glstat/time"]) > 10     # results.h5 keeps every history
+    named = run_deck(wall_deck(tmp_path / "named.k", binary=3), jobid="crash")
+    assert named.status == 0
+    for name in ("glstat", "matsum", "rwforc", "nodout", "d3hsp", "messag"):
+        assert (named.results.parent / f"crash.{name}").exists(), name
+    bad = run_deck(wall_deck(tmp_path / "bad.k", binary=4))
+    assert bad.status == 2
+    card = next(k for k, text in enumerate((tmp_path / "bad.k").read_text().splitlines(), 1)
+                if text.startswith("*DATABASE_GLSTAT")) + 1
+    assert f"bad.k:{card}: *DATABASE_GLSTAT: field BINARY: must be 1 (ASCII file), 2 (binout) or 3 (both)" \
+        in bad.stdout + bad.stderr
+
+
+def test_log_of_both_streams_is_in_order(tmp_path):
+    """stdout and stderr redirected to one file: the deck's warning comes before the model
+    summary and the progress lines, as it happened."""
+    from conftest import BINARY
+    deck = wall_deck(tmp_path / "log.k")
+    log = tmp_path / "log.txt"
+    with log.open("w") as stream:
+        status = subprocess.run([str(BINARY), f"i={deck}", f"outdir={tmp_path / 'out'}", "ncpu=1"],
+                                stdout=stream, stderr=subprocess.STDOUT, timeout=300).returncode
+    assert status == 0
+    lines = log.read_text().splitlines()
+    warning = next(k for k, text in enumerate(lines) if "*DATABASE_SECFORC" in text)
+    summary = next(k for k, text in enumerate(lines) if text.startswith("model:"))
+    progress = next(k for k, text in enumerate(lines) if text.strip().startswith("cycle"))
+    assert lines[0].startswith("crashfree ") and 0 < warning < summary < progress
