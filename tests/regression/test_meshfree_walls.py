@@ -127,11 +127,12 @@ def glstat_of(results):
 def check_momentum_and_energy(results, wall_id, expected_sign):
     time, force = wall_history(results, wall_id)
     glstat = glstat_of(results)
-    impulse_on_wall = impulse_of(time, force)
+    # rwforc holds LS-DYNA's sign, the force of the wall on the structure
+    impulse_on_structure = impulse_of(time, force)
     momentum_change = glstat["momentum"][-1] - glstat["momentum"][0]
-    mismatch = np.abs(-impulse_on_wall - momentum_change).max() / np.abs(momentum_change).max()
+    mismatch = np.abs(impulse_on_structure - momentum_change).max() / np.abs(momentum_change).max()
     ratio = glstat["energy_ratio"]
-    print(f"wall impulse {impulse_on_wall}, momentum change {momentum_change} (mismatch {mismatch:.2e}); energy "
+    print(f"wall impulse on the structure {impulse_on_structure}, momentum change {momentum_change} (mismatch {mismatch:.2e}); energy "
           f"ratio {ratio.min():.8f} .. {ratio.max():.8f}; wall energy {glstat['rigid_wall_energy'][-1]:.4e}")
     assert expected_sign * momentum_change[2] > 0.0, "the wall must have stopped the particles"
     assert mismatch <= 1e-6
@@ -161,7 +162,8 @@ def test_block_particles_stop_at_a_planar_wall(tmp_path, run_deck):
 
 def test_block_particles_slide_on_a_wall_with_friction(tmp_path, run_deck):
     """The block thrown at the wall obliquely (10 mm/ms along x, 20 down) with FRIC 0.3: friction
-    acts on the particles' physical tangential velocity, so the wall is dragged along x; its
+    acts on the particles' physical tangential velocity, so the wall holds the block back along x
+    (rwforc, the wall's force on the structure, is negative along x); its
     impulse equals the momentum change in every direction (1e-6), its tangential part is at most
     0.3 times its normal part;
     the energy balance closes within 1% and no particle passes the wall."""
@@ -176,8 +178,8 @@ def test_block_particles_slide_on_a_wall_with_friction(tmp_path, run_deck):
         check_momentum_and_energy(results, 3, +1.0)
         impulse = impulse_of(*wall_history(results, 3))
     ratio = np.linalg.norm(impulse[:2]) / abs(impulse[2])
-    print(f"tangential / normal impulse {ratio:.4f} (x part {impulse[0]:.4e}, along the motion)")
-    assert impulse[0] > 0.0 and 0.05 < ratio <= 0.3 * (1.0 + 1e-9)
+    print(f"tangential / normal impulse {ratio:.4f} (x part {impulse[0]:.4e}, against the motion)")
+    assert impulse[0] < 0.0 and 0.05 < ratio <= 0.3 * (1.0 + 1e-9)
     assert min(position[particles - 1, 2].min() - wall_z for _, position in positions) > -1e-9
 
 
@@ -224,10 +226,11 @@ def test_block_particles_struck_by_a_moving_wall(tmp_path, run_deck):
     initial = wall_mass * wall_speed
     assert np.abs(glstat["momentum"][:, 2] - initial).max() < 1e-9 * initial
     assert np.abs(glstat["energy_ratio"] - 1.0).max() < 0.01
-    # the wall's speed and position after each cycle (rwforc every cycle: the force on the
-    # wall over that cycle); its position moves with the speed of the cycle's start
+    # the wall's speed and position after each cycle (rwforc every cycle: the wall's force on the
+    # structure over that cycle, the opposite of the force on the wall); its position moves with
+    # the speed of the cycle's start
     steps = np.diff(time)
-    speed_after = wall_speed + np.cumsum(force[1:, 2] * steps) / wall_mass
+    speed_after = wall_speed - np.cumsum(force[1:, 2] * steps) / wall_mass
     speed_before = np.concatenate([[wall_speed], speed_after[:-1]])
     position = wall_z + np.concatenate([[0.0], np.cumsum(speed_before * steps)])
     assert speed_after[-1] < wall_speed, "the wall must have struck the block"
