@@ -19,6 +19,7 @@ module deck_contact
                          located_warning, keyword_label
   use deck_input, only: deck_input_t
   use deck_contact_input, only: contact_entry_t
+  use deck_database, only: check_binary
   use contact_surfaces, only: find_segment_owners, find_shell_owners
   implicit none
   private
@@ -288,14 +289,17 @@ contains
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
-    integer :: line, interval_curve
+    integer :: line, interval_curve, binary
     real(wp) :: interval
     line = 0
     if (.not. require_card(deck, block, line, standard_widths, card, log, &
                            "card 1 (DT BINARY LCUR IOOPT)", "DT")) return
     call get_real(deck, card, 1, "DT", interval, log)
+    call get_integer(deck, card, 2, "BINARY", binary, log)
     call get_integer(deck, card, 3, "LCUR", interval_curve, log)
     if (card%failed) return
+    call check_binary(deck, card, binary, log)
+    input%model%output%rcforc_binary = binary
     if (interval < 0.0_wp) call card_problem(deck, log, card, "DT", "output interval must "// &
       "be >= 0 (0: no output), found "//real_text(interval))
     if (interval_curve /= 0) call card_problem(deck, log, card, "LCUR", "output intervals from a "// &

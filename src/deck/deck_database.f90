@@ -17,7 +17,7 @@ module deck_database
 
   public :: read_plot_output, read_glstat_output, read_matsum_output, read_nodout_output, read_rwforc_output
   public :: read_history_nodes, read_history_node_sets, read_d3dump_output, read_runrsf_output
-  public :: read_unused_output
+  public :: read_unused_output, check_binary
 
   integer, parameter :: standard_widths(8) = 10
   !> The history outputs read by read_history_output.
@@ -95,7 +95,8 @@ contains
   end subroutine read_rwforc_output
 
   !> *DATABASE_GLSTAT / _MATSUM / _NODOUT / _RWFORC: DT BINARY LCUR IOOPT (NODOUT: OPTION1
-  !> OPTION2 for nodouthf). BINARY is not used: every history goes to results.h5.
+  !> OPTION2 for nodouthf). Every history goes to results.h5; BINARY 2 or 3 writes it to binout
+  !> as well (see check_binary).
   subroutine read_history_output_card(deck, block, history, input, log, warnings)
     type(deck_t), intent(in) :: deck
     integer, intent(in) :: block, history
@@ -103,26 +104,32 @@ contains
     type(problem_log_t), intent(inout) :: log
     type(error_list_t), intent(inout) :: warnings
     type(card_t) :: card
-    integer :: line, interval_curve
+    integer :: line, interval_curve, binary
     real(wp) :: interval
     line = 0
     if (.not. require_card(deck, block, line, standard_widths, card, log, &
                            "card 1 (DT BINARY LCUR IOOPT)", "DT")) return
     call get_real(deck, card, 1, "DT", interval, log)
+    call get_integer(deck, card, 2, "BINARY", binary, log)
     call get_integer(deck, card, 3, "LCUR", interval_curve, log)
     if (card%failed) return
     call check_interval(deck, card, interval, interval_curve, log)
+    call check_binary(deck, card, binary, log)
     select case (history)
     case (history_glstat)
       input%model%output%glstat_interval = interval
+      input%model%output%glstat_binary = binary
     case (history_matsum)
       input%model%output%matsum_interval = interval
+      input%model%output%matsum_binary = binary
     case (history_nodout)
       input%model%output%nodout_interval = interval
+      input%model%output%nodout_binary = binary
       input%nodout_line = line
       call warn_if_set(deck, card, 5, "OPTION1", "no high-frequency nodouthf output", warnings)
     case (history_rwforc)
       input%model%output%rwforc_interval = interval
+      input%model%output%rwforc_binary = binary
     end select
   end subroutine read_history_output_card
 
@@ -199,6 +206,18 @@ contains
       end if
     end if
   end subroutine read_dump_output
+
+  !> BINARY of a history database: 1 ASCII file, 2 binout, 3 both; 0 or blank is LS-DYNA's
+  !> default 1 (and becomes 1).
+  subroutine check_binary(deck, card, binary, log)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(in) :: card
+    integer, intent(inout) :: binary
+    type(problem_log_t), intent(inout) :: log
+    if (binary < 0 .or. binary > 3) call card_problem(deck, log, card, "BINARY", "must be 1 (ASCII file), 2 "// &
+      "(binout) or 3 (both); 0 or blank: 1; found "//integer_text(binary))
+    if (binary == 0) binary = 1
+  end subroutine check_binary
 
   subroutine check_interval(deck, card, interval, interval_curve, log)
     type(deck_t), intent(in) :: deck

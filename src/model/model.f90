@@ -393,6 +393,10 @@ module model
     integer :: running_restart_cycles = 0    !< *DATABASE_BINARY_RUNRSF CYCL (0: none)
     integer :: running_restart_files = 1     !< *DATABASE_BINARY_RUNRSF NR, written in turn
     integer, allocatable :: history_nodes(:) !< node indices for nodout
+    !> The BINARY field of *DATABASE_GLSTAT, _MATSUM, _NODOUT, _RWFORC, _RCFORC, _RBDOUT:
+    !> 1 the ASCII file, 2 binout, 3 both (0 or blank: 1, as LS-DYNA's SMP)
+    integer :: glstat_binary = 1, matsum_binary = 1, nodout_binary = 1, rwforc_binary = 1, &
+               rcforc_binary = 1, rbdout_binary = 1
   end type output_control_t
 
   !> The whole model.

@@ -13,6 +13,7 @@ module run_output
   use results_file, only: results_file_t, write_state
   use rigid_bodies, only: rigid_body_history_row
   use spot_weld_constraints, only: failed_weld_count
+  use binout_file, only: binout_requested, binout_name, write_binout
   implicit none
   private
 
@@ -72,7 +73,21 @@ contains
     if (clock_due(plan%rbdout, state%time, last)) call record_rigid_bodies(model, state, plan, histories)
     ! the state and the history rows recorded since the previous one, as one commit
     if (states_due) call write_current_state(model, state, plan, histories, results, error)
+    ! binout (BINARY 2 or 3), written whole: at the last output and the states 1, 2, 4, 8, ...
+    if (states_due .and. .not. allocated(error) .and. binout_requested(model)) then
+      if (last .or. iand(results%state_count, results%state_count - 1) == 0) &
+        call write_binout(model, histories, binout_path(results), error)
+    end if
   end subroutine write_due_output
+
+  !> binout beside the results file (results_file's DIR/JOBID.h5), named as LS-DYNA names it.
+  function binout_path(results) result(path)
+    type(results_file_t), intent(in) :: results
+    character(len=:), allocatable :: path
+    integer :: name_start
+    name_start = len(results%h5_path) - len(results%h5_name) + 1
+    path = results%h5_path(1:name_start - 1)//binout_name(results%h5_name(1:len(results%h5_name) - 3))
+  end function binout_path
 
   !> Wall force averaged over the sampling interval (impulse / interval), so that integrating
   !> the rwforc history gives the impulse exactly; at t = 0 the force of the first cycle is 0.
