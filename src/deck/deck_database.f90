@@ -16,12 +16,14 @@ module deck_database
   private
 
   public :: read_plot_output, read_glstat_output, read_matsum_output, read_nodout_output, read_rwforc_output
+  public :: read_rbdout_output
   public :: read_history_nodes, read_history_node_sets, read_d3dump_output, read_runrsf_output
   public :: read_unused_output, check_binary
 
   integer, parameter :: standard_widths(8) = 10
   !> The history outputs read by read_history_output.
-  integer, parameter :: history_glstat = 1, history_matsum = 2, history_nodout = 3, history_rwforc = 4
+  integer, parameter :: history_glstat = 1, history_matsum = 2, history_nodout = 3, history_rwforc = 4, &
+                        history_rbdout = 5
 
 contains
 
@@ -94,7 +96,18 @@ contains
     call read_history_output_card(deck, block, history_rwforc, input, log, warnings)
   end subroutine read_rwforc_output
 
-  !> *DATABASE_GLSTAT / _MATSUM / _NODOUT / _RWFORC: DT BINARY LCUR IOOPT (NODOUT: OPTION1
+  !> *DATABASE_RBDOUT: see read_history_output_card.
+  subroutine read_rbdout_output(deck, block, keyword, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(keyword_t), intent(in) :: keyword
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    call read_history_output_card(deck, block, history_rbdout, input, log, warnings)
+  end subroutine read_rbdout_output
+
+  !> *DATABASE_GLSTAT / _MATSUM / _NODOUT / _RWFORC / _RBDOUT: DT BINARY LCUR IOOPT (NODOUT: OPTION1
   !> OPTION2 for nodouthf). Every history goes to results.h5; BINARY 2 or 3 writes it to binout
   !> as well (see check_binary).
   subroutine read_history_output_card(deck, block, history, input, log, warnings)
@@ -130,6 +143,9 @@ contains
     case (history_rwforc)
       input%model%output%rwforc_interval = interval
       input%model%output%rwforc_binary = binary
+    case (history_rbdout)
+      input%model%output%rbdout_interval = interval
+      input%model%output%rbdout_binary = binary
     end select
   end subroutine read_history_output_card
 

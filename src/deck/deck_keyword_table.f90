@@ -47,8 +47,8 @@ module deck_keyword_table
     read_bulk_viscosity, read_energy_control, read_implicit_general, read_implicit_solution, &
     read_unused_control, read_sensor_definition
   use deck_database, only: read_plot_output, read_glstat_output, read_matsum_output, read_nodout_output, &
-    read_rwforc_output, read_history_nodes, read_history_node_sets, read_d3dump_output, read_runrsf_output, &
-    read_unused_output
+    read_rwforc_output, read_rbdout_output, read_history_nodes, read_history_node_sets, read_d3dump_output, &
+    read_runrsf_output, read_unused_output
   use deck_rigid_bodies, only: read_rigid_materials, read_rigid_motions, read_nodal_rigid_bodies, &
     read_element_masses, read_spot_welds, read_generalized_spot_welds, read_extra_nodes, read_extra_node_sets, &
     read_rigid_body_merges
@@ -150,7 +150,6 @@ contains
       keyword_entry_t("DATABASE_SWFORC", reader=read_unused_output), &
       keyword_entry_t("DATABASE_JNTFORC", reader=read_unused_output), &
       keyword_entry_t("DATABASE_DEFORC", reader=read_unused_output), &
-      keyword_entry_t("DATABASE_RBDOUT", reader=read_unused_output), &
       keyword_entry_t("DATABASE_SBTOUT", reader=read_unused_output), &
       keyword_entry_t("DATABASE_NODFOR", reader=read_unused_output), &
       keyword_entry_t("DATABASE_ABSTAT", reader=read_unused_output), &
@@ -201,6 +200,7 @@ contains
       keyword_entry_t("DATABASE_MATSUM", reader=read_matsum_output), &
       keyword_entry_t("DATABASE_NODOUT", reader=read_nodout_output), &
       keyword_entry_t("DATABASE_RWFORC", reader=read_rwforc_output), &
+      keyword_entry_t("DATABASE_RBDOUT", reader=read_rbdout_output), &
       keyword_entry_t("DATABASE_HISTORY_NODE", options="ID", reader=read_history_nodes), &
       keyword_entry_t("DATABASE_HISTORY_NODE_SET", reader=read_history_node_sets), &
       keyword_entry_t("CONTROL_IMPLICIT_GENERAL", reader=read_implicit_general), &

@@ -389,6 +389,7 @@ module model
     real(wp) :: nodout_interval = 0.0_wp
     real(wp) :: rwforc_interval = 0.0_wp
     real(wp) :: rcforc_interval = 0.0_wp     !< *DATABASE_RCFORC
+    real(wp) :: rbdout_interval = 0.0_wp     !< *DATABASE_RBDOUT (0: the glstat interval)
     integer :: dump_cycles = 0               !< *DATABASE_BINARY_D3DUMP CYCL (0: no periodic dumps)
     integer :: running_restart_cycles = 0    !< *DATABASE_BINARY_RUNRSF CYCL (0: none)
     integer :: running_restart_files = 1     !< *DATABASE_BINARY_RUNRSF NR, written in turn

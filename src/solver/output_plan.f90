@@ -128,10 +128,10 @@ contains
         end do
       end if
     end if
-    ! rbdout: every rigid body, at the glstat interval
+    ! rbdout: every rigid body, at the *DATABASE_RBDOUT interval (else the glstat one)
     allocate (plan%rbdout_series(0))
     if (allocated(model%rigid_bodies)) then
-      call set_clock(plan%rbdout, 0.0_wp, plan%glstat%interval, size(model%rigid_bodies) > 0)
+      call set_clock(plan%rbdout, model%output%rbdout_interval, plan%glstat%interval, size(model%rigid_bodies) > 0)
       if (plan%rbdout%active) then
         capacity = expected_rows(model, plan%rbdout)
         deallocate (plan%rbdout_series)

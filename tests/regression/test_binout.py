@@ -6,7 +6,8 @@
 - LS-DYNA's signs and physics: rwforc is the force the wall exerts on the block (positive along
   the wall normal), and its integral over time is the block's momentum change (1%); rcforc holds
   both sides of each contact, the primary side's force the opposite of the secondary side's, and
-  the secondary block's impulse is -2 m v (the blocks exchange velocities, 2%).
+  the secondary block's impulse is -2 m v (the blocks exchange velocities, 2%); rbdout of a free
+  rigid block: constant velocity, displacement v t.
 - A second, independent reader in this file walks the file's records in order (as dynareadout
   reads binout: CD and DATA records, no symbol table), checks that the record lengths chain to the
   end of the file and that every symbol-table entry points at its DATA record, and finds the same
@@ -173,6 +174,42 @@ def test_contact_forces_both_sides(tmp_path, run_deck):
     impulse = (x_force[1:, 0] * np.diff(time)).sum()
     assert abs(impulse + 2.0 * mass * 1.0) < 0.02 * 2.0 * mass
     check_against_record_walk(directory / "crash.binout", binout)
+
+
+def test_rigid_body_motion(tmp_path, run_deck):
+    """A free rigid block (*MAT_RIGID) at (3, -2, 1) mm/ms: rbdout's velocities are constant and
+    its displacements v t, equal to results.h5's rbdout."""
+    velocity = (3.0, -2.0, 1.0)
+    nodes, elements = block_mesh((2, 2, 2), (20.0, 30.0, 50.0))
+    deck = write_deck(
+        tmp_path / "rigid.k",
+        "*CONTROL_TERMINATION\n" + fields(2.0),
+        "*DATABASE_RBDOUT\n" + fields(0.1, 2),
+        "*PART\nblock\n" + fields(4, 1, 1),
+        "*SECTION_SOLID\n" + fields(1, 1),
+        "*MAT_RIGID\n" + fields(1, DENSITY, 210.0, POISSON) + "\n" + fields(0.0, 0.0, 0.0) + "\n" + fields(0.0),
+        "*INITIAL_VELOCITY\n" + fields(0) + "\n" + fields(*velocity),
+        nodes_card(nodes),
+        solids_card(elements, part_id=4),
+    )
+    run = run_deck(deck)
+    assert run.status == 0, run.stderr
+    binout = lasso_binout.Binout(str(run.results.parent / "binout"))
+    assert binout.read() == ["rbdout"]
+    assert list(binout.read("rbdout", "ids")) == [4]
+    with run.open() as results:
+        rbdout = results["history/rbdout/4"]
+        time = rbdout["time"][...]
+        displacement, body_velocity = rbdout["displacement"][...], rbdout["velocity"][...]
+    np.testing.assert_array_equal(binout.read("rbdout", "time"), time)
+    assert len(time) >= 20, "the *DATABASE_RBDOUT interval, 0.1 ms over 2 ms"
+    for axis, letter in enumerate("xyz"):
+        np.testing.assert_array_equal(binout.read("rbdout", f"global_d{letter}"), displacement[:, axis])
+        np.testing.assert_array_equal(binout.read("rbdout", f"global_v{letter}"), body_velocity[:, axis])
+        np.testing.assert_allclose(binout.read("rbdout", f"global_v{letter}"), velocity[axis], rtol=1e-12)
+        np.testing.assert_allclose(binout.read("rbdout", f"global_d{letter}"), velocity[axis] * time,
+                                   rtol=1e-9, atol=1e-12)
+    check_against_record_walk(run.results.parent / "binout", binout)
 
 
 def test_no_binout_unless_asked(tmp_path, run_deck):

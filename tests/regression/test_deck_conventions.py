@@ -296,7 +296,7 @@ def test_bookkeeping_keywords_are_read_and_change_nothing(tmp_path):
                     "CONTROL_ACCURACY", "DATABASE_EXTENT_BINARY", "DATABASE_FORMAT", "DATABASE_BINARY_INTFOR",
                     "DATABASE_SPCFORC", "DATABASE_SLEOUT", "DATABASE_SECFORC", "DATABASE_HISTORY_SOLID",
                     "SENSOR_DEFINE_NODE_SET", "SENSOR_DEFINE_FUNCTION", "CONTROL_MPP_DECOMPOSITION_AUTOMATIC",
-                    "CONTROL_MPP_IO_NODUMP", "DATABASE_RBDOUT"]:
+                    "CONTROL_MPP_IO_NODUMP"]:
         assert f"*{keyword}: read, not acted upon" in text, keyword
     # the fields a deck sets are named with their values
     assert "fields set, not used: NCPU=2 CONST=1" in text
