@@ -8,6 +8,7 @@
   both sides of each contact, the primary side's force the opposite of the secondary side's, and
   the secondary block's impulse is -2 m v (the blocks exchange velocities, 2%); rbdout of a free
   rigid block: constant velocity, displacement v t.
+- A run continued from a restart dump (r=) writes the binout of the uninterrupted run.
 - A second, independent reader in this file walks the file's records in order (as dynareadout
   reads binout: CD and DATA records, no symbol table), checks that the record lengths chain to the
   end of the file and that every symbol-table entry points at its DATA record, and finds the same
@@ -15,11 +16,15 @@
 - The file is named as LS-DYNA names it (binout; JOBID.binout), BINARY 1 (the default) writes
   none, and BINARY outside 0..3 is refused with the deck line.
 """
+import os
+import shutil
 import struct
+import subprocess
 
 import numpy as np
 import pytest
 
+from conftest import BINARY
 from deck_writer import block_mesh, fields, node_list_set, nodes_card, solids_card, write_deck
 
 lasso_binout = pytest.importorskip("lasso.dyna.binout")
@@ -210,6 +215,30 @@ def test_rigid_body_motion(tmp_path, run_deck):
         np.testing.assert_allclose(binout.read("rbdout", f"global_d{letter}"), velocity[axis] * time,
                                    rtol=1e-9, atol=1e-12)
     check_against_record_walk(run.results.parent / "binout", binout)
+
+
+def test_restart_writes_the_binout_of_the_uninterrupted_run(tmp_path, run_deck):
+    """r= from a dump in the middle of the run: binout is written again from the histories the
+    dump holds plus the rest of the run, every variable equal to the uninterrupted run's."""
+    deck, _ = wall_deck(tmp_path / "dumped.k")
+    deck.write_text(deck.read_text().replace("*DATABASE_BINARY_D3PLOT", "*DATABASE_BINARY_D3DUMP\n" + fields(10) +
+                                             "\n*DATABASE_BINARY_D3PLOT"))
+    run = run_deck(deck)
+    assert run.status == 0, run.stderr
+    directory = run.results.parent
+    dumps = sorted(directory.glob("d3dump*"))
+    assert len(dumps) >= 2
+    continued = tmp_path / "continued"
+    shutil.copytree(directory, continued)
+    (continued / "binout").unlink()
+    dump = continued / dumps[len(dumps) // 2].name
+    process = subprocess.run([str(BINARY), f"r={dump}", "ncpu=1"], capture_output=True, text=True, timeout=300,
+                             env=dict(os.environ, OMP_NUM_THREADS="1"))
+    assert process.returncode == 0, process.stdout + process.stderr
+    reference, restarted = walk_records(directory / "binout"), walk_records(continued / "binout")
+    assert reference.keys() == restarted.keys()
+    for name, (type_id, values, _) in reference.items():
+        assert restarted[name][:2] == (type_id, values), name
 
 
 def test_no_binout_unless_asked(tmp_path, run_deck):
