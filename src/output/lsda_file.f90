@@ -19,7 +19,7 @@
 !> records. This writer serves both: every DATA record follows a CD to its directory, and each
 !> `flush_lsda` appends a symbol table of the variables written since the previous one and
 !> links it from the previous one, so the file on disk is complete after every flush and the
-!> run can add to it as it goes. Values are written in the machine's byte order, which the
+!> run can add to it as it goes (a table is also flushed every `table_capacity` variables). Values are written in the machine's byte order, which the
 !> header states.
 module lsda_file
   use, intrinsic :: iso_fortran_env, only: int8, int16, int32, int64, real32, real64
@@ -41,6 +41,9 @@ module lsda_file
   !> Where the offset of the first symbol table is kept (after the header and the LENGTH and
   !> COMMAND of the SYMBOLTABLEOFFSET record).
   integer(int64), parameter :: first_link = 17
+  !> Variables held for the next symbol table at most: more are flushed, so that a file of
+  !> millions of variables (a long history at a short interval) does not keep them all in memory.
+  integer, parameter :: table_capacity = 4096
 
   !> One variable: its directory, name, type, DATA record and number of values.
   type :: lsda_entry_t
@@ -228,6 +231,10 @@ contains
       call make_error(error, "LSDA file: a write to a file that is not open")
       return
     end if
+    if (file%entry_count - file%listed_count >= table_capacity) then
+      call flush_lsda(file, error)
+      if (allocated(error)) return
+    end if
     if (len(name) < 1 .or. len(name) > 255 .or. index(name, "/") > 0) then
       call make_error(error, file%path//": variable name """//name//""" must have 1 to 255 characters and no /")
       return
@@ -312,7 +319,11 @@ contains
       return
     end if
     file%link_offset = file%end_offset - 8
-    file%listed_count = file%entry_count
+    ! the entries are on disk: a writer needs them no more (a reader lists them from the file)
+    file%entry_count = 0
+    file%listed_count = 0
+    ! the next DATA record says its directory again, for readers that walk the records
+    file%data_directory = ""
   end subroutine flush_lsda
 
   !> Flush and close (a file open for reading: close).

@@ -125,7 +125,7 @@ def test_wall_impact_histories_equal_results(tmp_path, run_deck):
     check_against_record_walk(binout_path, binout)
 
 
-def head_on_deck(path, end_time=0.03, jobid_speed=1.0):
+def head_on_deck(path, end_time=0.03, speed=1.0):
     """Two 40x5x5 elastic blocks meeting head on at 1 mm/ms each (contact 5, SURFA = block 1);
     rcforc to binout and the ASCII file (BINARY 3)."""
     counts, lengths, gap = (8, 1, 1), (40.0, 5.0, 5.0), 0.01
@@ -144,8 +144,8 @@ def head_on_deck(path, end_time=0.03, jobid_speed=1.0):
         "*MAT_ELASTIC\n" + fields(1, DENSITY, MODULUS, POISSON),
         node_list_set(1, list(range(1, count + 1))),
         node_list_set(2, list(range(count + 1, 2 * count + 1))),
-        "*INITIAL_VELOCITY\n" + fields(1) + "\n" + fields(jobid_speed, 0.0, 0.0),
-        "*INITIAL_VELOCITY\n" + fields(2) + "\n" + fields(-jobid_speed, 0.0, 0.0),
+        "*INITIAL_VELOCITY\n" + fields(1) + "\n" + fields(speed, 0.0, 0.0),
+        "*INITIAL_VELOCITY\n" + fields(2) + "\n" + fields(-speed, 0.0, 0.0),
         "*CONTACT_AUTOMATIC_SURFACE_TO_SURFACE_ID\n" + fields(5) + "blocks\n" + fields(1, 2, 3, 3) + "\n" +
         fields(0.0) + "\n" + fields(1.0),
         nodes_card(np.vstack([a_nodes, b_nodes])),

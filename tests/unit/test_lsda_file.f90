@@ -20,6 +20,7 @@ program test_lsda_file
   call test_round_trip(directory//"/binout")
   call test_layout(directory//"/binout")
   call test_read_checks(directory//"/binout", directory//"/not_lsda")
+  call test_many_variables(directory//"/many")
   call execute_command_line("rm -rf '"//directory//"'")
   call finish_suite(suite)
 
@@ -173,6 +174,48 @@ contains
     call check(suite, "a name of 256 characters refused", allocated(error), "no error")
     call close_lsda(file, error)
   end subroutine test_read_checks
+
+  !> More variables than one symbol table holds: the writer flushes on its own (a chain of
+  !> tables) and every variable reads back.
+  subroutine test_many_variables(path)
+    character(len=*), intent(in) :: path
+    type(lsda_file_t) :: file
+    type(error_t), allocatable :: error
+    real(real64), allocatable :: values_in(:)
+    character(len=16) :: sample
+    integer :: k, wrong
+    integer, parameter :: samples = 5000
+
+    call create_lsda(file, path, error)
+    do k = 1, samples
+      write (sample, '("d", i6.6)') k
+      call change_lsda_directory(file, "/glstat/"//trim(sample))
+      call write_lsda(file, "time", [real(k, real64)], error)
+      if (allocated(error)) exit
+      call write_lsda(file, "kinetic_energy", [1.0_real64/k], error)
+      if (allocated(error)) exit
+    end do
+    call check(suite, "many: written", .not. allocated(error))
+    call check(suite, "many: the writer keeps only the variables of the table to come", &
+               size(file%entries) <= 2*4096 .and. file%entry_count < 4096)
+    call close_lsda(file, error)
+    call open_lsda(file, path, error)
+    call check(suite, "many: open", .not. allocated(error))
+    if (allocated(error)) return
+    call check(suite, "many: every variable listed", file%entry_count == 2*samples)
+    wrong = 0
+    do k = 1, samples, 97
+      write (sample, '("d", i6.6)') k
+      call read_lsda(file, "/glstat/"//trim(sample)//"/kinetic_energy", values_in, error)
+      if (allocated(error)) then
+        wrong = wrong + 1
+      else if (.not. same_doubles([1.0_real64/k], values_in)) then
+        wrong = wrong + 1
+      end if
+    end do
+    call check(suite, "many: values read back", wrong == 0)
+    call close_lsda(file, error)
+  end subroutine test_many_variables
 
   logical function same_ints(expected, actual)
     integer(int64), intent(in) :: expected(:), actual(:)
