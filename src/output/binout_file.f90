@@ -14,8 +14,8 @@
 !> column, a factor and how it is derived. A variable whose column the run does not record is
 !> left out, so a quantity the histories gain later is one more row of the table.
 !>
-!> The file is written whole from the histories, under a temporary name and then renamed, so
-!> a reader never sees it half written; the output step calls `write_binout` at the last
+!> The file is written whole from the histories, under a hidden temporary name and then
+!> renamed, so a reader never sees it half written; the output step calls `write_binout` at the last
 !> output and at the states 1, 2, 4, 8, ... (the cost over the run is then at most about twice
 !> that of the final file, and a run that is killed still leaves most of its histories).
 module binout_file
@@ -122,7 +122,8 @@ contains
   end function binout_name
 
   !> Write `path` whole from the histories recorded so far (the databases whose BINARY is 2 or
-  !> 3): under `path` with ".partial" added, then renamed to `path`.
+  !> 3): as the hidden `.NAME.partial` beside it (which a reader's glob `binout*` does not
+  !> pick up, should a killed run leave it), then renamed to `path`.
   subroutine write_binout(model, histories, path, error)
     type(model_t), intent(in) :: model
     type(history_set_t), intent(in) :: histories
@@ -131,10 +132,11 @@ contains
     type(lsda_file_t) :: file
     type(error_t), allocatable :: close_error
     character(len=:), allocatable :: partial
-    integer :: k
+    integer :: k, slash
 
     if (.not. binout_requested(model)) return
-    partial = path//".partial"
+    slash = index(path, "/", back=.true.)
+    partial = path(1:slash)//"."//path(slash + 1:)//".partial"
     call create_lsda(file, partial, error)
     do k = 1, size(databases)
       if (allocated(error)) exit

@@ -76,7 +76,7 @@ def test_wall_impact_histories_equal_results(tmp_path, run_deck):
     assert run.status == 0, run.stderr
     binout_path = run.results.parent / "binout"
     assert binout_path.exists()
-    assert not list(run.results.parent.glob("*.partial"))
+    assert not list(run.results.parent.glob(".*partial")) and not list(run.results.parent.glob("*partial"))
     binout = lasso_binout.Binout(str(binout_path))
     assert sorted(binout.read()) == ["glstat", "matsum", "nodout", "rwforc"]
     assert binout.read("glstat", "title").rstrip() == "block against a rigid wall"
