@@ -4,10 +4,11 @@
   and rcforc of two blocks in head-on contact: every value equals results.h5's /history (binout
   stores R8, so to the bit); nodout's coordinates are the mesh's plus the displacements.
 - LS-DYNA's signs and physics: rwforc is the force the wall exerts on the block (positive along
-  the wall normal), and its integral over time is the block's momentum change (1%); rcforc holds
-  both sides of each contact, the primary side's force the opposite of the secondary side's, and
-  the secondary block's impulse is -2 m v (the blocks exchange velocities, 2%); rbdout of a free
-  rigid block: constant velocity, displacement v t.
+  the wall normal, normal_force its normal part; at a cylinder the radial part), and its integral
+  over time is the block's momentum change (1%); rcforc holds both sides of each contact, the
+  primary side's force the opposite of the secondary side's, and the secondary block's impulse is
+  -2 m v (the blocks exchange velocities, 2%); rbdout of a free rigid block: constant velocity,
+  displacement v t.
 - A run continued from a restart dump (r=) writes the binout of the uninterrupted run.
 - A second, independent reader in this file walks the file's records in order (as dynareadout
   reads binout: CD and DATA records, no symbol table), checks that the record lengths chain to the
@@ -123,6 +124,33 @@ def test_wall_impact_histories_equal_results(tmp_path, run_deck):
     assert abs(impulse - momentum_change) < 0.01 * momentum_change
     # the independent reader finds the same variables and values
     check_against_record_walk(binout_path, binout)
+
+
+def test_cylinder_wall_normal_force(tmp_path, run_deck):
+    """A block thrown in -x at an infinite cylinder along z, off-centre in y: rwforc's
+    normal_force is the radial part of the force on the block, hypot(x_force, y_force)."""
+    nodes, elements = block_mesh((3, 3, 3), (10.0, 10.0, 10.0))
+    deck = write_deck(
+        tmp_path / "post.k",
+        "*CONTROL_TERMINATION\n" + fields(0.05),
+        "*DATABASE_RWFORC\n" + fields(0.0005, 2),
+        "*PART\nblock\n" + fields(1, 1, 1),
+        "*SECTION_SOLID\n" + fields(1, 1),
+        "*MAT_ELASTIC\n" + fields(1, DENSITY, MODULUS, POISSON),
+        "*INITIAL_VELOCITY\n" + fields(0) + "\n" + fields(-SPEED, 0.0, 0.0),
+        "*RIGIDWALL_GEOMETRIC_CYLINDER_ID\n" + fields(3) + "post\n" + fields(0) + "\n" +
+        fields(-3.5, 4.0, 0.0, -3.5, 4.0, 1.0) + "\n" + fields(3.0, 0.0, 0),
+        nodes_card(nodes),
+        solids_card(elements),
+    )
+    run = run_deck(deck)
+    assert run.status == 0, run.stderr
+    binout = lasso_binout.Binout(str(run.results.parent / "binout"))
+    x_force, y_force, z_force = (binout.read("rwforc", "forces", f"{letter}_force") for letter in "xyz")
+    normal = binout.read("rwforc", "forces", "normal_force")
+    assert x_force.max() > 0.0, "the post pushes the block back in +x"
+    np.testing.assert_allclose(normal, np.hypot(x_force, y_force), rtol=1e-12, atol=1e-9 * normal.max())
+    assert np.abs(z_force).max() < 1e-6 * normal.max()
 
 
 def head_on_deck(path, end_time=0.03, speed=1.0):
