@@ -213,7 +213,7 @@ contains
     end do
     allocate (values(sides*count))
     do row = 1, rows
-      write (sample, '("d", i6.6)') row
+      write (sample, '("d", i0.6)') row
       call change_lsda_directory(file, base//"/"//trim(sample))
       call write_lsda(file, "time", [histories%series(series(1))%rows(1, row)], error)
       if (allocated(error)) return
