@@ -389,7 +389,7 @@ module model
     real(wp) :: nodout_interval = 0.0_wp
     real(wp) :: rwforc_interval = 0.0_wp
     real(wp) :: rcforc_interval = 0.0_wp     !< *DATABASE_RCFORC
-    real(wp) :: rbdout_interval = 0.0_wp     !< *DATABASE_RBDOUT
+    real(wp) :: rbdout_interval = 0.0_wp     !< *DATABASE_RBDOUT (0: the glstat interval)
     !> BINARY of *DATABASE_GLSTAT / _MATSUM / _NODOUT / _RWFORC / _RCFORC / _RBDOUT, as
     !> LS-DYNA: 1 the ASCII file, 2 binout, 3 both (0 or blank: 1). The ASCII file is written
     !> only when the keyword is in the deck (its interval > 0); results.h5 has every history.

@@ -15,6 +15,7 @@ module run_output
   use rigid_bodies, only: rigid_body_history_row
   use spot_weld_constraints, only: failed_weld_count
   use ascii_databases, only: c_exponential
+  use binout_file, only: binout_requested, binout_name, write_binout
   implicit none
   private
 
@@ -84,6 +85,11 @@ contains
     if (clock_due(plan%rbdout, state%time, last)) call record_rigid_bodies(model, state, plan, histories)
     ! the state and the history rows recorded since the previous one, as one commit
     if (states_due) call write_current_state(model, state, plan, histories, results, error)
+    ! binout (BINARY 2 or 3), written whole: at the last output and the states 1, 2, 4, 8, ...
+    if (states_due .and. .not. allocated(error) .and. binout_requested(model)) then
+      if (last .or. iand(results%state_count, results%state_count - 1) == 0) &
+        call write_binout(model, histories, binout_path(results), error)
+    end if
   end subroutine write_due_output
 
   !> The smallest stable step of each element kind at cycle 0 with its element, and the rigid
@@ -106,12 +112,21 @@ contains
                                 "  rigid bodies"//new_line("a")
   end subroutine record_initial_time_steps
 
+  !> binout beside the results file (results_file's DIR/JOBID.h5), named as LS-DYNA names it.
+  function binout_path(results) result(path)
+    type(results_file_t), intent(in) :: results
+    character(len=:), allocatable :: path
+    integer :: name_start
+    name_start = len(results%h5_path) - len(results%h5_name) + 1
+    path = results%h5_path(1:name_start - 1)//binout_name(results%h5_name(1:len(results%h5_name) - 3))
+  end function binout_path
+
   !> Wall force averaged over the sampling interval (impulse / interval), so that integrating
   !> the rwforc history gives the impulse exactly; at t = 0 the force of the first cycle is 0.
   !> LS-DYNA's sign: the force the wall exerts on the structure (the state's impulse is the
   !> one the wall received); the normal force is its component along a planar wall's normal
   !> (which points to the structure's side, so a wall pushing is positive), for a cylinder its
-  !> magnitude.
+  !> radial part.
   subroutine record_wall_forces(model, state, plan, histories)
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(in) :: state
@@ -127,7 +142,8 @@ contains
       if (model%walls(k)%kind == wall_planar) then
         normal_force = dot_product(force, model%walls(k)%normal)
       else
-        normal_force = norm2(force)
+        ! a cylinder's (model%walls(k)%normal: its axis): the radial part, what presses on its side
+        normal_force = norm2(force - dot_product(force, model%walls(k)%normal)*model%walls(k)%normal)
       end if
       call append_history_row(histories%series(plan%rwforc_series(k)), [state%time, force, normal_force])
       plan%wall_impulse(:, k) = state%walls(k)%impulse
