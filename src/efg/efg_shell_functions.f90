@@ -35,6 +35,10 @@ module efg_shell_functions
 
   !> Columns of R whose diagonal falls below this fraction of |R_11| are taken as dependent.
   real(wp), parameter, public :: shell_rank_tolerance = 1.0e-10_wp
+  !> A cell whose candidate particles and corners all lie within this fraction of h of its plane
+  !> is flat: its basis keeps the three planar terms (round-off of a flat part turned out of the
+  !> global axes is far below it).
+  real(wp), parameter, public :: shell_flat_tolerance = 1.0e-8_wp
 
   !> What the functions of one background cell need. Local nodes `nodes(1:node_count)` are the
   !> cell's Gamma vertices and the particles whose supports touch the cell, in ascending model
@@ -55,6 +59,11 @@ module efg_shell_functions
     integer, allocatable :: particle_local(:)         !< local node of each candidate particle
     real(wp), allocatable :: particle_position(:, :)  !< (3, candidates)
     real(wp), allocatable :: particle_planar(:, :)    !< (2, candidates)
+    real(wp), allocatable :: particle_height(:)       !< (candidates) e3 . (X_I - X_0), off the cell's plane
+    real(wp) :: corner_height(4) = 0.0_wp             !< e3 . (X_a - X_0) of the corners (a warped cell's)
+    !> the basis has the fourth term zeta (height off the cell's plane): some particle or corner
+    !> lies off the plane by more than shell_flat_tolerance h (a curved or warped part)
+    logical :: curved = .false.
     real(wp), allocatable :: particle_frame(:, :, :)  !< (3, 3, candidates)
     real(wp), allocatable :: particle_radius(:, :)    !< (3, candidates)
     integer, allocatable :: candidates(:)             !< particle numbers (search scratch)
@@ -134,10 +143,15 @@ contains
                                  context%candidates, candidate_count)
     context%particle_count = candidate_count
     call ensure_size(context, candidate_count)
+    do a = 1, 4
+      context%corner_height(a) = dot_product(context%positions(:, a) - context%origin, context%frame(:, 3))
+    end do
     do k = 1, candidate_count
       particle = context%candidates(k)
       context%particle_position(:, k) = supports%particle_coordinates(:, particle)
       context%particle_planar(:, k) = planar_coordinates(context, supports%particle_coordinates(:, particle))
+      context%particle_height(k) = dot_product(supports%particle_coordinates(:, particle) - context%origin, &
+                                               context%frame(:, 3))
       context%particle_frame(:, :, k) = supports%particle_frame(:, :, particle)
       context%particle_radius(:, k) = supports%particle_radius(:, particle)
     end do
@@ -150,6 +164,8 @@ contains
       gamma_corners(gamma_count) = cell_nodes(a)
     end do
     call sort_short_list(gamma_corners(1:gamma_count))
+    context%curved = any(abs(context%corner_height(1:context%corners)) > shell_flat_tolerance*context%scale_length) &
+                     .or. any(abs(context%particle_height(1:candidate_count)) > shell_flat_tolerance*context%scale_length)
 
     ! merge the two ascending lists (particle numbers ascend with their node indices)
     context%node_count = gamma_count + candidate_count
@@ -197,16 +213,18 @@ contains
     real(wp), intent(out) :: values(:)
     integer, intent(out) :: rank
     real(wp), intent(out) :: residual
-    real(wp) :: phi(4), position(3), moment(3), reproduced(3), tau(3), work(192), local(3), inverse_h
-    real(wp) :: weight(context%particle_count), shifted(3, context%particle_count)
-    real(wp) :: rows(max(context%particle_count, 1), 3), projected(max(context%particle_count, 3))
-    integer :: covering(context%particle_count), covering_count, pivot(3), info, a, i, k, n
+    real(wp) :: phi(4), position(3), moment(4), reproduced(4), tau(4), work(256), local(3), inverse_h, height
+    real(wp) :: weight(context%particle_count), shifted(4, context%particle_count)
+    real(wp) :: rows(max(context%particle_count, 1), 4), projected(max(context%particle_count, 4))
+    integer :: covering(context%particle_count), covering_count, pivot(4), info, a, i, k, n, terms
     real(wp), parameter :: origin(3) = 0.0_wp
 
     inverse_h = 1.0_wp/context%scale_length
     phi = corner_functions(context%corners, parametric)
     position = matmul(context%positions, phi)
     planar = matmul(context%planar, phi)
+    height = dot_product(context%corner_height, phi)
+    terms = merge(4, 3, context%curved)
     n = context%node_count
     values(1:n) = 0.0_wp
     rank = 0
@@ -216,14 +234,15 @@ contains
     moment = 0.0_wp
     do a = 1, context%corners
       if (context%corner_is_particle(a)) then
-        moment = moment + phi(a)*[1.0_wp, (context%planar(:, a) - planar)*inverse_h]
+        moment = moment + phi(a)*[1.0_wp, (context%planar(:, a) - planar)*inverse_h, &
+                                  (context%corner_height(a) - height)*inverse_h]
       else
         values(context%corner_local(a)) = values(context%corner_local(a)) + phi(a)
       end if
     end do
     ! b = 0 (a boundary edge, or a cell without interior vertices): every particle function is
     ! exactly zero here
-    if (all(moment == 0.0_wp)) return
+    if (all(moment(1:terms) == 0.0_wp)) return
 
     covering_count = 0
     do i = 1, context%particle_count
@@ -233,18 +252,19 @@ contains
       if (weight(i) <= 0.0_wp) cycle
       covering_count = covering_count + 1
       covering(covering_count) = i
-      shifted(:, i) = [1.0_wp, (context%particle_planar(:, i) - planar)*inverse_h]
-      rows(covering_count, :) = sqrt(weight(i))*shifted(:, i)
+      shifted(:, i) = [1.0_wp, (context%particle_planar(:, i) - planar)*inverse_h, &
+                       (context%particle_height(i) - height)*inverse_h]
+      rows(covering_count, 1:terms) = sqrt(weight(i))*shifted(1:terms, i)
     end do
     if (covering_count == 0) then
       ! only possible when the support rule is broken: report b as the residual
-      residual = maxval(abs(moment))
+      residual = maxval(abs(moment(1:terms)))
       return
     end if
 
     pivot = 0
-    call dgeqp3(covering_count, 3, rows, size(rows, 1), pivot, tau, work, size(work), info)
-    do k = 1, min(covering_count, 3)
+    call dgeqp3(covering_count, terms, rows, size(rows, 1), pivot, tau, work, size(work), info)
+    do k = 1, min(covering_count, terms)
       if (abs(rows(k, k)) <= shell_rank_tolerance*abs(rows(1, 1))) exit
       rank = k
     end do
@@ -253,16 +273,16 @@ contains
     do i = 1, rank
       projected(i) = (moment(pivot(i)) - dot_product(rows(1:i - 1, i), projected(1:i - 1)))/rows(i, i)
     end do
-    call dormqr("L", "N", covering_count, 1, min(covering_count, 3), rows, size(rows, 1), tau, projected, &
+    call dormqr("L", "N", covering_count, 1, min(covering_count, terms), rows, size(rows, 1), tau, projected, &
                 size(projected), work, size(work), info)
     reproduced = 0.0_wp
     do i = 1, covering_count
       associate (particle => covering(i))
         values(context%particle_local(particle)) = sqrt(weight(particle))*projected(i)
-        reproduced = reproduced + values(context%particle_local(particle))*shifted(:, particle)
+        reproduced(1:terms) = reproduced(1:terms) + values(context%particle_local(particle))*shifted(1:terms, particle)
       end associate
     end do
-    residual = maxval(abs(reproduced - moment))
+    residual = maxval(abs(reproduced(1:terms) - moment(1:terms)))
   end subroutine evaluate_shell_functions
 
 
@@ -276,11 +296,12 @@ contains
     if (allocated(context%particle_local)) then
       if (size(context%particle_local) >= count) return
       deallocate (context%particle_local, context%particle_position, context%particle_planar, &
-                  context%particle_frame, context%particle_radius, context%nodes)
+                  context%particle_height, context%particle_frame, context%particle_radius, context%nodes)
     end if
     capacity = max(count, 64)
     allocate (context%particle_local(capacity), context%particle_position(3, capacity), &
-              context%particle_planar(2, capacity), context%particle_frame(3, 3, capacity), &
+              context%particle_planar(2, capacity), context%particle_height(capacity), &
+              context%particle_frame(3, 3, capacity), &
               context%particle_radius(3, capacity), context%nodes(capacity + 4))
   end subroutine ensure_size
 end module efg_shell_functions
