@@ -14,7 +14,7 @@
 !> * sub-cell areas adding up to the cell areas and to the plate's area; row-sum masses adding up
 !>   to t A; transformation rows summing to 1 and reproducing the particle's 3D position;
 !> * node classes (boundary edges and extra Gamma nodes), point counts, and error messages;
-!> * identical parts for one and three threads;
+!> * identical parts for one and three threads (flat and cylinder);
 !> * the set-up seconds of a 100 x 100 plate, flat and wrapped on a cylinder (printed; linear in
 !>   the number of cells).
 !> Interior nodes are moved randomly by up to 25% of the cell size; the plate's outline stays a
@@ -595,23 +595,28 @@ contains
     type(efg_shell_part_t) :: single, several
     type(error_t), allocatable :: error
     logical, allocatable :: extra(:)
-    integer :: threads
-    model = plate_model(12, 9, .true., 0.0_wp, kernel_quadratic_box, [1.3_wp, 1.2_wp])
-    allocate (extra(size(model%coordinates, 2)))
-    extra = .false.
-    threads = omp_get_max_threads()
-    call omp_set_num_threads(1)
-    call build_efg_shell_part(model, 1, extra, single, error)
-    call omp_set_num_threads(3)
-    call build_efg_shell_part(model, 1, extra, several, error)
-    call omp_set_num_threads(threads)
-    call check(suite, "threads: 1 and 3 threads give identical parts", &
-               all(single%point_offsets == several%point_offsets) .and. all(single%pair_node == several%pair_node) &
-               .and. all(single%pair_gradient == several%pair_gradient) .and. &
-               all(single%shear_value == several%shear_value) .and. &
-               all(single%shear_gradient == several%shear_gradient) .and. &
-               all(single%mass_volume == several%mass_volume) .and. &
-               all(single%transform_value == several%transform_value))
+    integer :: threads, shape
+    real(wp), parameter :: radii(2) = [0.0_wp, 1.5_wp]       ! flat, and on a cylinder (curved cells)
+    character(len=*), parameter :: names(2) = ["flat    ", "cylinder"]
+    do shape = 1, 2
+      model = plate_model(12, 9, .true., radii(shape), kernel_quadratic_box, [1.3_wp, 1.2_wp])
+      if (allocated(extra)) deallocate (extra)
+      allocate (extra(size(model%coordinates, 2)))
+      extra = .false.
+      threads = omp_get_max_threads()
+      call omp_set_num_threads(1)
+      call build_efg_shell_part(model, 1, extra, single, error)
+      call omp_set_num_threads(3)
+      call build_efg_shell_part(model, 1, extra, several, error)
+      call omp_set_num_threads(threads)
+      call check(suite, "threads ("//trim(names(shape))//"): 1 and 3 threads give identical parts", &
+                 all(single%point_offsets == several%point_offsets) .and. all(single%pair_node == several%pair_node) &
+                 .and. all(single%pair_gradient == several%pair_gradient) .and. &
+                 all(single%shear_value == several%shear_value) .and. &
+                 all(single%shear_gradient == several%shear_gradient) .and. &
+                 all(single%mass_volume == several%mass_volume) .and. &
+                 all(single%transform_value == several%transform_value))
+    end do
   end subroutine test_thread_counts
 
   !> Set-up of a 100 x 100 plate: its seconds are printed (tests never assert wall-clock time;
