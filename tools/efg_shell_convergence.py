@@ -168,7 +168,8 @@ def section(cantilever, strip, ring, formulations, ring_variants, command, tests
         "reading is good to about 5e-4 (the FE column against the one-point theory). Decks: "
         "`tests/regression/plate_decks.py`; the verification tests: "
         "`tests/regression/test_efg_shell_verification.py` (patch tests, spinning plate, energy "
-        "drift, FE/EFG interface). Produced by:",
+        "drift, FE/EFG interface). The run seconds are wall-clock on one thread and depend on the "
+        "machine's load. Produced by:",
         "",
         "```sh",
         command,
