@@ -4,23 +4,28 @@
 !>
 !> A point is given by its parametric coordinates in the cell (quadrilateral: [-1, 1]^2 with
 !> bilinear functions; triangle, N4 = N3: area coordinates (s, t), Phi = 1 - s - t, s, t). Its
-!> position is X = sum_a Phi_a X_a (3D, on the undeformed surface) and its planar coordinates
+!> position is X = sum_a Phi_a X_a (3D, on the undeformed surface), its planar coordinates
 !> y = F^T (X - X_0) (first two components; F = shell_cell_frame of the cell, X_0 its first
-!> corner); particles get planar coordinates the same way, by projection on the cell's plane
-!> (exact for flat parts, a second-order approximation of the surface's own coordinates on curved
-!> parts). Then
+!> corner) and its height z = e3 . (X - X_0); particles get planar coordinates and heights the
+!> same way. Then
 !>   Gamma vertex L of the cell:   Psi_L = Phi_L (bilinear, or linear on a triangle);
-!>   interior particle I:          Psi_I = w_I(X) p(xi_I)^T alpha,   M alpha = b,
-!>     p(xi) = [1, xi_1, xi_2], xi_I = (y_I - y) / h (h the cell's mean edge length),
-!>     M = sum_I w_I p(xi_I) p(xi_I)^T over the particles covering X,
-!>     b = sum_V Phi_V p(xi_V) over the cell's interior vertices V (= p(0) - sum_L Phi_L p(xi_L)),
+!>   interior particle I:          Psi_I = w_I(X) p_I^T alpha,   M alpha = b,
+!>     p_I = [1, xi_1, xi_2] on a flat cell, [1, xi_1, xi_2, zeta] on a curved one,
+!>     xi_I = (y_I - y) / h, zeta_I = (z_I - z) / h (h the cell's mean edge length),
+!>     M = sum_I w_I p_I p_I^T over the particles covering X,
+!>     b = sum_V Phi_V p_V over the cell's interior vertices V,
 !> so that sum_J Psi_J = 1, sum_J Psi_J y_J = y (linear reproduction) and, on a boundary edge
-!> (where every Phi_V vanishes), every particle function is exactly zero.
+!> (where every Phi_V vanishes), every particle function is exactly zero. On a curved cell (a
+!> particle or corner off its plane by more than shell_flat_tolerance h) also sum_J Psi_J z_J = z:
+!> the functions reproduce every field linear in 3D position, sum_J Psi_J X_J = X, so a rigid
+!> rotation about an in-plane axis gives no membrane strain (without the height term it did, in
+!> proportion to the slope of the fitted surface off the cell's plane: membrane locking of curved
+!> parts). Flat cells keep the three planar terms and their functions bit for bit.
 !>
 !> Kernel weights are measured in each particle's own frame from 3D positions (efg_shell_supports),
 !> so they do not depend on the evaluation cell. The solve is the solids' rank-revealing one:
-!> column-pivoted QR of the rows sqrt(w_I) p(xi_I)^T (LAPACK dgeqp3), a triangular solve with
-!> R11^T and one product with Q (dormqr); the residual |sum_I Psi_I p(xi_I) - b| is returned.
+!> column-pivoted QR of the rows sqrt(w_I) p_I^T (LAPACK dgeqp3), a triangular solve with
+!> R11^T and one product with Q (dormqr); the residual |sum_I Psi_I p_I - b| is returned.
 module efg_shell_functions
   use kinds, only: wp
   use integer_lists, only: sorted_position, sort_short_list
