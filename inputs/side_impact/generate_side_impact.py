@@ -370,7 +370,7 @@ def main(argv=None):
     parser.add_argument("--states", type=int, default=30, help="number of state intervals")
     parser.add_argument("--dx", type=float, default=1.2, help="EFG solids: normalized support DX = DY = DZ")
     parser.add_argument("--shell-dx", type=float, default=1.1,
-                        help="EFG shells: normalized support DX = DY (LS-DYNA's default 1.1; wider supports stiffen the curved jacket)")
+                        help="EFG shells: normalized support DX = DY (LS-DYNA's default 1.1)")
     parser.add_argument("--ihq", type=int, default=1, help="hourglass type of the FE solids")
     parser.add_argument("--qh", type=float, default=0.1, help="hourglass coefficient")
     parser.add_argument("--tssfac", type=float, default=0.9, help="time step scale factor")

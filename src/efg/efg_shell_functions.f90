@@ -4,23 +4,28 @@
 !>
 !> A point is given by its parametric coordinates in the cell (quadrilateral: [-1, 1]^2 with
 !> bilinear functions; triangle, N4 = N3: area coordinates (s, t), Phi = 1 - s - t, s, t). Its
-!> position is X = sum_a Phi_a X_a (3D, on the undeformed surface) and its planar coordinates
+!> position is X = sum_a Phi_a X_a (3D, on the undeformed surface), its planar coordinates
 !> y = F^T (X - X_0) (first two components; F = shell_cell_frame of the cell, X_0 its first
-!> corner); particles get planar coordinates the same way, by projection on the cell's plane
-!> (exact for flat parts, a second-order approximation of the surface's own coordinates on curved
-!> parts). Then
+!> corner) and its height z = e3 . (X - X_0); particles get planar coordinates and heights the
+!> same way. Then
 !>   Gamma vertex L of the cell:   Psi_L = Phi_L (bilinear, or linear on a triangle);
-!>   interior particle I:          Psi_I = w_I(X) p(xi_I)^T alpha,   M alpha = b,
-!>     p(xi) = [1, xi_1, xi_2], xi_I = (y_I - y) / h (h the cell's mean edge length),
-!>     M = sum_I w_I p(xi_I) p(xi_I)^T over the particles covering X,
-!>     b = sum_V Phi_V p(xi_V) over the cell's interior vertices V (= p(0) - sum_L Phi_L p(xi_L)),
+!>   interior particle I:          Psi_I = w_I(X) p_I^T alpha,   M alpha = b,
+!>     p_I = [1, xi_1, xi_2] on a flat cell, [1, xi_1, xi_2, zeta] on a curved one,
+!>     xi_I = (y_I - y) / h, zeta_I = (z_I - z) / h (h the cell's mean edge length),
+!>     M = sum_I w_I p_I p_I^T over the particles covering X,
+!>     b = sum_V Phi_V p_V over the cell's interior vertices V,
 !> so that sum_J Psi_J = 1, sum_J Psi_J y_J = y (linear reproduction) and, on a boundary edge
-!> (where every Phi_V vanishes), every particle function is exactly zero.
+!> (where every Phi_V vanishes), every particle function is exactly zero. On a curved cell (a
+!> particle or corner off its plane by more than shell_flat_tolerance h) also sum_J Psi_J z_J = z:
+!> the functions reproduce every field linear in 3D position, sum_J Psi_J X_J = X, so a rigid
+!> rotation about an in-plane axis gives no membrane strain (without the height term it did, in
+!> proportion to the slope of the fitted surface off the cell's plane: membrane locking of curved
+!> parts). Flat cells keep the three planar terms and their functions bit for bit.
 !>
 !> Kernel weights are measured in each particle's own frame from 3D positions (efg_shell_supports),
 !> so they do not depend on the evaluation cell. The solve is the solids' rank-revealing one:
-!> column-pivoted QR of the rows sqrt(w_I) p(xi_I)^T (LAPACK dgeqp3), a triangular solve with
-!> R11^T and one product with Q (dormqr); the residual |sum_I Psi_I p(xi_I) - b| is returned.
+!> column-pivoted QR of the rows sqrt(w_I) p_I^T (LAPACK dgeqp3), a triangular solve with
+!> R11^T and one product with Q (dormqr); the residual |sum_I Psi_I p_I - b| is returned.
 module efg_shell_functions
   use kinds, only: wp
   use integer_lists, only: sorted_position, sort_short_list
@@ -35,6 +40,10 @@ module efg_shell_functions
 
   !> Columns of R whose diagonal falls below this fraction of |R_11| are taken as dependent.
   real(wp), parameter, public :: shell_rank_tolerance = 1.0e-10_wp
+  !> A cell whose candidate particles and corners all lie within this fraction of h of its plane
+  !> is flat: its basis keeps the three planar terms (round-off of a flat part turned out of the
+  !> global axes is far below it).
+  real(wp), parameter, public :: shell_flat_tolerance = 1.0e-8_wp
 
   !> What the functions of one background cell need. Local nodes `nodes(1:node_count)` are the
   !> cell's Gamma vertices and the particles whose supports touch the cell, in ascending model
@@ -55,6 +64,11 @@ module efg_shell_functions
     integer, allocatable :: particle_local(:)         !< local node of each candidate particle
     real(wp), allocatable :: particle_position(:, :)  !< (3, candidates)
     real(wp), allocatable :: particle_planar(:, :)    !< (2, candidates)
+    real(wp), allocatable :: particle_height(:)       !< (candidates) e3 . (X_I - X_0), off the cell's plane
+    real(wp) :: corner_height(4) = 0.0_wp             !< e3 . (X_a - X_0) of the corners (a warped cell's)
+    !> the basis has the fourth term zeta (height off the cell's plane): some particle or corner
+    !> lies off the plane by more than shell_flat_tolerance h (a curved or warped part)
+    logical :: curved = .false.
     real(wp), allocatable :: particle_frame(:, :, :)  !< (3, 3, candidates)
     real(wp), allocatable :: particle_radius(:, :)    !< (3, candidates)
     integer, allocatable :: candidates(:)             !< particle numbers (search scratch)
@@ -134,10 +148,15 @@ contains
                                  context%candidates, candidate_count)
     context%particle_count = candidate_count
     call ensure_size(context, candidate_count)
+    do a = 1, 4
+      context%corner_height(a) = dot_product(context%positions(:, a) - context%origin, context%frame(:, 3))
+    end do
     do k = 1, candidate_count
       particle = context%candidates(k)
       context%particle_position(:, k) = supports%particle_coordinates(:, particle)
       context%particle_planar(:, k) = planar_coordinates(context, supports%particle_coordinates(:, particle))
+      context%particle_height(k) = dot_product(supports%particle_coordinates(:, particle) - context%origin, &
+                                               context%frame(:, 3))
       context%particle_frame(:, :, k) = supports%particle_frame(:, :, particle)
       context%particle_radius(:, k) = supports%particle_radius(:, particle)
     end do
@@ -150,6 +169,8 @@ contains
       gamma_corners(gamma_count) = cell_nodes(a)
     end do
     call sort_short_list(gamma_corners(1:gamma_count))
+    context%curved = any(abs(context%corner_height(1:context%corners)) > shell_flat_tolerance*context%scale_length) &
+                     .or. any(abs(context%particle_height(1:candidate_count)) > shell_flat_tolerance*context%scale_length)
 
     ! merge the two ascending lists (particle numbers ascend with their node indices)
     context%node_count = gamma_count + candidate_count
@@ -197,16 +218,18 @@ contains
     real(wp), intent(out) :: values(:)
     integer, intent(out) :: rank
     real(wp), intent(out) :: residual
-    real(wp) :: phi(4), position(3), moment(3), reproduced(3), tau(3), work(192), local(3), inverse_h
-    real(wp) :: weight(context%particle_count), shifted(3, context%particle_count)
-    real(wp) :: rows(max(context%particle_count, 1), 3), projected(max(context%particle_count, 3))
-    integer :: covering(context%particle_count), covering_count, pivot(3), info, a, i, k, n
+    real(wp) :: phi(4), position(3), moment(4), reproduced(4), tau(4), work(256), local(3), inverse_h, height
+    real(wp) :: weight(context%particle_count), shifted(4, context%particle_count)
+    real(wp) :: rows(max(context%particle_count, 1), 4), projected(max(context%particle_count, 4))
+    integer :: covering(context%particle_count), covering_count, pivot(4), info, a, i, k, n, terms
     real(wp), parameter :: origin(3) = 0.0_wp
 
     inverse_h = 1.0_wp/context%scale_length
     phi = corner_functions(context%corners, parametric)
     position = matmul(context%positions, phi)
     planar = matmul(context%planar, phi)
+    height = dot_product(context%corner_height, phi)
+    terms = merge(4, 3, context%curved)
     n = context%node_count
     values(1:n) = 0.0_wp
     rank = 0
@@ -216,14 +239,15 @@ contains
     moment = 0.0_wp
     do a = 1, context%corners
       if (context%corner_is_particle(a)) then
-        moment = moment + phi(a)*[1.0_wp, (context%planar(:, a) - planar)*inverse_h]
+        moment = moment + phi(a)*[1.0_wp, (context%planar(:, a) - planar)*inverse_h, &
+                                  (context%corner_height(a) - height)*inverse_h]
       else
         values(context%corner_local(a)) = values(context%corner_local(a)) + phi(a)
       end if
     end do
     ! b = 0 (a boundary edge, or a cell without interior vertices): every particle function is
     ! exactly zero here
-    if (all(moment == 0.0_wp)) return
+    if (all(moment(1:terms) == 0.0_wp)) return
 
     covering_count = 0
     do i = 1, context%particle_count
@@ -233,18 +257,19 @@ contains
       if (weight(i) <= 0.0_wp) cycle
       covering_count = covering_count + 1
       covering(covering_count) = i
-      shifted(:, i) = [1.0_wp, (context%particle_planar(:, i) - planar)*inverse_h]
-      rows(covering_count, :) = sqrt(weight(i))*shifted(:, i)
+      shifted(:, i) = [1.0_wp, (context%particle_planar(:, i) - planar)*inverse_h, &
+                       (context%particle_height(i) - height)*inverse_h]
+      rows(covering_count, 1:terms) = sqrt(weight(i))*shifted(1:terms, i)
     end do
     if (covering_count == 0) then
       ! only possible when the support rule is broken: report b as the residual
-      residual = maxval(abs(moment))
+      residual = maxval(abs(moment(1:terms)))
       return
     end if
 
     pivot = 0
-    call dgeqp3(covering_count, 3, rows, size(rows, 1), pivot, tau, work, size(work), info)
-    do k = 1, min(covering_count, 3)
+    call dgeqp3(covering_count, terms, rows, size(rows, 1), pivot, tau, work, size(work), info)
+    do k = 1, min(covering_count, terms)
       if (abs(rows(k, k)) <= shell_rank_tolerance*abs(rows(1, 1))) exit
       rank = k
     end do
@@ -253,16 +278,16 @@ contains
     do i = 1, rank
       projected(i) = (moment(pivot(i)) - dot_product(rows(1:i - 1, i), projected(1:i - 1)))/rows(i, i)
     end do
-    call dormqr("L", "N", covering_count, 1, min(covering_count, 3), rows, size(rows, 1), tau, projected, &
+    call dormqr("L", "N", covering_count, 1, min(covering_count, terms), rows, size(rows, 1), tau, projected, &
                 size(projected), work, size(work), info)
     reproduced = 0.0_wp
     do i = 1, covering_count
       associate (particle => covering(i))
         values(context%particle_local(particle)) = sqrt(weight(particle))*projected(i)
-        reproduced = reproduced + values(context%particle_local(particle))*shifted(:, particle)
+        reproduced(1:terms) = reproduced(1:terms) + values(context%particle_local(particle))*shifted(1:terms, particle)
       end associate
     end do
-    residual = maxval(abs(reproduced - moment))
+    residual = maxval(abs(reproduced(1:terms) - moment(1:terms)))
   end subroutine evaluate_shell_functions
 
 
@@ -276,11 +301,12 @@ contains
     if (allocated(context%particle_local)) then
       if (size(context%particle_local) >= count) return
       deallocate (context%particle_local, context%particle_position, context%particle_planar, &
-                  context%particle_frame, context%particle_radius, context%nodes)
+                  context%particle_height, context%particle_frame, context%particle_radius, context%nodes)
     end if
     capacity = max(count, 64)
     allocate (context%particle_local(capacity), context%particle_position(3, capacity), &
-              context%particle_planar(2, capacity), context%particle_frame(3, 3, capacity), &
+              context%particle_planar(2, capacity), context%particle_height(capacity), &
+              context%particle_frame(3, 3, capacity), &
               context%particle_radius(3, capacity), context%nodes(capacity + 4))
   end subroutine ensure_size
 end module efg_shell_functions

@@ -6,7 +6,7 @@ module explicit_setup
   use text_format, only: integer_text
   use fixed_order_sum, only: chunk_count
   use error_handling, only: error_t, make_error
-  use model, only: model_t, formulation_efg
+  use model, only: model_t
   use nodal_state, only: allocate_nodal_state
   use explicit_state, only: explicit_state_t
   use run_state, only: run_state_t
@@ -140,8 +140,8 @@ contains
   !> Things the user should know before the run starts, one per line (empty: nothing):
   !> segment loads are applied by the static analysis only; conditions and loads on interior
   !> particles of meshfree parts act on generalized displacements; mass scaling leaves meshfree
-  !> parts alone, and wide supports stiffen curved meshfree shells. (Rigid walls and initial
-  !> velocities act on the particles' physical values: nothing to say.)
+  !> parts alone. (Rigid walls and initial velocities act on the particles' physical values, and
+  !> wide supports no longer stiffen curved meshfree shells: nothing to say.)
   function set_up_warnings(model, state) result(text)
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(in) :: state
@@ -175,72 +175,7 @@ contains
       if (len(text) > 0) text = text//new_line('a')
       text = text//"warning: mass scaling (DT2MS) applies to finite elements only; meshfree parts keep their density"
     end if
-    ! meshfree shells: supports wider than 1.2 stiffen curved parts
-    do k = 1, size(model%parts)
-      call note_curved_meshfree_shells(k)
-    end do
   contains
-    !> A meshfree shell part with DX or DY above 1.2 whose neighbouring cells (sharing a node)
-    !> turn by more than 2 degrees: wide supports span several facets of a curved surface in each
-    !> cell's plane, which stiffens it (membrane locking; docs/efg_shells.md: a quarter ring at
-    !> DX 1.5 is still 5% too stiff with cells turning by 2.25 degrees, 17% at 4.5).
-    subroutine note_curved_meshfree_shells(part)
-      integer, intent(in) :: part
-      real(wp), parameter :: widest = 1.2_wp, pi = 3.14159265358979323846_wp
-      real(wp), allocatable :: normal(:, :)
-      integer, allocatable :: first_cell(:), next_cell(:), cells(:)
-      real(wp) :: largest
-      integer :: shell, corner, node, a, b
-      character(len=16) :: degrees
-      if (.not. allocated(model%shell_part)) return
-      if (model%parts(part)%formulation /= formulation_efg) return
-      if (maxval(model%sections(model%parts(part)%section)%support_scale(1:2)) <= widest) return
-      cells = pack([(shell, shell=1, size(model%shell_part))], model%shell_part == part)
-      if (size(cells) == 0) return
-      allocate (normal(3, size(model%shell_part)), first_cell(size(model%coordinates, 2)), &
-                next_cell(4*size(cells)))
-      first_cell = 0
-      do a = 1, size(cells)
-        shell = cells(a)
-        associate (x => model%coordinates, n => model%shell_nodes(:, shell))
-          normal(:, shell) = cross(x(:, n(3)) - x(:, n(1)), x(:, n(4)) - x(:, n(2)))
-        end associate
-        normal(:, shell) = normal(:, shell)/max(norm2(normal(:, shell)), tiny(1.0_wp))
-      end do
-      ! cells around each node as linked lists (entry 4 (a - 1) + corner)
-      do a = 1, size(cells)
-        do corner = 1, 4
-          node = model%shell_nodes(corner, cells(a))
-          next_cell(4*(a - 1) + corner) = first_cell(node)
-          first_cell(node) = 4*(a - 1) + corner
-        end do
-      end do
-      largest = 1.0_wp
-      do node = 1, size(first_cell)
-        a = first_cell(node)
-        do while (a /= 0)
-          b = next_cell(a)
-          do while (b /= 0)
-            largest = min(largest, dot_product(normal(:, cells((a - 1)/4 + 1)), normal(:, cells((b - 1)/4 + 1))))
-            b = next_cell(b)
-          end do
-          a = next_cell(a)
-        end do
-      end do
-      if (largest >= cos(2.0_wp*pi/180.0_wp)) return
-      write (degrees, '(f0.1)') acos(max(-1.0_wp, largest))*180.0_wp/pi
-      if (len(text) > 0) text = text//new_line('a')
-      text = text//"warning: part "//trim(integer_text(model%parts(part)%id))//": a curved meshfree shell part "// &
-        "(neighbouring cells turn by up to "//trim(degrees)//" degrees) with DX or DY above 1.2: wide supports "// &
-        "stiffen curved shells (membrane locking, docs/efg_shells.md); the default 1.1 does not"
-    end subroutine note_curved_meshfree_shells
-
-    pure function cross(u, v) result(w)
-      real(wp), intent(in) :: u(3), v(3)
-      real(wp) :: w(3)
-      w = [u(2)*v(3) - u(3)*v(2), u(3)*v(1) - u(1)*v(3), u(1)*v(2) - u(2)*v(1)]
-    end function cross
-
     subroutine note_particle(node)
       integer, intent(in) :: node
       if (.not. state%nodes%is_particle(node)) return

@@ -351,3 +351,22 @@ def quarter_ring_deck(path, formulation, cells, radius, width, thickness, load, 
                "*BOUNDARY_SPC_NODE\n" + "\n".join(fields(k + 1, 0, 1, 1, 1, 1, 1, 1) for k in root),
                "*LOAD_NODE_POINT\n" + "\n".join(fields(k + 1, 3, 1, float(f)) for k, f in zip(tip, share)))
     return nodes, tip
+
+
+def turning_ring_deck(path, formulation, cells, radius, width, thickness, omega, end_time, support=1.5):
+    """The quarter ring of quarter_ring_deck, free, started turning about its own axis (y, an
+    in-plane axis of every cell) at `omega` rad/ms (*INITIAL_VELOCITY_GENERATION); GLSTAT."""
+    along, across = cells
+    phi = np.linspace(0.0, np.pi / 2.0, along + 1)
+    y = np.linspace(0.0, width, across + 1)
+    nodes = round_to_node_card(np.array([[radius * np.cos(a), b, radius * np.sin(a)] for a in phi for b in y]))
+    index = lambda i, j: i * (across + 1) + j
+    shells = np.array([[index(i, j), index(i + 1, j), index(i + 1, j + 1), index(i, j + 1)]
+                       for i in range(along) for j in range(across)], dtype=int)
+    write_deck(path,
+               *common_cards("turning quarter ring", end_time, end_time, formulation, thickness, 0.0,
+                             support=support, glstat_interval=end_time / 200.0),
+               nodes_card(nodes), shells_card(shells),
+               "*INITIAL_VELOCITY_GENERATION\n" + fields(0, 2, float(omega), 0.0, 0.0, 0.0) + "\n" +
+               fields(0.0, 0.0, 0.0, 0.0, 1.0, 0.0))
+    return nodes

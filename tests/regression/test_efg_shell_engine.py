@@ -343,34 +343,3 @@ def test_spot_weld_on_meshfree_shells_fails_by_their_plastic_strain(tmp_path, ru
         assert "meshfree shells: 16 cells" in run.stdout
     assert "spot weld" not in runs["holds"].stdout
     assert "reached the plastic strain" in runs["fails"].stdout
-
-
-def test_wide_supports_on_a_curved_part_are_announced(tmp_path, run_deck):
-    """A quarter cylinder (radius 50 mm, 10 x 2 cells: 9 degrees between neighbouring cells) of
-    meshfree shells with DX 1.5 gets a warning that wide supports stiffen curved shells; with the
-    default DX (1.1), and a flat plate with DX 1.5, get none."""
-    angle = np.linspace(0.0, np.pi / 2, 11)
-    width = np.linspace(0.0, 10.0, 3)
-    nodes = np.array([[50.0 * np.cos(a), 50.0 * np.sin(a), z] for a in angle for z in width])
-    shells = np.array([[i * 3 + j, (i + 1) * 3 + j, (i + 1) * 3 + j + 1, i * 3 + j + 1]
-                       for i in range(10) for j in range(2)])
-    texts = {}
-    for name, support in (("wide", 1.5), ("default", None)):
-        deck = write_deck(
-            tmp_path / f"{name}.k",
-            "*CONTROL_TERMINATION\n" + fields(0.001),
-            "*PART\nring\n" + fields(1, 1, 1),
-            "*SECTION_SHELL\n" + fields(1, 41, 1.0, 3) + "\n" + fields(2.0, 2.0, 2.0, 2.0) + "\n" +
-            fields(support, support),
-            "*MAT_ELASTIC\n" + fields(1, DENSITY, YOUNGS, POISSON),
-            nodes_card(round_to_node_card(nodes)),
-            shells_card(shells),
-        )
-        run = run_deck(deck, jobid=name)
-        assert run.status == 0, run.stdout + run.stderr
-        texts[name] = run.stderr
-    assert ("warning: part 1: a curved meshfree shell part (neighbouring cells turn by up to 9.0 degrees) with DX "
-            "or DY above 1.2: wide supports stiffen curved shells") in texts["wide"]
-    assert "curved meshfree shell" not in texts["default"]
-    flat = run_deck(stretch_deck(tmp_path / "flat.k", end_time=0.001), jobid="flat")
-    assert flat.status == 0 and "curved meshfree shell" not in flat.stderr

@@ -2,16 +2,21 @@
 !> irregular flat quadrilateral mesh, the same with triangles mixed in, and a curved
 !> (cylindrical) patch, with the three kernels (ISPLINE 0, 1, 2):
 !> * the coupled functions at random points of every cell: partition of unity and linear
-!>   reproduction in the cell's plane (1e-12), Kronecker delta at the Gamma vertices, particle
-!>   functions exactly zero on every edge between two Gamma nodes (the boundary edges);
+!>   reproduction in the cell's plane (1e-12), and of the 3D position on the cell (1e-12: on the
+!>   cylinder too, where the basis has the height term), Kronecker delta at the Gamma vertices,
+!>   particle functions exactly zero on every edge between two Gamma nodes (the boundary edges);
 !> * the smoothed gradients of a linear field exact at every membrane/bending point and at the
-!>   shear points (1e-10); the integration constraint sum_g bbar_I(g) W_g = 0 for every interior
-!>   particle on flat meshes (1e-12 relative);
+!>   shear points (1e-10); the smoothed gradient of the 3D position equal to that of the cell's
+!>   own bilinear surface at every point (1e-10; on a flat cell its in-plane axes: a rigid
+!>   rotation gives the membrane strain of the FE shell, none on a flat cell, also on the
+!>   cylinder); the integration constraint sum_g bbar_I(g) W_g = 0 for every interior particle on
+!>   flat meshes (1e-12 relative);
 !> * sub-cell areas adding up to the cell areas and to the plate's area; row-sum masses adding up
-!>   to t A; transformation rows summing to 1 and reproducing the particle's position (flat);
+!>   to t A; transformation rows summing to 1 and reproducing the particle's 3D position;
 !> * node classes (boundary edges and extra Gamma nodes), point counts, and error messages;
-!> * identical parts for one and three threads;
-!> * the set-up seconds of a 100 x 100 plate (printed; linear in the number of cells).
+!> * identical parts for one and three threads (flat and cylinder);
+!> * the set-up seconds of a 100 x 100 plate, flat and wrapped on a cylinder (printed; linear in
+!>   the number of cells).
 !> Interior nodes are moved randomly by up to 25% of the cell size; the plate's outline stays a
 !> rectangle (2 x 1), so its area is known exactly.
 program test_efg_shell
@@ -189,8 +194,9 @@ contains
     type(shell_supports_t) :: supports
     type(particle_grid_t) :: grid
     type(shell_cell_context_t) :: context
-    real(wp), allocatable :: values(:), node_planar(:, :)
+    real(wp), allocatable :: values(:), node_planar(:, :), node_position(:, :)
     real(wp) :: parametric(2), planar(2), residual, unity, reproduction, kronecker, edge_value, worst_residual
+    real(wp) :: spatial_reproduction
     real(wp) :: corners_parametric(2, 4), fraction
     integer :: k, cell, sample, rank, a, b, n, next
     logical :: particle_on_edge
@@ -199,6 +205,7 @@ contains
     call build_particle_grid(supports%particle_coordinates, supports%search_radius, grid)
     unity = 0.0_wp
     reproduction = 0.0_wp
+    spatial_reproduction = 0.0_wp
     kronecker = 0.0_wp
     edge_value = 0.0_wp
     worst_residual = 0.0_wp
@@ -207,13 +214,15 @@ contains
       cell = supports%cells(k)
       call prepare_shell_cell(supports, grid, model%coordinates, model%shell_nodes(:, cell), context)
       n = context%node_count
-      if (allocated(values)) deallocate (values, node_planar)
-      allocate (values(n), node_planar(2, n))
+      if (allocated(values)) deallocate (values, node_planar, node_position)
+      allocate (values(n), node_planar(2, n), node_position(3, n))
       do a = 1, context%particle_count
         node_planar(:, context%particle_local(a)) = context%particle_planar(:, a)
+        node_position(:, context%particle_local(a)) = context%particle_position(:, a)
       end do
       do a = 1, context%corners
         node_planar(:, context%corner_local(a)) = context%planar(:, a)
+        node_position(:, context%corner_local(a)) = context%positions(:, a)
       end do
       if (context%corners == 3) then
         corners_parametric = reshape([0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, 1.0_wp], [2, 4])
@@ -232,6 +241,8 @@ contains
         worst_residual = max(worst_residual, residual)
         unity = max(unity, abs(sum(values) - 1.0_wp))
         reproduction = max(reproduction, maxval(abs(matmul(node_planar, values) - planar))/context%scale_length)
+        spatial_reproduction = max(spatial_reproduction, maxval(abs(matmul(node_position, values) - &
+          matmul(context%positions, corner_functions(context%corners, parametric))))/context%scale_length)
       end do
       ! corners: Kronecker delta at Gamma corners (and PU at particle corners)
       do a = 1, context%corners
@@ -259,11 +270,13 @@ contains
     end do
     write (*, '(a)') "efg_shell: "//label//": |sum Psi - 1| "//trim(real_text(unity))//", linear "// &
       "reproduction "//trim(real_text(reproduction))//", Kronecker "//trim(real_text(kronecker))// &
-      ", moment residual "//trim(real_text(worst_residual))
+      ", moment residual "//trim(real_text(worst_residual))//", 3D position "//trim(real_text(spatial_reproduction))
     call check(suite, label//": interior particles exist", size(supports%particles) > 0)
     call check(suite, label//": moment residual at round-off", worst_residual < 1.0e-12_wp, real_text(worst_residual))
     call check(suite, label//": partition of unity", unity < tight, real_text(unity))
     call check(suite, label//": linear reproduction in the cell's plane", reproduction < tight, real_text(reproduction))
+    call check(suite, label//": the 3D position on the cell reproduced", spatial_reproduction < tight, &
+               real_text(spatial_reproduction))
     call check(suite, label//": Kronecker delta at Gamma vertices", kronecker < tight, real_text(kronecker))
     call check(suite, label//": particle functions exactly zero on Gamma edges", .not. particle_on_edge, &
                real_text(edge_value))
@@ -280,7 +293,7 @@ contains
     real(wp), allocatable :: constraint(:, :), scale(:)
     integer, allocatable :: slot(:)
     real(wp) :: gradient(2), origin(3), error_gradient, error_shear, worst, value_sum, planar(2), position(3)
-    real(wp) :: transform_sum, transform_position, expected_points
+    real(wp) :: transform_sum, transform_position, expected_points, position_gradient(3, 2), error_tangent
     integer :: g, pair, c, k, j, node, points, particle
     logical :: ascending, pairs_listed
 
@@ -314,7 +327,26 @@ contains
       end do
       error_gradient = max(error_gradient, maxval(abs(gradient - field_gradient)))
     end do
-    write (*, '(a)') "efg_shell: "//label//": smoothed gradient error "//trim(real_text(error_gradient))
+    ! smoothed gradient of the 3D position: that of the cell's bilinear surface (the FE shell's;
+    ! on a flat cell its in-plane axes e1, e2, with no component along the normal), so that a
+    ! rigid rotation gives no membrane strain rate beyond the FE shell's
+    error_tangent = 0.0_wp
+    do g = 1, points
+      c = geometry%point_cell(g)
+      position_gradient = 0.0_wp
+      do pair = geometry%point_offsets(g), geometry%point_offsets(g + 1) - 1
+        position_gradient(:, 1) = position_gradient(:, 1) + &
+                                  geometry%pair_gradient(1, pair)*model%coordinates(:, geometry%pair_node(pair))
+        position_gradient(:, 2) = position_gradient(:, 2) + &
+                                  geometry%pair_gradient(2, pair)*model%coordinates(:, geometry%pair_node(pair))
+      end do
+      error_tangent = max(error_tangent, maxval(abs(position_gradient - &
+        bilinear_position_gradient(model, geometry%cells(c), geometry%cell_frame(:, :, c), g - first_point(geometry, c) + 1))))
+    end do
+    write (*, '(a)') "efg_shell: "//label//": smoothed gradient error "//trim(real_text(error_gradient))// &
+      ", position gradient against the cell surface's "//trim(real_text(error_tangent))
+    call check(suite, label//": smoothed gradient of the position is the cell surface's", &
+               error_tangent < 1.0e-10_wp, real_text(error_tangent))
     call check(suite, label//": smoothed gradients of a linear field exact at every point", error_gradient < 1.0e-10_wp, &
                real_text(error_gradient))
     ! shear points: values reproduce the field at the centre, gradients exact
@@ -388,7 +420,8 @@ contains
                            real_text(worst))
     end block
 
-    ! transformation rows: sum to 1; on flat plates they reproduce the particle's position
+    ! transformation rows: sum to 1 and reproduce the particle's 3D position (the height term of
+    ! the basis on the cylinder)
     transform_sum = 0.0_wp
     transform_position = 0.0_wp
     call check(suite, label//": one transformation row per particle", &
@@ -405,8 +438,8 @@ contains
       transform_position = max(transform_position, norm2(position - model%coordinates(:, particle)))
     end do
     call check(suite, label//": transformation rows sum to 1", transform_sum < tight, real_text(transform_sum))
-    if (flat) call check(suite, label//": transformation rows reproduce the particle's position", &
-                         transform_position < tight, real_text(transform_position))
+    call check(suite, label//": transformation rows reproduce the particle's position", &
+               transform_position < tight, real_text(transform_position))
 
     ! edge midpoint rows (the transverse shear's Simpson rule): sum to 1, reproduce the midpoint
     block
@@ -439,10 +472,62 @@ contains
       write (*, '(a)') "efg_shell: "//label//": edge midpoint rows: sum - 1 "//trim(real_text(midpoint_sum))// &
         ", position "//trim(real_text(midpoint_position))
       call check(suite, label//": edge midpoint rows sum to 1", midpoint_sum < tight, real_text(midpoint_sum))
-      if (flat) call check(suite, label//": edge midpoint rows reproduce the midpoint", midpoint_position < tight, &
-                           real_text(midpoint_position))
+      call check(suite, label//": edge midpoint rows reproduce the midpoint", midpoint_position < tight, &
+                 real_text(midpoint_position))
     end block
   end subroutine check_part
+
+  !> Index of the first point of cell c.
+  pure integer function first_point(geometry, c)
+    type(efg_shell_part_t), intent(in) :: geometry
+    integer, intent(in) :: c
+    first_point = findloc(geometry%point_cell, c, dim=1)
+  end function first_point
+
+  !> Smoothed gradient (in the cell's plane) of the cell's own bilinear (or linear) surface
+  !> X(xi) = sum_a Phi_a X_a over sub-cell g: (1 / W_g) sum over its edges of X n_e L_e, two
+  !> Gauss points per edge, the set-up's rule with the FE functions.
+  function bilinear_position_gradient(model, cell, frame, g) result(gradient)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: cell, g
+    real(wp), intent(in) :: frame(3, 3)
+    real(wp) :: gradient(3, 2)
+    real(wp) :: parametric(2, 4), polygon(2, 4), corners(3, 4), planar(2, 4), edge(2), area, point(2)
+    integer :: n, e, q, next, previous
+    real(wp), parameter :: fraction(2) = [0.5_wp - 0.5_wp/sqrt(3.0_wp), 0.5_wp + 0.5_wp/sqrt(3.0_wp)]
+    n = corner_count(model%shell_nodes(:, cell))
+    corners = model%coordinates(:, model%shell_nodes(:, cell))
+    if (n == 3) then
+      parametric = reshape([0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, 1.0_wp], [2, 4])
+    else
+      parametric = reshape([-1.0_wp, -1.0_wp, 1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp, 1.0_wp], [2, 4])
+    end if
+    next = modulo(g, n) + 1
+    previous = modulo(g - 2, n) + 1
+    polygon(:, 1) = parametric(:, g)
+    polygon(:, 2) = 0.5_wp*(parametric(:, g) + parametric(:, next))
+    polygon(:, 3) = sum(parametric(:, 1:n), dim=2)/n
+    polygon(:, 4) = 0.5_wp*(parametric(:, g) + parametric(:, previous))
+    do e = 1, 4
+      planar(:, e) = matmul(transpose(frame(:, 1:2)), matmul(corners, corner_functions(n, polygon(:, e))) - corners(:, 1))
+    end do
+    area = 0.0_wp
+    do e = 1, 4
+      next = modulo(e, 4) + 1
+      area = area + 0.5_wp*(planar(1, e)*planar(2, next) - planar(2, e)*planar(1, next))
+    end do
+    gradient = 0.0_wp
+    do e = 1, 4
+      next = modulo(e, 4) + 1
+      edge = planar(:, next) - planar(:, e)
+      do q = 1, 2
+        point = polygon(:, e) + fraction(q)*(polygon(:, next) - polygon(:, e))
+        gradient(:, 1) = gradient(:, 1) + 0.5_wp*edge(2)*matmul(corners, corner_functions(n, point))
+        gradient(:, 2) = gradient(:, 2) - 0.5_wp*edge(1)*matmul(corners, corner_functions(n, point))
+      end do
+    end do
+    gradient = gradient/area
+  end function bilinear_position_gradient
 
   !> The linear field of cell c's plane at `position`: c + g . y, y the projection on e1, e2.
   pure real(wp) function field_value(geometry, c, origin, position)
@@ -545,23 +630,28 @@ contains
     type(efg_shell_part_t) :: single, several
     type(error_t), allocatable :: error
     logical, allocatable :: extra(:)
-    integer :: threads
-    model = plate_model(12, 9, .true., 0.0_wp, kernel_quadratic_box, [1.3_wp, 1.2_wp])
-    allocate (extra(size(model%coordinates, 2)))
-    extra = .false.
-    threads = omp_get_max_threads()
-    call omp_set_num_threads(1)
-    call build_efg_shell_part(model, 1, extra, single, error)
-    call omp_set_num_threads(3)
-    call build_efg_shell_part(model, 1, extra, several, error)
-    call omp_set_num_threads(threads)
-    call check(suite, "threads: 1 and 3 threads give identical parts", &
-               all(single%point_offsets == several%point_offsets) .and. all(single%pair_node == several%pair_node) &
-               .and. all(single%pair_gradient == several%pair_gradient) .and. &
-               all(single%shear_value == several%shear_value) .and. &
-               all(single%shear_gradient == several%shear_gradient) .and. &
-               all(single%mass_volume == several%mass_volume) .and. &
-               all(single%transform_value == several%transform_value))
+    integer :: threads, shape
+    real(wp), parameter :: radii(2) = [0.0_wp, 1.5_wp]       ! flat, and on a cylinder (curved cells)
+    character(len=*), parameter :: names(2) = ["flat    ", "cylinder"]
+    do shape = 1, 2
+      model = plate_model(12, 9, .true., radii(shape), kernel_quadratic_box, [1.3_wp, 1.2_wp])
+      if (allocated(extra)) deallocate (extra)
+      allocate (extra(size(model%coordinates, 2)))
+      extra = .false.
+      threads = omp_get_max_threads()
+      call omp_set_num_threads(1)
+      call build_efg_shell_part(model, 1, extra, single, error)
+      call omp_set_num_threads(3)
+      call build_efg_shell_part(model, 1, extra, several, error)
+      call omp_set_num_threads(threads)
+      call check(suite, "threads ("//trim(names(shape))//"): 1 and 3 threads give identical parts", &
+                 all(single%point_offsets == several%point_offsets) .and. all(single%pair_node == several%pair_node) &
+                 .and. all(single%pair_gradient == several%pair_gradient) .and. &
+                 all(single%shear_value == several%shear_value) .and. &
+                 all(single%shear_gradient == several%shear_gradient) .and. &
+                 all(single%mass_volume == several%mass_volume) .and. &
+                 all(single%transform_value == several%transform_value))
+    end do
   end subroutine test_thread_counts
 
   !> Set-up of a 100 x 100 plate: its seconds are printed (tests never assert wall-clock time;
@@ -583,6 +673,14 @@ contains
     write (*, '(a)') trim(line)
     call check(suite, "100 x 100 plate: at most 25 pairs per point", &
                maxval(geometry%point_offsets(2:) - geometry%point_offsets(:size(geometry%point_offsets) - 1)) <= 25)
+    ! the same wrapped on a cylinder (radius 1.5, the plate's length turns by 76 degrees): the
+    ! basis has its height term in every cell
+    model = plate_model(100, 100, .false., 1.5_wp, kernel_cubic_box, [1.1_wp, 1.1_wp])
+    call build_efg_shell_part(model, 1, extra, geometry, error)
+    call check(suite, "100 x 100 cylinder: set-up succeeds", .not. allocated(error))
+    write (line, '(a,f0.3,a,i0,a)') "efg_shell: 100 x 100 cylinder set-up ", geometry%setup_seconds, " s (", &
+      geometry%point_offsets(size(geometry%point_offsets)) - 1, " pairs)"
+    write (*, '(a)') trim(line)
   end subroutine test_setup_time
 
   function real_text(value) result(text)
