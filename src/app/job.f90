@@ -125,6 +125,12 @@ contains
       call set_up_restart_control(restart, model, settings%output_dir, settings%job_id, settings%deck, sources, &
                                   started)
       call run_explicit(model, run, results, summary, error, restart)
+      ! what the run printed while it went (already on the terminal): all of it into messag, its
+      ! warnings into /run/warnings as well
+      if (allocated(run%state%messages%text)) then
+        messages = messages//run%state%messages%text
+        warning_lines = warning_lines//warnings_among(run%state%messages%text)
+      end if
     end if
 
     summary%wall_s = seconds_now() - started
@@ -175,6 +181,21 @@ contains
   !> Print a warning or error on the terminal (standard error) after what standard output
   !> holds so far, so that a log of both reads in the order things happened, and keep it for
   !> messag.
+  !> The lines of `text` (each ended by a new line) that are warnings.
+  function warnings_among(text) result(lines)
+    character(len=*), intent(in) :: text
+    character(len=:), allocatable :: lines
+    integer :: start, finish
+    lines = ""
+    start = 1
+    do while (start <= len(text))
+      finish = index(text(start:), new_line("a")) + start - 1
+      if (finish < start) finish = len(text) + 1
+      if (index(text(start:finish - 1), "warning") == 1) lines = lines//text(start:finish - 1)//new_line("a")
+      start = finish + 1
+    end do
+  end function warnings_among
+
   subroutine report(text, messages)
     character(len=*), intent(in) :: text
     character(len=:), allocatable, intent(inout) :: messages

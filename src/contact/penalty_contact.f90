@@ -30,6 +30,7 @@
 !> in pair order. Results are bit-identical for any thread count; no atomics.
 module penalty_contact
   use kinds, only: wp
+  use message_log, only: message_log_t, log_message
   use error_handling, only: error_t, make_error
   use model, only: model_t, contact_t, contact_surface_t, contact_nodes_to_surface, &
                    contact_surface_to_surface, contact_single_surface, surface_segment_set, &
@@ -481,10 +482,11 @@ contains
   !> One warning line per contact whose first evaluation found penetrating nodes (then never
   !> again): how many (over its passes), the deepest and where. Their initial penetration is
   !> ignored.
-  subroutine report_initial_penetrations(model, contacts, time)
+  subroutine report_initial_penetrations(model, contacts, time, log)
     type(model_t), intent(in) :: model
     type(contact_state_t), intent(inout) :: contacts(:)
     real(wp), intent(in) :: time
+    type(message_log_t), intent(inout) :: log
     character(len=300) :: text
     integer :: k, p, count, node
     real(wp) :: deepest
@@ -509,7 +511,7 @@ contains
       write (text, '(a,i0,a,i0,a,es10.3,a,i0,a,es10.3,a)') "warning: contact ", model%contacts(k)%id, ": ", &
         count, " node(s) penetrate at the first contact check (t = ", time, "), the deepest node ", &
         model%node_ids(node), " by ", deepest, "; these initial penetrations are ignored (as LS-DYNA's IGNORE = 1)"
-      write (*, '(a)') trim(text)
+      call log_message(log, trim(text))
     end do
   end subroutine report_initial_penetrations
 

@@ -69,7 +69,7 @@ contains
         model%solid_ids(now_worst_element), " (part ", model%parts(model%solid_part(now_worst_element))%id, &
         "), has a corner Jacobian ratio of ", now_worst_ratio, &
         ". Their one-point volumes stay positive and hourglass forces hold them: results there are not reliable"
-      write (*, '(a)') trim(text)
+      distortion%message = trim(text)
       distortion%reported = distortion%tangled
     end if
   end subroutine check_solid_distortion

@@ -36,6 +36,9 @@ module element_group
     integer :: reported = 0                 !< the count of the last warning
     real(wp) :: worst_ratio = 1.0_wp        !< smallest corner Jacobian ratio of any check
     integer :: worst_element = 0            !< its element (0: none)
+    !> the warning of the last check that found more folded elements than before ("" none);
+    !> the solver prints and keeps it
+    character(len=:), allocatable :: message
   end type distortion_t
 
   !> The element fields of one output state, filled by the groups (each writes its elements'

@@ -22,6 +22,7 @@
 !> between, is driven from above (app/explicit_run): the physics does not know the files.
 module explicit_solver
   use kinds, only: wp
+  use message_log, only: log_message
   use fixed_order_sum, only: sum_chunk_size, sum_in_order
   use error_handling, only: error_t
   use model, only: model_t
@@ -175,8 +176,8 @@ contains
       elements = state%groups(k)%group%newly_eroded_elements()
       write (time_text, '(es12.5)') state%time
       do n = 1, size(elements)
-        write (*, '(a)') state%groups(k)%group%describe(model, elements(n))//" failed at time "// &
-          trim(adjustl(time_text))//", cycle "//integer_text(state%cycle)
+        call log_message(state%messages, state%groups(k)%group%describe(model, elements(n))//" failed at time "// &
+                         trim(adjustl(time_text))//", cycle "//integer_text(state%cycle))
       end do
     end do
     ! the contacts drop the eroded elements' segments before their forces of this cycle
@@ -317,7 +318,7 @@ contains
     end if
     call advance_spot_welds(model, state%welds, state%time, step, average_step, state%nodes%coordinates, &
                             state%nodes%angular_acceleration, state%nodes%rotary_inertia, state%nodes%velocity, &
-                            state%nodes%angular_velocity, state%weld_node_plastic_strain)
+                            state%nodes%angular_velocity, state%weld_node_plastic_strain, state%messages)
   end subroutine move_rigid_bodies
 
   !> The nodes of failed welds are free (drilling constraint included) from the step after the
@@ -380,7 +381,7 @@ contains
       end do
     end if
     state%energy%contact = state%energy%contact + work
-    call report_initial_penetrations(model, state%contacts, state%time)
+    call report_initial_penetrations(model, state%contacts, state%time, state%messages)
   end subroutine contact_forces
 
   !> The physical positions and velocities of every node for the contacts: the solver's values,
@@ -521,7 +522,9 @@ contains
     if (.not. clock_is_due(run%plan%states, run%state%time, last)) return
     call start_phase(run%timers(phase_checks))
     do k = 1, size(run%state%groups)
+      run%distortion%message = ""
       call run%state%groups(k)%group%check_distortion(model, run%state%nodes, run%state%time, run%distortion)
+      if (len(run%distortion%message) > 0) call log_message(run%state%messages, run%distortion%message)
     end do
     call stop_phase(run%timers(phase_checks))
   end subroutine check_distortion

@@ -5,6 +5,7 @@
 !> everything the next cycle needs and nothing the deck already holds.
 module explicit_state
   use kinds, only: wp
+  use message_log, only: message_log_t
   use nodal_state, only: nodal_state_t
   use element_group, only: group_holder_t
   use rigid_body_state, only: rigid_body_state_t
@@ -49,6 +50,8 @@ module explicit_state
   end type run_watch_t
 
   type :: explicit_state_t
+    !> what the run printed while it went (messag, /run/warnings; not in restart dumps)
+    type(message_log_t) :: messages
     ! the clock
     integer :: cycle = 0
     real(wp) :: time = 0.0_wp

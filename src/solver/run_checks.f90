@@ -21,6 +21,7 @@
 module run_checks
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp
+  use message_log, only: log_message
   use text_format, only: integer_text
   use error_handling, only: error_t, make_error
   use model, only: model_t, law_null
@@ -297,10 +298,10 @@ contains
       end if
       fraction = step/watch%first_time_step
       if (fraction < 0.1_wp**(watch%step_decades_reported + 1)) then
-        write (*, '(a)') "warning: t = "//real_text(state%time)//": the time step "//real_text(step)// &
-          " has fallen to "//real_text(fraction)//" times the first step "//real_text(watch%first_time_step)// &
-          " ("//step_setter(model, state)//"); *CONTROL_TERMINATION DTMIN stops a run whose step falls below "// &
-          "a fraction of the first one"
+        call log_message(state%messages, "warning: t = "//real_text(state%time)//": the time step "// &
+          real_text(step)//" has fallen to "//real_text(fraction)//" times the first step "// &
+          real_text(watch%first_time_step)//" ("//step_setter(model, state)//"); *CONTROL_TERMINATION DTMIN "// &
+          "stops a run whose step falls below a fraction of the first one")
         watch%step_decades_reported = min(int(-log10(fraction)), 300)
       end if
     end associate

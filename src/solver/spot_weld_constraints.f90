@@ -17,6 +17,7 @@
 !> depend on the thread count. Failures are printed after the loop in weld order.
 module spot_weld_constraints
   use kinds, only: wp
+  use message_log, only: message_log_t, log_message
   use model, only: model_t
   use rigid_body_state, only: rigid_body_state_t
   use rigid_bodies, only: set_up_body, advance_body
@@ -91,7 +92,7 @@ contains
   !> `velocity` holds v^{n+1/2} after the ordinary update; `angular_velocity` of weld nodes with
   !> rotary inertia follows the weld. Failures are printed.
   subroutine advance_spot_welds(model, welds, time, dt, average_dt, coordinates, angular_acceleration, &
-                                rotary_inertia, velocity, angular_velocity, node_plastic_strain)
+                                rotary_inertia, velocity, angular_velocity, node_plastic_strain, log)
     type(model_t), intent(in) :: model
     type(spot_weld_state_t), intent(inout) :: welds(:)
     real(wp), intent(in) :: time, dt, average_dt
@@ -100,6 +101,7 @@ contains
     !> fails by plastic strain (EP / EPSF)
     real(wp), intent(in) :: node_plastic_strain(:)
     real(wp), intent(inout) :: velocity(:, :), angular_velocity(:, :)
+    type(message_log_t), intent(inout) :: log     !< a weld's failure is printed and kept
     real(wp) :: work, force(3), axis(3), value
     logical :: was_failed
     integer :: w, k
@@ -163,7 +165,7 @@ contains
             node_list(model, given%nodes), ") fails at t = ", time, ": normal force ", weld%normal_force, &
             ", shear force ", weld%shear_force, " (its strengths SN, SS reached)"
         end if
-        write (*, '(a)') trim(text)
+        call log_message(log, trim(text))
       end associate
     end do
   end subroutine advance_spot_welds

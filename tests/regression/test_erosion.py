@@ -114,6 +114,9 @@ def test_solid_bar_erodes_at_the_failure_strain_of_mat_003(tmp_path, run_deck, f
     for kind, _, time, _ in eroded:
         assert kind == "solid"
         assert abs(time - expected) < 5e-3 * expected
+    # messag, beside the results, lists the same failures in the same order as the terminal
+    messag = (run.results.parent / "messag").read_text()
+    assert FAILURE_LINE.findall(messag) == FAILURE_LINE.findall(run.stdout)
     with run.open() as results:
         glstat = check_energy_balance(results)
         count = glstat["eroded_elements"][...]
