@@ -73,6 +73,8 @@ module results_file
                          clear_system_error, system_error_number, system_error_text, &
                          error_no_space, error_quota_exceeded
   use file_lock, only: file_lock_t, acquire_file_lock, release_file_lock
+  use d3plot_file, only: d3plot_file_t, open_d3plot, write_d3plot_state, close_d3plot, d3plot_base_name, &
+                         default_file_scale
   implicit none
   private
 
@@ -92,6 +94,7 @@ module results_file
     character(len=:), allocatable :: xdmf_path    !< DIR/JOBID.xdmf
     character(len=:), allocatable :: h5_name      !< JOBID.h5, as the XDMF refers to it
     type(file_lock_t) :: lock                     !< held on DIR/JOBID.lock while open
+    type(d3plot_file_t) :: d3plot                 !< LS-DYNA's d3plot beside it, with the same states
     !> A random number written to /run as `run_id` when the file is created; a restart dump
     !> records it, and a restart continues only the file of the run that wrote the dump.
     integer(long_int) :: run_id = 0
@@ -148,13 +151,15 @@ contains
   !> Lock `directory/job_id.lock`, create `directory/job_id.h5` (replacing an earlier file)
   !> and write `/mesh` and `/run` (status "running"). The directory must exist. On a failure
   !> nothing stays open or locked, and a half-written file is removed.
-  subroutine open_results(results, directory, job_id, model, threads, error)
+  subroutine open_results(results, directory, job_id, model, threads, error, d3plot_scale)
     type(results_file_t), intent(inout) :: results
     character(len=*), intent(in) :: directory   !< output directory ("" for the current one)
     character(len=*), intent(in) :: job_id      !< base name of the files, e.g. "results"
     type(model_t), intent(in) :: model
     integer, intent(in) :: threads              !< OpenMP threads of the run
     type(error_t), allocatable, intent(out) :: error
+    !> d3plot family file size in multiples of 512^2 words (x=; default LS-DYNA's 7)
+    integer, intent(in), optional :: d3plot_scale
     type(error_t), allocatable :: space_error
     integer(hid_t) :: access_list
     integer :: status, ignored
@@ -248,6 +253,15 @@ contains
         end if
       end if
     end if
+    ! LS-DYNA's d3plot beside it, with every state written here
+    if (.not. allocated(error)) then
+      if (present(d3plot_scale)) then
+        call open_d3plot(results%d3plot, join_path(directory, d3plot_base_name(job_id)), model, d3plot_scale, error)
+      else
+        call open_d3plot(results%d3plot, join_path(directory, d3plot_base_name(job_id)), model, default_file_scale, &
+                         error)
+      end if
+    end if
     if (allocated(error)) then
       ! Abandoned, not closed (a close would flush into a file that cannot take it), and
       ! removed: it holds no result.
@@ -276,7 +290,7 @@ contains
   subroutine write_state(results, time, displacement, velocity, solid_stress, &
                          solid_plastic_strain, error, shell_stress, shell_plastic_strain, shell_stress_peak, &
                          shell_plastic_strain_peak, histories, beam_resultant, beam_plastic_strain, beam_failed, &
-                         solid_eroded, shell_eroded, eroded_count)
+                         solid_eroded, shell_eroded, eroded_count, acceleration, globals)
     type(results_file_t), intent(inout) :: results
     real(wp), intent(in) :: time
     ! Contiguous: the solver's whole arrays go to HDF5 without a copy.
@@ -293,6 +307,9 @@ contains
     !> deleted-element flags (1: eroded) and the count of eroded elements (explicit runs)
     integer, intent(in), contiguous, optional :: solid_eroded(:), shell_eroded(:)
     integer, intent(in), optional :: eroded_count
+    !> for the d3plot only: (3, nodes) accelerations (absent: 0), and its global values
+    !> (kinetic, internal, total energy, velocity (3), per part internal then kinetic energy)
+    real(wp), intent(in), contiguous, optional :: acceleration(:, :), globals(:)
     real(wp) :: no_shell_stress(6, 0), no_shell_strain(0)
     real(wp), allocatable :: grown(:)
     type(error_t), allocatable :: space_error
@@ -408,8 +425,58 @@ contains
     results%state_count = results%state_count + 1
     results%state_times(results%state_count) = time
 
+    if (results%d3plot%is_open) then
+      call write_d3plot(results%d3plot, time, displacement, velocity, solid_stress, solid_plastic_strain, error, &
+                        shell_stress, shell_plastic_strain, beam_resultant, beam_failed, solid_eroded, shell_eroded, &
+                        acceleration, globals)
+      if (allocated(error)) return
+    end if
     if (xdmf_due(results)) call write_xdmf_now(results, error)
   end subroutine write_state
+
+  !> The state just written to results.h5, into the d3plot (what results.h5 does not have is
+  !> written as 0: the accelerations and global values of a static state).
+  subroutine write_d3plot(plot, time, displacement, velocity, solid_stress, solid_plastic_strain, error, &
+                          shell_stress, shell_plastic_strain, beam_resultant, beam_failed, solid_eroded, shell_eroded, &
+                          acceleration, globals)
+    type(d3plot_file_t), intent(inout) :: plot
+    real(wp), intent(in) :: time
+    real(wp), intent(in) :: displacement(:, :), velocity(:, :), solid_stress(:, :), solid_plastic_strain(:)
+    type(error_t), allocatable, intent(out) :: error
+    real(wp), intent(in), optional :: shell_stress(:, :), shell_plastic_strain(:)
+    real(wp), intent(in), optional :: beam_resultant(:, :), beam_failed(:)
+    integer, intent(in), optional :: solid_eroded(:), shell_eroded(:)
+    real(wp), intent(in), optional :: acceleration(:, :), globals(:)
+    real(wp), allocatable :: layer_stress(:, :, :), layer_strain(:, :), resultant(:, :), global_values(:)
+    real(wp), allocatable :: node_acceleration(:, :)
+
+    associate (layout => plot%layout)
+      allocate (layer_stress(6, layout%shell_layers, layout%shell_count), source=0.0_wp)
+      allocate (layer_strain(layout%shell_layers, layout%shell_count), source=0.0_wp)
+      ! results.h5 keeps the mid-surface values: one layer
+      if (present(shell_stress) .and. layout%shell_count > 0) then
+        layer_stress(:, 1, :) = shell_stress
+        layer_strain(1, :) = shell_plastic_strain
+      end if
+      allocate (resultant(6, layout%beam_count), source=0.0_wp)
+      if (present(beam_resultant) .and. layout%beam_count > 0) resultant = beam_resultant
+      allocate (global_values(layout%global_count), source=0.0_wp)
+      if (present(globals)) global_values = globals(1:layout%global_count)
+      allocate (node_acceleration(3, layout%node_count), source=0.0_wp)
+      if (present(acceleration)) node_acceleration = acceleration
+    end associate
+    if (present(beam_failed)) then
+      if (size(beam_failed) /= plot%layout%beam_count) then
+        call write_d3plot_state(plot, time, global_values, displacement, velocity, node_acceleration, solid_stress, &
+                                solid_plastic_strain, layer_stress, layer_strain, resultant, error, solid_eroded, &
+                                shell_eroded)
+        return
+      end if
+    end if
+    call write_d3plot_state(plot, time, global_values, displacement, velocity, node_acceleration, solid_stress, &
+                            solid_plastic_strain, layer_stress, layer_strain, resultant, error, solid_eroded, &
+                            shell_eroded, beam_failed)
+  end subroutine write_d3plot
 
   !> Add the history rows recorded since the previous call (each series as
   !> `/history/<group>/<column>`), and flush. Rows already in the file are not written again;
@@ -459,6 +526,7 @@ contains
     integer :: status
     logical :: failed_before
 
+    call close_d3plot(results%d3plot)
     if (.not. results%is_open) return
     ! a failure that happens first here has no run error to report it: keep its reason
     failed_before = results%failed

@@ -1,0 +1,125 @@
+!> What one state of LS-DYNA's d3plot database holds, and in which order: the layout of a
+!> state (counts and the values per node and element, as the control words of the header say
+!> them) and the assembly of one state's 32-bit words from crashfree's double-precision results.
+!>
+!> A state is, in LS-DYNA's order (d3plot database manual, "STATE DATA"): the time; NGLBV
+!> global values; the nodes' current coordinates (IU), velocities (IV) and accelerations (IA);
+!> per solid NV3D values (stress xx yy zz xy yz zx, effective plastic strain); per beam NV1D
+!> values (axial force, shear s, shear t, bending moment s, bending moment t, torsion); per
+!> shell NV2D values (per layer of MAXINT: stress xx yy zz xy yz zx, effective plastic
+!> strain); and the deletion flags of the solids, shells and beams (1.0 in the model, 0.0
+!> deleted), which LS-DYNA writes when MAXINT is given as -(MAXINT + 10000).
+module d3plot_states
+  use, intrinsic :: iso_fortran_env, only: real32, int64
+  use kinds, only: wp
+  implicit none
+  private
+
+  public :: d3plot_layout_t, state_word_count, fill_state_words
+
+  !> The sizes of a state, fixed when the database is opened.
+  type :: d3plot_layout_t
+    integer :: node_count = 0     !< NUMNP
+    integer :: solid_count = 0    !< NEL8
+    integer :: shell_count = 0    !< NEL4
+    integer :: beam_count = 0     !< NEL2
+    integer :: part_count = 0     !< NMMAT
+    integer :: shell_layers = 1   !< MAXINT: through-thickness points written per shell
+    integer :: global_count = 0   !< NGLBV: 6 + 2 per part (internal, kinetic energy)
+    integer :: solid_values = 7   !< NV3D
+    integer :: beam_values = 6    !< NV1D
+    integer :: shell_values = 7   !< NV2D = MAXINT * 7
+  end type d3plot_layout_t
+
+contains
+
+  !> Words of one state (the time word included).
+  pure function state_word_count(layout) result(words)
+    type(d3plot_layout_t), intent(in) :: layout
+    integer(int64) :: words
+    words = 1_int64 + layout%global_count + 9_int64*layout%node_count + &
+            int(layout%solid_values, int64)*layout%solid_count + &
+            int(layout%beam_values, int64)*layout%beam_count + &
+            int(layout%shell_values, int64)*layout%shell_count + &
+            int(layout%solid_count + layout%shell_count + layout%beam_count, int64)
+  end function state_word_count
+
+  !> The words of one state into `words` (size state_word_count). `globals` are the NGLBV
+  !> global values; `coordinates`, `velocity`, `acceleration` (3, nodes) the physical nodal
+  !> values; `shell_stress` (6, MAXINT, shells) and `shell_plastic_strain` (MAXINT, shells) the
+  !> layers; `beam_resultant` (6, beams) in crashfree's order N, Q_s, Q_t, T, M_s, M_t; the
+  !> eroded flags 1 for an element out of the model (absent: none is).
+  subroutine fill_state_words(layout, time, globals, coordinates, velocity, acceleration, solid_stress, &
+                              solid_plastic_strain, shell_stress, shell_plastic_strain, beam_resultant, words, &
+                              solid_eroded, shell_eroded, beam_failed)
+    type(d3plot_layout_t), intent(in) :: layout
+    real(wp), intent(in) :: time
+    real(wp), intent(in) :: globals(:)
+    real(wp), intent(in) :: coordinates(:, :), velocity(:, :), acceleration(:, :)
+    real(wp), intent(in) :: solid_stress(:, :), solid_plastic_strain(:)
+    real(wp), intent(in) :: shell_stress(:, :, :), shell_plastic_strain(:, :)
+    real(wp), intent(in) :: beam_resultant(:, :)
+    real(real32), intent(out) :: words(:)
+    integer, intent(in), optional :: solid_eroded(:), shell_eroded(:)
+    real(wp), intent(in), optional :: beam_failed(:)
+    integer(int64) :: next
+    integer :: node, element, layer
+    ! LS-DYNA's beam resultant order from crashfree's (N, Q_s, Q_t, T, M_s, M_t)
+    integer, parameter :: beam_order(6) = [1, 2, 3, 5, 6, 4]
+
+    words = 0.0_real32
+    words(1) = real(time, real32)
+    next = 2
+    words(next:next + layout%global_count - 1) = real(globals(1:layout%global_count), real32)
+    next = next + layout%global_count
+    do node = 1, layout%node_count
+      words(next:next + 2) = real(coordinates(:, node), real32)
+      next = next + 3
+    end do
+    do node = 1, layout%node_count
+      words(next:next + 2) = real(velocity(:, node), real32)
+      next = next + 3
+    end do
+    do node = 1, layout%node_count
+      words(next:next + 2) = real(acceleration(:, node), real32)
+      next = next + 3
+    end do
+    do element = 1, layout%solid_count
+      words(next:next + 5) = real(solid_stress(:, element), real32)
+      words(next + 6) = real(solid_plastic_strain(element), real32)
+      next = next + layout%solid_values
+    end do
+    do element = 1, layout%beam_count
+      words(next:next + 5) = real(beam_resultant(beam_order, element), real32)
+      next = next + layout%beam_values
+    end do
+    do element = 1, layout%shell_count
+      do layer = 1, layout%shell_layers
+        words(next:next + 5) = real(shell_stress(:, layer, element), real32)
+        words(next + 6) = real(shell_plastic_strain(layer, element), real32)
+        next = next + 7
+      end do
+    end do
+    ! deletion flags: solids, (thick shells: none), shells, beams
+    words(next:next + layout%solid_count - 1) = 1.0_real32
+    if (present(solid_eroded)) then
+      do element = 1, layout%solid_count
+        if (solid_eroded(element) /= 0) words(next + element - 1) = 0.0_real32
+      end do
+    end if
+    next = next + layout%solid_count
+    words(next:next + layout%shell_count - 1) = 1.0_real32
+    if (present(shell_eroded)) then
+      do element = 1, layout%shell_count
+        if (shell_eroded(element) /= 0) words(next + element - 1) = 0.0_real32
+      end do
+    end if
+    next = next + layout%shell_count
+    words(next:next + layout%beam_count - 1) = 1.0_real32
+    if (present(beam_failed)) then
+      do element = 1, layout%beam_count
+        if (beam_failed(element) > 0.5_wp) words(next + element - 1) = 0.0_real32
+      end do
+    end if
+  end subroutine fill_state_words
+end module d3plot_states
