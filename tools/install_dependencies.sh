@@ -18,7 +18,7 @@ if ((${#missing[@]})); then
 fi
 
 python=${PYTHON:-python3}
-if ! "$python" -c "import numpy, h5py, matplotlib, pytest" 2>/dev/null; then
+if ! "$python" -c "import numpy, h5py, matplotlib, pytest, lasso.dyna" 2>/dev/null; then
   echo "crashfree: installing Python packages from postproc/requirements.txt"
   "$python" -m pip install -q -r postproc/requirements.txt 2>/dev/null \
     || "$python" -m pip install -q --break-system-packages -r postproc/requirements.txt

@@ -85,7 +85,8 @@ contains
       call continue_restart_results(restart, results, settings%output_dir, settings%job_id, model, summary%threads, &
                                     error)
     else
-      call open_results(results, settings%output_dir, settings%job_id, model, summary%threads, error)
+      call open_results(results, settings%output_dir, settings%job_id, model, summary%threads, error, &
+                        d3plot_scale=settings%binary_file_scale)
     end if
     if (allocated(error)) then
       write (error_unit, '(a)') "crashfree: "//error%message

@@ -1,0 +1,251 @@
+"""LS-DYNA's d3plot database beside results.h5, read by lasso-python (docs/output.md, d3plot).
+
+Every test opens the d3plot of a run with lasso-python's D3plot and compares it with the run's
+results.h5: node count and ids, element ids, connectivity, part ids and titles, the time of
+every state, the current coordinates (reference + displacement), velocities, stresses and
+plastic strains at every state. d3plot stores 32-bit floats, so values agree to single
+precision: 1e-6 of the largest value of the field (coordinates: of the model's size). The
+global energies agree with glstat at the same times; eroded elements carry LS-DYNA's deleted
+flag; family files (d3plot01, ...) past the size limit (x=) read as one database.
+"""
+from __future__ import annotations
+
+import os
+import subprocess
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+lasso_dyna = pytest.importorskip("lasso.dyna")
+D3plot, ArrayType = lasso_dyna.D3plot, lasso_dyna.ArrayType
+
+from conftest import BINARY, REPOSITORY  # noqa: E402
+from deck_writer import (block_mesh, fields, node_list_set, nodes_card, plate_mesh, round_to_node_card,  # noqa: E402
+                         shells_card, solids_card, write_deck)
+
+E, NU, SIGY, ETAN, DENSITY = 200.0, 0.3, 0.25, 2.0, 7.85e-6   # GPa, kg/mm^3 (mm, ms)
+SPEED, RAMP = 0.2, 0.05                                        # mm/ms, ms
+SINGLE = 1e-6                                                  # single precision, relative
+
+
+def ramp_curve():
+    return "*DEFINE_CURVE\n" + fields(1) + "\n" + fields(0.0, 0.0, width=20) + "\n" + \
+        fields(RAMP, 1.0, width=20) + "\n" + fields(100.0, 1.0, width=20)
+
+
+def pulled_deck(path, kind, cells, length, end_time, state_interval, points=5, failure=0.0, title="pulled"):
+    """A bar of solids (1 x 1 mm) or a strip of shells (1 mm wide, 0.1 mm thick, NIP `points`)
+    of *MAT_PIECEWISE_LINEAR_PLASTICITY in uniaxial stress, its end x = `length` pulled at SPEED
+    after a ramp: it yields (SIGY / E = 0.125 %) within the run. Node ids start at 101, element
+    ids at 1001 and the part id is 7, so that ids and indices differ."""
+    if kind == "solid":
+        nodes, elements = block_mesh((cells, 1, 1), (length, 1.0, 1.0))
+        element_cards = solids_card(elements, part_id=7, first_id=1001, first_node_id=101)
+        section = "*SECTION_SOLID\n" + fields(3, 1)
+    else:
+        nodes, elements = plate_mesh((cells, 1), (length, 1.0))
+        element_cards = shells_card(elements, part_id=7, first_id=1001, first_node_id=101)
+        section = "*SECTION_SHELL\n" + fields(3, 2, 1.0, points) + "\n" + fields(*[0.1] * 4)
+    nodes = round_to_node_card(nodes)
+    spc = ["*BOUNDARY_SPC_NODE"]
+    for k, node in enumerate(nodes):
+        dofs = [int(abs(node[axis]) < 1e-9) for axis in range(3)]
+        if kind == "shell":
+            dofs[2] = 1
+        if any(dofs):
+            spc.append(fields(k + 101, 0, *dofs, *([1, 1, 1] if kind == "shell" else [0, 0, 0])))
+    pulled = list(np.flatnonzero(np.abs(nodes[:, 0] - length) < 1e-9) + 101)
+    return write_deck(
+        path,
+        f"*TITLE\n{title}",
+        "*CONTROL_TERMINATION\n" + fields(end_time),
+        "*DATABASE_GLSTAT\n" + fields(state_interval / 2),
+        "*DATABASE_BINARY_D3PLOT\n" + fields(state_interval),
+        f"*PART\n{kind} of part seven\n" + fields(7, 3, 5),
+        section,
+        "*MAT_PIECEWISE_LINEAR_PLASTICITY\n" + fields(5, DENSITY, E, NU, SIGY, ETAN, failure) + "\n" + fields(0.0),
+        ramp_curve(),
+        node_list_set(1, pulled),
+        "*BOUNDARY_PRESCRIBED_MOTION_SET\n" + fields(1, 1, 0, 1, SPEED),
+        "\n".join(spc),
+        nodes_card(nodes, first_id=101),
+        element_cards,
+    )
+
+
+def run_solver(deck, output, *extra):
+    output.mkdir(exist_ok=True)
+    environment = dict(os.environ, OMP_NUM_THREADS="1")
+    process = subprocess.run([str(BINARY), f"i={deck}", f"outdir={output}", "ncpu=1", *extra],
+                             capture_output=True, text=True, timeout=300, env=environment)
+    assert process.returncode == 0, process.stderr
+    return process
+
+
+def states(results, name):
+    """(states, ...) array of `name` over every state of results.h5."""
+    return np.stack([results["states"][key][name][()] for key in sorted(results["states"])])
+
+
+def assert_close(actual, expected, what):
+    """Equal to single precision: within SINGLE of the field's largest magnitude."""
+    actual, expected = np.asarray(actual, float), np.asarray(expected, float)
+    assert actual.shape == expected.shape, f"{what}: shape {actual.shape} != {expected.shape}"
+    scale = max(np.abs(expected).max(initial=0.0), 1e-30)
+    error = np.abs(actual - expected).max(initial=0.0)
+    print(f"  {what}: largest difference {error:.3e} of {scale:.3e}")
+    assert error <= SINGLE * scale, f"{what}: differs by {error} (scale {scale})"
+
+
+def check_common(plot, results):
+    """Mesh, ids, parts, times, coordinates and velocities: d3plot against results.h5."""
+    mesh = results["mesh"]
+    node_ids = mesh["nodes/ids"][()]
+    coordinates = mesh["nodes/coordinates"][()]
+    assert plot.header.n_nodes == len(node_ids)
+    assert np.array_equal(plot.arrays[ArrayType.node_ids], node_ids)
+    assert_close(plot.arrays[ArrayType.node_coordinates], coordinates, "reference coordinates")
+    part_ids = mesh["parts/ids"][()]
+    assert np.array_equal(plot.arrays[ArrayType.part_ids], part_ids)
+    assert np.array_equal(plot.arrays[ArrayType.part_titles_ids], part_ids)
+    times = np.array([results["states"][key].attrs["time"] for key in sorted(results["states"])])
+    assert len(times) >= 3
+    assert_close(plot.arrays[ArrayType.global_timesteps], times, "times")
+    scale = np.abs(coordinates).max()
+    current = plot.arrays[ArrayType.node_displacement]  # LS-DYNA writes the current coordinates
+    displacement = states(results, "displacement")
+    error = np.abs(current - (coordinates + displacement)).max()
+    print(f"  coordinates: largest difference {error:.3e} of the model size {scale:.3e}")
+    assert error <= SINGLE * scale
+    assert np.abs(displacement).max() > 1e-3 * scale          # the model moved
+    assert_close(plot.arrays[ArrayType.node_velocity], states(results, "velocity"), "velocities")
+    return times
+
+
+def check_solids(plot, results):
+    mesh = results["mesh"]
+    assert np.array_equal(plot.arrays[ArrayType.element_solid_ids], mesh["solids/ids"][()])
+    node_ids = plot.arrays[ArrayType.node_ids]
+    connectivity = node_ids[plot.arrays[ArrayType.element_solid_node_indexes]]
+    assert np.array_equal(connectivity, mesh["solids/connectivity"][()])
+    part_ids = plot.arrays[ArrayType.part_ids][plot.arrays[ArrayType.element_solid_part_indexes]]
+    assert np.array_equal(part_ids, mesh["solids/part_ids"][()])
+    assert_close(plot.arrays[ArrayType.element_solid_stress][:, :, 0, :], states(results, "solid_stress"),
+                 "solid stresses")
+    assert_close(plot.arrays[ArrayType.element_solid_effective_plastic_strain][:, :, 0],
+                 states(results, "solid_plastic_strain"), "solid plastic strains")
+
+
+def check_energies(plot, results, times):
+    """Kinetic and internal energy of the states against glstat at the same times."""
+    glstat = results["history/glstat"]
+    rows = [int(np.argmin(np.abs(glstat["time"][()] - t))) for t in times]
+    assert np.allclose(glstat["time"][()][rows], times, rtol=0, atol=1e-9)
+    assert_close(plot.arrays[ArrayType.global_kinetic_energy], glstat["kinetic_energy"][()][rows], "kinetic energy")
+    assert_close(plot.arrays[ArrayType.global_internal_energy], glstat["internal_energy"][()][rows],
+                 "internal energy")
+    assert_close(plot.arrays[ArrayType.part_internal_energy][:, 0], glstat["internal_energy"][()][rows],
+                 "internal energy of the one part")
+
+
+def test_solid_bar_d3plot_equals_results(tmp_path, run_deck):
+    """A pulled bar of 6 plastic solids: mesh, ids, part title, every state; energies as glstat."""
+    deck = pulled_deck(tmp_path / "bar.k", "solid", 6, 6.0, 0.2, 0.02)
+    run = run_deck(deck)
+    assert run.status == 0, run.stderr
+    plot = D3plot(str(run.results.parent / "d3plot"))
+    assert plot.header.title == "pulled"
+    assert plot.arrays[ArrayType.part_titles][0].decode().strip() == "solid of part seven"
+    assert plot.header.n_solids == 6 and plot.header.n_shells == 0
+    with run.open() as results:
+        times = check_common(plot, results)
+        check_solids(plot, results)
+        assert states(results, "solid_plastic_strain").max() > 1e-3     # it yielded
+        check_energies(plot, results, times)
+    assert np.all(plot.arrays[ArrayType.element_solid_is_alive] == 1.0)
+
+
+def test_plastic_shell_strip_nip5_d3plot_equals_results(tmp_path, run_deck):
+    """A pulled strip of 8 plastic Belytschko-Tsay shells with 5 points through the thickness:
+    shell connectivity, ids, part, stresses and plastic strains at every state."""
+    deck = pulled_deck(tmp_path / "strip.k", "shell", 8, 8.0, 0.2, 0.02, points=5)
+    run = run_deck(deck)
+    assert run.status == 0, run.stderr
+    plot = D3plot(str(run.results.parent / "d3plot"))
+    assert plot.header.n_shells == 8 and plot.header.n_solids == 0
+    with run.open() as results:
+        check_common(plot, results)
+        mesh = results["mesh"]
+        assert np.array_equal(plot.arrays[ArrayType.element_shell_ids], mesh["shells/ids"][()])
+        node_ids = plot.arrays[ArrayType.node_ids]
+        connectivity = node_ids[plot.arrays[ArrayType.element_shell_node_indexes]]
+        assert np.array_equal(connectivity, mesh["shells/connectivity"][()])
+        part_ids = plot.arrays[ArrayType.part_ids][plot.arrays[ArrayType.element_shell_part_indexes]]
+        assert np.array_equal(part_ids, mesh["shells/part_ids"][()])
+        stress = plot.arrays[ArrayType.element_shell_stress]            # (states, shells, layers, 6)
+        strain = plot.arrays[ArrayType.element_shell_effective_plastic_strain]
+        expected_strain = states(results, "shell_plastic_strain")
+        assert expected_strain.max() > 1e-3                              # it yielded
+        # the mid-surface values of results.h5: the mean over the layers written
+        assert_close(stress.mean(axis=2), states(results, "shell_stress"), "shell stresses")
+        assert_close(strain.mean(axis=2), expected_strain, "shell plastic strains")
+
+
+def test_meshfree_cube_d3plot_has_the_physical_values(tmp_path, run_deck):
+    """The squeezed meshfree (EFG) cube: its background cells as solids, the particles'
+    physical (transformed) displacements and velocities, as in results.h5."""
+    run = run_deck(REPOSITORY / "inputs" / "squeeze_cube" / "efg.k")
+    assert run.status == 0, run.stderr
+    plot = D3plot(str(run.results.parent / "d3plot"))
+    with run.open() as results:
+        assert list(results["mesh/parts/formulation"].asstr()[()]) == ["efg"]
+        check_common(plot, results)
+        check_solids(plot, results)
+
+
+def test_eroded_shells_carry_the_deleted_flag(tmp_path, run_deck):
+    """FAIL = 0.03: the 4 shells of the strip erode; the d3plot flags them deleted (0.0) from
+    the state where results.h5 says they are eroded, and 1.0 before."""
+    deck = pulled_deck(tmp_path / "erode.k", "shell", 4, 4.0, 0.8, 0.05, points=3, failure=0.03)
+    run = run_deck(deck)
+    assert run.status == 0, run.stderr
+    plot = D3plot(str(run.results.parent / "d3plot"))
+    with run.open() as results:
+        eroded = states(results, "shell_eroded")
+    alive = plot.arrays[ArrayType.element_shell_is_alive]
+    assert eroded[0].sum() == 0 and eroded[-1].sum() == 4
+    assert np.array_equal(alive, 1.0 - eroded)
+
+
+def test_family_files_past_the_size_limit_read_as_one(tmp_path):
+    """A block of 1000 solids, 41 states, x=1 (files of 512^2 words, about 13 states each):
+    the states go on in NAME.d3plot01, 02, ...; lasso-python reads them as one database whose
+    states equal results.h5's."""
+    nodes, elements = block_mesh((10, 10, 10), (10.0, 10.0, 10.0))
+    nodes = round_to_node_card(nodes)
+    deck = write_deck(
+        tmp_path / "block.k",
+        "*CONTROL_TERMINATION\n" + fields(0.4),
+        "*DATABASE_BINARY_D3PLOT\n" + fields(0.01),
+        "*PART\nblock\n" + fields(1, 1, 1),
+        "*SECTION_SOLID\n" + fields(1, 1),
+        "*MAT_ELASTIC\n" + fields(1, DENSITY, E, NU),
+        "*INITIAL_VELOCITY_GENERATION\n" + fields(1, 2, 0.0, 1.0, 0.0, 0.0) + "\n" + fields(0.0, 0.0, 0.0, 0.0, 0.0,
+                                                                                           1.0),
+        nodes_card(nodes),
+        solids_card(elements),
+    )
+    output = tmp_path / "out"
+    run_solver(deck, output, "jobid=crash", "x=1")
+    words = 512 ** 2
+    family = sorted(output.glob("crash.d3plot*"))
+    print(f"  files: {[(f.name, f.stat().st_size) for f in family]}")
+    assert len(family) >= 3
+    assert all(f.stat().st_size <= 4 * words for f in family)
+    plot = D3plot(str(output / "crash.d3plot"))
+    with h5py.File(output / "crash.h5", "r") as results:
+        assert len(results["states"]) == 41
+        check_common(plot, results)
+        check_solids(plot, results)
