@@ -26,7 +26,7 @@ module element_group
   implicit none
   private
 
-  public :: element_group_t, group_holder_t, element_results_t, distortion_t
+  public :: element_group_t, group_holder_t, element_results_t, distortion_t, shell_output_points
 
   !> Elements folded inside out at a corner while their volume stays positive (distortion_check),
   !> checked at every output state.
@@ -51,6 +51,11 @@ module element_group
     real(wp), allocatable :: beam_failed(:)              !< (beams) 1 failed (*MAT_SPOTWELD), 0 not
     !> deleted-element flags: 1 for an eroded element, 0 otherwise (solids, shells)
     integer, allocatable :: solid_eroded(:), shell_eroded(:)
+    !> For the d3plot (optional, allocated by the output plan): (6, shell_output_points, shells)
+    !> global stress and (points, shells) plastic strain at each point through the thickness,
+    !> bottom to top, and (shells) how many points a group wrote (0: none, e.g. meshfree shells)
+    real(wp), allocatable :: shell_point_stress(:, :, :), shell_point_plastic_strain(:, :)
+    integer, allocatable :: shell_point_count(:)
   end type element_results_t
 
   type, abstract :: element_group_t
@@ -287,4 +292,18 @@ contains
     logical, intent(in) :: wanted(:)
     real(wp), intent(inout) :: strain(:)
   end subroutine raise_nodal_plastic_strain
+
+  !> Points through the thickness written per shell to the d3plot (its MAXINT): the largest NIP
+  !> of the sections of the model's shells (at most 10), 1 without shells.
+  pure integer function shell_output_points(model)
+    type(model_t), intent(in) :: model
+    integer :: shell, section
+    shell_output_points = 1
+    if (.not. allocated(model%shell_ids)) return
+    do shell = 1, size(model%shell_ids)
+      section = model%parts(model%shell_part(shell))%section
+      if (section < 1 .or. section > size(model%sections)) cycle
+      shell_output_points = max(shell_output_points, min(10, model%sections(section)%integration_points))
+    end do
+  end function shell_output_points
 end module element_group

@@ -980,13 +980,28 @@ contains
   !> over the points) and the stress of the point with the largest von Mises stress, both in
   !> global axes (xx, yy, zz, xy, yz, zx), and the mean and largest effective plastic strain.
   subroutine shell_block_element_results(block, material, mid_stress, peak_stress, mean_plastic_strain, &
-                                         peak_plastic_strain)
+                                         peak_plastic_strain, point_stress, point_plastic_strain, point_count)
     type(shell_block_t), intent(in) :: block
     type(material_t), intent(in) :: material
     real(wp), intent(inout) :: mid_stress(:, :), peak_stress(:, :), mean_plastic_strain(:), peak_plastic_strain(:)
+    !> (the d3plot's) global stress (6, points, shells) and plastic strain (points, shells) at
+    !> each point, bottom to top, and the points written (shells)
+    real(wp), intent(inout), optional :: point_stress(:, :, :), point_plastic_strain(:, :)
+    integer, intent(inout), optional :: point_count(:)
     real(wp) :: point_strain(block_size), mean_local(5), effective, largest
-    integer :: nel, i, point, peak
+    integer :: nel, i, point, peak, written
     nel = block%element_count
+    ! Gauss points are numbered from the bottom (height -1/2) to the top, as LS-DYNA's layers
+    written = 0
+    if (present(point_stress)) written = min(block%point_count, size(point_stress, 2))
+    do i = 1, nel
+      if (written == 0) exit
+      point_count(block%elements(i)) = written
+      do point = 1, written
+        point_stress(:, point, block%elements(i)) = global_stress(block%frame(i, :, :), block%stress(i, :, point))
+      end do
+      point_plastic_strain(:, block%elements(i)) = 0.0_wp
+    end do
     do i = 1, nel
       mean_local = 0.0_wp
       largest = -1.0_wp
@@ -1015,6 +1030,10 @@ contains
         mean_plastic_strain(block%elements(i)) = mean_plastic_strain(block%elements(i)) &
                                                  + block%point_weight(point)*point_strain(i)
         peak_plastic_strain(block%elements(i)) = max(peak_plastic_strain(block%elements(i)), point_strain(i))
+      end do
+      if (point > written) cycle
+      do i = 1, nel
+        point_plastic_strain(point, block%elements(i)) = point_strain(i)
       end do
     end do
   end subroutine shell_block_element_results

@@ -19,6 +19,7 @@ module d3plot_file
   use text_format, only: integer_text, real_text
   use file_system, only: remove_file, file_size
   use model, only: model_t
+  use element_group, only: shell_output_points
   use d3plot_states, only: d3plot_layout_t, state_word_count, fill_state_words
   implicit none
   private
@@ -180,7 +181,7 @@ contains
       if (allocated(model%beam_ids)) layout%beam_count = size(model%beam_ids)
       layout%part_count = 0
       if (allocated(model%parts)) layout%part_count = size(model%parts)
-      layout%shell_layers = 1
+      layout%shell_layers = shell_output_points(model)
       layout%global_count = 6 + 2*layout%part_count
       layout%solid_values = 7
       layout%beam_values = 6

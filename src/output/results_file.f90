@@ -290,7 +290,8 @@ contains
   subroutine write_state(results, time, displacement, velocity, solid_stress, &
                          solid_plastic_strain, error, shell_stress, shell_plastic_strain, shell_stress_peak, &
                          shell_plastic_strain_peak, histories, beam_resultant, beam_plastic_strain, beam_failed, &
-                         solid_eroded, shell_eroded, eroded_count, acceleration, globals)
+                         solid_eroded, shell_eroded, eroded_count, acceleration, globals, shell_point_stress, &
+                         shell_point_plastic_strain, shell_point_count)
     type(results_file_t), intent(inout) :: results
     real(wp), intent(in) :: time
     ! Contiguous: the solver's whole arrays go to HDF5 without a copy.
@@ -310,6 +311,9 @@ contains
     !> for the d3plot only: (3, nodes) accelerations (absent: 0), and its global values
     !> (kinetic, internal, total energy, velocity (3), per part internal then kinetic energy)
     real(wp), intent(in), contiguous, optional :: acceleration(:, :), globals(:)
+    !> for the d3plot only: the shells' points through the thickness (element_results_t)
+    real(wp), intent(in), contiguous, optional :: shell_point_stress(:, :, :), shell_point_plastic_strain(:, :)
+    integer, intent(in), contiguous, optional :: shell_point_count(:)
     real(wp) :: no_shell_stress(6, 0), no_shell_strain(0)
     real(wp), allocatable :: grown(:)
     type(error_t), allocatable :: space_error
@@ -428,7 +432,7 @@ contains
     if (results%d3plot%is_open) then
       call write_d3plot(results%d3plot, time, displacement, velocity, solid_stress, solid_plastic_strain, error, &
                         shell_stress, shell_plastic_strain, beam_resultant, beam_failed, solid_eroded, shell_eroded, &
-                        acceleration, globals)
+                        acceleration, globals, shell_point_stress, shell_point_plastic_strain, shell_point_count)
       if (allocated(error)) return
     end if
     if (xdmf_due(results)) call write_xdmf_now(results, error)
@@ -438,7 +442,7 @@ contains
   !> written as 0: the accelerations and global values of a static state).
   subroutine write_d3plot(plot, time, displacement, velocity, solid_stress, solid_plastic_strain, error, &
                           shell_stress, shell_plastic_strain, beam_resultant, beam_failed, solid_eroded, shell_eroded, &
-                          acceleration, globals)
+                          acceleration, globals, shell_point_stress, shell_point_plastic_strain, shell_point_count)
     type(d3plot_file_t), intent(inout) :: plot
     real(wp), intent(in) :: time
     real(wp), intent(in) :: displacement(:, :), velocity(:, :), solid_stress(:, :), solid_plastic_strain(:)
@@ -447,16 +451,31 @@ contains
     real(wp), intent(in), optional :: beam_resultant(:, :), beam_failed(:)
     integer, intent(in), optional :: solid_eroded(:), shell_eroded(:)
     real(wp), intent(in), optional :: acceleration(:, :), globals(:)
+    real(wp), intent(in), optional :: shell_point_stress(:, :, :), shell_point_plastic_strain(:, :)
+    integer, intent(in), optional :: shell_point_count(:)
     real(wp), allocatable :: layer_stress(:, :, :), layer_strain(:, :), resultant(:, :), global_values(:)
     real(wp), allocatable :: node_acceleration(:, :)
+    integer :: shell, layer, points
 
     associate (layout => plot%layout)
       allocate (layer_stress(6, layout%shell_layers, layout%shell_count), source=0.0_wp)
       allocate (layer_strain(layout%shell_layers, layout%shell_count), source=0.0_wp)
-      ! results.h5 keeps the mid-surface values: one layer
+      ! each shell's points through the thickness; a shell whose group gives none (meshfree
+      ! shells, rigid parts, a static state) has its mid-surface values in every layer
       if (present(shell_stress) .and. layout%shell_count > 0) then
-        layer_stress(:, 1, :) = shell_stress
-        layer_strain(1, :) = shell_plastic_strain
+        do shell = 1, layout%shell_count
+          points = 0
+          if (present(shell_point_count)) points = min(shell_point_count(shell), layout%shell_layers)
+          if (points > 0) then
+            layer_stress(:, 1:points, shell) = shell_point_stress(:, 1:points, shell)
+            layer_strain(1:points, shell) = shell_point_plastic_strain(1:points, shell)
+          else
+            do layer = 1, layout%shell_layers
+              layer_stress(:, layer, shell) = shell_stress(:, shell)
+              layer_strain(layer, shell) = shell_plastic_strain(shell)
+            end do
+          end if
+        end do
       end if
       allocate (resultant(6, layout%beam_count), source=0.0_wp)
       if (present(beam_resultant) .and. layout%beam_count > 0) resultant = beam_resultant

@@ -191,7 +191,10 @@ contains
                          beam_resultant=fields%beam_resultant, beam_plastic_strain=fields%beam_plastic_strain, &
                          beam_failed=fields%beam_failed, &
                          solid_eroded=fields%solid_eroded, shell_eroded=fields%shell_eroded, &
-                         eroded_count=state%eroded_count, acceleration=plan%node_acceleration, globals=globals)
+                         eroded_count=state%eroded_count, acceleration=plan%node_acceleration, globals=globals, &
+                         shell_point_stress=fields%shell_point_stress, &
+                         shell_point_plastic_strain=fields%shell_point_plastic_strain, &
+                         shell_point_count=fields%shell_point_count)
       else
         ! (beam fields not allocated: a model without beams; the dummies are then absent)
         call write_state(results, state%time, plan%node_displacement, plan%node_velocity, fields%solid_stress, &

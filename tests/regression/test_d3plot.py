@@ -186,11 +186,20 @@ def test_plastic_shell_strip_nip5_d3plot_equals_results(tmp_path, run_deck):
         assert np.array_equal(part_ids, mesh["shells/part_ids"][()])
         stress = plot.arrays[ArrayType.element_shell_stress]            # (states, shells, layers, 6)
         strain = plot.arrays[ArrayType.element_shell_effective_plastic_strain]
+        assert plot.header.n_shell_tshell_layers == 5 and stress.shape[2] == 5
         expected_strain = states(results, "shell_plastic_strain")
         assert expected_strain.max() > 1e-3                              # it yielded
-        # the mid-surface values of results.h5: the mean over the layers written
-        assert_close(stress.mean(axis=2), states(results, "shell_stress"), "shell stresses")
-        assert_close(strain.mean(axis=2), expected_strain, "shell plastic strains")
+        # results.h5's mid-surface values are the Gauss-weighted means over the 5 points, its
+        # peak values those of the point of largest von Mises stress / plastic strain
+        weights = np.polynomial.legendre.leggauss(5)[1] / 2.0
+        assert_close(np.einsum("l,selk->sek", weights, stress), states(results, "shell_stress"), "shell stresses")
+        assert_close(strain @ weights, expected_strain, "shell plastic strains")
+        assert_close(strain.max(axis=2), states(results, "shell_plastic_strain_peak"), "peak plastic strains")
+        s = stress
+        mises = s[..., 0] ** 2 - s[..., 0] * s[..., 1] + s[..., 1] ** 2 + 3 * (s[..., 3] ** 2 + s[..., 4] ** 2 +
+                                                                               s[..., 5] ** 2)
+        peak = np.take_along_axis(stress, mises.argmax(axis=2)[..., None, None], axis=2)[:, :, 0, :]
+        assert_close(peak, states(results, "shell_stress_peak"), "peak stresses")
 
 
 def test_meshfree_cube_d3plot_has_the_physical_values(tmp_path, run_deck):
