@@ -89,14 +89,22 @@ def states(results, name):
     return np.stack([results["states"][key][name][()] for key in sorted(results["states"])])
 
 
-def assert_close(actual, expected, what):
-    """Equal to single precision: within SINGLE of the field's largest magnitude."""
+def assert_close(actual, expected, what, scale=None):
+    """Equal to single precision: within SINGLE of `scale`, by default the field's largest
+    magnitude (a mean over layers: the layers' largest magnitude, whose rounding it carries)."""
     actual, expected = np.asarray(actual, float), np.asarray(expected, float)
     assert actual.shape == expected.shape, f"{what}: shape {actual.shape} != {expected.shape}"
-    scale = max(np.abs(expected).max(initial=0.0), 1e-30)
+    if scale is None:
+        scale = max(np.abs(expected).max(initial=0.0), 1e-30)
     error = np.abs(actual - expected).max(initial=0.0)
     print(f"  {what}: largest difference {error:.3e} of {scale:.3e}")
     assert error <= SINGLE * scale, f"{what}: differs by {error} (scale {scale})"
+
+
+def von_mises(s):
+    """Von Mises stress of (..., 6) global stresses xx yy zz xy yz zx."""
+    return np.sqrt(0.5 * ((s[..., 0] - s[..., 1]) ** 2 + (s[..., 1] - s[..., 2]) ** 2 + (s[..., 2] - s[..., 0]) ** 2)
+                   + 3 * (s[..., 3] ** 2 + s[..., 4] ** 2 + s[..., 5] ** 2))
 
 
 def check_common(plot, results):
@@ -258,3 +266,35 @@ def test_family_files_past_the_size_limit_read_as_one(tmp_path):
         assert len(results["states"]) == 41
         check_common(plot, results)
         check_solids(plot, results)
+
+
+def test_bent_shell_layers_hold_the_plastic_hinge(tmp_path, run_deck):
+    """The plastic collapse of a cantilever strip (test_shell_physics, NIP 5, elastic-perfectly
+    plastic): at the last state the root element is a hinge, so its bottom and top points are on
+    the yield surface (von Mises = SIGY to 0.1 %) with axial stresses of opposite sign, the
+    middle point carries less; the Gauss-weighted mean over the layers is results.h5's
+    mid-surface stress and the largest von Mises stress of the layers its peak's."""
+    from test_shell_physics import YIELD, cantilever_deck
+    deck, _ = cantilever_deck(tmp_path / "cantilever.k", 5)
+    run = run_deck(deck)
+    assert run.status == 0, run.stderr
+    plot = D3plot(str(run.results.parent / "d3plot"))
+    stress = plot.arrays[ArrayType.element_shell_stress].astype(float)   # (states, shells, layers, 6)
+    mises = von_mises(stress)
+    root = int(np.argmin(plot.arrays[ArrayType.node_coordinates][
+        plot.arrays[ArrayType.element_shell_node_indexes]][:, :, 0].mean(axis=1)))
+    last = mises[-1, root]
+    print(f"  root element, last state: von Mises / SIGY by layer {np.round(last / YIELD, 4)}, "
+          f"sigma_xx {np.round(stress[-1, root, :, 0], 4)}")
+    assert np.allclose(last[[0, 4]], YIELD, rtol=1e-3)
+    assert stress[-1, root, 0, 0] * stress[-1, root, 4, 0] < 0
+    assert last[2] < 0.9 * YIELD
+    weights = np.polynomial.legendre.leggauss(5)[1] / 2.0
+    with run.open() as results:
+        assert_close(np.einsum("l,selk->sek", weights, stress), states(results, "shell_stress"), "shell stresses",
+                     scale=np.abs(stress).max())
+        # top and bottom points tie in a hinge: compare the peak's von Mises stress
+        assert_close(mises.max(axis=2), von_mises(states(results, "shell_stress_peak")), "peak von Mises stresses")
+        strain = plot.arrays[ArrayType.element_shell_effective_plastic_strain]
+        assert_close(strain @ weights, states(results, "shell_plastic_strain"), "shell plastic strains")
+        assert_close(strain.max(axis=2), states(results, "shell_plastic_strain_peak"), "peak plastic strains")
