@@ -298,3 +298,37 @@ def test_bent_shell_layers_hold_the_plastic_hinge(tmp_path, run_deck):
         strain = plot.arrays[ArrayType.element_shell_effective_plastic_strain]
         assert_close(strain @ weights, states(results, "shell_plastic_strain"), "shell plastic strains")
         assert_close(strain.max(axis=2), states(results, "shell_plastic_strain_peak"), "peak plastic strains")
+
+
+def test_coupled_meshfree_shell_strip_d3plot_has_the_physical_values(tmp_path, run_deck):
+    """A strip of FE shells (x < 30 mm) coupled to meshfree EFG shells (ELFORM 41) beyond, its
+    end x = 0 pushed transversely by a short pulse: the flexural wave crosses the interface.
+    The EFG cells are written as shells with the particles' physical (transformed)
+    displacements and velocities of results.h5, both parts with their titles."""
+    import plate_decks
+    deck = tmp_path / "coupled.k"
+    end_time = 0.04
+    plate_decks.interface_strip_deck(deck, True, (40, 2), 100.0, 5.0, 1.0, 0.0, 100.0, 0.01, end_time,
+                                     probes=(10.0, 50.0), direction=3, interface=30.0)
+    text = deck.read_text().replace("*END", "*DATABASE_BINARY_D3PLOT\n" + fields(end_time / 8) + "\n*END")
+    deck.write_text(text)
+    run = run_deck(deck)
+    assert run.status == 0, run.stderr
+    plot = D3plot(str(run.results.parent / "d3plot"))
+    titles = [title.decode().strip() for title in plot.arrays[ArrayType.part_titles]]
+    assert titles == ["fe half", "second half"]
+    with run.open() as results:
+        assert list(results["mesh/parts/formulation"].asstr()[()]) == ["fe", "efg"]
+        check_common(plot, results)
+        efg = results["mesh/shells/part_ids"][()] == 2
+        efg_nodes = np.unique(plot.arrays[ArrayType.element_shell_node_indexes][efg])
+        moved = np.abs(states(results, "displacement")[:, efg_nodes, 2]).max()
+        print(f"  largest transverse displacement of the meshfree particles {moved:.3e} mm")
+        assert moved > 1e-4
+        stress = plot.arrays[ArrayType.element_shell_stress]             # (states, shells, 3 layers, 6)
+        mid = states(results, "shell_stress")
+        for layer in range(3):        # meshfree cells: their mid-surface values in every layer
+            assert_close(stress[:, efg, layer, :], mid[:, efg], f"meshfree shell stresses, layer {layer + 1}")
+        weights = np.polynomial.legendre.leggauss(3)[1] / 2.0
+        assert_close(np.einsum("l,selk->sek", weights, stress[:, ~efg]), mid[:, ~efg], "FE shell stresses",
+                     scale=np.abs(stress).max())
