@@ -332,3 +332,36 @@ def test_coupled_meshfree_shell_strip_d3plot_has_the_physical_values(tmp_path, r
         weights = np.polynomial.legendre.leggauss(3)[1] / 2.0
         assert_close(np.einsum("l,selk->sek", weights, stress[:, ~efg]), mid[:, ~efg], "FE shell stresses",
                      scale=np.abs(stress).max())
+
+
+def test_beam_cantilever_d3plot_has_the_beams_and_their_resultants(tmp_path, run_deck):
+    """The beam cantilever of test_beams (10 Hughes-Liu beams, tip load along z): beam ids,
+    nodes N1 N2 and the orientation node, part, and at every state the resultants of results.h5
+    in LS-DYNA's order (axial, shear s, shear t, moment s, moment t, torsion). The root
+    element, whose moment is largest, carries a shear of the order of the tip load."""
+    from test_beams import TIP_LOAD, cantilever_deck
+    run = run_deck(cantilever_deck(tmp_path / "cantilever.k", end_time=8.0, rise_time=6.0))
+    assert run.status == 0, run.stderr
+    plot = D3plot(str(run.results.parent / "d3plot"))
+    assert plot.header.n_beams == 10
+    with run.open() as results:
+        check_common(plot, results)
+        mesh = results["mesh/beams"]
+        assert np.array_equal(plot.arrays[ArrayType.element_beam_ids], mesh["ids"][()])
+        node_ids = plot.arrays[ArrayType.node_ids]
+        nodes = plot.arrays[ArrayType.element_beam_node_indexes]
+        assert np.array_equal(node_ids[nodes[:, :2]], mesh["connectivity"][()])
+        assert np.array_equal(node_ids[nodes[:, 2]], mesh["orientation_node"][()])
+        part_ids = plot.arrays[ArrayType.part_ids][plot.arrays[ArrayType.element_beam_part_indexes]]
+        assert np.array_equal(part_ids, mesh["part_ids"][()])
+        resultant = states(results, "beam_resultant")        # N, Q_s, Q_t, T, M_s, M_t
+    assert_close(plot.arrays[ArrayType.element_beam_axial_force], resultant[..., 0], "axial forces",
+                 scale=np.abs(resultant).max())
+    assert_close(plot.arrays[ArrayType.element_beam_shear_force], resultant[..., 1:3], "shear forces")
+    assert_close(plot.arrays[ArrayType.element_beam_bending_moment], resultant[..., 4:6], "bending moments")
+    assert_close(plot.arrays[ArrayType.element_beam_torsion_moment], resultant[..., 3], "torsion",
+                 scale=np.abs(resultant).max())
+    shear = np.abs(plot.arrays[ArrayType.element_beam_shear_force][-1, 0]).max()
+    print(f"  root shear at the end {shear:.4f} for a tip load {TIP_LOAD}")
+    assert 0.5 * TIP_LOAD < shear < 1.5 * TIP_LOAD
+    assert np.all(plot.arrays[ArrayType.element_beam_is_alive] == 1.0)
