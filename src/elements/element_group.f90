@@ -293,12 +293,13 @@ contains
     real(wp), intent(inout) :: strain(:)
   end subroutine raise_nodal_plastic_strain
 
-  !> Points through the thickness written per shell to the d3plot (its MAXINT): the largest NIP
-  !> of the sections of the model's shells (at most 10), 1 without shells.
+  !> Layers written per shell to the d3plot (its MAXINT): LS-DYNA's default 3 (mid, inner and
+  !> outer surface) when no shell section has more than 3 points (NIP), else the largest NIP
+  !> (at most 10: every point, as LS-DYNA writes them with MAXINT = NIP).
   pure integer function shell_output_points(model)
     type(model_t), intent(in) :: model
     integer :: shell, section
-    shell_output_points = 1
+    shell_output_points = 3
     if (.not. allocated(model%shell_ids)) return
     do shell = 1, size(model%shell_ids)
       section = model%parts(model%shell_part(shell))%section

@@ -49,6 +49,7 @@ module d3plot_file
     integer :: state_count = 0                    !< states written (all files)
     type(d3plot_layout_t) :: layout
     real(wp), allocatable :: reference(:, :)      !< (3, nodes) reference coordinates
+    integer, allocatable :: solid_part(:), shell_part(:), beam_part(:)  !< part numbers of the elements
     real(real32), allocatable :: words(:)         !< one state
   end type d3plot_file_t
 
@@ -135,7 +136,8 @@ contains
     state_words = state_word_count(plot%layout)
     call fill_state_words(plot%layout, time, globals, plot%reference + displacement, velocity, acceleration, &
                           solid_stress, solid_plastic_strain, shell_stress, shell_plastic_strain, beam_resultant, &
-                          plot%words, solid_eroded, shell_eroded, beam_failed)
+                          plot%solid_part, plot%shell_part, plot%beam_part, plot%words, solid_eroded, shell_eroded, &
+                          beam_failed)
     status = 0
     ! a new family file when this state would pass the limit (a file holds at least one state)
     if (plot%file_words > 0 .and. plot%file_words + state_words + 1 > plot%limit_words) &
@@ -190,6 +192,12 @@ contains
     if (allocated(plot%reference)) deallocate (plot%reference)
     allocate (plot%reference(3, plot%layout%node_count))
     if (plot%layout%node_count > 0) plot%reference = model%coordinates
+    plot%solid_part = [integer ::]
+    if (plot%layout%solid_count > 0) plot%solid_part = model%solid_part
+    plot%shell_part = [integer ::]
+    if (plot%layout%shell_count > 0) plot%shell_part = model%shell_part
+    plot%beam_part = [integer ::]
+    if (plot%layout%beam_count > 0) plot%beam_part = model%beam_part
     if (allocated(plot%words)) deallocate (plot%words)
     allocate (plot%words(state_word_count(plot%layout)))
   end subroutine set_layout

@@ -7,15 +7,16 @@
 !> per solid NV3D values (stress xx yy zz xy yz zx, effective plastic strain); per beam NV1D
 !> values (axial force, shear s, shear t, bending moment s, bending moment t, torsion); per
 !> shell NV2D values (per layer of MAXINT: stress xx yy zz xy yz zx, effective plastic
-!> strain); and the deletion flags of the solids, shells and beams (1.0 in the model, 0.0
-!> deleted), which LS-DYNA writes when MAXINT is given as -(MAXINT + 10000).
+!> strain); and the deletion flags of the solids, shells and beams (the element's part number
+!> while it is in the model, 0.0 once deleted), which LS-DYNA writes when MAXINT is given as
+!> -(MAXINT + 10000).
 module d3plot_states
   use, intrinsic :: iso_fortran_env, only: real32, int64
   use kinds, only: wp
   implicit none
   private
 
-  public :: d3plot_layout_t, state_word_count, fill_state_words
+  public :: d3plot_layout_t, state_word_count, fill_state_words, shell_layer_values
 
   !> The sizes of a state, fixed when the database is opened.
   type :: d3plot_layout_t
@@ -48,10 +49,11 @@ contains
   !> global values; `coordinates`, `velocity`, `acceleration` (3, nodes) the physical nodal
   !> values; `shell_stress` (6, MAXINT, shells) and `shell_plastic_strain` (MAXINT, shells) the
   !> layers; `beam_resultant` (6, beams) in crashfree's order N, Q_s, Q_t, T, M_s, M_t; the
-  !> eroded flags 1 for an element out of the model (absent: none is).
+  !> part numbers of the elements; the eroded flags 1 for an element out of the model (absent:
+  !> none is).
   subroutine fill_state_words(layout, time, globals, coordinates, velocity, acceleration, solid_stress, &
-                              solid_plastic_strain, shell_stress, shell_plastic_strain, beam_resultant, words, &
-                              solid_eroded, shell_eroded, beam_failed)
+                              solid_plastic_strain, shell_stress, shell_plastic_strain, beam_resultant, solid_part, &
+                              shell_part, beam_part, words, solid_eroded, shell_eroded, beam_failed)
     type(d3plot_layout_t), intent(in) :: layout
     real(wp), intent(in) :: time
     real(wp), intent(in) :: globals(:)
@@ -59,6 +61,7 @@ contains
     real(wp), intent(in) :: solid_stress(:, :), solid_plastic_strain(:)
     real(wp), intent(in) :: shell_stress(:, :, :), shell_plastic_strain(:, :)
     real(wp), intent(in) :: beam_resultant(:, :)
+    integer, intent(in) :: solid_part(:), shell_part(:), beam_part(:)   !< part numbers (1-based)
     real(real32), intent(out) :: words(:)
     integer, intent(in), optional :: solid_eroded(:), shell_eroded(:)
     real(wp), intent(in), optional :: beam_failed(:)
@@ -100,26 +103,59 @@ contains
         next = next + 7
       end do
     end do
-    ! deletion flags: solids, (thick shells: none), shells, beams
-    words(next:next + layout%solid_count - 1) = 1.0_real32
+    ! deletion flags: solids, (thick shells: none), shells, beams; LS-DYNA writes the element's
+    ! material (part) number, 0 for a deleted element
+    words(next:next + layout%solid_count - 1) = real(solid_part, real32)
     if (present(solid_eroded)) then
       do element = 1, layout%solid_count
         if (solid_eroded(element) /= 0) words(next + element - 1) = 0.0_real32
       end do
     end if
     next = next + layout%solid_count
-    words(next:next + layout%shell_count - 1) = 1.0_real32
+    words(next:next + layout%shell_count - 1) = real(shell_part, real32)
     if (present(shell_eroded)) then
       do element = 1, layout%shell_count
         if (shell_eroded(element) /= 0) words(next + element - 1) = 0.0_real32
       end do
     end if
     next = next + layout%shell_count
-    words(next:next + layout%beam_count - 1) = 1.0_real32
+    words(next:next + layout%beam_count - 1) = real(beam_part, real32)
     if (present(beam_failed)) then
       do element = 1, layout%beam_count
         if (beam_failed(element) > 0.5_wp) words(next + element - 1) = 0.0_real32
       end do
     end if
   end subroutine fill_state_words
+
+  !> One shell's layers from its `count` points through the thickness (bottom to top), as
+  !> LS-DYNA writes them: with MAXINT = 3 the mid surface (the middle point, or the mean of the
+  !> two nearest it for an even count), the inner (first) and the outer (last) point; with any
+  !> other MAXINT the first MAXINT points in order (layers beyond `count` are 0).
+  pure subroutine shell_layer_values(count, point_stress, point_strain, layer_stress, layer_strain)
+    integer, intent(in) :: count
+    real(wp), intent(in) :: point_stress(:, :), point_strain(:)     ! (6, points), (points)
+    real(wp), intent(out) :: layer_stress(:, :), layer_strain(:)    ! (6, MAXINT), (MAXINT)
+    integer :: layers, middle
+    layers = size(layer_strain)
+    layer_stress = 0.0_wp
+    layer_strain = 0.0_wp
+    if (count < 1) return
+    if (layers == 3) then
+      middle = (count + 1)/2
+      if (mod(count, 2) == 1) then
+        layer_stress(:, 1) = point_stress(:, middle)
+        layer_strain(1) = point_strain(middle)
+      else
+        layer_stress(:, 1) = 0.5_wp*(point_stress(:, middle) + point_stress(:, middle + 1))
+        layer_strain(1) = 0.5_wp*(point_strain(middle) + point_strain(middle + 1))
+      end if
+      layer_stress(:, 2) = point_stress(:, 1)
+      layer_strain(2) = point_strain(1)
+      layer_stress(:, 3) = point_stress(:, count)
+      layer_strain(3) = point_strain(count)
+    else
+      layer_stress(:, 1:min(count, layers)) = point_stress(:, 1:min(count, layers))
+      layer_strain(1:min(count, layers)) = point_strain(1:min(count, layers))
+    end if
+  end subroutine shell_layer_values
 end module d3plot_states

@@ -75,6 +75,7 @@ module results_file
   use file_lock, only: file_lock_t, acquire_file_lock, release_file_lock
   use d3plot_file, only: d3plot_file_t, open_d3plot, write_d3plot_state, close_d3plot, d3plot_base_name, &
                          default_file_scale
+  use d3plot_states, only: shell_layer_values
   implicit none
   private
 
@@ -465,10 +466,11 @@ contains
       if (present(shell_stress) .and. layout%shell_count > 0) then
         do shell = 1, layout%shell_count
           points = 0
-          if (present(shell_point_count)) points = min(shell_point_count(shell), layout%shell_layers)
+          if (present(shell_point_count)) points = min(shell_point_count(shell), size(shell_point_stress, 2))
           if (points > 0) then
-            layer_stress(:, 1:points, shell) = shell_point_stress(:, 1:points, shell)
-            layer_strain(1:points, shell) = shell_point_plastic_strain(1:points, shell)
+            call shell_layer_values(points, shell_point_stress(:, 1:points, shell), &
+                                    shell_point_plastic_strain(1:points, shell), layer_stress(:, :, shell), &
+                                    layer_strain(:, shell))
           else
             do layer = 1, layout%shell_layers
               layer_stress(:, layer, shell) = shell_stress(:, shell)

@@ -172,6 +172,7 @@ def test_solid_bar_d3plot_equals_results(tmp_path, run_deck):
         check_solids(plot, results)
         assert states(results, "solid_plastic_strain").max() > 1e-3     # it yielded
         check_energies(plot, results, times)
+    # LS-DYNA's deletion flag: the element's part number (1-based) while it is in the model
     assert np.all(plot.arrays[ArrayType.element_solid_is_alive] == 1.0)
 
 
@@ -224,7 +225,7 @@ def test_meshfree_cube_d3plot_has_the_physical_values(tmp_path, run_deck):
 
 def test_eroded_shells_carry_the_deleted_flag(tmp_path, run_deck):
     """FAIL = 0.03: the 4 shells of the strip erode; the d3plot flags them deleted (0.0) from
-    the state where results.h5 says they are eroded, and 1.0 before."""
+    the state where results.h5 says they are eroded, and with their part number (1) before."""
     deck = pulled_deck(tmp_path / "erode.k", "shell", 4, 4.0, 0.8, 0.05, points=3, failure=0.03)
     run = run_deck(deck)
     assert run.status == 0, run.stderr
@@ -329,9 +330,18 @@ def test_coupled_meshfree_shell_strip_d3plot_has_the_physical_values(tmp_path, r
         mid = states(results, "shell_stress")
         for layer in range(3):        # meshfree cells: their mid-surface values in every layer
             assert_close(stress[:, efg, layer, :], mid[:, efg], f"meshfree shell stresses, layer {layer + 1}")
-        weights = np.polynomial.legendre.leggauss(3)[1] / 2.0
+        # FE shells, NIP 3 (LS-DYNA's MAXINT 3): the layers are the mid, inner (bottom) and outer
+        # (top) points, so the Gauss mean weighs them 8/9, 5/9, 5/9 (over 2)
+        weights = np.array([8.0, 5.0, 5.0]) / 18.0
         assert_close(np.einsum("l,selk->sek", weights, stress[:, ~efg]), mid[:, ~efg], "FE shell stresses",
                      scale=np.abs(stress).max())
+        bending = np.abs(stress[:, ~efg, 1, 0] - stress[:, ~efg, 2, 0]).max()
+        print(f"  largest difference of the FE shells' inner and outer axial stress {bending:.3e}")
+        assert bending > 0.1 * np.abs(stress).max()               # the layers are the bent shell's
+    # no erosion: every shell's deletion flag is its part number, 1 (FE) or 2 (meshfree)
+    part_numbers = plot.arrays[ArrayType.element_shell_part_indexes] + 1
+    assert set(part_numbers) == {1, 2}
+    assert np.all(plot.arrays[ArrayType.element_shell_is_alive] == part_numbers)
 
 
 def test_beam_cantilever_d3plot_has_the_beams_and_their_resultants(tmp_path, run_deck):
