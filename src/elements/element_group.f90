@@ -56,6 +56,10 @@ module element_group
     !> bottom to top, and (shells) how many points a group wrote (0: none, e.g. meshfree shells)
     real(wp), allocatable :: shell_point_stress(:, :, :), shell_point_plastic_strain(:, :)
     integer, allocatable :: shell_point_count(:)
+    !> For the d3plot, with the points: (8, shells) resultants per unit width in the shell's
+    !> local frame, M_xx M_yy M_xy Q_x Q_y N_xx N_yy N_xy, its thickness and its internal energy
+    !> per unit volume (shells)
+    real(wp), allocatable :: shell_resultant(:, :), shell_thickness(:), shell_energy_density(:)
   end type element_results_t
 
   type, abstract :: element_group_t

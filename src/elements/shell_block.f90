@@ -980,7 +980,8 @@ contains
   !> over the points) and the stress of the point with the largest von Mises stress, both in
   !> global axes (xx, yy, zz, xy, yz, zx), and the mean and largest effective plastic strain.
   subroutine shell_block_element_results(block, material, mid_stress, peak_stress, mean_plastic_strain, &
-                                         peak_plastic_strain, point_stress, point_plastic_strain, point_count)
+                                         peak_plastic_strain, point_stress, point_plastic_strain, point_count, &
+                                         resultant, thickness, energy_density)
     type(shell_block_t), intent(in) :: block
     type(material_t), intent(in) :: material
     real(wp), intent(inout) :: mid_stress(:, :), peak_stress(:, :), mean_plastic_strain(:), peak_plastic_strain(:)
@@ -988,7 +989,10 @@ contains
     !> each point, bottom to top, and the points written (shells)
     real(wp), intent(inout), optional :: point_stress(:, :, :), point_plastic_strain(:, :)
     integer, intent(inout), optional :: point_count(:)
-    real(wp) :: point_strain(block_size), mean_local(5), effective, largest
+    !> (with the points) (8, shells) resultants per unit width in the local frame: M_xx M_yy
+    !> M_xy Q_x Q_y N_xx N_yy N_xy; the thickness; the internal energy per unit volume
+    real(wp), intent(inout), optional :: resultant(:, :), thickness(:), energy_density(:)
+    real(wp) :: point_strain(block_size), mean_local(5), effective, largest, through(5), moment(3)
     integer :: nel, i, point, peak, written
     nel = block%element_count
     ! Gauss points are numbered from the bottom (height -1/2) to the top, as LS-DYNA's layers
@@ -1001,6 +1005,21 @@ contains
         point_stress(:, point, block%elements(i)) = global_stress(block%frame(i, :, :), block%stress(i, :, point))
       end do
       point_plastic_strain(:, block%elements(i)) = 0.0_wp
+      ! resultants per unit width: N = t sum w s, M = t^2 sum w h s (h = z / t), Q = t sum w s_xz
+      through = 0.0_wp
+      moment = 0.0_wp
+      do point = 1, block%point_count
+        through = through + block%point_weight(point)*block%stress(i, :, point)
+        moment = moment + block%point_weight(point)*block%point_height(point)*block%stress(i, 1:3, point)
+      end do
+      resultant(1:3, block%elements(i)) = block%thickness(i)**2*moment
+      resultant(4, block%elements(i)) = block%thickness(i)*through(5)
+      resultant(5, block%elements(i)) = block%thickness(i)*through(4)
+      resultant(6:8, block%elements(i)) = block%thickness(i)*through(1:3)
+      thickness(block%elements(i)) = block%thickness(i)
+      energy_density(block%elements(i)) = 0.0_wp
+      if (block%area(i)*block%thickness(i) > 0.0_wp) &
+        energy_density(block%elements(i)) = block%internal_energy(i)/(block%area(i)*block%thickness(i))
     end do
     do i = 1, nel
       mean_local = 0.0_wp

@@ -305,7 +305,8 @@ contains
                                          results%shell_stress, results%shell_stress_peak, &
                                          results%shell_plastic_strain, results%shell_plastic_strain_peak, &
                                          results%shell_point_stress, results%shell_point_plastic_strain, &
-                                         results%shell_point_count)
+                                         results%shell_point_count, results%shell_resultant, &
+                                         results%shell_thickness, results%shell_energy_density)
       else
         call shell_block_element_results(self%blocks(b), model%materials(self%blocks(b)%material), &
                                          results%shell_stress, results%shell_stress_peak, &

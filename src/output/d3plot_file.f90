@@ -20,7 +20,7 @@ module d3plot_file
   use file_system, only: remove_file, file_size
   use model, only: model_t
   use element_group, only: shell_output_points
-  use d3plot_states, only: d3plot_layout_t, state_word_count, fill_state_words
+  use d3plot_states, only: d3plot_layout_t, state_word_count, fill_state_words, shell_extra_values
   implicit none
   private
 
@@ -50,6 +50,7 @@ module d3plot_file
     type(d3plot_layout_t) :: layout
     real(wp), allocatable :: reference(:, :)      !< (3, nodes) reference coordinates
     integer, allocatable :: solid_part(:), shell_part(:), beam_part(:)  !< part numbers of the elements
+    real(wp), allocatable :: shell_thickness(:)   !< the deck's (mean of the corners), for shells without points
     real(real32), allocatable :: words(:)         !< one state
   end type d3plot_file_t
 
@@ -116,14 +117,15 @@ contains
   !> reference coordinates, as LS-DYNA writes the current coordinates). After a failed write
   !> the database is closed with the states before it, and later calls do nothing.
   subroutine write_d3plot_state(plot, time, globals, displacement, velocity, acceleration, solid_stress, &
-                                solid_plastic_strain, shell_stress, shell_plastic_strain, beam_resultant, error, &
-                                solid_eroded, shell_eroded, beam_failed)
+                                solid_plastic_strain, shell_stress, shell_plastic_strain, shell_extra, beam_resultant, &
+                                error, solid_eroded, shell_eroded, beam_failed)
     type(d3plot_file_t), intent(inout) :: plot
     real(wp), intent(in) :: time
     real(wp), intent(in) :: globals(:)
     real(wp), intent(in) :: displacement(:, :), velocity(:, :), acceleration(:, :)
     real(wp), intent(in) :: solid_stress(:, :), solid_plastic_strain(:)
     real(wp), intent(in) :: shell_stress(:, :, :), shell_plastic_strain(:, :)
+    real(wp), intent(in) :: shell_extra(:, :)
     real(wp), intent(in) :: beam_resultant(:, :)
     type(error_t), allocatable, intent(out) :: error
     integer, intent(in), optional :: solid_eroded(:), shell_eroded(:)
@@ -135,9 +137,9 @@ contains
     if (.not. plot%is_open .or. plot%failed) return
     state_words = state_word_count(plot%layout)
     call fill_state_words(plot%layout, time, globals, plot%reference + displacement, velocity, acceleration, &
-                          solid_stress, solid_plastic_strain, shell_stress, shell_plastic_strain, beam_resultant, &
-                          plot%solid_part, plot%shell_part, plot%beam_part, plot%words, solid_eroded, shell_eroded, &
-                          beam_failed)
+                          solid_stress, solid_plastic_strain, shell_stress, shell_plastic_strain, shell_extra, &
+                          beam_resultant, plot%solid_part, plot%shell_part, plot%beam_part, plot%words, &
+                          solid_eroded, shell_eroded, beam_failed)
     status = 0
     ! a new family file when this state would pass the limit (a file holds at least one state)
     if (plot%file_words > 0 .and. plot%file_words + state_words + 1 > plot%limit_words) &
@@ -172,6 +174,7 @@ contains
   subroutine set_layout(plot, model)
     type(d3plot_file_t), intent(inout) :: plot
     type(model_t), intent(in) :: model
+    integer :: element
     associate (layout => plot%layout)
       layout%node_count = 0
       if (allocated(model%node_ids)) layout%node_count = size(model%node_ids)
@@ -187,15 +190,24 @@ contains
       layout%global_count = 6 + 2*layout%part_count
       layout%solid_values = 7
       layout%beam_values = 6
-      layout%shell_values = 7*layout%shell_layers
+      layout%shell_values = 7*layout%shell_layers + shell_extra_values
     end associate
     if (allocated(plot%reference)) deallocate (plot%reference)
+    if (allocated(plot%shell_thickness)) deallocate (plot%shell_thickness)
     allocate (plot%reference(3, plot%layout%node_count))
     if (plot%layout%node_count > 0) plot%reference = model%coordinates
     plot%solid_part = [integer ::]
     if (plot%layout%solid_count > 0) plot%solid_part = model%solid_part
     plot%shell_part = [integer ::]
     if (plot%layout%shell_count > 0) plot%shell_part = model%shell_part
+    allocate (plot%shell_thickness(plot%layout%shell_count))
+    do element = 1, plot%layout%shell_count
+      if (model%shell_nodes(3, element) == model%shell_nodes(4, element)) then
+        plot%shell_thickness(element) = sum(model%shell_thickness(1:3, element))/3.0_wp
+      else
+        plot%shell_thickness(element) = 0.25_wp*sum(model%shell_thickness(:, element))
+      end if
+    end do
     plot%beam_part = [integer ::]
     if (plot%layout%beam_count > 0) plot%beam_part = model%beam_part
     if (allocated(plot%words)) deallocate (plot%words)
@@ -250,8 +262,8 @@ contains
     control(40) = numbering_word_count(plot%layout)             ! NARBS
     control(44) = 1000                                          ! IOSHL(1): stresses
     control(45) = 1000                                          ! IOSHL(2): plastic strains
-    control(46) = 0                                             ! IOSHL(3): no shell resultants
-    control(47) = 0                                             ! IOSHL(4): no thickness, energy
+    control(46) = 1000                                          ! IOSHL(3): shell resultants
+    control(47) = 1000                                          ! IOSHL(4): thickness, energy
     control(52) = plot%layout%part_count                        ! NMMAT
     write (plot%unit, iostat=status, iomsg=message) control
     plot%file_words = 64

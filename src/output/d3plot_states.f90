@@ -7,7 +7,7 @@
 !> per solid NV3D values (stress xx yy zz xy yz zx, effective plastic strain); per beam NV1D
 !> values (axial force, shear s, shear t, bending moment s, bending moment t, torsion); per
 !> shell NV2D values (per layer of MAXINT: stress xx yy zz xy yz zx, effective plastic
-!> strain); and the deletion flags of the solids, shells and beams (the element's part number
+!> strain; then the resultants, thickness and energy density, shell_extra_values); and the deletion flags of the solids, shells and beams (the element's part number
 !> while it is in the model, 0.0 once deleted), which LS-DYNA writes when MAXINT is given as
 !> -(MAXINT + 10000).
 module d3plot_states
@@ -29,8 +29,13 @@ module d3plot_states
     integer :: global_count = 0   !< NGLBV: 6 + 2 per part (internal, kinetic energy)
     integer :: solid_values = 7   !< NV3D
     integer :: beam_values = 6    !< NV1D
-    integer :: shell_values = 7   !< NV2D = MAXINT * 7
+    integer :: shell_values = 19  !< NV2D = MAXINT * 7 + 12
   end type d3plot_layout_t
+
+  !> After the layers, per shell (IOSHL(3) = IOSHL(4) = 1000): M_xx M_yy M_xy Q_x Q_y N_xx N_yy
+  !> N_xy (local frame, per unit width), thickness, two element-dependent values, internal
+  !> energy density.
+  integer, parameter, public :: shell_extra_values = 12
 
 contains
 
@@ -52,14 +57,15 @@ contains
   !> part numbers of the elements; the eroded flags 1 for an element out of the model (absent:
   !> none is).
   subroutine fill_state_words(layout, time, globals, coordinates, velocity, acceleration, solid_stress, &
-                              solid_plastic_strain, shell_stress, shell_plastic_strain, beam_resultant, solid_part, &
-                              shell_part, beam_part, words, solid_eroded, shell_eroded, beam_failed)
+                              solid_plastic_strain, shell_stress, shell_plastic_strain, shell_extra, beam_resultant, &
+                              solid_part, shell_part, beam_part, words, solid_eroded, shell_eroded, beam_failed)
     type(d3plot_layout_t), intent(in) :: layout
     real(wp), intent(in) :: time
     real(wp), intent(in) :: globals(:)
     real(wp), intent(in) :: coordinates(:, :), velocity(:, :), acceleration(:, :)
     real(wp), intent(in) :: solid_stress(:, :), solid_plastic_strain(:)
     real(wp), intent(in) :: shell_stress(:, :, :), shell_plastic_strain(:, :)
+    real(wp), intent(in) :: shell_extra(:, :)        !< (shell_extra_values, shells)
     real(wp), intent(in) :: beam_resultant(:, :)
     integer, intent(in) :: solid_part(:), shell_part(:), beam_part(:)   !< part numbers (1-based)
     real(real32), intent(out) :: words(:)
@@ -102,6 +108,8 @@ contains
         words(next + 6) = real(shell_plastic_strain(layer, element), real32)
         next = next + 7
       end do
+      words(next:next + shell_extra_values - 1) = real(shell_extra(:, element), real32)
+      next = next + shell_extra_values
     end do
     ! deletion flags: solids, (thick shells: none), shells, beams; LS-DYNA writes the element's
     ! material (part) number, 0 for a deleted element

@@ -75,7 +75,7 @@ module results_file
   use file_lock, only: file_lock_t, acquire_file_lock, release_file_lock
   use d3plot_file, only: d3plot_file_t, open_d3plot, write_d3plot_state, close_d3plot, d3plot_base_name, &
                          default_file_scale
-  use d3plot_states, only: shell_layer_values
+  use d3plot_states, only: shell_layer_values, shell_extra_values
   implicit none
   private
 
@@ -292,7 +292,8 @@ contains
                          solid_plastic_strain, error, shell_stress, shell_plastic_strain, shell_stress_peak, &
                          shell_plastic_strain_peak, histories, beam_resultant, beam_plastic_strain, beam_failed, &
                          solid_eroded, shell_eroded, eroded_count, acceleration, globals, shell_point_stress, &
-                         shell_point_plastic_strain, shell_point_count)
+                         shell_point_plastic_strain, shell_point_count, shell_resultant, shell_thickness, &
+                         shell_energy_density)
     type(results_file_t), intent(inout) :: results
     real(wp), intent(in) :: time
     ! Contiguous: the solver's whole arrays go to HDF5 without a copy.
@@ -315,6 +316,7 @@ contains
     !> for the d3plot only: the shells' points through the thickness (element_results_t)
     real(wp), intent(in), contiguous, optional :: shell_point_stress(:, :, :), shell_point_plastic_strain(:, :)
     integer, intent(in), contiguous, optional :: shell_point_count(:)
+    real(wp), intent(in), contiguous, optional :: shell_resultant(:, :), shell_thickness(:), shell_energy_density(:)
     real(wp) :: no_shell_stress(6, 0), no_shell_strain(0)
     real(wp), allocatable :: grown(:)
     type(error_t), allocatable :: space_error
@@ -433,7 +435,8 @@ contains
     if (results%d3plot%is_open) then
       call write_d3plot(results%d3plot, time, displacement, velocity, solid_stress, solid_plastic_strain, error, &
                         shell_stress, shell_plastic_strain, beam_resultant, beam_failed, solid_eroded, shell_eroded, &
-                        acceleration, globals, shell_point_stress, shell_point_plastic_strain, shell_point_count)
+                        acceleration, globals, shell_point_stress, shell_point_plastic_strain, shell_point_count, &
+                        shell_resultant, shell_thickness, shell_energy_density)
       if (allocated(error)) return
     end if
     if (xdmf_due(results)) call write_xdmf_now(results, error)
@@ -443,7 +446,8 @@ contains
   !> written as 0: the accelerations and global values of a static state).
   subroutine write_d3plot(plot, time, displacement, velocity, solid_stress, solid_plastic_strain, error, &
                           shell_stress, shell_plastic_strain, beam_resultant, beam_failed, solid_eroded, shell_eroded, &
-                          acceleration, globals, shell_point_stress, shell_point_plastic_strain, shell_point_count)
+                          acceleration, globals, shell_point_stress, shell_point_plastic_strain, shell_point_count, &
+                          shell_resultant, shell_thickness, shell_energy_density)
     type(d3plot_file_t), intent(inout) :: plot
     real(wp), intent(in) :: time
     real(wp), intent(in) :: displacement(:, :), velocity(:, :), solid_stress(:, :), solid_plastic_strain(:)
@@ -454,23 +458,34 @@ contains
     real(wp), intent(in), optional :: acceleration(:, :), globals(:)
     real(wp), intent(in), optional :: shell_point_stress(:, :, :), shell_point_plastic_strain(:, :)
     integer, intent(in), optional :: shell_point_count(:)
+    real(wp), intent(in), optional :: shell_resultant(:, :), shell_thickness(:), shell_energy_density(:)
     real(wp), allocatable :: layer_stress(:, :, :), layer_strain(:, :), resultant(:, :), global_values(:)
+    real(wp), allocatable :: shell_extra(:, :)
     real(wp), allocatable :: node_acceleration(:, :)
     integer :: shell, layer, points
 
     associate (layout => plot%layout)
       allocate (layer_stress(6, layout%shell_layers, layout%shell_count), source=0.0_wp)
       allocate (layer_strain(layout%shell_layers, layout%shell_count), source=0.0_wp)
+      allocate (shell_extra(shell_extra_values, layout%shell_count), source=0.0_wp)
       ! each shell's points through the thickness; a shell whose group gives none (meshfree
       ! shells, rigid parts, a static state) has its mid-surface values in every layer
       if (present(shell_stress) .and. layout%shell_count > 0) then
         do shell = 1, layout%shell_count
           points = 0
           if (present(shell_point_count)) points = min(shell_point_count(shell), size(shell_point_stress, 2))
+          ! resultants, thickness and energy density where the group gave them, else the deck's
+          ! thickness only
+          shell_extra(9, shell) = plot%shell_thickness(shell)
           if (points > 0) then
             call shell_layer_values(points, shell_point_stress(:, 1:points, shell), &
                                     shell_point_plastic_strain(1:points, shell), layer_stress(:, :, shell), &
                                     layer_strain(:, shell))
+            if (present(shell_resultant)) then
+              shell_extra(1:8, shell) = shell_resultant(:, shell)
+              shell_extra(9, shell) = shell_thickness(shell)
+              shell_extra(12, shell) = shell_energy_density(shell)
+            end if
           else
             do layer = 1, layout%shell_layers
               layer_stress(:, layer, shell) = shell_stress(:, shell)
@@ -489,14 +504,14 @@ contains
     if (present(beam_failed)) then
       if (size(beam_failed) /= plot%layout%beam_count) then
         call write_d3plot_state(plot, time, global_values, displacement, velocity, node_acceleration, solid_stress, &
-                                solid_plastic_strain, layer_stress, layer_strain, resultant, error, solid_eroded, &
-                                shell_eroded)
+                                solid_plastic_strain, layer_stress, layer_strain, shell_extra, resultant, error, &
+                                solid_eroded, shell_eroded)
         return
       end if
     end if
     call write_d3plot_state(plot, time, global_values, displacement, velocity, node_acceleration, solid_stress, &
-                            solid_plastic_strain, layer_stress, layer_strain, resultant, error, solid_eroded, &
-                            shell_eroded, beam_failed)
+                            solid_plastic_strain, layer_stress, layer_strain, shell_extra, resultant, error, &
+                            solid_eroded, shell_eroded, beam_failed)
   end subroutine write_d3plot
 
   !> Add the history rows recorded since the previous call (each series as

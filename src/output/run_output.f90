@@ -194,7 +194,8 @@ contains
                          eroded_count=state%eroded_count, acceleration=plan%node_acceleration, globals=globals, &
                          shell_point_stress=fields%shell_point_stress, &
                          shell_point_plastic_strain=fields%shell_point_plastic_strain, &
-                         shell_point_count=fields%shell_point_count)
+                         shell_point_count=fields%shell_point_count, shell_resultant=fields%shell_resultant, &
+                         shell_thickness=fields%shell_thickness, shell_energy_density=fields%shell_energy_density)
       else
         ! (beam fields not allocated: a model without beams; the dummies are then absent)
         call write_state(results, state%time, plan%node_displacement, plan%node_velocity, fields%solid_stress, &

@@ -178,6 +178,11 @@ contains
       results%shell_point_stress = 0.0_wp
       results%shell_point_plastic_strain = 0.0_wp
       results%shell_point_count = 0
+      allocate (results%shell_resultant(8, size(model%shell_ids)), results%shell_thickness(size(model%shell_ids)), &
+                results%shell_energy_density(size(model%shell_ids)))
+      results%shell_resultant = 0.0_wp
+      results%shell_thickness = 0.0_wp
+      results%shell_energy_density = 0.0_wp
     end associate
     allocate (plan%node_velocity(3, size(model%node_ids)), plan%node_displacement(3, size(model%node_ids)), &
               plan%generalized_velocity(3, size(model%node_ids)), plan%node_acceleration(3, size(model%node_ids)))

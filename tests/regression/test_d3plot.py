@@ -273,8 +273,10 @@ def test_bent_shell_layers_hold_the_plastic_hinge(tmp_path, run_deck):
     """The plastic collapse of a cantilever strip (test_shell_physics, NIP 5, elastic-perfectly
     plastic): at the last state the root element is a hinge, so its bottom and top points are on
     the yield surface (von Mises = SIGY to 0.1 %) with axial stresses of opposite sign, the
-    middle point carries less; the Gauss-weighted mean over the layers is results.h5's
-    mid-surface stress and the largest von Mises stress of the layers its peak's."""
+    middle point carries less; its bending moment is the Gauss rule's plastic moment; the
+    energy densities add up to glstat's internal energy; the Gauss-weighted mean over the layers
+    is results.h5's mid-surface stress and the largest von Mises stress of the layers its
+    peak's."""
     from test_shell_physics import YIELD, cantilever_deck
     deck, _ = cantilever_deck(tmp_path / "cantilever.k", 5)
     run = run_deck(deck)
@@ -290,8 +292,32 @@ def test_bent_shell_layers_hold_the_plastic_hinge(tmp_path, run_deck):
     assert np.allclose(last[[0, 4]], YIELD, rtol=1e-3)
     assert stress[-1, root, 0, 0] * stress[-1, root, 4, 0] < 0
     assert last[2] < 0.9 * YIELD
-    weights = np.polynomial.legendre.leggauss(5)[1] / 2.0
+    # the resultants per unit width (local frame): the hinge's moment is the Gauss rule's plastic
+    # moment k SIGY t^2 / 4 (measured 1.01-1.02 of it: some plate action, see test_shell_physics)
+    points, weights = np.polynomial.legendre.leggauss(5)
+    weights = weights / 2.0
+    thickness = plot.arrays[ArrayType.element_shell_thickness]
+    assert np.all(thickness == 2.0)
+    moment = plot.arrays[ArrayType.element_shell_bending_moment][-1, root, 0]
+    plastic = np.sum(weights * np.abs(points)) * YIELD * 2.0 ** 2 / 2.0      # per unit width
+    from_layers = 2.0 ** 2 * np.sum(weights * points / 2.0 * stress[-1, root, :, 0])
+    normal = plot.arrays[ArrayType.element_shell_normal_force][-1, root, 0]
+    print(f"  root M_xx {moment:.5f}, from the layers {from_layers:.5f}, Gauss plastic moment {plastic:.5f}; "
+          f"N_xx {normal:.2e}")
+    assert abs(abs(moment) / plastic - 1.0) < 0.03
+    assert abs(abs(moment) - abs(from_layers)) < 2e-3 * plastic
+    assert abs(normal) < 0.02 * YIELD * 2.0
+    # the internal energy densities times the elements' volumes add up to glstat's internal energy
+    corners = plot.arrays[ArrayType.node_displacement][:, plot.arrays[ArrayType.element_shell_node_indexes]]
+    area = 0.5 * np.linalg.norm(np.cross(corners[:, :, 2] - corners[:, :, 0], corners[:, :, 3] - corners[:, :, 1]),
+                                axis=-1)
+    energy = np.sum(plot.arrays[ArrayType.element_shell_internal_energy] * area * thickness, axis=1)
     with run.open() as results:
+        internal = results["history/glstat/internal_energy"][()]
+        rows = [int(np.argmin(np.abs(results["history/glstat/time"][()] - t)))
+                for t in plot.arrays[ArrayType.global_timesteps]]
+        print(f"  internal energy from the densities / glstat at the end {energy[-1] / internal[rows][-1]:.6f}")
+        assert np.allclose(energy, internal[rows], rtol=2e-3, atol=1e-6 * internal.max())
         assert_close(np.einsum("l,selk->sek", weights, stress), states(results, "shell_stress"), "shell stresses",
                      scale=np.abs(stress).max())
         # top and bottom points tie in a hinge: compare the peak's von Mises stress
