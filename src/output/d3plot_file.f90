@@ -24,7 +24,7 @@ module d3plot_file
   implicit none
   private
 
-  public :: d3plot_file_t, open_d3plot, write_d3plot_state, close_d3plot, d3plot_base_name
+  public :: d3plot_file_t, open_d3plot, continue_d3plot, write_d3plot_state, close_d3plot, d3plot_base_name
   public :: default_file_scale, words_per_scale
 
   !> LS-DYNA's default family file size: 7 x 512^2 words; x= on the command line gives the
@@ -112,6 +112,84 @@ contains
       call fail(plot)
     end if
   end subroutine open_d3plot
+
+  !> Continue the d3plot of an interrupted run (restart): keep its first `kept_states` states,
+  !> the ones results.h5 keeps, and write on after them. The states after them are overwritten
+  !> with zeros (readers count a file's states from its last non-zero word) and later family
+  !> files are deleted. A d3plot that does not hold those states (missing, written by another
+  !> model, or cut short) is not continued: `continued` is false and it is left as it is.
+  subroutine continue_d3plot(plot, base_path, model, kept_states, file_scale, continued)
+    type(d3plot_file_t), intent(inout) :: plot
+    character(len=*), intent(in) :: base_path
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: kept_states, file_scale
+    logical, intent(out) :: continued
+    integer(int64) :: state_words, base_words, file_words, bytes, keep_words
+    integer :: member, remaining, in_file, status
+    integer(int32) :: control(64)
+    integer(int32), allocatable :: zeros(:)
+    character(len=:), allocatable :: path
+    character(len=256) :: message
+
+    continued = .false.
+    plot%base_path = base_path
+    plot%failed = .false.
+    plot%limit_words = max(1, file_scale)*words_per_scale
+    call set_layout(plot, model)
+    state_words = state_word_count(plot%layout)
+    base_words = first_file_words(plot%layout)
+    ! the control words must be this model's
+    bytes = file_size(base_path)
+    if (bytes < 4*(base_words + 1)) return
+    open (newunit=plot%unit, file=base_path, access="stream", form="unformatted", status="old", action="read", &
+          iostat=status)
+    if (status /= 0) return
+    read (plot%unit, iostat=status) control
+    close (plot%unit)
+    if (status /= 0) return
+    if (control(17) /= plot%layout%node_count .or. control(24) /= plot%layout%solid_count .or. &
+        control(32) /= plot%layout%shell_count .or. control(29) /= plot%layout%beam_count .or. &
+        control(34) /= plot%layout%shell_values .or. control(19) /= plot%layout%global_count) return
+    ! the file holding the last state kept
+    remaining = kept_states
+    member = 0
+    do
+      path = base_path
+      if (member > 0) path = base_path//member_suffix(member)
+      bytes = file_size(path)
+      if (bytes < 4) return
+      file_words = bytes/4 - 1
+      if (member == 0) file_words = file_words - base_words
+      in_file = int(max(0_int64, file_words)/state_words)
+      if (in_file >= remaining) exit
+      remaining = remaining - in_file
+      member = member + 1
+    end do
+    keep_words = int(remaining, int64)*state_words
+    if (member == 0) keep_words = keep_words + base_words
+    open (newunit=plot%unit, file=path, access="stream", form="unformatted", status="old", action="readwrite", &
+          iostat=status)
+    if (status /= 0) return
+    plot%is_open = .true.
+    plot%path = path
+    plot%member = member
+    plot%file_words = keep_words
+    ! zeros over what follows, then the end marker
+    allocate (zeros(max(0_int64, bytes/4 - keep_words)), source=0_int32)
+    write (plot%unit, pos=4*keep_words + 1, iostat=status) zeros
+    if (status == 0) call write_end_marker(plot, status, message)
+    if (status /= 0) then
+      call fail(plot)
+      return
+    end if
+    member = member + 1
+    do while (file_size(base_path//member_suffix(member)) >= 0)
+      call remove_file(base_path//member_suffix(member))
+      member = member + 1
+    end do
+    plot%state_count = kept_states
+    continued = .true.
+  end subroutine continue_d3plot
 
   !> Append one state (see d3plot_states for the arguments; `displacement` is added to the
   !> reference coordinates, as LS-DYNA writes the current coordinates). After a failed write
@@ -302,6 +380,16 @@ contains
                         6_int64*layout%beam_count + 5_int64*layout%shell_count
     end associate
   end subroutine write_geometry
+
+  !> Words of the first file before its states: control words, geometry, numbering, the end
+  !> marker and the part titles.
+  pure function first_file_words(layout) result(words)
+    type(d3plot_layout_t), intent(in) :: layout
+    integer(int64) :: words
+    words = 64_int64 + 3_int64*layout%node_count + 9_int64*layout%solid_count + 6_int64*layout%beam_count + &
+            5_int64*layout%shell_count + numbering_word_count(layout) + 1 + 2 + &
+            (1 + title_characters/4)*int(layout%part_count, int64)
+  end function first_file_words
 
   !> NARBS: 16 words of pointers and counts, the node, solid, beam, shell (and thick shell: none)
   !> ids, and the part ids three times (sorted, as defined, and the cross-reference).

@@ -73,8 +73,8 @@ module results_file
                          clear_system_error, system_error_number, system_error_text, &
                          error_no_space, error_quota_exceeded
   use file_lock, only: file_lock_t, acquire_file_lock, release_file_lock
-  use d3plot_file, only: d3plot_file_t, open_d3plot, write_d3plot_state, close_d3plot, d3plot_base_name, &
-                         default_file_scale
+  use d3plot_file, only: d3plot_file_t, open_d3plot, continue_d3plot, write_d3plot_state, close_d3plot, &
+                         d3plot_base_name, default_file_scale
   use d3plot_states, only: shell_layer_values, shell_extra_values
   implicit none
   private
@@ -622,7 +622,7 @@ contains
   !> the dump are removed, `/run` says "running" again and the XDMF file lists the states kept;
   !> the continued run then writes on as `open_results` had left it. `dump_path` names the dump
   !> in messages.
-  subroutine continue_results(results, directory, job_id, model, threads, histories, dump_path, error)
+  subroutine continue_results(results, directory, job_id, model, threads, histories, dump_path, error, d3plot_scale)
     type(results_file_t), intent(inout) :: results
     character(len=*), intent(in) :: directory, job_id
     type(model_t), intent(in) :: model
@@ -630,11 +630,12 @@ contains
     type(history_set_t), intent(in) :: histories
     character(len=*), intent(in) :: dump_path
     type(error_t), allocatable, intent(out) :: error
+    integer, intent(in), optional :: d3plot_scale   !< d3plot family file size (x=), see open_results
     integer(hid_t) :: access_list
     integer(long_int) :: file_run_id
     integer, allocatable :: grown(:)
     integer :: status, ignored
-    logical :: exists
+    logical :: exists, continued
 
     if (results%is_open) then
       call make_error(error, "results file "//results%h5_path//": already open")
@@ -718,6 +719,14 @@ contains
     results%is_open = .true.
     ! the XDMF file of the interrupted run may list states removed here
     call write_xdmf_now(results, error)
+    ! its d3plot too, when it holds the states kept (else the continued run writes none)
+    if (present(d3plot_scale)) then
+      call continue_d3plot(results%d3plot, join_path(directory, d3plot_base_name(job_id)), model, &
+                           results%state_count, d3plot_scale, continued)
+    else
+      call continue_d3plot(results%d3plot, join_path(directory, d3plot_base_name(job_id)), model, &
+                           results%state_count, default_file_scale, continued)
+    end if
   end subroutine continue_results
 
   !> The states the dump counts are in the file, at the dump's times.

@@ -401,3 +401,61 @@ def test_beam_cantilever_d3plot_has_the_beams_and_their_resultants(tmp_path, run
     print(f"  root shear at the end {shear:.4f} for a tip load {TIP_LOAD}")
     assert 0.5 * TIP_LOAD < shear < 1.5 * TIP_LOAD
     assert np.all(plot.arrays[ArrayType.element_beam_is_alive] == 1.0)
+
+
+def garble_states_after(directory, plot, time):
+    """Overwrite with 7.0 every word of the d3plot states of `directory` later than `time`
+    (`plot`: the same database read, for its sizes and times); the count of states garbled."""
+    state_bytes = plot._compute_n_bytes_per_state()
+    times = plot.arrays[ArrayType.global_timesteps]
+    files = sorted(directory.glob("d3plot*"), key=lambda path: (len(path.name), path.name))
+    index, garbled = 0, 0
+    for number, path in enumerate(files):
+        start = plot.geometry_section_size if number == 0 else 0
+        count = (path.stat().st_size - 4 - start) // state_bytes
+        with open(path, "r+b") as stream:
+            for k in range(count):
+                if times[index + k] > time:
+                    stream.seek(start + k * state_bytes)
+                    stream.write(np.full(state_bytes // 4, 7.0, np.float32).tobytes())
+                    garbled += 1
+        index += count
+    assert index == len(times)
+    return garbled
+
+
+@pytest.mark.parametrize("scale", [None, 1])
+def test_restart_continues_the_d3plot(tmp_path, scale):
+    """A run continued from a restart dump (test_restart's plastic block thrown at a wall) keeps
+    the d3plot states before the dump, overwrites the ones after it (garbled here, as an
+    interrupted run may have left them) and writes on: its d3plot equals the uninterrupted
+    run's. With x=1 and a finer state interval the states fill
+    family files, and the continued run cuts and goes on in the family file of the dump."""
+    from test_restart import copy_run, restart, run_fresh, solids_deck
+    deck = solids_deck(tmp_path / "block.k", cells=8 if scale else 5)
+    if scale:
+        deck.write_text(deck.read_text().replace("*DATABASE_BINARY_D3PLOT\n", "*DATABASE_BINARY_D3PLOT\n" +
+                                                 fields(0.001) + "\n$ (the finer interval)\n$", 1))
+    extra = [f"x={scale}"] if scale else []
+    reference_dir = tmp_path / "one"
+    process = run_fresh(deck, reference_dir) if not extra else run_solver(deck, reference_dir, *extra)
+    reference = D3plot(str(reference_dir / "d3plot"))
+    family = sorted(p.name for p in reference_dir.glob("d3plot*"))
+    print(f"  {len(reference.arrays[ArrayType.global_timesteps])} states in {family}")
+    if scale:
+        assert len(family) >= 3
+    dumps = sorted(p.name for p in reference_dir.glob("d3dump*"))
+    for dump in (dumps[len(dumps) // 2], dumps[-2]):
+        target = copy_run(reference_dir, tmp_path / f"restart_{dump}")
+        with h5py.File(target / dump, "r") as store:
+            dump_time = store["clock/time"][()]
+        # what the interrupted run wrote after its dump: the continued run must replace it
+        garbled = garble_states_after(target, reference, dump_time)
+        assert garbled > 0
+        process = restart(target / dump, 1, *extra)
+        assert process.returncode == 0, process.stdout + process.stderr
+        assert sorted(p.name for p in target.glob("d3plot*")) == family
+        continued = D3plot(str(target / "d3plot"))
+        for array in (ArrayType.global_timesteps, ArrayType.node_displacement, ArrayType.node_velocity,
+                      ArrayType.element_solid_stress, ArrayType.element_solid_effective_plastic_strain):
+            assert np.array_equal(continued.arrays[array], reference.arrays[array]), f"{dump}: {array}"
