@@ -459,3 +459,14 @@ def test_restart_continues_the_d3plot(tmp_path, scale):
         for array in (ArrayType.global_timesteps, ArrayType.node_displacement, ArrayType.node_velocity,
                       ArrayType.element_solid_stress, ArrayType.element_solid_effective_plastic_strain):
             assert np.array_equal(continued.arrays[array], reference.arrays[array]), f"{dump}: {array}"
+
+
+@pytest.mark.parametrize("value", ["0", "-3", "big", "1.5"])
+def test_a_bad_file_size_scale_is_refused(tmp_path, value):
+    """x= must be a positive whole number: anything else is refused before the run (exit 2)."""
+    deck = pulled_deck(tmp_path / "bar.k", "solid", 2, 2.0, 0.01, 0.005)
+    process = subprocess.run([str(BINARY), f"i={deck}", f"outdir={tmp_path / 'out'}", f"x={value}"],
+                             capture_output=True, text=True, timeout=60)
+    assert process.returncode == 2, process.stderr
+    assert f"command line: x='{value}' is not a positive whole number" in process.stderr
+    assert not (tmp_path / "out" / "d3plot").exists()
