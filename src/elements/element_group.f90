@@ -304,7 +304,7 @@ contains
     type(model_t), intent(in) :: model
     integer :: shell, section
     shell_output_points = 3
-    if (.not. allocated(model%shell_ids)) return
+    if (.not. (allocated(model%shell_ids) .and. allocated(model%sections))) return
     do shell = 1, size(model%shell_ids)
       section = model%parts(model%shell_part(shell))%section
       if (section < 1 .or. section > size(model%sections)) cycle

@@ -1017,9 +1017,12 @@ contains
       resultant(5, block%elements(i)) = block%thickness(i)*through(4)
       resultant(6:8, block%elements(i)) = block%thickness(i)*through(1:3)
       thickness(block%elements(i)) = block%thickness(i)
+      ! (0 for a volume so small that the quotient would overflow: a collapsed element)
       energy_density(block%elements(i)) = 0.0_wp
-      if (block%area(i)*block%thickness(i) > 0.0_wp) &
-        energy_density(block%elements(i)) = block%internal_energy(i)/(block%area(i)*block%thickness(i))
+      associate (volume => block%area(i)*block%thickness(i))
+        if (volume >= 1.0_wp .or. abs(block%internal_energy(i)) < huge(1.0_wp)*volume) &
+          energy_density(block%elements(i)) = block%internal_energy(i)/volume
+      end associate
     end do
     do i = 1, nel
       mean_local = 0.0_wp

@@ -20,7 +20,7 @@ module d3plot_file
   use file_system, only: remove_file, file_size
   use model, only: model_t
   use element_group, only: shell_output_points
-  use d3plot_states, only: d3plot_layout_t, state_word_count, fill_state_words, shell_extra_values
+  use d3plot_states, only: d3plot_layout_t, state_word_count, fill_state_words, shell_extra_values, single
   implicit none
   private
 
@@ -278,14 +278,17 @@ contains
     if (plot%layout%solid_count > 0) plot%solid_part = model%solid_part
     plot%shell_part = [integer ::]
     if (plot%layout%shell_count > 0) plot%shell_part = model%shell_part
-    allocate (plot%shell_thickness(plot%layout%shell_count))
-    do element = 1, plot%layout%shell_count
-      if (model%shell_nodes(3, element) == model%shell_nodes(4, element)) then
-        plot%shell_thickness(element) = sum(model%shell_thickness(1:3, element))/3.0_wp
-      else
-        plot%shell_thickness(element) = 0.25_wp*sum(model%shell_thickness(:, element))
-      end if
-    end do
+    ! the deck's thickness (mean of the corners, of the three of a triangle)
+    allocate (plot%shell_thickness(plot%layout%shell_count), source=0.0_wp)
+    if (allocated(model%shell_thickness)) then
+      do element = 1, plot%layout%shell_count
+        if (model%shell_nodes(3, element) == model%shell_nodes(4, element)) then
+          plot%shell_thickness(element) = sum(model%shell_thickness(1:3, element))/3.0_wp
+        else
+          plot%shell_thickness(element) = 0.25_wp*sum(model%shell_thickness(:, element))
+        end if
+      end do
+    end if
     plot%beam_part = [integer ::]
     if (plot%layout%beam_count > 0) plot%beam_part = model%beam_part
     if (allocated(plot%words)) deallocate (plot%words)
@@ -372,7 +375,7 @@ contains
         shells(5, element) = model%shell_part(element)
       end do
       status = 0
-      if (layout%node_count > 0) write (plot%unit, iostat=status, iomsg=message) real(plot%reference, real32)
+      if (layout%node_count > 0) write (plot%unit, iostat=status, iomsg=message) single(plot%reference)
       if (status == 0) write (plot%unit, iostat=status, iomsg=message) solids
       if (status == 0) write (plot%unit, iostat=status, iomsg=message) beams
       if (status == 0) write (plot%unit, iostat=status, iomsg=message) shells

@@ -12,11 +12,13 @@
 !> -(MAXINT + 10000).
 module d3plot_states
   use, intrinsic :: iso_fortran_env, only: real32, int64
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_value, ieee_quiet_nan, ieee_positive_inf, &
+                                           ieee_negative_inf
   use kinds, only: wp
   implicit none
   private
 
-  public :: d3plot_layout_t, state_word_count, fill_state_words, shell_layer_values
+  public :: d3plot_layout_t, state_word_count, fill_state_words, shell_layer_values, single
 
   !> The sizes of a state, fixed when the database is opened.
   type :: d3plot_layout_t
@@ -77,38 +79,38 @@ contains
     integer, parameter :: beam_order(6) = [1, 2, 3, 5, 6, 4]
 
     words = 0.0_real32
-    words(1) = real(time, real32)
+    words(1) = single(time)
     next = 2
-    words(next:next + layout%global_count - 1) = real(globals(1:layout%global_count), real32)
+    words(next:next + layout%global_count - 1) = single(globals(1:layout%global_count))
     next = next + layout%global_count
     do node = 1, layout%node_count
-      words(next:next + 2) = real(coordinates(:, node), real32)
+      words(next:next + 2) = single(coordinates(:, node))
       next = next + 3
     end do
     do node = 1, layout%node_count
-      words(next:next + 2) = real(velocity(:, node), real32)
+      words(next:next + 2) = single(velocity(:, node))
       next = next + 3
     end do
     do node = 1, layout%node_count
-      words(next:next + 2) = real(acceleration(:, node), real32)
+      words(next:next + 2) = single(acceleration(:, node))
       next = next + 3
     end do
     do element = 1, layout%solid_count
-      words(next:next + 5) = real(solid_stress(:, element), real32)
-      words(next + 6) = real(solid_plastic_strain(element), real32)
+      words(next:next + 5) = single(solid_stress(:, element))
+      words(next + 6) = single(solid_plastic_strain(element))
       next = next + layout%solid_values
     end do
     do element = 1, layout%beam_count
-      words(next:next + 5) = real(beam_resultant(beam_order, element), real32)
+      words(next:next + 5) = single(beam_resultant(beam_order, element))
       next = next + layout%beam_values
     end do
     do element = 1, layout%shell_count
       do layer = 1, layout%shell_layers
-        words(next:next + 5) = real(shell_stress(:, layer, element), real32)
-        words(next + 6) = real(shell_plastic_strain(layer, element), real32)
+        words(next:next + 5) = single(shell_stress(:, layer, element))
+        words(next + 6) = single(shell_plastic_strain(layer, element))
         next = next + 7
       end do
-      words(next:next + shell_extra_values - 1) = real(shell_extra(:, element), real32)
+      words(next:next + shell_extra_values - 1) = single(shell_extra(:, element))
       next = next + shell_extra_values
     end do
     ! deletion flags: solids, (thick shells: none), shells, beams; LS-DYNA writes the element's
@@ -166,4 +168,21 @@ contains
       layer_strain(1:min(count, layers)) = point_strain(1:min(count, layers))
     end if
   end subroutine shell_layer_values
+
+  !> A double-precision value as a 32-bit word: beyond single precision's range (a run that
+  !> blew up) it is written as an infinity of its sign, NaN as NaN, without the overflow a plain
+  !> conversion raises.
+  elemental function single(value) result(word)
+    real(wp), intent(in) :: value
+    real(real32) :: word
+    if (ieee_is_nan(value)) then
+      word = ieee_value(word, ieee_quiet_nan)
+    else if (value > huge(word)) then
+      word = ieee_value(word, ieee_positive_inf)
+    else if (value < -huge(word)) then
+      word = ieee_value(word, ieee_negative_inf)
+    else
+      word = real(value, real32)
+    end if
+  end function single
 end module d3plot_states
