@@ -6,9 +6,10 @@
 !> "d3plot database manual": the 64 control words; the geometry (node coordinates, solids as
 !> 8 nodes + part, beams as N1 N2 N3 + two unused words + part, shells as 4 nodes + part, all
 !> 1-based); the arbitrary-numbering section (the deck's node, element and part ids); an
-!> end-of-file marker (-999999.0), the part titles (type 90001) and another marker; then the
-!> states (d3plot_states). When the next state would take a file past its size limit, the
-!> states go on in the family files `d3plot01`, `d3plot02`, ..., which hold states only.
+!> end-of-file marker (-999999.0), the part titles (type 90001) and another marker. The states
+!> (d3plot_states) follow in the family files `d3plot01`, `d3plot02`, ...: a new one when the
+!> next state would take the file past its size limit. (lasso-python also reads states after
+!> the titles in the first file; ParaView's reader looks for them in the next file.)
 !> Every file ends with the end-of-file marker: a state is written over the marker of the
 !> previous one and followed by a new marker, so that a run that stops anywhere leaves files
 !> a reader takes whole (readers count a file's states from its last non-zero byte).
@@ -106,6 +107,9 @@ contains
     if (status == 0) call write_numbering(plot, model, status, message)
     if (status == 0) call write_part_titles(plot, model, status, message)
     if (status == 0) call write_end_marker(plot, status, message)
+    ! the states go into the family files: a reader that meets the end marker after the
+    ! geometry (ParaView's) looks for them in the next file
+    if (status == 0) call next_member(plot, status, message)
     if (status == 0) flush (plot%unit, iostat=status, iomsg=message)
     if (status /= 0) then
       call make_error(error, "d3plot "//plot%path//": cannot write the geometry: "//trim(message))
@@ -138,9 +142,9 @@ contains
     call set_layout(plot, model)
     state_words = state_word_count(plot%layout)
     base_words = first_file_words(plot%layout)
-    ! the control words must be this model's
+    ! the first file must be this model's geometry (its control words), with no states
     bytes = file_size(base_path)
-    if (bytes < 4*(base_words + 1)) return
+    if (bytes /= 4*(base_words + 1)) return
     open (newunit=plot%unit, file=base_path, access="stream", form="unformatted", status="old", action="read", &
           iostat=status)
     if (status /= 0) return
@@ -152,21 +156,18 @@ contains
         control(34) /= plot%layout%shell_values .or. control(19) /= plot%layout%global_count) return
     ! the file holding the last state kept
     remaining = kept_states
-    member = 0
+    member = 1
     do
-      path = base_path
-      if (member > 0) path = base_path//member_suffix(member)
+      path = base_path//member_suffix(member)
       bytes = file_size(path)
       if (bytes < 4) return
       file_words = bytes/4 - 1
-      if (member == 0) file_words = file_words - base_words
       in_file = int(max(0_int64, file_words)/state_words)
       if (in_file >= remaining) exit
       remaining = remaining - in_file
       member = member + 1
     end do
     keep_words = int(remaining, int64)*state_words
-    if (member == 0) keep_words = keep_words + base_words
     open (newunit=plot%unit, file=path, access="stream", form="unformatted", status="old", action="readwrite", &
           iostat=status)
     if (status /= 0) return
@@ -384,8 +385,8 @@ contains
     end associate
   end subroutine write_geometry
 
-  !> Words of the first file before its states: control words, geometry, numbering, the end
-  !> marker and the part titles.
+  !> Words of the first file before its final end marker: control words, geometry, numbering,
+  !> the end marker and the part titles.
   pure function first_file_words(layout) result(words)
     type(d3plot_layout_t), intent(in) :: layout
     integer(int64) :: words
@@ -498,6 +499,7 @@ contains
     if (status /= 0) return
     plot%is_open = .true.
     plot%file_words = 0
+    call write_end_marker(plot, status, message)
   end subroutine next_member
 
   !> A write failed: close what is open, write no more.

@@ -412,7 +412,7 @@ def garble_states_after(directory, plot, time):
     index, garbled = 0, 0
     for number, path in enumerate(files):
         start = plot.geometry_section_size if number == 0 else 0
-        count = (path.stat().st_size - 4 - start) // state_bytes
+        count = max(0, (path.stat().st_size - 4 - start) // state_bytes)
         with open(path, "r+b") as stream:
             for k in range(count):
                 if times[index + k] > time:
@@ -470,3 +470,36 @@ def test_a_bad_file_size_scale_is_refused(tmp_path, value):
     assert process.returncode == 2, process.stderr
     assert f"command line: x='{value}' is not a positive whole number" in process.stderr
     assert not (tmp_path / "out" / "d3plot").exists()
+
+
+def test_paraview_lsdyna_reader_reads_the_states(tmp_path, run_deck):
+    """VTK's LS-DYNA reader (ParaView's) finds every state of the d3plot, which start in
+    d3plot01, and reads the last one's deflected coordinates and solid stresses as results.h5
+    has them (the reader orders a part's points its own way: they are matched by their
+    coordinates at the first state; one part, the elements keep the file's order)."""
+    vtk = pytest.importorskip("vtk")
+    from vtk.util.numpy_support import vtk_to_numpy
+    run = run_deck(REPOSITORY / "inputs" / "squeeze_cube" / "fe.k")
+    assert run.status == 0, run.stderr
+    reader = vtk.vtkLSDynaReader()
+    reader.SetFileName(str(run.results.parent / "d3plot"))
+    reader.UpdateInformation()
+    with run.open() as results:
+        names = sorted(results["states"])
+        assert reader.GetNumberOfTimeSteps() == len(names)
+        last = results["states"][names[-1]]
+        reference = results["mesh/nodes/coordinates"][()]
+        reader.UpdateTimeStep(reader.GetTimeValue(0))
+        first = vtk_to_numpy(reader.GetOutput().GetBlock(0).GetPoints().GetData()).astype(float)
+        rows = np.lexsort(np.round(first, 4).T)
+        expected_rows = np.lexsort(np.round(reference, 4).T)
+        order = np.empty(len(first), int)
+        order[rows] = expected_rows                      # reader's point k is node order[k]
+        assert_close(first, reference[order], "ParaView: coordinates at the first state")
+        reader.UpdateTimeStep(reader.GetTimeValue(len(names) - 1))
+        block = reader.GetOutput().GetBlock(0)
+        coordinates = vtk_to_numpy(block.GetPointData().GetArray("Deflected Coordinates"))
+        assert_close(coordinates, (reference + last["displacement"][()])[order], "ParaView: deflected coordinates")
+        assert_close(vtk_to_numpy(block.GetCellData().GetArray("Stress")), last["solid_stress"][()],
+                     "ParaView: solid stresses")
+        assert abs(reader.GetTimeValue(len(names) - 1) - last.attrs["time"]) < 1e-6 * last.attrs["time"]

@@ -331,8 +331,8 @@ def test_running_restart_files_job_names_and_directories(tmp_path):
     out = tmp_path / "out"
     names = sorted(p.name for p in out.iterdir())
     assert names == ["crash.d3dump01", "crash.d3dump02", "crash.d3dump03", "crash.d3dump04", "crash.d3dump05",
-                     "crash.d3dump06", "crash.d3plot", "crash.h5", "crash.lock", "crash.runrsf01", "crash.runrsf02",
-                     "crash.xdmf"]
+                     "crash.d3dump06", "crash.d3plot", "crash.d3plot01", "crash.h5", "crash.lock", "crash.runrsf01",
+                     "crash.runrsf02", "crash.xdmf"]
     cycles = {}
     for name in ("crash.runrsf01", "crash.runrsf02", "crash.d3dump03"):
         with h5py.File(out / name, "r") as dump:
