@@ -44,6 +44,7 @@
 !> L = A / longest side (LS-DYNA's default) and c = sqrt(E / (rho (1 - nu^2))), unless a bound
 !> on the out-of-plane frequencies asks for less (stable_steps).
 module shell_block
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp, block_size
   use model, only: model_t, material_t, formulation_fe, law_null
   use plane_stress_dispatch, only: plane_stress_history_count, initialize_plane_stress_history, &
@@ -1018,10 +1019,17 @@ contains
       resultant(6:8, block%elements(i)) = block%thickness(i)*through(1:3)
       thickness(block%elements(i)) = block%thickness(i)
       ! (0 for a volume so small that the quotient would overflow: a collapsed element)
+      ! (and 0 when either is not finite: a run that blew up, whose comparisons must not trap)
       energy_density(block%elements(i)) = 0.0_wp
       associate (volume => block%area(i)*block%thickness(i))
-        if (volume >= 1.0_wp .or. abs(block%internal_energy(i)) < huge(1.0_wp)*volume) &
-          energy_density(block%elements(i)) = block%internal_energy(i)/volume
+        if (ieee_is_finite(volume) .and. ieee_is_finite(block%internal_energy(i))) then
+          ! (two tests, not one .or.: huge x volume would overflow for a volume above 1)
+          if (volume >= 1.0_wp) then
+            energy_density(block%elements(i)) = block%internal_energy(i)/volume
+          else if (abs(block%internal_energy(i)) < huge(1.0_wp)*volume) then
+            energy_density(block%elements(i)) = block%internal_energy(i)/volume
+          end if
+        end if
       end associate
     end do
     do i = 1, nel

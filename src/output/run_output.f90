@@ -180,7 +180,7 @@ contains
     type(output_plan_t), intent(inout) :: plan
     type(history_set_t), intent(in) :: histories
     type(results_file_t), intent(inout) :: results
-    real(wp), intent(in) :: globals(:)           !< the d3plot's global values
+    real(wp), intent(in), contiguous :: globals(:)   !< the d3plot's global values
     type(error_t), allocatable, intent(out) :: error
     call collect_element_results(model, state%groups, plan%element_results)
     associate (fields => plan%element_results)
