@@ -95,9 +95,10 @@ contains
     end if
     if (restart%resuming) then
       call continue_restart_results(restart, results, settings%output_dir, settings%job_id, model, summary%threads, &
-                                    error)
+                                    error, d3plot_scale=settings%binary_file_scale)
     else
-      call open_results(results, settings%output_dir, settings%job_id, model, summary%threads, error)
+      call open_results(results, settings%output_dir, settings%job_id, model, summary%threads, error, &
+                        d3plot_scale=settings%binary_file_scale)
     end if
     if (allocated(error)) then
       call report("crashfree: "//error%message, messages)

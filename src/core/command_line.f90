@@ -24,6 +24,8 @@ module command_line
     character(len=:), allocatable :: job_id        !< jobid= (default "results"; with r= unset: the dump's)
     character(len=:), allocatable :: restart_file  !< r= (the deck, when i= is not given, is the dump's)
     integer :: threads = 0                         !< ncpu= (0: OMP_NUM_THREADS, else all cores)
+    !> x=: d3plot family file size in multiples of 512^2 words (LS-DYNA's default 7)
+    integer :: binary_file_scale = 7
     logical :: ignore_unknown = .false.            !< --ignore-unknown
     logical :: show_help = .false.
     logical :: show_version = .false.
@@ -102,6 +104,9 @@ contains
       case ("ncpu")
         call read_thread_count(value, options, error)
         if (allocated(error)) return
+      case ("x")
+        call read_file_scale(value, options, error)
+        if (allocated(error)) return
       case default
         note = ignored_argument_note(key)
         if (len(note) == 0) then
@@ -147,6 +152,21 @@ contains
       "negative ncpu asks for)")
   end subroutine read_thread_count
 
+  !> x=N: the d3plot family files hold up to N x 512^2 words (a positive whole number).
+  subroutine read_file_scale(value, options, error)
+    character(len=*), intent(in) :: value
+    type(run_options_t), intent(inout) :: options
+    type(error_t), allocatable, intent(out) :: error
+    integer :: status
+    status = 1
+    if (verify(value, "0123456789") == 0 .and. len(value) >= 1 .and. len(value) <= 6) &
+      read (value, *, iostat=status) options%binary_file_scale
+    if (status /= 0 .or. options%binary_file_scale < 1) then
+      call make_error(error, "command line: x='"//value//"' is not a positive whole number (the d3plot file "// &
+                      "size in multiples of 512^2 words)")
+    end if
+  end subroutine read_file_scale
+
   !> Why LS-DYNA's argument `key`= is not used here ("" for a key LS-DYNA does not have
   !> either, which is an error).
   pure function ignored_argument_note(key) result(note)
@@ -186,6 +206,7 @@ contains
            "  ncpu=N          OpenMP threads (default: OMP_NUM_THREADS, else all cores; at most"//nl// &
            "                  the processors available); results are bit-identical for any N"//nl// &
            "  jobid=NAME      name the results NAME.h5 and NAME.xdmf (default: results)"//nl// &
+           "  x=N             d3plot family files of up to N x 512^2 words (default: 7)"//nl// &
            "  r=DUMP          continue the run from a restart dump (DIR/d3dump01, DIR/runrsf, ...): the"//nl// &
            "                  deck is read again from its recorded path (or i=) and must be unchanged;"//nl// &
            "                  results go on in the run's DIR/JOBID.h5 (default: the dump's directory"//nl// &

@@ -322,8 +322,8 @@ contains
     name = keyword_label(deck, block)
     if (index(name, "DATABASE_EXTENT_BINARY") == 1) then
       call note_not_acted_upon(deck, block, [character(len=1) :: ], "it chooses what "// &
-        "LS-DYNA's d3plot holds; results.h5 holds its fixed set of nodal and element results", &
-        warnings)
+        "LS-DYNA's d3plot holds; crashfree's d3plot and results.h5 hold their fixed set of nodal and "// &
+        "element results (shell layers: every integration point)", warnings)
     else if (index(name, "DATABASE_FORMAT") == 1) then
       call note_not_acted_upon(deck, block, [character(len=1) :: ], "results are written to "// &
         "HDF5 (results.h5)", warnings)

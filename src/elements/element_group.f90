@@ -27,7 +27,7 @@ module element_group
   implicit none
   private
 
-  public :: element_group_t, group_holder_t, element_results_t, distortion_t
+  public :: element_group_t, group_holder_t, element_results_t, distortion_t, shell_output_points
 
   !> Elements folded inside out at a corner while their volume stays positive (distortion_check),
   !> checked at every output state.
@@ -55,6 +55,15 @@ module element_group
     real(wp), allocatable :: beam_failed(:)              !< (beams) 1 failed (*MAT_SPOTWELD), 0 not
     !> deleted-element flags: 1 for an eroded element, 0 otherwise (solids, shells)
     integer, allocatable :: solid_eroded(:), shell_eroded(:)
+    !> For the d3plot (optional, allocated by the output plan): (6, shell_output_points, shells)
+    !> global stress and (points, shells) plastic strain at each point through the thickness,
+    !> bottom to top, and (shells) how many points a group wrote (0: none, e.g. meshfree shells)
+    real(wp), allocatable :: shell_point_stress(:, :, :), shell_point_plastic_strain(:, :)
+    integer, allocatable :: shell_point_count(:)
+    !> For the d3plot, with the points: (8, shells) resultants per unit width in the shell's
+    !> local frame, M_xx M_yy M_xy Q_x Q_y N_xx N_yy N_xy, its thickness and its internal energy
+    !> per unit volume (shells)
+    real(wp), allocatable :: shell_resultant(:, :), shell_thickness(:), shell_energy_density(:)
   end type element_results_t
 
   type, abstract :: element_group_t
@@ -310,4 +319,19 @@ contains
     logical, intent(in) :: wanted(:)
     real(wp), intent(inout) :: strain(:)
   end subroutine raise_nodal_plastic_strain
+
+  !> Layers written per shell to the d3plot (its MAXINT): LS-DYNA's default 3 (mid, inner and
+  !> outer surface) when no shell section has more than 3 points (NIP), else the largest NIP
+  !> (at most 10: every point, as LS-DYNA writes them with MAXINT = NIP).
+  pure integer function shell_output_points(model)
+    type(model_t), intent(in) :: model
+    integer :: shell, section
+    shell_output_points = 3
+    if (.not. (allocated(model%shell_ids) .and. allocated(model%sections))) return
+    do shell = 1, size(model%shell_ids)
+      section = model%parts(model%shell_part(shell))%section
+      if (section < 1 .or. section > size(model%sections)) cycle
+      shell_output_points = max(shell_output_points, min(10, model%sections(section)%integration_points))
+    end do
+  end function shell_output_points
 end module element_group

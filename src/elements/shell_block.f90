@@ -44,6 +44,7 @@
 !> L = A / longest side (LS-DYNA's default) and c = sqrt(E / (rho (1 - nu^2))), unless a bound
 !> on the out-of-plane frequencies asks for less (stable_steps).
 module shell_block
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp, block_size
   use model, only: model_t, material_t, formulation_fe, law_null
   use plane_stress_dispatch, only: plane_stress_history_count, initialize_plane_stress_history, &
@@ -980,13 +981,57 @@ contains
   !> over the points) and the stress of the point with the largest von Mises stress, both in
   !> global axes (xx, yy, zz, xy, yz, zx), and the mean and largest effective plastic strain.
   subroutine shell_block_element_results(block, material, mid_stress, peak_stress, mean_plastic_strain, &
-                                         peak_plastic_strain)
+                                         peak_plastic_strain, point_stress, point_plastic_strain, point_count, &
+                                         resultant, thickness, energy_density)
     type(shell_block_t), intent(in) :: block
     type(material_t), intent(in) :: material
     real(wp), intent(inout) :: mid_stress(:, :), peak_stress(:, :), mean_plastic_strain(:), peak_plastic_strain(:)
-    real(wp) :: point_strain(block_size), mean_local(5), effective, largest
-    integer :: nel, i, point, peak
+    !> (the d3plot's) global stress (6, points, shells) and plastic strain (points, shells) at
+    !> each point, bottom to top, and the points written (shells)
+    real(wp), intent(inout), optional :: point_stress(:, :, :), point_plastic_strain(:, :)
+    integer, intent(inout), optional :: point_count(:)
+    !> (with the points) (8, shells) resultants per unit width in the local frame: M_xx M_yy
+    !> M_xy Q_x Q_y N_xx N_yy N_xy; the thickness; the internal energy per unit volume
+    real(wp), intent(inout), optional :: resultant(:, :), thickness(:), energy_density(:)
+    real(wp) :: point_strain(block_size), mean_local(5), effective, largest, through(5), moment(3)
+    integer :: nel, i, point, peak, written
     nel = block%element_count
+    ! Gauss points are numbered from the bottom (height -1/2) to the top, as LS-DYNA's layers
+    written = 0
+    if (present(point_stress)) written = min(block%point_count, size(point_stress, 2))
+    do i = 1, nel
+      if (written == 0) exit
+      point_count(block%elements(i)) = written
+      do point = 1, written
+        point_stress(:, point, block%elements(i)) = global_stress(block%frame(i, :, :), block%stress(i, :, point))
+      end do
+      point_plastic_strain(:, block%elements(i)) = 0.0_wp
+      ! resultants per unit width: N = t sum w s, M = t^2 sum w h s (h = z / t), Q = t sum w s_xz
+      through = 0.0_wp
+      moment = 0.0_wp
+      do point = 1, block%point_count
+        through = through + block%point_weight(point)*block%stress(i, :, point)
+        moment = moment + block%point_weight(point)*block%point_height(point)*block%stress(i, 1:3, point)
+      end do
+      resultant(1:3, block%elements(i)) = block%thickness(i)**2*moment
+      resultant(4, block%elements(i)) = block%thickness(i)*through(5)
+      resultant(5, block%elements(i)) = block%thickness(i)*through(4)
+      resultant(6:8, block%elements(i)) = block%thickness(i)*through(1:3)
+      thickness(block%elements(i)) = block%thickness(i)
+      ! (0 for a volume so small that the quotient would overflow: a collapsed element)
+      ! (and 0 when either is not finite: a run that blew up, whose comparisons must not trap)
+      energy_density(block%elements(i)) = 0.0_wp
+      associate (volume => block%area(i)*block%thickness(i))
+        if (ieee_is_finite(volume) .and. ieee_is_finite(block%internal_energy(i))) then
+          ! (two tests, not one .or.: huge x volume would overflow for a volume above 1)
+          if (volume >= 1.0_wp) then
+            energy_density(block%elements(i)) = block%internal_energy(i)/volume
+          else if (abs(block%internal_energy(i)) < huge(1.0_wp)*volume) then
+            energy_density(block%elements(i)) = block%internal_energy(i)/volume
+          end if
+        end if
+      end associate
+    end do
     do i = 1, nel
       mean_local = 0.0_wp
       largest = -1.0_wp
@@ -1015,6 +1060,10 @@ contains
         mean_plastic_strain(block%elements(i)) = mean_plastic_strain(block%elements(i)) &
                                                  + block%point_weight(point)*point_strain(i)
         peak_plastic_strain(block%elements(i)) = max(peak_plastic_strain(block%elements(i)), point_strain(i))
+      end do
+      if (point > written) cycle
+      do i = 1, nel
+        point_plastic_strain(point, block%elements(i)) = point_strain(i)
       end do
     end do
   end subroutine shell_block_element_results

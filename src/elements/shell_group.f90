@@ -321,9 +321,18 @@ contains
     type(element_results_t), intent(inout) :: results
     integer :: b, lane
     do b = 1, size(self%blocks)
-      call shell_block_element_results(self%blocks(b), model%materials(self%blocks(b)%material), &
-                                       results%shell_stress, results%shell_stress_peak, results%shell_plastic_strain, &
-                                       results%shell_plastic_strain_peak)
+      if (allocated(results%shell_point_stress)) then
+        call shell_block_element_results(self%blocks(b), model%materials(self%blocks(b)%material), &
+                                         results%shell_stress, results%shell_stress_peak, &
+                                         results%shell_plastic_strain, results%shell_plastic_strain_peak, &
+                                         results%shell_point_stress, results%shell_point_plastic_strain, &
+                                         results%shell_point_count, results%shell_resultant, &
+                                         results%shell_thickness, results%shell_energy_density)
+      else
+        call shell_block_element_results(self%blocks(b), model%materials(self%blocks(b)%material), &
+                                         results%shell_stress, results%shell_stress_peak, &
+                                         results%shell_plastic_strain, results%shell_plastic_strain_peak)
+      end if
       if (.not. allocated(results%shell_eroded)) cycle
       do lane = 1, self%blocks(b)%element_count
         results%shell_eroded(self%blocks(b)%elements(lane)) = merge(1, 0, self%blocks(b)%eroded(lane))

@@ -305,18 +305,20 @@ contains
   end subroutine check_restart_deck
 
   !> Continue the results file of the interrupted run (see results_file's continue_results).
-  subroutine continue_restart_results(control, results, directory, job_id, model, threads, error)
+  subroutine continue_restart_results(control, results, directory, job_id, model, threads, error, d3plot_scale)
     type(restart_control_t), intent(inout) :: control
     type(results_file_t), intent(inout) :: results
     character(len=*), intent(in) :: directory, job_id
     type(model_t), intent(in) :: model
     integer, intent(in) :: threads
     type(error_t), allocatable, intent(out) :: error
+    integer, intent(in), optional :: d3plot_scale   !< d3plot family file size (x=), see open_results
     type(history_set_t) :: histories
     call exchange_results_progress(control%source, "results", results, error)
     call exchange_history_set(control%source, "histories", histories, error)
     if (allocated(error)) return
-    call continue_results(results, directory, job_id, model, threads, histories, control%source%path, error)
+    call continue_results(results, directory, job_id, model, threads, histories, control%source%path, error, &
+                          d3plot_scale)
   end subroutine continue_restart_results
 
   !> Read the run state from the dump into the run state that the deck built, and close the dump.

@@ -73,6 +73,9 @@ module results_file
                          clear_system_error, system_error_number, system_error_text, &
                          error_no_space, error_quota_exceeded
   use file_lock, only: file_lock_t, acquire_file_lock, release_file_lock
+  use d3plot_file, only: d3plot_file_t, open_d3plot, continue_d3plot, write_d3plot_state, close_d3plot, &
+                         d3plot_base_name, default_file_scale
+  use d3plot_states, only: shell_layer_values, shell_extra_values
   implicit none
   private
 
@@ -92,6 +95,7 @@ module results_file
     character(len=:), allocatable :: xdmf_path    !< DIR/JOBID.xdmf
     character(len=:), allocatable :: h5_name      !< JOBID.h5, as the XDMF refers to it
     type(file_lock_t) :: lock                     !< held on DIR/JOBID.lock while open
+    type(d3plot_file_t) :: d3plot                 !< LS-DYNA's d3plot beside it, with the same states
     !> A random number written to /run as `run_id` when the file is created; a restart dump
     !> records it, and a restart continues only the file of the run that wrote the dump.
     integer(long_int) :: run_id = 0
@@ -148,13 +152,15 @@ contains
   !> Lock `directory/job_id.lock`, create `directory/job_id.h5` (replacing an earlier file)
   !> and write `/mesh` and `/run` (status "running"). The directory must exist. On a failure
   !> nothing stays open or locked, and a half-written file is removed.
-  subroutine open_results(results, directory, job_id, model, threads, error)
+  subroutine open_results(results, directory, job_id, model, threads, error, d3plot_scale)
     type(results_file_t), intent(inout) :: results
     character(len=*), intent(in) :: directory   !< output directory ("" for the current one)
     character(len=*), intent(in) :: job_id      !< base name of the files, e.g. "results"
     type(model_t), intent(in) :: model
     integer, intent(in) :: threads              !< OpenMP threads of the run
     type(error_t), allocatable, intent(out) :: error
+    !> d3plot family file size in multiples of 512^2 words (x=; default LS-DYNA's 7)
+    integer, intent(in), optional :: d3plot_scale
     type(error_t), allocatable :: space_error
     integer(hid_t) :: access_list
     integer :: status, ignored
@@ -248,6 +254,15 @@ contains
         end if
       end if
     end if
+    ! LS-DYNA's d3plot beside it, with every state written here
+    if (.not. allocated(error)) then
+      if (present(d3plot_scale)) then
+        call open_d3plot(results%d3plot, join_path(directory, d3plot_base_name(job_id)), model, d3plot_scale, error)
+      else
+        call open_d3plot(results%d3plot, join_path(directory, d3plot_base_name(job_id)), model, default_file_scale, &
+                         error)
+      end if
+    end if
     if (allocated(error)) then
       ! Abandoned, not closed (a close would flush into a file that cannot take it), and
       ! removed: it holds no result.
@@ -276,7 +291,9 @@ contains
   subroutine write_state(results, time, displacement, velocity, solid_stress, &
                          solid_plastic_strain, error, shell_stress, shell_plastic_strain, shell_stress_peak, &
                          shell_plastic_strain_peak, histories, beam_resultant, beam_plastic_strain, beam_failed, &
-                         solid_eroded, shell_eroded, eroded_count)
+                         solid_eroded, shell_eroded, eroded_count, acceleration, globals, shell_point_stress, &
+                         shell_point_plastic_strain, shell_point_count, shell_resultant, shell_thickness, &
+                         shell_energy_density)
     type(results_file_t), intent(inout) :: results
     real(wp), intent(in) :: time
     ! Contiguous: the solver's whole arrays go to HDF5 without a copy.
@@ -293,6 +310,13 @@ contains
     !> deleted-element flags (1: eroded) and the count of eroded elements (explicit runs)
     integer, intent(in), contiguous, optional :: solid_eroded(:), shell_eroded(:)
     integer, intent(in), optional :: eroded_count
+    !> for the d3plot only: (3, nodes) accelerations (absent: 0), and its global values
+    !> (kinetic, internal, total energy, velocity (3), per part internal then kinetic energy)
+    real(wp), intent(in), contiguous, optional :: acceleration(:, :), globals(:)
+    !> for the d3plot only: the shells' points through the thickness (element_results_t)
+    real(wp), intent(in), contiguous, optional :: shell_point_stress(:, :, :), shell_point_plastic_strain(:, :)
+    integer, intent(in), contiguous, optional :: shell_point_count(:)
+    real(wp), intent(in), contiguous, optional :: shell_resultant(:, :), shell_thickness(:), shell_energy_density(:)
     real(wp) :: no_shell_stress(6, 0), no_shell_strain(0)
     real(wp), allocatable :: grown(:)
     type(error_t), allocatable :: space_error
@@ -408,8 +432,87 @@ contains
     results%state_count = results%state_count + 1
     results%state_times(results%state_count) = time
 
+    if (results%d3plot%is_open) then
+      call write_d3plot(results%d3plot, time, displacement, velocity, solid_stress, solid_plastic_strain, error, &
+                        shell_stress, shell_plastic_strain, beam_resultant, beam_failed, solid_eroded, shell_eroded, &
+                        acceleration, globals, shell_point_stress, shell_point_plastic_strain, shell_point_count, &
+                        shell_resultant, shell_thickness, shell_energy_density)
+      if (allocated(error)) return
+    end if
     if (xdmf_due(results)) call write_xdmf_now(results, error)
   end subroutine write_state
+
+  !> The state just written to results.h5, into the d3plot (what results.h5 does not have is
+  !> written as 0: the accelerations and global values of a static state).
+  subroutine write_d3plot(plot, time, displacement, velocity, solid_stress, solid_plastic_strain, error, &
+                          shell_stress, shell_plastic_strain, beam_resultant, beam_failed, solid_eroded, shell_eroded, &
+                          acceleration, globals, shell_point_stress, shell_point_plastic_strain, shell_point_count, &
+                          shell_resultant, shell_thickness, shell_energy_density)
+    type(d3plot_file_t), intent(inout) :: plot
+    real(wp), intent(in) :: time
+    real(wp), intent(in) :: displacement(:, :), velocity(:, :), solid_stress(:, :), solid_plastic_strain(:)
+    type(error_t), allocatable, intent(out) :: error
+    real(wp), intent(in), optional :: shell_stress(:, :), shell_plastic_strain(:)
+    real(wp), intent(in), optional :: beam_resultant(:, :), beam_failed(:)
+    integer, intent(in), optional :: solid_eroded(:), shell_eroded(:)
+    real(wp), intent(in), optional :: acceleration(:, :), globals(:)
+    real(wp), intent(in), optional :: shell_point_stress(:, :, :), shell_point_plastic_strain(:, :)
+    integer, intent(in), optional :: shell_point_count(:)
+    real(wp), intent(in), optional :: shell_resultant(:, :), shell_thickness(:), shell_energy_density(:)
+    real(wp), allocatable :: layer_stress(:, :, :), layer_strain(:, :), resultant(:, :), global_values(:)
+    real(wp), allocatable :: shell_extra(:, :)
+    real(wp), allocatable :: node_acceleration(:, :)
+    integer :: shell, layer, points
+
+    associate (layout => plot%layout)
+      allocate (layer_stress(6, layout%shell_layers, layout%shell_count), source=0.0_wp)
+      allocate (layer_strain(layout%shell_layers, layout%shell_count), source=0.0_wp)
+      allocate (shell_extra(shell_extra_values, layout%shell_count), source=0.0_wp)
+      ! each shell's points through the thickness; a shell whose group gives none (meshfree
+      ! shells, rigid parts, a static state) has its mid-surface values in every layer
+      if (present(shell_stress) .and. layout%shell_count > 0) then
+        do shell = 1, layout%shell_count
+          points = 0
+          if (present(shell_point_count)) points = min(shell_point_count(shell), size(shell_point_stress, 2))
+          ! resultants, thickness and energy density where the group gave them, else the deck's
+          ! thickness only
+          shell_extra(9, shell) = plot%shell_thickness(shell)
+          if (points > 0) then
+            call shell_layer_values(points, shell_point_stress(:, 1:points, shell), &
+                                    shell_point_plastic_strain(1:points, shell), layer_stress(:, :, shell), &
+                                    layer_strain(:, shell))
+            if (present(shell_resultant)) then
+              shell_extra(1:8, shell) = shell_resultant(:, shell)
+              shell_extra(9, shell) = shell_thickness(shell)
+              shell_extra(12, shell) = shell_energy_density(shell)
+            end if
+          else
+            do layer = 1, layout%shell_layers
+              layer_stress(:, layer, shell) = shell_stress(:, shell)
+              layer_strain(layer, shell) = shell_plastic_strain(shell)
+            end do
+          end if
+        end do
+      end if
+      allocate (resultant(6, layout%beam_count), source=0.0_wp)
+      if (present(beam_resultant) .and. layout%beam_count > 0) resultant = beam_resultant
+      allocate (global_values(layout%global_count), source=0.0_wp)
+      if (present(globals)) global_values = globals(1:layout%global_count)
+      allocate (node_acceleration(3, layout%node_count), source=0.0_wp)
+      if (present(acceleration)) node_acceleration = acceleration
+    end associate
+    if (present(beam_failed)) then
+      if (size(beam_failed) /= plot%layout%beam_count) then
+        call write_d3plot_state(plot, time, global_values, displacement, velocity, node_acceleration, solid_stress, &
+                                solid_plastic_strain, layer_stress, layer_strain, shell_extra, resultant, error, &
+                                solid_eroded, shell_eroded)
+        return
+      end if
+    end if
+    call write_d3plot_state(plot, time, global_values, displacement, velocity, node_acceleration, solid_stress, &
+                            solid_plastic_strain, layer_stress, layer_strain, shell_extra, resultant, error, &
+                            solid_eroded, shell_eroded, beam_failed)
+  end subroutine write_d3plot
 
   !> Add the history rows recorded since the previous call (each series as
   !> `/history/<group>/<column>`), and flush. Rows already in the file are not written again;
@@ -459,6 +562,7 @@ contains
     integer :: status
     logical :: failed_before
 
+    call close_d3plot(results%d3plot)
     if (.not. results%is_open) return
     ! a failure that happens first here has no run error to report it: keep its reason
     failed_before = results%failed
@@ -518,7 +622,7 @@ contains
   !> the dump are removed, `/run` says "running" again and the XDMF file lists the states kept;
   !> the continued run then writes on as `open_results` had left it. `dump_path` names the dump
   !> in messages.
-  subroutine continue_results(results, directory, job_id, model, threads, histories, dump_path, error)
+  subroutine continue_results(results, directory, job_id, model, threads, histories, dump_path, error, d3plot_scale)
     type(results_file_t), intent(inout) :: results
     character(len=*), intent(in) :: directory, job_id
     type(model_t), intent(in) :: model
@@ -526,11 +630,12 @@ contains
     type(history_set_t), intent(in) :: histories
     character(len=*), intent(in) :: dump_path
     type(error_t), allocatable, intent(out) :: error
+    integer, intent(in), optional :: d3plot_scale   !< d3plot family file size (x=), see open_results
     integer(hid_t) :: access_list
     integer(long_int) :: file_run_id
     integer, allocatable :: grown(:)
     integer :: status, ignored
-    logical :: exists
+    logical :: exists, continued
 
     if (results%is_open) then
       call make_error(error, "results file "//results%h5_path//": already open")
@@ -614,6 +719,14 @@ contains
     results%is_open = .true.
     ! the XDMF file of the interrupted run may list states removed here
     call write_xdmf_now(results, error)
+    ! its d3plot too, when it holds the states kept (else the continued run writes none)
+    if (present(d3plot_scale)) then
+      call continue_d3plot(results%d3plot, join_path(directory, d3plot_base_name(job_id)), model, &
+                           results%state_count, d3plot_scale, continued)
+    else
+      call continue_d3plot(results%d3plot, join_path(directory, d3plot_base_name(job_id)), model, &
+                           results%state_count, default_file_scale, continued)
+    end if
   end subroutine continue_results
 
   !> The states the dump counts are in the file, at the dump's times.

@@ -84,7 +84,8 @@ contains
     if (clock_due(plan%rcforc, state%time, last)) call record_contact_forces(state, plan, histories)
     if (clock_due(plan%rbdout, state%time, last)) call record_rigid_bodies(model, state, plan, histories)
     ! the state and the history rows recorded since the previous one, as one commit
-    if (states_due) call write_current_state(model, state, plan, histories, results, error)
+    if (states_due) call write_current_state(model, state, plan, histories, results, &
+                                             d3plot_globals(model, state, plan, scratch), error)
     ! binout (BINARY 2 or 3), written whole: at the last output and the states 1, 2, 4, 8, ...
     if (states_due .and. .not. allocated(error) .and. binout_requested(model)) then
       if (last .or. iand(results%state_count, results%state_count - 1) == 0) &
@@ -120,6 +121,34 @@ contains
     name_start = len(results%h5_path) - len(results%h5_name) + 1
     path = results%h5_path(1:name_start - 1)//binout_name(results%h5_name(1:len(results%h5_name) - 3))
   end function binout_path
+
+  !> The d3plot's global values of the state: kinetic, internal and total energy, the velocity
+  !> of the centre of mass (momentum / mass), then per part the internal and the kinetic energy.
+  function d3plot_globals(model, state, plan, scratch) result(globals)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(in) :: state
+    type(output_plan_t), intent(inout) :: plan
+    real(wp), intent(inout) :: scratch(:, :)
+    real(wp), allocatable :: globals(:)
+    type(energy_totals_t) :: energy
+    real(wp) :: mass
+    integer :: parts, node
+    parts = size(model%parts)
+    allocate (globals(6 + 2*parts), source=0.0_wp)
+    energy = state%energy
+    call measured_energies(model, state, scratch, energy)
+    call part_energies(model, state, parts, plan%part_kinetic, plan%part_internal, plan%part_hourglass)
+    mass = 0.0_wp
+    do node = 1, size(state%nodes%mass)
+      mass = mass + state%nodes%mass(node)
+    end do
+    globals(1) = energy%kinetic
+    globals(2) = energy%internal
+    globals(3) = total_energy(energy)
+    if (mass > 0.0_wp) globals(4:6) = energy%momentum/mass
+    globals(7:6 + parts) = plan%part_internal
+    globals(7 + parts:6 + 2*parts) = plan%part_kinetic
+  end function d3plot_globals
 
   !> Wall force averaged over the sampling interval (impulse / interval), so that integrating
   !> the rwforc history gives the impulse exactly; at t = 0 the force of the first cycle is 0.
@@ -204,12 +233,13 @@ contains
     end do
   end subroutine physical_node_fields
 
-  subroutine write_current_state(model, state, plan, histories, results, error)
+  subroutine write_current_state(model, state, plan, histories, results, globals, error)
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(in) :: state
     type(output_plan_t), intent(inout) :: plan
     type(history_set_t), intent(in) :: histories
     type(results_file_t), intent(inout) :: results
+    real(wp), intent(in), contiguous :: globals(:)   !< the d3plot's global values
     type(error_t), allocatable, intent(out) :: error
     call collect_element_results(model, state%groups, plan%element_results)
     associate (fields => plan%element_results)
@@ -220,14 +250,19 @@ contains
                          beam_resultant=fields%beam_resultant, beam_plastic_strain=fields%beam_plastic_strain, &
                          beam_failed=fields%beam_failed, &
                          solid_eroded=fields%solid_eroded, shell_eroded=fields%shell_eroded, &
-                         eroded_count=state%eroded_count)
+                         eroded_count=state%eroded_count, acceleration=plan%node_acceleration, globals=globals, &
+                         shell_point_stress=fields%shell_point_stress, &
+                         shell_point_plastic_strain=fields%shell_point_plastic_strain, &
+                         shell_point_count=fields%shell_point_count, shell_resultant=fields%shell_resultant, &
+                         shell_thickness=fields%shell_thickness, shell_energy_density=fields%shell_energy_density)
       else
         ! (beam fields not allocated: a model without beams; the dummies are then absent)
         call write_state(results, state%time, plan%node_displacement, plan%node_velocity, fields%solid_stress, &
                          fields%solid_plastic_strain, error, histories=histories, &
                          beam_resultant=fields%beam_resultant, beam_plastic_strain=fields%beam_plastic_strain, &
                          beam_failed=fields%beam_failed, &
-                         solid_eroded=fields%solid_eroded, eroded_count=state%eroded_count)
+                         solid_eroded=fields%solid_eroded, eroded_count=state%eroded_count, &
+                         acceleration=plan%node_acceleration, globals=globals)
       end if
     end associate
   end subroutine write_current_state

@@ -10,7 +10,7 @@ module output_plan
   use kinds, only: wp
   use model, only: model_t
   use history_buffer, only: history_set_t, add_history_series
-  use element_group, only: element_results_t
+  use element_group, only: element_results_t, shell_output_points
   implicit none
   private
 
@@ -180,6 +180,18 @@ contains
       allocate (results%solid_eroded(size(model%solid_ids)), results%shell_eroded(size(model%shell_ids)))
       results%solid_eroded = 0
       results%shell_eroded = 0
+      ! the d3plot's layers through the thickness
+      allocate (results%shell_point_stress(6, shell_output_points(model), size(model%shell_ids)), &
+                results%shell_point_plastic_strain(shell_output_points(model), size(model%shell_ids)), &
+                results%shell_point_count(size(model%shell_ids)))
+      results%shell_point_stress = 0.0_wp
+      results%shell_point_plastic_strain = 0.0_wp
+      results%shell_point_count = 0
+      allocate (results%shell_resultant(8, size(model%shell_ids)), results%shell_thickness(size(model%shell_ids)), &
+                results%shell_energy_density(size(model%shell_ids)))
+      results%shell_resultant = 0.0_wp
+      results%shell_thickness = 0.0_wp
+      results%shell_energy_density = 0.0_wp
     end associate
     allocate (plan%node_velocity(3, size(model%node_ids)), plan%node_displacement(3, size(model%node_ids)), &
               plan%generalized_velocity(3, size(model%node_ids)), plan%node_acceleration(3, size(model%node_ids)))

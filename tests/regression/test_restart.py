@@ -330,11 +330,12 @@ def test_running_restart_files_job_names_and_directories(tmp_path):
     assert process.returncode == 0, process.stdout + process.stderr
     out = tmp_path / "out"
     names = sorted(p.name for p in out.iterdir())
-    # (and LS-DYNA's ASCII files of the deck's *DATABASE_ keywords, d3hsp and messag, as LS-DYNA
-    # names them with a job id)
+    # (and LS-DYNA's d3plot, the ASCII files of the deck's *DATABASE_ keywords, d3hsp and messag,
+    # as LS-DYNA names them with a job id)
     assert names == ["crash.d3dump01", "crash.d3dump02", "crash.d3dump03", "crash.d3dump04", "crash.d3dump05",
-                     "crash.d3dump06", "crash.d3hsp", "crash.glstat", "crash.h5", "crash.lock", "crash.matsum",
-                     "crash.messag", "crash.nodout", "crash.runrsf01", "crash.runrsf02", "crash.rwforc", "crash.xdmf"]
+                     "crash.d3dump06", "crash.d3hsp", "crash.d3plot", "crash.d3plot01", "crash.glstat", "crash.h5",
+                     "crash.lock", "crash.matsum", "crash.messag", "crash.nodout", "crash.runrsf01", "crash.runrsf02",
+                     "crash.rwforc", "crash.xdmf"]
     cycles = {}
     for name in ("crash.runrsf01", "crash.runrsf02", "crash.d3dump03"):
         with h5py.File(out / name, "r") as dump:
