@@ -39,7 +39,7 @@ from vtkmodules.vtkFiltersCore import vtkAppendPolyData  # noqa: E402
 from vtkmodules.vtkFiltersGeometry import vtkDataSetSurfaceFilter  # noqa: E402
 from vtkmodules.vtkIOImage import vtkPNGWriter  # noqa: E402
 from vtkmodules.vtkIOXdmf2 import vtkXdmfReader  # noqa: E402
-from vtkmodules.vtkRenderingAnnotation import vtkScalarBarActor  # noqa: E402
+from vtkmodules.vtkRenderingAnnotation import vtkAxesActor, vtkScalarBarActor  # noqa: E402
 from vtkmodules.vtkRenderingCore import (  # noqa: E402
     vtkActor, vtkPolyDataMapper, vtkRenderer, vtkRenderWindow, vtkTextActor, vtkWindowToImageFilter)
 
@@ -325,6 +325,7 @@ def render(xdmf_path: Path, output: Path, time: float | None = None, state: int 
     window.SetSize(*size)
     window.SetMultiSamples(8)
     window.AddRenderer(renderer)
+    window.AddRenderer(axes_triad(camera))
     window.Render()
     grab = vtkWindowToImageFilter()
     grab.SetInput(window)
@@ -338,6 +339,34 @@ def render(xdmf_path: Path, output: Path, time: float | None = None, state: int 
     window.Finalize()
     return {"time": shown_time, "field": field, "range": (low, high), "bounds": tuple(bounds),
             "rigid_parts": sorted(rigid)}
+
+
+def axes_triad(camera) -> vtkRenderer:
+    """The global x, y, z axes in the lower left corner, turned as the model is."""
+    axes = vtkAxesActor()
+    axes.SetShaftTypeToCylinder()
+    axes.SetTotalLength(1.0, 1.0, 1.0)
+    axes.SetCylinderRadius(0.03)
+    axes.SetConeRadius(0.12)
+    for caption in (axes.GetXAxisCaptionActor2D(), axes.GetYAxisCaptionActor2D(), axes.GetZAxisCaptionActor2D()):
+        caption.GetCaptionTextProperty().SetColor(0.1, 0.1, 0.1)
+        caption.GetCaptionTextProperty().ShadowOff()
+        caption.GetCaptionTextProperty().ItalicOff()
+    corner = vtkRenderer()
+    corner.SetViewport(0.0, 0.0, 0.16, 0.24)
+    corner.SetLayer(0)
+    corner.InteractiveOff()
+    corner.AddActor(axes)
+    corner.SetBackgroundAlpha(0.0)
+    corner.PreserveColorBufferOn()
+    corner.PreserveDepthBufferOff()
+    view = corner.GetActiveCamera()
+    direction = np.array(camera.GetDirectionOfProjection())
+    view.SetFocalPoint(0.0, 0.0, 0.0)
+    view.SetPosition(*(-4.0 * direction))
+    view.SetViewUp(*camera.GetViewUp())
+    corner.ResetCamera()
+    return corner
 
 
 def default_output(xdmf_path: Path) -> Path:
