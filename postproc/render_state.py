@@ -214,6 +214,15 @@ def choose_field(blocks, requested: str) -> str:
     return "plastic_strain" if largest > YIELD_THRESHOLD else "displacement"
 
 
+def rounded_up(value: float) -> float:
+    """The top of the colour scale: `value` rounded up to two significant digits (349.5 -> 350,
+    so that the five steps of the bar read 70, 140, ...); 1 for nothing to show."""
+    if not value > 0.0:
+        return 1.0
+    unit = 10.0 ** (np.floor(np.log10(value)) - 1)
+    return float(np.ceil(value / unit * (1 - 1e-12)) * unit)
+
+
 def view_direction(view: str) -> np.ndarray:
     if view in VIEWS:
         direction = np.array(VIEWS[view], dtype=float)
@@ -229,8 +238,8 @@ def view_direction(view: str) -> np.ndarray:
 
 def render(xdmf_path: Path, output: Path, time: float | None = None, state: int | None = None,
            field: str = "auto", view: str = "iso", up: str = "y", size=(1600, 1000)) -> dict:
-    """Write the picture; returns what it shows (time, field, its range, the bounds of the
-    deformed mesh) for the caller to print or check."""
+    """Write the picture; returns what it shows (time, field, its largest value and the
+    colour scale's range, the bounds of the deformed mesh) for the caller to print or check."""
     shown_time, shown_index, state_count, blocks = read_state(xdmf_path, time, state)
     field = choose_field(blocks, field)
     rigid = rigid_part_ids(xdmf_path)
@@ -240,9 +249,8 @@ def render(xdmf_path: Path, output: Path, time: float | None = None, state: int 
     scalars = (surface.GetPointData() if field == "displacement" else surface.GetCellData()).GetArray("value")
     values = vtk_to_numpy(scalars)
     finite = values[np.isfinite(values)]
-    low, high = (0.0, float(finite.max())) if finite.size else (0.0, 1.0)
-    if high <= low:
-        high = low + 1.0
+    largest = float(finite.max()) if finite.size else 0.0
+    low, high = 0.0, rounded_up(largest)
 
     table = vtkLookupTable()
     table.SetNumberOfTableValues(256)
@@ -337,7 +345,7 @@ def render(xdmf_path: Path, output: Path, time: float | None = None, state: int 
     writer.SetInputConnection(grab.GetOutputPort())
     writer.Write()
     window.Finalize()
-    return {"time": shown_time, "field": field, "range": (low, high), "bounds": tuple(bounds),
+    return {"time": shown_time, "field": field, "largest": largest, "range": (low, high), "bounds": tuple(bounds),
             "rigid_parts": sorted(rigid)}
 
 
@@ -352,8 +360,9 @@ def axes_triad(camera) -> vtkRenderer:
         caption.GetCaptionTextProperty().SetColor(0.1, 0.1, 0.1)
         caption.GetCaptionTextProperty().ShadowOff()
         caption.GetCaptionTextProperty().ItalicOff()
+        caption.GetCaptionTextProperty().BoldOn()
     corner = vtkRenderer()
-    corner.SetViewport(0.0, 0.0, 0.16, 0.24)
+    corner.SetViewport(0.0, 0.0, 0.2, 0.3)
     corner.SetLayer(0)
     corner.InteractiveOff()
     corner.AddActor(axes)
@@ -393,8 +402,8 @@ def main(arguments=None) -> int:
     shown = render(options.xdmf, output, options.time, options.state, options.field, options.view,
                    options.up, (width, height))
     low, high = shown["range"]
-    print(f"picture of the state at t = {shown['time']:.6g}, coloured by "
-          f"{shown['field'].replace('_', ' ')} ({low:.3g} to {high:.3g}): {output}")
+    print(f"picture of the state at t = {shown['time']:.6g}, coloured by {shown['field'].replace('_', ' ')} "
+          f"(largest {shown['largest']:.4g}, scale {low:.3g} to {high:.3g}): {output}")
     return 0
 
 
