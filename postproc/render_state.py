@@ -240,6 +240,10 @@ def render(xdmf_path: Path, output: Path, time: float | None = None, state: int 
            field: str = "auto", view: str = "iso", up: str = "y", size=(1600, 1000)) -> dict:
     """Write the picture; returns what it shows (time, field, its largest value and the
     colour scale's range, the bounds of the deformed mesh) for the caller to print or check."""
+    try:
+        output.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise SystemExit(f"render_state: cannot write the picture {output}: {error.strerror}")
     shown_time, shown_index, state_count, blocks = read_state(xdmf_path, time, state)
     field = choose_field(blocks, field)
     rigid = rigid_part_ids(xdmf_path)
@@ -339,12 +343,13 @@ def render(xdmf_path: Path, output: Path, time: float | None = None, state: int 
     grab.SetInput(window)
     grab.ReadFrontBufferOff()
     grab.Update()
-    output.parent.mkdir(parents=True, exist_ok=True)
     writer = vtkPNGWriter()
     writer.SetFileName(str(output))
     writer.SetInputConnection(grab.GetOutputPort())
     writer.Write()
     window.Finalize()
+    if writer.GetErrorCode() != 0 or not output.is_file():
+        raise SystemExit(f"render_state: cannot write the picture {output}")
     return {"time": shown_time, "field": field, "largest": largest, "range": (low, high), "bounds": tuple(bounds),
             "rigid_parts": sorted(rigid)}
 
@@ -398,6 +403,8 @@ def main(arguments=None) -> int:
         width, height = (int(v) for v in options.size.lower().split("x"))
     except ValueError:
         parser.error(f"--size {options.size}: give WIDTHxHEIGHT, e.g. 1600x1000")
+    if min(width, height) < 100 or max(width, height) > 8000:
+        parser.error(f"--size {options.size}: width and height from 100 to 8000 pixels")
     output = options.output or default_output(options.xdmf)
     shown = render(options.xdmf, output, options.time, options.state, options.field, options.view,
                    options.up, (width, height))

@@ -297,6 +297,22 @@ def test_render_state_draws_the_final_state(cantilevers):
     assert np.mean(saturation > 0.5) > 0.05
 
 
+def test_render_state_names_what_is_wrong(cantilevers, tmp_path):
+    """A missing file, a state the run does not have, a view without a direction and a picture
+    that cannot be written: a message naming it and a non-zero exit, no picture."""
+    script = str(REPOSITORY / "postproc" / "render_state.py")
+    xdmf = str(cantilevers / "results.xdmf")
+    cases = [([str(tmp_path / "none.xdmf")], f"{tmp_path / 'none.xdmf'}: no such file"),
+             ([xdmf, "--state", "5"], "has 5 states; --state 5 is not one"),
+             ([xdmf, "--view", "0,0,0"], "--view 0,0,0: give iso, x, y, z"),
+             ([xdmf, "-o", str(tmp_path / "file" / "picture.png")], "cannot write the picture")]
+    (tmp_path / "file").write_text("a file where the picture's folder should be")
+    for arguments, message in cases:
+        process = subprocess.run([sys.executable, script, *arguments], capture_output=True, text=True, timeout=300)
+        assert process.returncode == 1 and message in process.stderr, (arguments, process.stderr)
+    assert not list(tmp_path.glob("**/*.png"))
+
+
 # ---------------------------------------------------------------------------------------------
 
 if __name__ == "__main__":
