@@ -6,7 +6,7 @@ plastic strain of the elements or by the displacement magnitude of the nodes, wi
 bar, the time and the title of the run.
 
     python3 postproc/render_state.py DIR/results.xdmf [-o picture.png] [--time T | --state N]
-        [--field auto|plastic_strain|displacement] [--view iso|x|y|z|-x|-y|-z|DX,DY,DZ]
+        [--field auto|plastic_strain|displacement] [--view=iso|x|y|z|-x|-y|-z|DX,DY,DZ]
         [--up x|y|z] [--size 1600x1000]
 
 Without -o the picture is DIR/results_final_state.png (DIR/NAME_final_state.png for
@@ -395,7 +395,8 @@ def main(arguments=None) -> int:
     which.add_argument("--time", type=float, help="the state nearest this time")
     which.add_argument("--state", type=int, help="state index, 0 the first, -1 the last (default)")
     parser.add_argument("--field", choices=("auto", "plastic_strain", "displacement"), default="auto")
-    parser.add_argument("--view", default="iso", help="direction from the model to the camera")
+    parser.add_argument("--view", default="iso",
+                        help="direction from the model to the camera (with a minus sign: --view=-z)")
     parser.add_argument("--up", choices=("x", "y", "z"), default="y", help="the axis that points up")
     parser.add_argument("--size", default="1600x1000", help="width x height in pixels")
     options = parser.parse_args(arguments)

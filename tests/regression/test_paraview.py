@@ -295,6 +295,14 @@ def test_render_state_draws_the_final_state(cantilevers):
     # background: more than the colour bar alone (about 2% of the window)
     saturation = pixels.max(axis=2) - pixels.min(axis=2)
     assert np.mean(saturation > 0.5) > 0.05
+    # by displacement: the largest displacement magnitude of the last state (every node here
+    # belongs to an element, so the drawn surfaces carry them all)
+    process = subprocess.run([sys.executable, str(REPOSITORY / "postproc" / "render_state.py"),
+                              str(directory / "results.xdmf"), "-o", str(picture), "--size", "800x500",
+                              "--field", "displacement", "--view=-z"], capture_output=True, text=True, timeout=300)
+    assert process.returncode == 0, process.stderr
+    largest = np.linalg.norm(expected["displacement"][-1], axis=1).max()
+    assert f"coloured by displacement (largest {largest:.4g}," in process.stdout
 
 
 def test_render_state_names_what_is_wrong(cantilevers, tmp_path):
