@@ -11,8 +11,8 @@ bar, the time and the title of the run.
 
 Without -o the picture is DIR/results_final_state.png (DIR/NAME_final_state.png for
 NAME.xdmf). `--field auto` (the default) colours by plastic strain when some element has
-yielded (above 0.1%), else by displacement. Elements of rigid parts (results.h5 beside the
-.xdmf, /mesh/parts/formulation) are drawn grey. No display is needed: without $DISPLAY the
+yielded (above 0.1%), else by displacement. Coloured by plastic strain, the elements of rigid
+parts (results.h5 beside the .xdmf, /mesh/parts/formulation) are drawn grey. No display is needed: without $DISPLAY the
 picture is rendered off screen (EGL, Mesa's software renderer on a machine without a GPU).
 """
 from __future__ import annotations
@@ -130,7 +130,7 @@ def rigid_part_ids(xdmf_path: Path) -> set[int]:
         parts = results.get("mesh/parts")
         if parts is None or "formulation" not in parts:
             return set()
-        formulation = [f.decode() if isinstance(f, bytes) else str(f) for f in parts["formulation"][...]]
+        formulation = [(f.decode() if isinstance(f, bytes) else str(f)).strip() for f in parts["formulation"][...]]
         return {int(i) for i, kind in zip(parts["ids"][...], formulation) if kind == "rigid"}
 
 
@@ -224,6 +224,7 @@ def rounded_up(value: float) -> float:
 
 
 def view_direction(view: str) -> np.ndarray:
+    """The unit vector from the model to the camera: a named view or "DX,DY,DZ"."""
     if view in VIEWS:
         direction = np.array(VIEWS[view], dtype=float)
     else:
@@ -231,7 +232,7 @@ def view_direction(view: str) -> np.ndarray:
             direction = np.array([float(v) for v in view.split(",")])
         except ValueError:
             direction = np.zeros(0)
-        if direction.shape != (3,) or not np.any(direction):
+        if direction.shape != (3,) or not np.all(np.isfinite(direction)) or not np.any(direction):
             raise SystemExit(f"render_state: --view {view}: give iso, x, y, z, -x, -y, -z or DX,DY,DZ")
     return direction / np.linalg.norm(direction)
 
