@@ -1,7 +1,8 @@
 # crashfree: build, run and test.
 #   make            release build: bin/crashfree and lib/libcrashfree.a (+ .mod files in lib/)
 #   make run        install what is missing, build, run the default job (the ODB component test,
-#                   coupled FE/EFG, about 2 min on one core), plot and tabulate (ODB_FE=1: run fe.k too)
+#                   coupled FE/EFG, about 2 min on one core), plot and tabulate (ODB_FE=1: run fe.k too),
+#                   and a picture of the final state (results/odb_component/coupled/results_final_state.png)
 #   make taylor     the same for the Taylor bar
 #   make vehicle    the same for the vehicle front structure (inputs/vehicle_front; 8 min on 2 threads, NCPU=2)
 #   make side-impact  the side-impact dummy component test (inputs/side_impact): fe.k, ribs_efg.k
@@ -103,9 +104,15 @@ regression: all
 layers:
 	@$(PYTHON) tools/check_layers.py
 
+# The default job (tools/run_default.sh), then a picture of the barrier's final state through
+# ParaView's XDMF reader (postproc/render_state.py: results/odb_component/coupled/
+# results_final_state.png), seen from the impactor's side above the crushed corner, coloured by
+# the displacement (the honeycomb has no plastic strain to show).
 run: deps
 	@$(MAKE) --no-print-directory all
 	@bash tools/run_default.sh
+	@$(PYTHON) postproc/render_state.py results/odb_component/coupled/results.xdmf --field displacement \
+	    --view=-1,0.7,1.3
 
 taylor: deps
 	@$(MAKE) --no-print-directory all

@@ -1,9 +1,13 @@
 #!/usr/bin/env bash
 # Install what crashfree needs and is missing: Debian packages for the build, Python packages
 # for post-processing and regression tests. Idempotent and quick when everything is there.
+# ParaView's readers and off-screen pictures (postproc/render_state.py, tests/regression/
+# test_paraview.py) come with the `vtk` package of PyPI; it draws without a display through EGL,
+# which Mesa's libraries give on a machine without a GPU (libegl1, libegl-mesa0, libgl1-mesa-dri).
 set -euo pipefail
 
-debian_packages=(gfortran make libhdf5-dev libmetis-dev liblapack-dev libopenblas-dev python3 python3-pip)
+debian_packages=(gfortran make libhdf5-dev libmetis-dev liblapack-dev libopenblas-dev python3 python3-pip
+                 libegl1 libegl-mesa0 libgl1-mesa-dri)
 missing=()
 for package in "${debian_packages[@]}"; do
   dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")
@@ -18,7 +22,7 @@ if ((${#missing[@]})); then
 fi
 
 python=${PYTHON:-python3}
-if ! "$python" -c "import numpy, h5py, matplotlib, pytest, lasso.dyna" 2>/dev/null; then
+if ! "$python" -c "import numpy, h5py, matplotlib, pytest, lasso.dyna, vtk" 2>/dev/null; then
   echo "crashfree: installing Python packages from postproc/requirements.txt"
   "$python" -m pip install -q -r postproc/requirements.txt 2>/dev/null \
     || "$python" -m pip install -q --break-system-packages -r postproc/requirements.txt
