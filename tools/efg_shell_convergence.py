@@ -220,7 +220,7 @@ def section(cantilever, strip, ring, formulations, ring_variants, command, tests
         "",
         "**Problems found** and their state on this build:",
         "",
-        "- fixed (efgshell-forces 97f2748): constant curvature was not reproduced (pure bending patch "
+        "- fixed (commit 97f2748): constant curvature was not reproduced (pure bending patch "
         "test, w error 6.9e-3 on a regular mesh at DX 1.5, 3.5e-2 on the irregular one; the one MLS "
         "shear point per cell); now 2.0e-5 and 2.7e-5, stress within 0.1%;",
         "- fixed (same commit): triangle cells locked in transverse shear (a cantilever of triangles "

@@ -208,7 +208,7 @@ def test_pure_bending_patch_test_of_efg_shells(tmp_path, run_deck, perturbation)
     are printed beside: on the irregular mesh they fail it (w 3.5e-2, stress -21%..+14%: the
     one-point shell's transverse shear is not zero for a constant curvature on a distorted
     quadrilateral). (Before the EFG shell's assumed-strain shear on the cells' physical corner
-    values, efgshell-forces 97f2748, it failed too: w 6.9e-3 and 3.5e-2.)"""
+    values, commit 97f2748, it failed too: w 6.9e-3 and 3.5e-2.)"""
     w_error, (low, high), other, ratio = bending_errors(run_deck, tmp_path, EFG, perturbation,
                                                         (9, 22))
     fe_folder = tmp_path / "fe"
@@ -284,7 +284,7 @@ def test_cantilever_plate_of_fe_triangles(tmp_path, run_deck):
 
 def test_cantilever_plate_of_efg_triangles(tmp_path, run_deck):
     """The same mesh of triangles as EFG shells: within 1% (measured 0.99826, FE 0.99751; with
-    one shear point at the centroid, before efgshell-forces 97f2748, they locked: 0.578)."""
+    one shear point at the centroid, before commit 97f2748, they locked: 0.578)."""
     efg = cantilever_ratio(run_deck, tmp_path / "efg.k", EFG, TRIANGLE_CELLS, triangles=True)
     print(f"figure: cantilever 10 x 2 split into triangles: tip deflection / Timoshenko EFG {efg:.5f}")
     assert abs(efg - 1.0) < 0.01
