@@ -66,15 +66,21 @@ contains
   pure function midpoint_update(increment) result(update)
     real(wp), intent(in) :: increment(3, 3)
     real(wp) :: update(3, 3)
-    real(wp) :: minus(3, 3), plus(3, 3)
-    integer :: k
+    real(wp) :: minus(3, 3), plus(3, 3), inverse(3, 3)
+    integer :: i, j, k
     minus = -0.5_wp*increment
     plus = 0.5_wp*increment
     do k = 1, 3
       minus(k, k) = minus(k, k) + 1.0_wp
       plus(k, k) = plus(k, k) + 1.0_wp
     end do
-    update = matmul(inverse3(minus), plus)
+    inverse = inverse3(minus)
+    ! the 3x3 product written out (an inlined matmul of a function result draws false warnings)
+    do j = 1, 3
+      do i = 1, 3
+        update(i, j) = inverse(i, 1)*plus(1, j) + inverse(i, 2)*plus(2, j) + inverse(i, 3)*plus(3, j)
+      end do
+    end do
   end function midpoint_update
 
   !> Eigenvalues and eigenvectors (columns) of a symmetric 3x3 matrix by cyclic Jacobi
