@@ -43,6 +43,7 @@
 !> colours one after another, the blocks of a colour in parallel, each node receives its
 !> contributions in the same order for any thread count.
 module efg_shell_forces
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp, block_size
   use gather_list, only: gather_list_t
   use block_colouring, only: colour_blocks_by_node_lists
@@ -963,13 +964,23 @@ contains
   !> of the local stresses, in global axes; the point of largest von Mises stress; the mean and
   !> largest effective plastic strain.
   subroutine efg_shell_cell_results(material, solver, mid_stress, peak_stress, mean_plastic_strain, &
-                                    peak_plastic_strain)
+                                    peak_plastic_strain, point_stress, point_plastic_strain, point_count, &
+                                    resultant, thickness, energy_density)
     type(material_t), intent(in) :: material
     type(efg_shell_solver_t), intent(in) :: solver
     real(wp), intent(inout) :: mid_stress(:, :), peak_stress(:, :), mean_plastic_strain(:), peak_plastic_strain(:)
+    !> For the d3plot, as the FE shells' (shell_block_element_results): per cell, each thickness
+    !> point's stress (global) and plastic strain, bottom to top, as the area-weighted mean of its
+    !> sub-cell points; the resultants per unit width in the cell's frame (M_xx M_yy M_xy Q_x Q_y
+    !> N_xx N_yy N_xy); the thickness; the internal energy (membrane, bending and transverse
+    !> shear work) per unit current volume.
+    real(wp), intent(inout), optional :: point_stress(:, :, :), point_plastic_strain(:, :)
+    integer, intent(inout), optional :: point_count(:)
+    real(wp), intent(inout), optional :: resultant(:, :), thickness(:), energy_density(:)
     real(wp) :: point_strain(block_size, max_shell_points), local(5), mean(5), peak(5), effective, largest
-    real(wp) :: weight_sum, area, mean_strain, peak_strain
-    integer :: b, c, i, point, shell, lane
+    real(wp) :: weight_sum, area, mean_strain, peak_strain, layer(5, max_shell_points), layer_strain(max_shell_points)
+    real(wp) :: through(5), moment(3), height, energy, volume
+    integer :: b, c, i, point, shell, lane, written
     do b = 1, size(solver%blocks)
       associate (block => solver%blocks(b), geometry => solver%geometry)
         point_strain = 0.0_wp
@@ -987,12 +998,17 @@ contains
           weight_sum = 0.0_wp
           mean_strain = 0.0_wp
           peak_strain = 0.0_wp
+          layer = 0.0_wp
+          layer_strain = 0.0_wp
+          energy = block%shear_energy(lane)
           do i = 1, block%point_count
             if (geometry%point_cell(block%first_point + i - 1) /= c) cycle
             area = geometry%point_area(block%first_point + i - 1)
             do point = 1, solver%thickness_points
               local = [block%stress(i, :, point), block%shear_stress(i, 2), block%shear_stress(i, 1)]
               mean = mean + solver%point_weight(point)*area*local
+              layer(:, point) = layer(:, point) + area*local
+              layer_strain(point) = layer_strain(point) + area*point_strain(i, point)
               mean_strain = mean_strain + solver%point_weight(point)*area*point_strain(i, point)
               peak_strain = max(peak_strain, point_strain(i, point))
               effective = local(1)**2 - local(1)*local(2) + local(2)**2 + 3.0_wp*(local(3)**2 + local(4)**2 + local(5)**2)
@@ -1002,16 +1018,49 @@ contains
               end if
             end do
             weight_sum = weight_sum + area
+            energy = energy + block%internal_energy(i)
           end do
           if (weight_sum > 0.0_wp) then
             mean = mean/weight_sum
             mean_strain = mean_strain/weight_sum
+            layer = layer/weight_sum
+            layer_strain = layer_strain/weight_sum
           end if
           shell = geometry%cells(c)
           mid_stress(:, shell) = global_stress(solver%cell_frame(:, :, c), mean)
           peak_stress(:, shell) = global_stress(solver%cell_frame(:, :, c), peak)
           mean_plastic_strain(shell) = mean_strain
           peak_plastic_strain(shell) = peak_strain
+          if (.not. present(point_stress)) cycle
+          ! the d3plot's layers, resultants, thickness and energy density (as the FE shells')
+          written = min(solver%thickness_points, size(point_stress, 2))
+          point_count(shell) = written
+          do point = 1, written
+            point_stress(:, point, shell) = global_stress(solver%cell_frame(:, :, c), layer(:, point))
+            point_plastic_strain(point, shell) = layer_strain(point)
+          end do
+          through = 0.0_wp
+          moment = 0.0_wp
+          do point = 1, solver%thickness_points
+            height = solver%point_height(point)
+            through = through + solver%point_weight(point)*layer(:, point)
+            moment = moment + solver%point_weight(point)*height*layer(1:3, point)
+          end do
+          resultant(1:3, shell) = geometry%cell_thickness(c)**2*moment
+          resultant(4, shell) = geometry%cell_thickness(c)*through(5)
+          resultant(5, shell) = geometry%cell_thickness(c)*through(4)
+          resultant(6:8, shell) = geometry%cell_thickness(c)*through(1:3)
+          thickness(shell) = geometry%cell_thickness(c)
+          ! (0 for a volume so small or values so large that the quotient would overflow)
+          volume = solver%cell_area(c)*geometry%cell_thickness(c)
+          energy_density(shell) = 0.0_wp
+          if (ieee_is_finite(volume) .and. ieee_is_finite(energy)) then
+            if (volume >= 1.0_wp) then
+              energy_density(shell) = energy/volume
+            else if (abs(energy) < huge(1.0_wp)*volume) then
+              energy_density(shell) = energy/volume
+            end if
+          end if
         end do
       end associate
     end do

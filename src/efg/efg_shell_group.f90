@@ -323,9 +323,17 @@ contains
     type(element_results_t), intent(inout) :: results
     integer :: k
     do k = 1, size(self%parts)
-      call efg_shell_cell_results(model%materials(self%parts(k)%geometry%material), self%parts(k), &
-                                  results%shell_stress, results%shell_stress_peak, results%shell_plastic_strain, &
-                                  results%shell_plastic_strain_peak)
+      if (allocated(results%shell_point_stress)) then
+        call efg_shell_cell_results(model%materials(self%parts(k)%geometry%material), self%parts(k), &
+                                    results%shell_stress, results%shell_stress_peak, results%shell_plastic_strain, &
+                                    results%shell_plastic_strain_peak, results%shell_point_stress, &
+                                    results%shell_point_plastic_strain, results%shell_point_count, &
+                                    results%shell_resultant, results%shell_thickness, results%shell_energy_density)
+      else
+        call efg_shell_cell_results(model%materials(self%parts(k)%geometry%material), self%parts(k), &
+                                    results%shell_stress, results%shell_stress_peak, results%shell_plastic_strain, &
+                                    results%shell_plastic_strain_peak)
+      end if
     end do
   end subroutine element_results
 

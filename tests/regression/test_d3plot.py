@@ -331,7 +331,8 @@ def test_coupled_meshfree_shell_strip_d3plot_has_the_physical_values(tmp_path, r
     """A strip of FE shells (x < 30 mm) coupled to meshfree EFG shells (ELFORM 41) beyond, its
     end x = 0 pushed transversely by a short pulse: the flexural wave crosses the interface.
     The EFG cells are written as shells with the particles' physical (transformed)
-    displacements and velocities of results.h5, both parts with their titles."""
+    displacements and velocities of results.h5, both parts with their titles; their layers and
+    bending moments as the FE shells'."""
     import plate_decks
     deck = tmp_path / "coupled.k"
     end_time = 0.04
@@ -354,16 +355,26 @@ def test_coupled_meshfree_shell_strip_d3plot_has_the_physical_values(tmp_path, r
         assert moved > 1e-4
         stress = plot.arrays[ArrayType.element_shell_stress]             # (states, shells, 3 layers, 6)
         mid = states(results, "shell_stress")
-        for layer in range(3):        # meshfree cells: their mid-surface values in every layer
-            assert_close(stress[:, efg, layer, :], mid[:, efg], f"meshfree shell stresses, layer {layer + 1}")
-        # FE shells, NIP 3 (LS-DYNA's MAXINT 3): the layers are the mid, inner (bottom) and outer
-        # (top) points, so the Gauss mean weighs them 8/9, 5/9, 5/9 (over 2)
+        # both kinds, NIP 3 (LS-DYNA's MAXINT 3): the layers are the mid, inner (bottom) and outer
+        # (top) points, so the Gauss mean weighs them 8/9, 5/9, 5/9 (over 2); a meshfree cell's
+        # layer is the area-weighted mean of its sub-cell points at that height
         weights = np.array([8.0, 5.0, 5.0]) / 18.0
-        assert_close(np.einsum("l,selk->sek", weights, stress[:, ~efg]), mid[:, ~efg], "FE shell stresses",
-                     scale=np.abs(stress).max())
-        bending = np.abs(stress[:, ~efg, 1, 0] - stress[:, ~efg, 2, 0]).max()
-        print(f"  largest difference of the FE shells' inner and outer axial stress {bending:.3e}")
-        assert bending > 0.1 * np.abs(stress).max()               # the layers are the bent shell's
+        for kind, cells in (("FE", ~efg), ("meshfree", efg)):
+            assert_close(np.einsum("l,selk->sek", weights, stress[:, cells]), mid[:, cells], f"{kind} shell stresses",
+                         scale=np.abs(stress).max())
+            bending = np.abs(stress[:, cells, 1, 0] - stress[:, cells, 2, 0]).max()
+            print(f"  largest difference of the {kind} shells' inner and outer axial stress {bending:.3e}")
+            assert bending > 0.1 * np.abs(stress).max()           # the layers are the bent shell's
+        # resultants per unit width from the layers (t = 1, points at z = 0, -/+ sqrt(3/5) t / 2):
+        # M_xx = t^2 sum w h s_xx in the shell's frame; along the strip (x) frame and global agree
+        height = np.array([0.0, -np.sqrt(0.6) / 2.0, np.sqrt(0.6) / 2.0])
+        moment = plot.arrays[ArrayType.element_shell_bending_moment][:, efg, 0]
+        from_layers = np.einsum("l,sel->se", weights * height, stress[..., 0][:, efg])
+        print(f"  meshfree M_xx: largest {np.abs(moment).max():.3e}, from the layers {np.abs(from_layers).max():.3e}")
+        assert np.abs(moment).max() > 0.0
+        assert np.allclose(np.abs(moment), np.abs(from_layers), rtol=0, atol=2e-3 * np.abs(moment).max())
+        thickness = plot.arrays[ArrayType.element_shell_thickness]
+        assert np.all(thickness == 1.0)
     # no erosion: every shell's deletion flag is its part number, 1 (FE) or 2 (meshfree)
     part_numbers = plot.arrays[ArrayType.element_shell_part_indexes] + 1
     assert set(part_numbers) == {1, 2}
