@@ -4,7 +4,7 @@
 !> LS-DYNA Users Conference: Lagrangian MLS functions on the undeformed surface, co-rotational
 !> update as in the Belytschko-Tsay shell, stabilized conforming (sub-cell) integration of the
 !> membrane and bending strains) with an assumed-strain transverse shear on the cells' physical
-!> corner values (below). The geometry (pairs, smoothed gradients, masses, transformation) comes
+!> corner and edge-midpoint values (below). The geometry (pairs, smoothed gradients, masses, transformation) comes
 !> from the set-up (efg_shell_part); this module is the per-cycle work on it.
 !>
 !> Per background cell c: the current frame E = shell_cell_frame of its current corners, the
@@ -24,12 +24,15 @@
 !> shell_block's rotate_with_material). Resultants N, M per unit current length; the point's
 !> forces and moments are the transposes, W J N g_I and W J (M-moments), J = det F.
 !> Transverse shear (docs/efg_shells.md says why not from the meshfree functions): on the
-!> physical values of the cell's corners (a particle corner through its transformation row),
-!> MITC4 on a quadrilateral (Bathe & Dvorkin 1985: covariant shear at the edge midpoints,
-!> interpolated to the four sub-cell points), the FE triangle's edge-based constant shear on a
-!> triangle (shell_triangle); a Kirchhoff mode has no shear on any mesh. Elastic with SHRF G,
-!> uniform through the thickness as in shell_block; forces and moments onto the physical corners
-!> are handed to the nodes through the rows (A^T).
+!> physical values of the cell's stations, its corners (a particle corner through its
+!> transformation row) and its edge midpoints (the functions there), MITC4 on a quadrilateral
+!> (Bathe & Dvorkin 1985: covariant shear of each edge, interpolated to the four sub-cell
+!> points), the FE triangle's edge-based constant shear on a triangle (shell_triangle), each
+!> edge's mean rotation by Simpson's rule on its corners and midpoint (exact for a rotation
+!> quadratic along the edge, where the corners' mean leaves the FE shell's -1/(4 n^2) in a
+!> cantilever); a Kirchhoff mode has no shear on any mesh. Elastic with SHRF G, uniform through
+!> the thickness as in shell_block; forces and moments onto the stations are handed to the
+!> nodes through the rows (A^T).
 !>
 !> Energies are the exact work of the nodal forces and moments (element_work's add_force_work,
 !> as efg_forces and shell_block). Their power needs no pair loop: a point's forces and moments
@@ -39,7 +42,7 @@
 !>
 !> Blocks are runs of whole cells, at most block_size membrane/bending points each (a lane per
 !> point for the materials; the block's cells go with it). Blocks are coloured by the nodes of
-!> their pairs, corners and corner rows, so the blocks of one colour share no node:
+!> their pairs, corners and station rows, so the blocks of one colour share no node:
 !> colours one after another, the blocks of a colour in parallel, each node receives its
 !> contributions in the same order for any thread count.
 module efg_shell_forces
