@@ -565,7 +565,7 @@ contains
     call add_force_work(nel, dt, block%previous_time_step, old_power, new_power, block%force_power, &
                         block%internal_energy)
 
-    ! transverse shear: assumed strain on the cells' physical corner values (module comment)
+    ! transverse shear: assumed strain on the cells' physical station values (module comment)
     do lane = 1, block%cell_count
       cell = block%first_cell + lane - 1
       triangle = cell_nodes(3, cell) == cell_nodes(4, cell)
