@@ -13,9 +13,10 @@
 !>   smoothed gradients (local boundary integration over the sub-cell's edges) of every node's
 !>   function, in the cell's reference frame (components along e1 and e2);
 !> * one point per cell at its centre, with the functions' values and gradients there. The
-!>   explicit update takes its transverse shear from the cells' physical corner and edge-midpoint values instead
-!>   (an assumed strain, efg_shell_forces: the MLS w of a linear basis gives a Kirchhoff mode a
-!>   spurious shear); it uses these points' pairs only for the nodes' rotary-inertia areas.
+!>   explicit update takes its transverse shear from the cells' physical corner and
+!>   edge-midpoint values instead (an assumed strain, efg_shell_forces: the MLS w of a linear
+!>   basis gives a Kirchhoff mode a spurious shear); it uses these points' pairs only for the
+!>   nodes' rotary-inertia areas.
 !> The points of one cell are consecutive and the cells come in ascending order.
 module efg_shell_part
   use kinds, only: wp
