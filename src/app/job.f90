@@ -151,7 +151,7 @@ contains
       call write_ascii_databases(model, run%histories, settings%output_dir, settings%job_id, ascii_error)
       if (.not. allocated(ascii_error)) &
         call write_d3hsp(model, run%state, run%histories, initial_time_steps(run), summary, settings%output_dir, &
-                         settings%job_id, ascii_error)
+                         settings%job_id, ascii_error, sources)
     end if
     if (allocated(ascii_error)) exit_status = 1
     call close_results(results, summary, close_error)

@@ -15,6 +15,7 @@ module ascii_run_summary
   use history_buffer, only: history_set_t
   use ascii_databases, only: lsdyna_file_path, c_exponential, text_buffer_t, add_line, finish_database
   use version, only: crashfree_version
+  use deck_signature, only: deck_source_t
   implicit none
   private
 
@@ -51,7 +52,7 @@ contains
   end subroutine write_messag
 
   !> `d3hsp` (`JOB.d3hsp` with jobid=).
-  subroutine write_d3hsp(model, state, histories, initial_time_steps, summary, directory, job_id, error)
+  subroutine write_d3hsp(model, state, histories, initial_time_steps, summary, directory, job_id, error, sources)
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(in) :: state
     type(history_set_t), intent(in) :: histories
@@ -59,6 +60,8 @@ contains
     type(run_summary_t), intent(in) :: summary
     character(len=*), intent(in) :: directory, job_id
     type(error_t), allocatable, intent(out) :: error
+    !> the deck's files as read (the main deck, then its includes, paths resolved): echoed
+    type(deck_source_t), intent(in), optional :: sources(:)
     type(text_buffer_t) :: out
     character(len=8) :: date
     character(len=16) :: cycles
@@ -71,6 +74,7 @@ contains
     call write_controls(out, model)
     call write_parts(out, model, state)
     call write_time_steps(out, model, state, histories, initial_time_steps)
+    if (present(sources)) call echo_deck(out, sources)
     call add_line(out, "")
     write (cycles, '(i0)') summary%cycles
     call add_line(out, " cycles: "//trim(cycles)//", problem time "// &
@@ -82,6 +86,40 @@ contains
     end if
     call finish_database(out, lsdyna_file_path(directory, job_id, "d3hsp"), error)
   end subroutine write_d3hsp
+
+  !> The input as read, file by file (LS-DYNA's d3hsp echoes its input too): each file's text
+  !> under a line naming it. A file that cannot be read any more is named as such.
+  subroutine echo_deck(out, sources)
+    type(text_buffer_t), intent(inout) :: out
+    type(deck_source_t), intent(in) :: sources(:)
+    character(len=:), allocatable :: text
+    integer :: k, unit, status, bytes
+    call add_line(out, "")
+    call add_line(out, " i n p u t   d e c k   a s   r e a d   (file by file, include paths resolved)")
+    do k = 1, size(sources)
+      call add_line(out, "")
+      call add_line(out, " ---- "//sources(k)%path)
+      open (newunit=unit, file=sources(k)%path, access="stream", form="unformatted", action="read", &
+            status="old", iostat=status)
+      if (status == 0) inquire (unit=unit, size=bytes, iostat=status)
+      if (status == 0) then
+        allocate (character(len=max(bytes, 0)) :: text)
+        if (bytes > 0) read (unit, iostat=status) text
+        close (unit)
+      end if
+      if (status /= 0) then
+        call add_line(out, " (cannot be read now)")
+      else if (len(text) > 0) then
+        ! the text as it is, without a second new line after its last one
+        if (text(len(text):len(text)) == new_line("a")) then
+          call add_line(out, text(1:len(text) - 1))
+        else
+          call add_line(out, text)
+        end if
+      end if
+      if (allocated(text)) deallocate (text)
+    end do
+  end subroutine echo_deck
 
   !> One "label ..... value" line of the control section.
   subroutine control_line(out, label, value)

@@ -7,7 +7,8 @@ precision. Physics: matsum's momentum of each part is sum m v of its nodes (the 
 times its velocity for a block moving as a whole), a rigid part's rigid-body velocity is its
 velocity; rwforc has LS-DYNA's sign (a block moving in -x into a wall gets a force in +x) and
 its time integral is the block's momentum change; rcforc's two sides are opposite. messag has
-the warnings with file:line, d3hsp the parts and masses; BINARY=2 writes no ASCII file.
+the warnings with file:line, d3hsp the parts and masses and the deck as read; BINARY=2 writes no
+ASCII file.
 """
 import re
 import subprocess
@@ -265,6 +266,11 @@ def test_ascii_files_equal_results_and_physics(tmp_path, run_deck):
         start += 1
     assert len(steps) == 2 and "rigid bodies" in lines[start - 1]
     assert abs(0.9 * min(steps) - glstat["time_step"][0]) <= 1e-5 * glstat["time_step"][0]
+    # the input as read, as LS-DYNA's d3hsp echoes it: the deck's lines under its path
+    echo = d3hsp.split("i n p u t   d e c k   a s   r e a d")[1]
+    deck_text = (tmp_path / "wall.k").read_text()
+    assert any(text.startswith(" ---- ") and text.endswith("wall.k") for text in echo.splitlines())
+    assert deck_text.rstrip("\n") in echo
 
 
 def test_contact_forces_both_sides(tmp_path, run_deck):
