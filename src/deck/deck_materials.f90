@@ -228,10 +228,7 @@ contains
         call get_real(deck, card, 7, "YM", material%youngs_modulus, log)
         call get_real(deck, card, 8, "PR", material%poissons_ratio, log)
         if (.not. card%failed) then
-          if (material%id <= 0) call card_problem(deck, log, card, "MID", "material id must be "// &
-                                                  "> 0, found "//integer_text(material%id))
-          if (material%density <= 0.0_wp) call card_problem(deck, log, card, "RO", "density must "// &
-            "be > 0, found "//shown(card, 2, material%density))
+          call check_id_and_density(deck, card, material, log)
           if (material%pressure_cutoff > 0.0_wp) call card_problem(deck, log, card, "PC", "pressure "// &
             "cut-off must be <= 0, found "//real_text(material%pressure_cutoff))
           if (material%viscosity < 0.0_wp) call card_problem(deck, log, card, "MU", "viscosity "// &
@@ -521,10 +518,7 @@ contains
         call get_real(deck, card, 8, "DAMP", material%viscosity, log)
         material%curve_ids = [max(curve, 0)]
         if (.not. card%failed) then
-          if (material%id <= 0) call card_problem(deck, log, card, "MID", "material id must be "// &
-                                                  "> 0, found "//integer_text(material%id))
-          if (material%density <= 0.0_wp) call card_problem(deck, log, card, "RO", "density must "// &
-            "be > 0, found "//shown(card, 2, material%density))
+          call check_id_and_density(deck, card, material, log)
           if (material%youngs_modulus <= 0.0_wp) call card_problem(deck, log, card, "E", "Young's "// &
             "modulus (tension, unloading) must be > 0, found "//shown(card, 3, material%youngs_modulus))
           if (curve <= 0) call card_problem(deck, log, card, "LCID", "a loading curve id > 0 is required, "// &
@@ -595,10 +589,7 @@ contains
         call require_zero(deck, card, 6, "REF", "initialisation from a reference geometry "// &
                           "(*INITIAL_FOAM_REFERENCE_GEOMETRY) is not available", log)
         if (.not. card%failed) then
-          if (material%id <= 0) call card_problem(deck, log, card, "MID", "material id must be "// &
-                                                  "> 0, found "//integer_text(material%id))
-          if (material%density <= 0.0_wp) call card_problem(deck, log, card, "RO", "density must "// &
-            "be > 0, found "//shown(card, 2, material%density))
+          call check_id_and_density(deck, card, material, log)
           if (material%poissons_ratio >= 0.5_wp) call card_problem(deck, log, card, "PR", "Poisson's ratio "// &
             "must be < 0.5 (0.49 to 0.495 are usual for rubber), found "//shown(card, 3, material%poissons_ratio))
         end if
@@ -707,10 +698,7 @@ contains
         material%poissons_ratio = blatz_ko_poissons_ratio
         material%youngs_modulus = 2.0_wp*shear_modulus*(1.0_wp + blatz_ko_poissons_ratio)
         if (.not. card%failed) then
-          if (material%id <= 0) call card_problem(deck, log, card, "MID", "material id must be "// &
-                                                  "> 0, found "//integer_text(material%id))
-          if (material%density <= 0.0_wp) call card_problem(deck, log, card, "RO", "density must "// &
-            "be > 0, found "//shown(card, 2, material%density))
+          call check_id_and_density(deck, card, material, log)
           if (.not. shear_modulus > 0.0_wp) call card_problem(deck, log, card, "G", "shear modulus must "// &
             "be > 0, found "//shown(card, 3, shear_modulus))
         end if
@@ -746,10 +734,7 @@ contains
         call get_real(deck, card, 6, "BETA", material%decay_constant, log)
         call require_zero(deck, card, 7, "REF", "initialisation from a reference geometry is not available", log)
         if (.not. card%failed) then
-          if (material%id <= 0) call card_problem(deck, log, card, "MID", "material id must be "// &
-                                                  "> 0, found "//integer_text(material%id))
-          if (material%density <= 0.0_wp) call card_problem(deck, log, card, "RO", "density must "// &
-            "be > 0, found "//shown(card, 2, material%density))
+          call check_id_and_density(deck, card, material, log)
           if (.not. bulk_modulus > 0.0_wp) call card_problem(deck, log, card, "BULK", "bulk modulus must "// &
             "be > 0, found "//shown(card, 3, bulk_modulus))
           if (.not. short_term_shear > 0.0_wp) call card_problem(deck, log, card, "G0", "short-time shear "// &
@@ -799,10 +784,7 @@ contains
     call get_real(deck, card, 3, "E", material%youngs_modulus, log)
     call get_real(deck, card, 4, "PR", material%poissons_ratio, log)
     if (card%failed) return
-    if (material%id <= 0) call card_problem(deck, log, card, "MID", "material id must be "// &
-                                            "> 0, found "//integer_text(material%id))
-    if (material%density <= 0.0_wp) call card_problem(deck, log, card, "RO", "density must "// &
-      "be > 0, found "//shown(card, 2, material%density))
+    call check_id_and_density(deck, card, material, log)
     if (material%youngs_modulus < 0.0_wp) then
       call card_problem(deck, log, card, "E", "Young's modulus must be > 0, found "// &
         shown(card, 3, material%youngs_modulus)//" (E < 0, a curve of E, is not available)")
@@ -862,6 +844,18 @@ contains
   end subroutine check_rate
 
   !> A value for a message, saying when it came from a blank field.
+  !> MID > 0 and RO > 0 (fields 1 and 2 of card 1, the same on every material keyword read here).
+  subroutine check_id_and_density(deck, card, material, log)
+    type(deck_t), intent(in) :: deck
+    type(card_t), intent(in) :: card
+    type(material_t), intent(in) :: material
+    type(problem_log_t), intent(inout) :: log
+    if (material%id <= 0) call card_problem(deck, log, card, "MID", "material id must be > 0, found "// &
+                                            integer_text(material%id))
+    if (material%density <= 0.0_wp) call card_problem(deck, log, card, "RO", "density must be > 0, found "// &
+                                                      shown(card, 2, material%density))
+  end subroutine check_id_and_density
+
   function shown(card, k, value) result(text)
     type(card_t), intent(in) :: card
     integer, intent(in) :: k

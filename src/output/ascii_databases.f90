@@ -168,6 +168,28 @@ contains
   end subroutine start_database
 
   !> Append one line (and its new line) to `out`, doubling the buffer when it is full.
+  !> The history series "<database>/<id>" of each id, and the rows all of them hold; false when
+  !> one of them was not recorded.
+  logical function series_of(histories, database, ids, series, rows) result(found)
+    type(history_set_t), intent(in) :: histories
+    character(len=*), intent(in) :: database
+    integer, intent(in) :: ids(:)
+    integer, allocatable, intent(out) :: series(:)
+    integer, intent(out) :: rows
+    character(len=16) :: id_text
+    integer :: k
+    allocate (series(size(ids)))
+    rows = huge(1)
+    found = .false.
+    do k = 1, size(ids)
+      write (id_text, '(i0)') ids(k)
+      series(k) = series_index(histories, database//"/"//trim(id_text))
+      if (series(k) == 0) return
+      rows = min(rows, histories%series(series(k))%count)
+    end do
+    found = .true.
+  end function series_of
+
   subroutine add_line(out, line)
     type(text_buffer_t), intent(inout) :: out
     character(len=*), intent(in) :: line
@@ -293,13 +315,9 @@ contains
     character(len=16) :: id_text
     type(text_buffer_t) :: out
     integer :: k, row, rows
-    allocate (part_series(size(model%parts)), titles(size(model%parts)))
-    rows = huge(1)
+    allocate (titles(size(model%parts)))
+    if (.not. series_of(histories, "matsum", model%parts%id, part_series, rows)) return
     do k = 1, size(model%parts)
-      write (id_text, '(i0)') model%parts(k)%id
-      part_series(k) = series_index(histories, "matsum/"//trim(id_text))
-      if (part_series(k) == 0) return
-      rows = min(rows, histories%series(part_series(k))%count)
       titles(k) = ""
       if (allocated(model%parts(k)%title)) titles(k) = model%parts(k)%title
     end do
@@ -342,7 +360,6 @@ contains
     character(len=*), intent(in) :: path
     type(error_t), allocatable, intent(out) :: error
     integer, allocatable :: node_series(:)
-    character(len=16) :: id_text
     character(len=9) :: node_text
     character(len=8) :: cycle_text
     type(text_buffer_t) :: out
@@ -350,14 +367,7 @@ contains
     character(len=:), allocatable :: line
     if (.not. allocated(model%output%history_nodes)) return
     if (size(model%output%history_nodes) == 0) return
-    allocate (node_series(size(model%output%history_nodes)))
-    rows = huge(1)
-    do k = 1, size(node_series)
-      write (id_text, '(i0)') model%node_ids(model%output%history_nodes(k))
-      node_series(k) = series_index(histories, "nodout/"//trim(id_text))
-      if (node_series(k) == 0) return
-      rows = min(rows, histories%series(node_series(k))%count)
-    end do
+    if (.not. series_of(histories, "nodout", model%node_ids(model%output%history_nodes), node_series, rows)) return
     call start_database(model, out)
     do row = 1, rows
       associate (first => histories%series(node_series(1)))
@@ -404,18 +414,13 @@ contains
     type(error_t), allocatable, intent(out) :: error
     integer, allocatable :: wall_series(:)
     character(len=70), allocatable :: titles(:)
-    character(len=16) :: id_text
     character(len=8) :: wall_text
     type(text_buffer_t) :: out
     integer :: k, j, row, rows
     character(len=:), allocatable :: line
-    allocate (wall_series(size(model%walls)), titles(size(model%walls)))
-    rows = huge(1)
+    allocate (titles(size(model%walls)))
+    if (.not. series_of(histories, "rwforc", model%walls%id, wall_series, rows)) return
     do k = 1, size(model%walls)
-      write (id_text, '(i0)') model%walls(k)%id
-      wall_series(k) = series_index(histories, "rwforc/"//trim(id_text))
-      if (wall_series(k) == 0) return
-      rows = min(rows, histories%series(wall_series(k))%count)
       titles(k) = ""
       if (allocated(model%walls(k)%title)) titles(k) = model%walls(k)%title
     end do
@@ -450,17 +455,12 @@ contains
     type(error_t), allocatable, intent(out) :: error
     integer, allocatable :: contact_series(:)
     character(len=70), allocatable :: titles(:)
-    character(len=16) :: id_text
     character(len=11) :: contact_text
     type(text_buffer_t) :: out
     integer :: k, row, rows
-    allocate (contact_series(size(model%contacts)), titles(size(model%contacts)))
-    rows = huge(1)
+    allocate (titles(size(model%contacts)))
+    if (.not. series_of(histories, "rcforc", model%contacts%id, contact_series, rows)) return
     do k = 1, size(model%contacts)
-      write (id_text, '(i0)') model%contacts(k)%id
-      contact_series(k) = series_index(histories, "rcforc/"//trim(id_text))
-      if (contact_series(k) == 0) return
-      rows = min(rows, histories%series(contact_series(k))%count)
       titles(k) = ""
       if (allocated(model%contacts(k)%title)) titles(k) = model%contacts(k)%title
     end do
