@@ -47,8 +47,8 @@ module output_plan
     real(wp), allocatable :: node_acceleration(:, :) !< physical accelerations (nodout)
     real(wp), allocatable :: part_kinetic(:), part_internal(:), part_hourglass(:)
     real(wp), allocatable :: part_momentum(:, :), part_mass(:), part_rigid_velocity(:, :)   !< matsum
-    !> d3hsp's table of the smallest stable steps at cycle 0, one line per element kind (not
-    !> kept in restart dumps: a continued run's d3hsp has the last cycle's only)
+    !> d3hsp's tables of the smallest stable steps at cycle 0 (ascii_run_summary; not kept in
+    !> restart dumps: a continued run's d3hsp has the last cycle's only)
     character(len=:), allocatable :: initial_time_steps
   end type output_plan_t
 

@@ -13,9 +13,10 @@ ASCII file.
 import re
 import subprocess
 
+import h5py
 import numpy as np
 
-from deck_writer import block_mesh, fields, nodes_card, solids_card, write_deck
+from deck_writer import block_mesh, fields, nodes_card, shells_card, solids_card, write_deck
 from test_contact import head_on_deck
 
 DENSITY = 7.85e-6        # kg/mm^3
@@ -327,3 +328,82 @@ def test_log_of_both_streams_is_in_order(tmp_path):
     summary = next(k for k, text in enumerate(lines) if text.startswith("model:"))
     progress = next(k for k, text in enumerate(lines) if text.strip().startswith("cycle"))
     assert lines[0].startswith("crashfree ") and 0 < warning < summary < progress
+
+
+# ------------------------------------------------------------------ d3hsp: 100 smallest timesteps
+
+SOLID_YOUNGS, SOLID_DENSITY, SOLID_SIZE = 210.0, 7.85e-6, 2.0                # steel cubes, nu = 0
+SHELL_YOUNGS, SHELL_DENSITY, SHELL_POISSON = 70.0, 2.7e-6, 0.33              # aluminium plate
+SHELL_WIDTHS, SHELL_HEIGHT = (1.2, 0.6, 1.0, 0.8), 1.5                       # columns, one row height
+TIME_STEP_SCALE = 0.8
+
+
+def time_step_deck(path):
+    """A 3 x 3 x 3 block of steel cubes (nu = 0, where the eigenvalue bound of the exposed
+    elements equals LS-DYNA's rule: every element's step is L / c, c = sqrt(E / rho)) and, far
+    from it, an aluminium plate of 4 x 3 shells whose columns have the widths SHELL_WIDTHS and
+    height 1.5 (L = area / longest side = the width; c = sqrt(E / (rho (1 - nu^2))))."""
+    solid_nodes, solid_elements = block_mesh((3, 3, 3), (3 * SOLID_SIZE,) * 3)
+    edges = np.concatenate([[0.0], np.cumsum(SHELL_WIDTHS)])
+    rows = np.arange(4) * SHELL_HEIGHT
+    plate_nodes = np.array([[x, y, 50.0] for x in edges for y in rows])
+    shells = [[i * 4 + j, (i + 1) * 4 + j, (i + 1) * 4 + j + 1, i * 4 + j + 1]
+              for i in range(len(SHELL_WIDTHS)) for j in range(3)]
+    count = len(solid_nodes)
+    deck = write_deck(
+        path,
+        "*TITLE\ntime steps by element",
+        "*CONTROL_TERMINATION\n" + fields(0.002),
+        "*CONTROL_TIMESTEP\n" + fields(0.0, TIME_STEP_SCALE),
+        "*DATABASE_GLSTAT\n" + fields(0.001),
+        "*PART\ncubes\n" + fields(1, 1, 1),
+        "*PART\nplate\n" + fields(2, 2, 2),
+        "*SECTION_SOLID\n" + fields(1, 1),
+        "*SECTION_SHELL\n" + fields(2, 2, 1.0, 2) + "\n" + fields(0.5, 0.5, 0.5, 0.5),
+        "*MAT_ELASTIC\n" + fields(1, SOLID_DENSITY, SOLID_YOUNGS, 0.0),
+        "*MAT_ELASTIC\n" + fields(2, SHELL_DENSITY, SHELL_YOUNGS, SHELL_POISSON),
+        nodes_card(np.vstack([solid_nodes, plate_nodes])),
+        solids_card(solid_elements, part_id=1, first_id=101),
+        shells_card(np.array(shells), part_id=2, first_id=501, first_node_id=count + 1),
+    )
+    shell_speed = np.sqrt(SHELL_YOUNGS / (SHELL_DENSITY * (1.0 - SHELL_POISSON ** 2)))
+    expected = [("shell", 501 + k, 2, SHELL_WIDTHS[k // 3] / shell_speed) for k in range(len(shells))]
+    expected += [("solid", 101 + k, 1, SOLID_SIZE / np.sqrt(SOLID_YOUNGS / SOLID_DENSITY))
+                 for k in range(len(solid_elements))]
+    expected.sort(key=lambda row: row[3])
+    return deck, expected
+
+
+def read_smallest_time_steps(path):
+    """d3hsp's table as LS-DYNA's readers take it: the rows start three lines below the line
+    holding "100 smallest timesteps" (a rule and the column header between); each row is
+    element type, number, part, time step, separated by blanks; the table ends at a blank line."""
+    lines = path.read_text().splitlines()
+    start = next(k for k, line in enumerate(lines) if " 100 smallest timesteps" in line) + 3
+    rows = []
+    for line in lines[start:]:
+        if not line.strip():
+            break
+        words = line.split()
+        rows.append((words[0], int(words[1]), int(words[-2]), float(words[-1])))
+    return rows
+
+
+def test_d3hsp_lists_the_smallest_element_time_steps(tmp_path, run_deck):
+    deck, expected = time_step_deck(tmp_path / "time_steps.k")
+    run = run_deck(deck)
+    assert run.status == 0, run.stderr
+    rows = read_smallest_time_steps(run.results.parent / "d3hsp")
+    # 12 shells + 27 solids: all of them, smallest first, each at its analytical step (the
+    # order among analytically equal steps follows their last bits: compared as sets)
+    assert len(rows) == len(expected) == 39
+    assert all(rows[k][3] <= rows[k + 1][3] for k in range(len(rows) - 1))
+    for step in sorted({row[3] for row in expected}):
+        places = [k for k, row in enumerate(expected) if row[3] == step]
+        assert {rows[k][:3] for k in places} == {expected[k][:3] for k in places}, step
+        for k in places:
+            assert abs(rows[k][3] - step) <= 1e-6 * step, (rows[k], step)
+    # the smallest is the step the run started with, over TSSFAC
+    with run.open() as results:
+        first_step = results["history/glstat/time_step"][0]
+    assert abs(rows[0][3] * TIME_STEP_SCALE - first_step) <= 1e-6 * first_step
