@@ -185,13 +185,13 @@ contains
     type(explicit_state_t), intent(in) :: state
     type(output_plan_t), intent(inout) :: plan
     type(history_set_t), intent(inout) :: histories
-    real(wp) :: row(13)
+    real(wp) :: row(37)
     integer :: k
     do k = 1, size(plan%rbdout_series)
       call rigid_body_history_row(model, k, state%rigid(k), state%nodes%acceleration, state%nodes%mass, state%time, &
                                   0.5_wp*state%time_step, state%time - plan%last_rbdout_time, plan%rigid_impulse(:, k), &
                                   row)
-      call append_history_row(histories%series(plan%rbdout_series(k)), row)
+      call append_history_row(histories%series(plan%rbdout_series(k)), [row, real(state%cycle, wp)])
     end do
     plan%last_rbdout_time = state%time
   end subroutine record_rigid_bodies

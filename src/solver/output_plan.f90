@@ -147,8 +147,11 @@ contains
         allocate (plan%rbdout_series(size(model%rigid_bodies)))
         do k = 1, size(model%rigid_bodies)
           write (label, '(i0)') model%rigid_bodies(k)%id
+          ! (the columns after angular_momentum came with LS-DYNA's rbdout file, appended)
           call add_history_series(histories, "rbdout/"//trim(label), [character(len=32) :: "time", &
-                                  "displacement", "velocity", "force", "angular_momentum"], [1, 3, 3, 3, 3], &
+                                  "displacement", "velocity", "force", "angular_momentum", "coordinates", &
+                                  "acceleration", "rotation", "angular_velocity", "angular_acceleration", &
+                                  "direction_cosines", "cycle"], [1, 3, 3, 3, 3, 3, 3, 3, 3, 3, 9, 1], &
                                   capacity, plan%rbdout_series(k))
         end do
       end if

@@ -13,8 +13,8 @@ ASCII file.
 import re
 import subprocess
 
-import h5py
 import numpy as np
+import pytest
 
 from deck_writer import block_mesh, fields, nodes_card, shells_card, solids_card, write_deck
 from test_contact import head_on_deck
@@ -407,3 +407,138 @@ def test_d3hsp_lists_the_smallest_element_time_steps(tmp_path, run_deck):
     with run.open() as results:
         first_step = results["history/glstat/time_step"][0]
     assert abs(rows[0][3] * TIME_STEP_SCALE - first_step) <= 1e-6 * first_step
+
+
+# ------------------------------------------------------------------ rbdout
+
+RIGID_SIZE = 10.0                        # mm, one rigid cube
+RIGID_ORIGIN = (5.0, -2.0, 1.0)
+RIGID_VELOCITY = (1.0, 0.5, -0.3)        # mm/ms
+RIGID_FORCE = (0.02, -0.01, 0.0)         # kN on the whole body (an eighth of it at each node)
+
+
+def rigid_body_deck(path, binary=""):
+    """A rigid cube with an initial velocity pushed by a constant force: its centre moves as
+    x(t) = x0 + v0 t + F t^2 / (2 m)."""
+    nodes, elements = block_mesh((1, 1, 1), (RIGID_SIZE,) * 3, origin=RIGID_ORIGIN)
+    loads = "\n".join("*LOAD_NODE_SET\n" + fields(1, dof + 1, 1, RIGID_FORCE[dof] / 8.0)
+                      for dof in range(3) if RIGID_FORCE[dof] != 0.0)
+    return write_deck(
+        path,
+        "*TITLE\na pushed block",
+        "*CONTROL_TERMINATION\n" + fields(1.0),
+        "*DATABASE_GLSTAT\n" + fields(0.1),
+        "*DATABASE_RBDOUT\n" + fields(0.1, binary),
+        "*PART\nrigid cube\n" + fields(4, 1, 1),
+        "*SECTION_SOLID\n" + fields(1, 1),
+        "*MAT_RIGID\n" + fields(1, DENSITY, 200.0, 0.3) + "\n" + fields(0.0, 0.0, 0.0),
+        "*DEFINE_CURVE\n" + fields(1) + "\n" + fields(0.0, 1.0, width=20) + "\n" + fields(10.0, 1.0, width=20),
+        "*SET_NODE_LIST\n" + fields(1) + "\n" + fields(*range(1, 9)),
+        loads,
+        "*INITIAL_VELOCITY\n" + fields(1) + "\n" + fields(*RIGID_VELOCITY),
+        nodes_card(nodes),
+        solids_card(elements, part_id=4),
+    )
+
+
+def read_rbdout(path):
+    """[(cycle, time, {body: {label: values}})]: per sample the "r i g i d   b o d y" line
+    (cycle in columns 50-57, time in 68-82), per body its id (columns 12-19 of " rigid body"),
+    then lines of a label in columns 1-15 and values of 12 columns each from column 16; the
+    local-axes block's labels get the prefix "local ", the direction vectors' rows "row N"."""
+    samples, body, local = [], None, False
+    for line in path.read_text().splitlines():
+        if line.startswith("  r i g i d   b o d y   m o t i o n   a t  cycle="):
+            samples.append((int(line[49:57]), number(line[67:82]), {}))
+        elif line.startswith(" rigid body"):
+            body, local = int(line[11:19]), False
+            samples[-1][2][body] = {}
+        elif line.startswith(" output in principal"):
+            local = True
+        elif body is not None and line[:15].strip().endswith(":") or line[:15].strip().startswith("row "):
+            label = line[:15].strip().rstrip(":")
+            values = [number(line[15 + 12 * k:27 + 12 * k]) for k in range((len(line) - 15) // 12)]
+            samples[-1][2][body][("local " if local else "") + label] = np.array(values)
+    return samples
+
+
+def read_rbdout_by_offsets(path):
+    """The 48 numbers of each body block as the public MATLAB reader lsdyna.read.rbdout
+    (matlab-lsdyna) takes them: sscanf of a fixed format on the characters 91 to 1128 after the
+    body's id (so the line between the id and the coordinates must be 88 characters long)."""
+    text = path.read_text()
+    pattern = ""
+    for label, count in (("coordinates:", 3), ("displacements:", 6), ("velocities:", 6), ("accelerations:", 6),
+                         ("principal or user defined local coordinate direction vectors a b c", 0),
+                         ("row 1", 3), ("row 2", 3), ("row 3", 3),
+                         ("output in principal or user defined local coordinate directions "
+                          "a b c a-rot b-rot c-rot", 0),
+                         ("displacements:", 6), ("velocities:", 6), ("accelerations:", 6)):
+        pattern += r"\s*" + r"\s*".join(re.escape(word) for word in label.split())
+        pattern += r"\s*([-+]?[0-9.]+(?:E[-+][0-9]+)?)" * count
+    blocks = []
+    for match in re.finditer(r"^ (nodal )?rigid body\s*(\d+)", text, re.M):
+        found = re.match(pattern, text[match.end() + 90:match.end() + 1127])
+        assert found, text[match.end():match.end() + 200]
+        blocks.append(np.array([float(value) for value in found.groups()]))
+    return blocks
+
+
+def test_rbdout_equals_results_and_the_analytical_motion(tmp_path, run_deck):
+    # BINARY 3: the ASCII file and binout
+    run = run_deck(rigid_body_deck(tmp_path / "rigid.k", binary=3))
+    assert run.status == 0, run.stderr
+    samples = read_rbdout(run.results.parent / "rbdout")
+    with run.open() as results:
+        series = results["history/rbdout/4"]
+        columns = {name: series[name][...] for name in series}
+    assert len(samples) == len(columns["time"]) >= 11
+    mass = DENSITY * RIGID_SIZE ** 3
+    force, velocity = np.array(RIGID_FORCE), np.array(RIGID_VELOCITY)
+    centre = np.array(RIGID_ORIGIN) + RIGID_SIZE / 2
+    for row, (cycle, time, bodies) in enumerate(samples):
+        body = bodies[4]
+        # the file equals results.h5 to its printed digits
+        assert cycle == columns["cycle"][row] and close(time, columns["time"][row], 7)
+        exact = {"coordinates": columns["coordinates"][row],
+                 "displacements": np.concatenate([columns["displacement"][row], columns["rotation"][row]]),
+                 "velocities": np.concatenate([columns["velocity"][row], columns["angular_velocity"][row]]),
+                 "accelerations": np.concatenate([columns["acceleration"][row],
+                                                  columns["angular_acceleration"][row]])}
+        for label, values in exact.items():
+            assert all(close(p, e, 4) for p, e in zip(body[label], values)), (label, body[label], values)
+        axes = columns["direction_cosines"][row].reshape(3, 3)
+        for k in range(3):
+            assert all(close(p, e, 4) for p, e in zip(body[f"row {k + 1}"], axes[k]))
+        # the body does not turn: its axes stay the global ones, the local values the global
+        for label in ("displacements", "velocities", "accelerations"):
+            assert np.allclose(body["local " + label], exact[label], rtol=1e-4, atol=1e-12), label
+        # physics: x(t) = x0 + v0 t + F t^2 / (2 m), a constant acceleration F / m, no rotation
+        time = columns["time"][row]
+        expected = velocity * time + force * time ** 2 / (2 * mass)
+        assert np.allclose(columns["displacement"][row], expected, rtol=1e-9, atol=1e-9 * RIGID_SIZE)
+        assert np.allclose(columns["coordinates"][row], centre + expected, rtol=1e-12)
+        assert np.allclose(columns["velocity"][row], velocity + force * time / mass, rtol=1e-9, atol=1e-12)
+        assert np.allclose(columns["acceleration"][row], force / mass, rtol=1e-9, atol=1e-12)
+        assert np.abs(columns["angular_velocity"][row]).max() < 1e-12
+        assert np.allclose(axes, np.eye(3), atol=1e-12)
+    assert columns["time"][-1] >= 1.0 and abs(columns["displacement"][-1, 0]) > 1.0
+    # a reader that counts characters finds the same numbers
+    blocks = read_rbdout_by_offsets(run.results.parent / "rbdout")
+    assert len(blocks) == len(samples)
+    for block, (_, _, bodies) in zip(blocks, samples):
+        body = bodies[4]
+        assert np.array_equal(block[:21], np.concatenate([body["coordinates"], body["displacements"],
+                                                          body["velocities"], body["accelerations"]]))
+        assert np.array_equal(block[21:30], np.concatenate([body[f"row {k}"] for k in (1, 2, 3)]))
+    # binout's rbdout under LS-DYNA's names (lasso-python), the values of results.h5
+    lasso_binout = pytest.importorskip("lasso.dyna.binout")
+    binout = lasso_binout.Binout(str(run.results.parent / "binout"))
+    for name, column in (("global_", "coordinates"), ("global_a", "acceleration"), ("global_rd", "rotation"),
+                         ("global_rv", "angular_velocity"), ("global_ra", "angular_acceleration")):
+        for axis, letter in enumerate("xyz"):
+            np.testing.assert_array_equal(binout.read("rbdout", name + letter), columns[column][:, axis])
+    for i in range(3):
+        for j in range(3):
+            np.testing.assert_array_equal(binout.read("rbdout", f"dircos_{i + 1}{j + 1}"),
+                                          columns["direction_cosines"][:, 3 * i + j])
