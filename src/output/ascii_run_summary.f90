@@ -1,6 +1,7 @@
 !> LS-DYNA's run files beside results.h5: `d3hsp` (the model summary: controls, parts with
 !> their material, section, element counts and mass, the total mass, the time step
-!> information with the smallest stable steps by element kind, and the termination line) and
+!> information with LS-DYNA's 100 smallest element steps at the start and the smallest step
+!> of each element kind, the deck as read and the termination line) and
 !> `messag` (every warning and error the job printed, with file:line as the terminal showed
 !> them, and the termination line). Both are written at the end of the run (normal or error
 !> termination); the layout is in docs/output.md.
