@@ -584,3 +584,25 @@ def test_element_strains_with_strflg(tmp_path, run_deck):
     # (without *CONTROL_SHELL ISTUPD the shells keep their thickness, as LS-DYNA's do)
     expected_zz = np.log(thickness / 0.1)
     assert np.abs(shell_strain[:, :, :, 2] - expected_zz[:, :, None]).max() <= 2 * SINGLE * expected_xx.max()
+
+
+@pytest.mark.parametrize("value, message", [
+    (2, "field STRFLG: must be 0 or 1"),
+    (-1, "field STRFLG: must be 0 or 1"),
+    (11, "field STRFLG: ignored (its digits for the plastic and thermal strain tensors"),
+])
+def test_strain_flag_checked(tmp_path, run_deck, value, message):
+    """STRFLG: a last digit other than 0 or 1 is refused with its file:line; LS-DYNA's digits
+    for the plastic and thermal strain tensors get a warning and the strains are written."""
+    deck, _, _ = stretched_deck(tmp_path / "stretched.k")
+    deck.write_text(deck.read_text().replace("*DATABASE_EXTENT_BINARY\n" + fields(0, 0, 3, 1),
+                                             "*DATABASE_EXTENT_BINARY\n" + fields(0, 0, 3, value)))
+    line = deck.read_text().splitlines().index(fields(0, 0, 3, value)) + 1
+    run = run_deck(deck)
+    assert f"stretched.k:{line}: *DATABASE_EXTENT_BINARY: {message}" in run.stderr, run.stderr
+    if value == 11:
+        assert run.status == 0
+        plot = D3plot(str(run.results.parent / "d3plot"))
+        assert plot.arrays[ArrayType.element_solid_strain].shape[-1] == 6
+    else:
+        assert run.status == 2
