@@ -526,7 +526,9 @@ contains
     real(wp) :: axes(3, 3), displacement(6), velocity(6), acceleration(6)
     type(text_buffer_t) :: out
     integer :: k, j, i, row, rows
-    if (.not. series_of(histories, "rbdout", model%rigid_bodies%id, body_series, rows)) return
+    ! (the ids as an array expression: a component of an array of types is not contiguous)
+    if (.not. series_of(histories, "rbdout", [(model%rigid_bodies(k)%id, k = 1, size(model%rigid_bodies))], &
+                        body_series, rows)) return
     ! the column titles end one column after their numbers (the header is 88 characters, where
     ! readers that count characters from the body's line expect the coordinates)
     header = "          global"
