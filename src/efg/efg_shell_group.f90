@@ -27,10 +27,9 @@ module efg_shell_group
   use element_work, only: booked_energy, add_kinetic_energy
   use efg_shell_part, only: efg_shell_part_t
   use efg_shell_setup, only: build_efg_shell_part
-  use efg_shell_forces, only: efg_shell_cell_time_steps
   use efg_shell_forces, only: efg_shell_solver_t, set_up_efg_shell_solver, compute_efg_shell_forces, &
                               efg_shell_cell_results, efg_shell_nodal_masses, transform_shell_to_physical, &
-                              transpose_shell_to_generalized, raise_corner_plastic_strain
+                              transpose_shell_to_generalized, raise_corner_plastic_strain, efg_shell_cell_time_steps
   implicit none
   private
 

@@ -435,9 +435,8 @@ contains
     call exchange_restart(store, path//"/point_failed", block%point_failed, error)
   end subroutine exchange_shell_block
 
-  !> d3hsp's table: each shell's stable step at the current configuration at rest (no bulk
-  !> viscosity; the routine of mass scaling, the force call's shell step without its rates), in
-  !> block and lane order; eroded elements are left out.
+  !> d3hsp's table: each shell's stable step at the current configuration (the routine of mass
+  !> scaling and of the force call), in block and lane order; eroded elements are left out.
   subroutine list_time_steps(self, model, nodes, kind, element_ids, part_ids, steps)
     class(shell_group_t), intent(in) :: self
     type(model_t), intent(in) :: model
