@@ -415,12 +415,15 @@ RIGID_SIZE = 10.0                        # mm, one rigid cube
 RIGID_ORIGIN = (5.0, -2.0, 1.0)
 RIGID_VELOCITY = (1.0, 0.5, -0.3)        # mm/ms
 RIGID_FORCE = (0.02, -0.01, 0.0)         # kN on the whole body (an eighth of it at each node)
+NODAL_BODY_VELOCITY = (0.0, 0.0, 2.0)    # mm/ms, a free *CONSTRAINED_NODAL_RIGID_BODY
 
 
 def rigid_body_deck(path, binary=""):
-    """A rigid cube with an initial velocity pushed by a constant force: its centre moves as
-    x(t) = x0 + v0 t + F t^2 / (2 m)."""
+    """A rigid cube (part 4) with an initial velocity pushed by a constant force: its centre
+    moves as x(t) = x0 + v0 t + F t^2 / (2 m); and far from it the eight nodes of an elastic
+    cube as a free nodal rigid body 9 at a constant velocity."""
     nodes, elements = block_mesh((1, 1, 1), (RIGID_SIZE,) * 3, origin=RIGID_ORIGIN)
+    free_nodes, free_elements = block_mesh((1, 1, 1), (RIGID_SIZE,) * 3, origin=(50.0, 0.0, 0.0))
     loads = "\n".join("*LOAD_NODE_SET\n" + fields(1, dof + 1, 1, RIGID_FORCE[dof] / 8.0)
                       for dof in range(3) if RIGID_FORCE[dof] != 0.0)
     return write_deck(
@@ -432,26 +435,33 @@ def rigid_body_deck(path, binary=""):
         "*PART\nrigid cube\n" + fields(4, 1, 1),
         "*SECTION_SOLID\n" + fields(1, 1),
         "*MAT_RIGID\n" + fields(1, DENSITY, 200.0, 0.3) + "\n" + fields(0.0, 0.0, 0.0),
+        "*PART\nfree cube\n" + fields(5, 1, 2),
+        "*MAT_ELASTIC\n" + fields(2, DENSITY, 200.0, 0.3),
+        "*SET_NODE_LIST\n" + fields(3) + "\n" + fields(*range(9, 17)),
+        "*CONSTRAINED_NODAL_RIGID_BODY\n" + fields(9, 0, 3),
+        "*INITIAL_VELOCITY\n" + fields(3) + "\n" + fields(*NODAL_BODY_VELOCITY),
         "*DEFINE_CURVE\n" + fields(1) + "\n" + fields(0.0, 1.0, width=20) + "\n" + fields(10.0, 1.0, width=20),
         "*SET_NODE_LIST\n" + fields(1) + "\n" + fields(*range(1, 9)),
         loads,
         "*INITIAL_VELOCITY\n" + fields(1) + "\n" + fields(*RIGID_VELOCITY),
-        nodes_card(nodes),
-        solids_card(elements, part_id=4),
+        nodes_card(np.vstack([nodes, free_nodes])),
+        solids_card(elements, part_id=4) + "\n" +
+        solids_card(free_elements, part_id=5, first_id=2, first_node_id=9).split("\n", 1)[1],
     )
 
 
 def read_rbdout(path):
     """[(cycle, time, {body: {label: values}})]: per sample the "r i g i d   b o d y" line
-    (cycle in columns 50-57, time in 68-82), per body its id (columns 12-19 of " rigid body"),
+    (cycle in columns 50-57, time in 68-82), per body its id (columns 12-19 of " rigid body",
+    18-25 of " nodal rigid body"),
     then lines of a label in columns 1-15 and values of 12 columns each from column 16; the
     local-axes block's labels get the prefix "local ", the direction vectors' rows "row N"."""
     samples, body, local = [], None, False
     for line in path.read_text().splitlines():
         if line.startswith("  r i g i d   b o d y   m o t i o n   a t  cycle="):
             samples.append((int(line[49:57]), number(line[67:82]), {}))
-        elif line.startswith(" rigid body"):
-            body, local = int(line[11:19]), False
+        elif line.startswith(" rigid body") or line.startswith(" nodal rigid body"):
+            body, local = int(line[11:19]) if line.startswith(" rigid") else int(line[17:25]), False
             samples[-1][2][body] = {}
         elif line.startswith(" output in principal"):
             local = True
@@ -492,6 +502,7 @@ def test_rbdout_equals_results_and_the_analytical_motion(tmp_path, run_deck):
     with run.open() as results:
         series = results["history/rbdout/4"]
         columns = {name: series[name][...] for name in series}
+        free = {name: results["history/rbdout/9"][name][...] for name in ("displacement", "velocity")}
     assert len(samples) == len(columns["time"]) >= 11
     mass = DENSITY * RIGID_SIZE ** 3
     force, velocity = np.array(RIGID_FORCE), np.array(RIGID_VELOCITY)
@@ -523,10 +534,18 @@ def test_rbdout_equals_results_and_the_analytical_motion(tmp_path, run_deck):
         assert np.abs(columns["angular_velocity"][row]).max() < 1e-12
         assert np.allclose(axes, np.eye(3), atol=1e-12)
     assert columns["time"][-1] >= 1.0 and abs(columns["displacement"][-1, 0]) > 1.0
+    # the nodal rigid body: its own block, at its constant velocity
+    text = (run.results.parent / "rbdout").read_text()
+    assert text.count(" nodal rigid body       9") == text.count(" rigid body       4") == len(samples)
+    for row, (_, _, bodies) in enumerate(samples):
+        time = columns["time"][row]
+        assert np.allclose(free["displacement"][row], np.array(NODAL_BODY_VELOCITY) * time, rtol=1e-9, atol=1e-9)
+        assert all(close(p, e, 4) for p, e in zip(bodies[9]["displacements"][:3], free["displacement"][row]))
+        assert np.abs(bodies[9]["accelerations"]).max() < 1e-9
     # a reader that counts characters finds the same numbers
     blocks = read_rbdout_by_offsets(run.results.parent / "rbdout")
-    assert len(blocks) == len(samples)
-    for block, (_, _, bodies) in zip(blocks, samples):
+    assert len(blocks) == 2 * len(samples)
+    for block, (_, _, bodies) in zip(blocks[::2], samples):
         body = bodies[4]
         assert np.array_equal(block[:21], np.concatenate([body["coordinates"], body["displacements"],
                                                           body["velocities"], body["accelerations"]]))
@@ -534,11 +553,12 @@ def test_rbdout_equals_results_and_the_analytical_motion(tmp_path, run_deck):
     # binout's rbdout under LS-DYNA's names (lasso-python), the values of results.h5
     lasso_binout = pytest.importorskip("lasso.dyna.binout")
     binout = lasso_binout.Binout(str(run.results.parent / "binout"))
+    assert list(binout.read("rbdout", "ids")) == [4, 9]
     for name, column in (("global_", "coordinates"), ("global_a", "acceleration"), ("global_rd", "rotation"),
                          ("global_rv", "angular_velocity"), ("global_ra", "angular_acceleration")):
         for axis, letter in enumerate("xyz"):
-            np.testing.assert_array_equal(binout.read("rbdout", name + letter), columns[column][:, axis])
+            np.testing.assert_array_equal(binout.read("rbdout", name + letter)[:, 0], columns[column][:, axis])
     for i in range(3):
         for j in range(3):
-            np.testing.assert_array_equal(binout.read("rbdout", f"dircos_{i + 1}{j + 1}"),
+            np.testing.assert_array_equal(binout.read("rbdout", f"dircos_{i + 1}{j + 1}")[:, 0],
                                           columns["direction_cosines"][:, 3 * i + j])
