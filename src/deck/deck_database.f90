@@ -321,8 +321,9 @@ contains
     character(len=:), allocatable :: name
     name = keyword_label(deck, block)
     if (index(name, "DATABASE_EXTENT_BINARY") == 1) then
-      call note_not_acted_upon(deck, block, [character(len=1) :: ], "it chooses what "// &
-        "LS-DYNA's d3plot holds; crashfree's d3plot and results.h5 hold their fixed set of nodal and "// &
+      if (name == "DATABASE_EXTENT_BINARY") call read_strain_flag(deck, block, input, log, warnings)
+      call note_not_acted_upon(deck, block, [character(len=1) :: ], "apart from STRFLG, it chooses "// &
+        "what LS-DYNA's d3plot holds; crashfree's d3plot and results.h5 hold their fixed set of nodal and "// &
         "element results (shell layers: every integration point)", warnings)
     else if (index(name, "DATABASE_FORMAT") == 1) then
       call note_not_acted_upon(deck, block, [character(len=1) :: ], "results are written to "// &
@@ -336,4 +337,30 @@ contains
         "docs/keywords.md", warnings)
     end if
   end subroutine read_unused_output
+
+  !> *DATABASE_EXTENT_BINARY card 1, field 4: STRFLG (LS-DYNA's digits abc: c = 1 the strain
+  !> tensors of the solids and of the shells' inner and outer surfaces in the d3plot; b, a the
+  !> plastic and thermal strain tensors, which crashfree does not write).
+  subroutine read_strain_flag(deck, block, input, log, warnings)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: block
+    type(deck_input_t), intent(inout) :: input
+    type(problem_log_t), intent(inout) :: log
+    type(error_list_t), intent(inout) :: warnings
+    type(card_t) :: card
+    integer :: line, flag
+    line = 0
+    if (.not. next_line(deck, block, line, .false.)) return
+    call open_card(deck, block, line, standard_widths, card, log)
+    call get_integer(deck, card, 4, "STRFLG", flag, log)
+    if (card%failed) return
+    if (flag < 0 .or. mod(flag, 10) > 1) then
+      call card_problem(deck, log, card, "STRFLG", "must be 0 or 1 (1: strain tensors in the d3plot; "// &
+                        "LS-DYNA's digits abc with c = 0 or 1), found "//integer_text(flag))
+      return
+    end if
+    if (flag >= 10) call warn_if_set(deck, card, 4, "STRFLG", "its digits for the plastic and thermal "// &
+                                     "strain tensors: the d3plot holds the strain tensors only", warnings)
+    input%model%output%element_strains = mod(flag, 10) == 1
+  end subroutine read_strain_flag
 end module deck_database

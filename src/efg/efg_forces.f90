@@ -34,7 +34,8 @@ module efg_forces
   use model, only: model_t, material_t
   use efg_part, only: efg_part_t
   use material_dispatch, only: material_history_count, initialize_material_history, update_material_block, &
-                               rotate_material_history, material_plastic_strain
+                               rotate_material_history, material_plastic_strain, &
+                               material_wave_modulus
   use objective_rotation, only: incremental_rotation, rotate_symmetric_tensors
   use small_tensors, only: symmetric_matrix
   use hex8_geometry, only: deformation_increments
@@ -45,6 +46,7 @@ module efg_forces
 
   public :: efg_solver_t, set_up_efg_solver, compute_efg_forces, efg_point_results
   public :: transform_to_physical
+  public :: efg_point_time_steps
 
   !> Up to block_size consecutive integration points of one part and their state.
   type :: efg_block_t
@@ -555,4 +557,42 @@ contains
       end if
     end do
   end subroutine efg_point_results
+
+  !> Stable step (no TSSFAC) of every integration point of one part at the displacement given,
+  !> at rest (no bulk viscosity): the force call's rule (compute_efg_block, L = the point's
+  !> length times the smallest stretch of Fbar) with the material's wave modulus at rest, as
+  !> the finite elements' solid_block_time_steps (d3hsp's table of the smallest steps).
+  subroutine efg_point_time_steps(material, solver, displacement, point_time_step)
+    type(material_t), intent(in) :: material
+    type(efg_solver_t), intent(in) :: solver
+    real(wp), intent(in), contiguous :: displacement(:, :)
+    real(wp), intent(out) :: point_time_step(:)       !< (points)
+    real(wp) :: deformation(3, 3, block_size), rate(3, 3), jacobian, mid_jacobian, point_gradient(9)
+    real(wp) :: length(block_size), unit_area(block_size), wave_modulus(block_size), density(block_size)
+    real(wp) :: rest(block_size), lane_step(block_size)
+    integer :: b, i, g, nel
+    call material_wave_modulus(material, block_size, wave_modulus)
+    unit_area = 1.0_wp
+    density = solver%density
+    rest = 0.0_wp
+    deformation = 0.0_wp
+    do b = 1, size(solver%blocks)
+      nel = solver%blocks(b)%point_count
+      do i = 1, nel
+        g = solver%blocks(b)%first_point + i - 1
+        ! (dt = 0: the displacement stands for the velocity too, whose rate is not used)
+        call point_kinematics(solver%geometry, g, displacement, displacement, 0.0_wp, deformation(:, :, i), rate, &
+                              jacobian, mid_jacobian, point_gradient)
+      end do
+      call smallest_stretches(nel, deformation, length)
+      do i = 1, nel
+        length(i) = solver%geometry%point_length(solver%blocks(b)%first_point + i - 1)*length(i)
+      end do
+      call solid_element_time_steps(nel, solver%bulk_quadratic, solver%bulk_linear, length, unit_area, wave_modulus, &
+                                    density, rest, lane_step)
+      do i = 1, nel
+        point_time_step(solver%blocks(b)%first_point + i - 1) = lane_step(i)
+      end do
+    end do
+  end subroutine efg_point_time_steps
 end module efg_forces

@@ -17,7 +17,7 @@ module efg_group
   use efg_part, only: efg_part_t
   use efg_setup, only: build_efg_part
   use efg_forces, only: efg_solver_t, set_up_efg_solver, compute_efg_forces, efg_point_results, &
-                        transform_to_physical
+                        transform_to_physical, efg_point_time_steps
   implicit none
   private
 
@@ -42,6 +42,7 @@ module efg_group
     procedure :: to_physical
     procedure :: forces_to_generalized
     procedure :: add_particle_rows
+    procedure :: list_time_steps
   end type efg_group_t
 
 contains
@@ -364,4 +365,48 @@ contains
       call exchange_restart(store, block_path//"/previous_time_step", solver%blocks(b)%previous_time_step, error)
     end do
   end subroutine exchange_meshfree
+
+  !> d3hsp's table: per background cell (a solid of the deck, LS-DYNA's "solid") the smallest
+  !> step of its integration points at the current displacement, at rest (efg_point_time_steps),
+  !> part after part, in the order of the points.
+  subroutine list_time_steps(self, model, nodes, kind, element_ids, part_ids, steps)
+    class(efg_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    type(nodal_state_t), intent(in) :: nodes
+    character(len=:), allocatable, intent(out) :: kind
+    integer, allocatable, intent(out) :: element_ids(:), part_ids(:)
+    real(wp), allocatable, intent(out) :: steps(:)
+    real(wp), allocatable :: point_step(:)
+    integer :: k, g, count, cell
+    kind = "solid"
+    count = 0
+    do k = 1, size(self%parts)
+      count = count + size(self%parts(k)%geometry%point_cell)
+    end do
+    allocate (element_ids(count), part_ids(count), steps(count))
+    count = 0
+    do k = 1, size(self%parts)
+      associate (efg => self%parts(k))
+        allocate (point_step(size(efg%geometry%point_cell)))
+        call efg_point_time_steps(model%materials(efg%geometry%material), efg, nodes%displacement, point_step)
+        cell = 0
+        do g = 1, size(point_step)
+          ! a cell's points are consecutive
+          if (efg%geometry%point_cell(g) /= cell) then
+            cell = efg%geometry%point_cell(g)
+            count = count + 1
+            element_ids(count) = model%solid_ids(cell)
+            part_ids(count) = model%parts(model%solid_part(cell))%id
+            steps(count) = point_step(g)
+          else
+            steps(count) = min(steps(count), point_step(g))
+          end if
+        end do
+        deallocate (point_step)
+      end associate
+    end do
+    element_ids = element_ids(1:count)
+    part_ids = part_ids(1:count)
+    steps = steps(1:count)
+  end subroutine list_time_steps
 end module efg_group

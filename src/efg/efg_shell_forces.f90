@@ -64,6 +64,7 @@ module efg_shell_forces
   public :: efg_shell_block_t, efg_shell_solver_t, set_up_efg_shell_solver, compute_efg_shell_forces
   public :: efg_shell_cell_results, efg_shell_nodal_masses, transform_shell_to_physical, transpose_shell_to_generalized
   public :: efg_shell_rotary_factor, raise_corner_plastic_strain
+  public :: efg_shell_cell_time_steps
 
   !> Transverse shear stations of a cell: corners 1-4, midpoints 5-8 of the edges 1-2, 2-3, 3-4, 4-1.
   integer, parameter :: stations_per_cell = 8
@@ -457,7 +458,7 @@ contains
     real(wp) :: area_scale
     real(wp) :: position_sum(3, 2), inverse(2, 2), rate(2, 2), bend(2, 2), determinant
     real(wp) :: shear_modulus, height, gamma(2), transverse(2), resultant(6), weight, arm
-    real(wp) :: area, longest, wave_speed, cell_step
+    real(wp) :: area, wave_speed, cell_step
     integer :: nel, i, g, cell, lane, point, corner, k, first_point, station
     logical :: triangle
 
@@ -465,9 +466,7 @@ contains
     failed_cell = 0
     shear_modulus = 0.0_wp
     if (material%law /= law_null) shear_modulus = material%youngs_modulus/(2.0_wp*(1.0_wp + material%poissons_ratio))
-    wave_speed = 0.0_wp
-    if (material%youngs_modulus > 0.0_wp .and. density > 0.0_wp) &
-      wave_speed = sqrt(material%youngs_modulus/(density*(1.0_wp - material%poissons_ratio**2)))
+    wave_speed = shell_wave_speed(material, density)
     critical_time_step = huge(1.0_wp)
     critical_cell = 0
 
@@ -484,21 +483,11 @@ contains
                                dot_product(cell_frame(:, 1, cell), mid_frame(:, 1, lane)))
       second_turn(lane) = atan2(dot_product(mid_frame(:, 1, lane), end_frame(:, 2, lane)), &
                                 dot_product(mid_frame(:, 1, lane), end_frame(:, 1, lane)))
-      ! LS-DYNA's characteristic length of a shell, (1 + beta) A / longest side (beta = 1 on a
-      ! triangle), on the current corners
-      area = 0.5_wp*norm2(cross_product(corners(:, 3) - corners(:, 1), corners(:, 4) - corners(:, 2)))
-      longest = 0.0_wp
-      do corner = 1, 4
-        longest = max(longest, norm2(corners(:, modulo(corner, 4) + 1) - corners(:, corner)))
-      end do
+      call cell_stable_step(corners, cell_nodes(3, cell) == cell_nodes(4, cell), wave_speed, area, cell_step)
       cell_area(cell) = area
-      if (wave_speed > 0.0_wp) then
-        cell_step = merge(2.0_wp, 1.0_wp, cell_nodes(3, cell) == cell_nodes(4, cell))*area/max(longest, tiny(1.0_wp)) &
-                    /wave_speed
-        if (cell_step < critical_time_step) then
-          critical_time_step = cell_step
-          critical_cell = cell
-        end if
+      if (cell_step < critical_time_step) then
+        critical_time_step = cell_step
+        critical_cell = cell
       end if
       ! (a NaN area gives a NaN step: the group reports it as not finite)
       if (area /= area) then
@@ -1108,4 +1097,50 @@ contains
     g = matmul(frame, matmul(s, transpose(frame)))
     stress = [g(1, 1), g(2, 2), g(3, 3), g(1, 2), g(2, 3), g(3, 1)]
   end function global_stress
+
+  !> The plane-stress wave speed sqrt(E / (rho (1 - nu^2))) of a part's cells (0: a material
+  !> without Young's modulus sets no step).
+  pure real(wp) function shell_wave_speed(material, density) result(wave_speed)
+    type(material_t), intent(in) :: material
+    real(wp), intent(in) :: density
+    wave_speed = 0.0_wp
+    if (material%youngs_modulus > 0.0_wp .and. density > 0.0_wp) &
+      wave_speed = sqrt(material%youngs_modulus/(density*(1.0_wp - material%poissons_ratio**2)))
+  end function shell_wave_speed
+
+  !> A cell's area and stable step on its corners: LS-DYNA's characteristic length of a shell,
+  !> (1 + beta) A / longest side (beta = 1 on a triangle), over the wave speed (huge without one).
+  pure subroutine cell_stable_step(corners, triangle, wave_speed, area, step)
+    real(wp), intent(in) :: corners(3, 4), wave_speed
+    logical, intent(in) :: triangle
+    real(wp), intent(out) :: area, step
+    real(wp) :: longest
+    integer :: corner
+    area = 0.5_wp*norm2(cross_product(corners(:, 3) - corners(:, 1), corners(:, 4) - corners(:, 2)))
+    longest = 0.0_wp
+    do corner = 1, 4
+      longest = max(longest, norm2(corners(:, modulo(corner, 4) + 1) - corners(:, corner)))
+    end do
+    step = huge(1.0_wp)
+    if (wave_speed > 0.0_wp) step = merge(2.0_wp, 1.0_wp, triangle)*area/max(longest, tiny(1.0_wp))/wave_speed
+  end subroutine cell_stable_step
+
+  !> Stable step (no TSSFAC) of every cell of one part on the current coordinates: the force
+  !> call's rule (compute_shell_block), for d3hsp's table of the smallest steps.
+  subroutine efg_shell_cell_time_steps(material, solver, coordinates, cell_time_step)
+    type(material_t), intent(in) :: material
+    type(efg_shell_solver_t), intent(in) :: solver
+    real(wp), intent(in), contiguous :: coordinates(:, :)
+    real(wp), intent(out) :: cell_time_step(:)        !< (cells)
+    real(wp) :: corners(3, 4), area, wave_speed
+    integer :: cell, corner
+    wave_speed = shell_wave_speed(material, solver%density)
+    do cell = 1, size(solver%cell_nodes, 2)
+      do corner = 1, 4
+        corners(:, corner) = coordinates(:, solver%cell_nodes(corner, cell))
+      end do
+      call cell_stable_step(corners, solver%cell_nodes(3, cell) == solver%cell_nodes(4, cell), wave_speed, area, &
+                            cell_time_step(cell))
+    end do
+  end subroutine efg_shell_cell_time_steps
 end module efg_shell_forces

@@ -29,7 +29,7 @@ module efg_shell_group
   use efg_shell_setup, only: build_efg_shell_part
   use efg_shell_forces, only: efg_shell_solver_t, set_up_efg_shell_solver, compute_efg_shell_forces, &
                               efg_shell_cell_results, efg_shell_nodal_masses, transform_shell_to_physical, &
-                              transpose_shell_to_generalized, raise_corner_plastic_strain
+                              transpose_shell_to_generalized, raise_corner_plastic_strain, efg_shell_cell_time_steps
   implicit none
   private
 
@@ -62,6 +62,7 @@ module efg_shell_group
     procedure :: add_particle_rows
     procedure :: thinnest
     procedure :: raise_nodal_plastic_strain
+    procedure :: list_time_steps
   end type efg_shell_group_t
 
 contains
@@ -473,4 +474,34 @@ contains
       call exchange_restart(store, block_path//"/previous_time_step", solver%blocks(b)%previous_time_step, error)
     end do
   end subroutine exchange_part
+
+  !> d3hsp's table: each cell's stable step on the current coordinates (a shell of the deck,
+  !> LS-DYNA's "shell"; efg_shell_cell_time_steps), part after part, in cell order.
+  subroutine list_time_steps(self, model, nodes, kind, element_ids, part_ids, steps)
+    class(efg_shell_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    type(nodal_state_t), intent(in) :: nodes
+    character(len=:), allocatable, intent(out) :: kind
+    integer, allocatable, intent(out) :: element_ids(:), part_ids(:)
+    real(wp), allocatable, intent(out) :: steps(:)
+    integer :: k, c, count
+    kind = "shell"
+    count = 0
+    do k = 1, size(self%parts)
+      count = count + size(self%parts(k)%geometry%cells)
+    end do
+    allocate (element_ids(count), part_ids(count), steps(count))
+    count = 0
+    do k = 1, size(self%parts)
+      associate (efg => self%parts(k))
+        call efg_shell_cell_time_steps(model%materials(efg%geometry%material), efg, nodes%coordinates, &
+                                       steps(count + 1:count + size(efg%geometry%cells)))
+        do c = 1, size(efg%geometry%cells)
+          element_ids(count + c) = model%shell_ids(efg%geometry%cells(c))
+          part_ids(count + c) = model%parts(model%shell_part(efg%geometry%cells(c)))%id
+        end do
+        count = count + size(efg%geometry%cells)
+      end associate
+    end do
+  end subroutine list_time_steps
 end module efg_shell_group

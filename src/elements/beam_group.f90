@@ -48,6 +48,7 @@ module beam_group
     procedure :: most_scaled
     procedure :: newly_eroded_elements
     procedure :: add_eroded_energies
+    procedure :: list_time_steps
   end type beam_group_t
 
 contains
@@ -366,4 +367,36 @@ contains
     call exchange_restart(store, path//"/stress", block%stress, error)
     call exchange_restart(store, path//"/plastic_strain", block%plastic_strain, error)
   end subroutine exchange_beam_block
+
+  !> d3hsp's table: each beam's stable step at the current configuration (the routine of mass
+  !> scaling and of the force call), in block and lane order; failed welds keep theirs, as
+  !> they keep setting the step (beam_block).
+  subroutine list_time_steps(self, model, nodes, kind, element_ids, part_ids, steps)
+    class(beam_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    type(nodal_state_t), intent(in) :: nodes
+    character(len=:), allocatable, intent(out) :: kind
+    integer, allocatable, intent(out) :: element_ids(:), part_ids(:)
+    real(wp), allocatable, intent(out) :: steps(:)
+    real(wp) :: lane_step(block_size)
+    integer :: b, lane, count
+    kind = "beam"
+    count = 0
+    do b = 1, size(self%blocks)
+      count = count + self%blocks(b)%element_count
+    end do
+    allocate (element_ids(count), part_ids(count), steps(count))
+    count = 0
+    do b = 1, size(self%blocks)
+      associate (block => self%blocks(b))
+        call beam_block_time_steps(block, model%materials(block%material), nodes%coordinates, lane_step)
+        do lane = 1, block%element_count
+          count = count + 1
+          element_ids(count) = model%beam_ids(block%elements(lane))
+          part_ids(count) = model%parts(model%beam_part(block%elements(lane)))%id
+          steps(count) = lane_step(lane)
+        end do
+      end associate
+    end do
+  end subroutine list_time_steps
 end module beam_group

@@ -139,6 +139,10 @@ module element_group
     !> Optional (shells): raise `strain(node)`, at the nodes `wanted` flags, to the largest
     !> effective plastic strain of its elements on the node (spot welds failing by EP).
     procedure :: raise_nodal_plastic_strain
+    !> Optional (d3hsp's table of the smallest steps): every element's stable step (no TSSFAC)
+    !> at the current configuration, with its deck id and part id, from the routines that give
+    !> the engine its step (default: none).
+    procedure :: list_time_steps
   end type element_group_t
 
   !> An array element holding one group of any kind.
@@ -319,6 +323,19 @@ contains
     logical, intent(in) :: wanted(:)
     real(wp), intent(inout) :: strain(:)
   end subroutine raise_nodal_plastic_strain
+
+  !> Lists nothing: `kind` "" and empty lists (kinds without a per-element step).
+  subroutine list_time_steps(self, model, nodes, kind, element_ids, part_ids, steps)
+    class(element_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    type(nodal_state_t), intent(in) :: nodes
+    !> LS-DYNA's word for the element type in d3hsp: "solid", "shell", "beam"
+    character(len=:), allocatable, intent(out) :: kind
+    integer, allocatable, intent(out) :: element_ids(:), part_ids(:)   !< deck ids
+    real(wp), allocatable, intent(out) :: steps(:)
+    kind = ""
+    allocate (element_ids(0), part_ids(0), steps(0))
+  end subroutine list_time_steps
 
   !> Layers written per shell to the d3plot (its MAXINT): LS-DYNA's default 3 (mid, inner and
   !> outer surface) when no shell section has more than 3 points (NIP), else the largest NIP

@@ -49,6 +49,7 @@ module shell_group
     procedure :: newly_eroded_elements
     procedure :: mark_eroded
     procedure :: add_eroded_energies
+    procedure :: list_time_steps
     procedure :: raise_nodal_plastic_strain
   end type shell_group_t
 
@@ -433,4 +434,39 @@ contains
     call exchange_restart(store, path//"/newly_eroded", block%newly_eroded, error)
     call exchange_restart(store, path//"/point_failed", block%point_failed, error)
   end subroutine exchange_shell_block
+
+  !> d3hsp's table: each shell's stable step at the current configuration (the routine of mass
+  !> scaling and of the force call), in block and lane order; eroded elements are left out.
+  subroutine list_time_steps(self, model, nodes, kind, element_ids, part_ids, steps)
+    class(shell_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    type(nodal_state_t), intent(in) :: nodes
+    character(len=:), allocatable, intent(out) :: kind
+    integer, allocatable, intent(out) :: element_ids(:), part_ids(:)
+    real(wp), allocatable, intent(out) :: steps(:)
+    real(wp) :: lane_step(block_size)
+    integer :: b, lane, count
+    kind = "shell"
+    count = 0
+    do b = 1, size(self%blocks)
+      count = count + self%blocks(b)%element_count
+    end do
+    allocate (element_ids(count), part_ids(count), steps(count))
+    count = 0
+    do b = 1, size(self%blocks)
+      associate (block => self%blocks(b))
+        call shell_block_time_steps(block, model%materials(block%material), nodes%coordinates, lane_step)
+        do lane = 1, block%element_count
+          if (block%eroded(lane)) cycle
+          count = count + 1
+          element_ids(count) = model%shell_ids(block%elements(lane))
+          part_ids(count) = model%parts(model%shell_part(block%elements(lane)))%id
+          steps(count) = lane_step(lane)
+        end do
+      end associate
+    end do
+    element_ids = element_ids(1:count)
+    part_ids = part_ids(1:count)
+    steps = steps(1:count)
+  end subroutine list_time_steps
 end module shell_group

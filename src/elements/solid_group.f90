@@ -46,6 +46,7 @@ module solid_group
     procedure :: newly_eroded_elements
     procedure :: mark_eroded
     procedure :: add_eroded_energies
+    procedure :: list_time_steps
   end type solid_group_t
 
 contains
@@ -387,4 +388,40 @@ contains
     call exchange_restart(store, path//"/eroded", block%eroded, error)
     call exchange_restart(store, path//"/newly_eroded", block%newly_eroded, error)
   end subroutine exchange_solid_block
+
+  !> d3hsp's table: each solid's stable step at the current configuration at rest (no bulk
+  !> viscosity; the routine of mass scaling, the force call's solid step without its rates), in
+  !> block and lane order; eroded elements are left out.
+  subroutine list_time_steps(self, model, nodes, kind, element_ids, part_ids, steps)
+    class(solid_group_t), intent(in) :: self
+    type(model_t), intent(in) :: model
+    type(nodal_state_t), intent(in) :: nodes
+    character(len=:), allocatable, intent(out) :: kind
+    integer, allocatable, intent(out) :: element_ids(:), part_ids(:)
+    real(wp), allocatable, intent(out) :: steps(:)
+    real(wp) :: lane_step(block_size)
+    integer :: b, lane, count
+    kind = "solid"
+    count = 0
+    do b = 1, size(self%blocks)
+      count = count + self%blocks(b)%element_count
+    end do
+    allocate (element_ids(count), part_ids(count), steps(count))
+    count = 0
+    do b = 1, size(self%blocks)
+      associate (block => self%blocks(b))
+        call solid_block_time_steps(block, model%materials(block%material), nodes%coordinates, lane_step)
+        do lane = 1, block%element_count
+          if (block%eroded(lane)) cycle
+          count = count + 1
+          element_ids(count) = model%solid_ids(block%elements(lane))
+          part_ids(count) = model%parts(model%solid_part(block%elements(lane)))%id
+          steps(count) = lane_step(lane)
+        end do
+      end associate
+    end do
+    element_ids = element_ids(1:count)
+    part_ids = part_ids(1:count)
+    steps = steps(1:count)
+  end subroutine list_time_steps
 end module solid_group

@@ -403,6 +403,7 @@ module model
     integer :: running_restart_cycles = 0    !< *DATABASE_BINARY_RUNRSF CYCL (0: none)
     integer :: running_restart_files = 1     !< *DATABASE_BINARY_RUNRSF NR, written in turn
     integer, allocatable :: history_nodes(:) !< node indices for nodout
+    logical :: element_strains = .false.     !< *DATABASE_EXTENT_BINARY STRFLG = 1: strain tensors in the d3plot
   end type output_control_t
 
   !> The whole model.

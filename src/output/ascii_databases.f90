@@ -1,4 +1,4 @@
-!> LS-DYNA's ASCII history files (glstat, matsum, nodout, rwforc, rcforc) written beside
+!> LS-DYNA's ASCII history files (glstat, matsum, nodout, rwforc, rcforc, rbdout) written beside
 !> results.h5 from the run's histories, in LS-DYNA's layout (labels, column positions and
 !> number formats as LS-DYNA and its binout-to-ASCII translator write them), so that the
 !> parsers crash engineers already use read them. A file is written when the deck has its
@@ -51,6 +51,12 @@ contains
     if (wanted(model%output%rwforc_interval, model%output%rwforc_binary) .and. size(model%walls) > 0) then
       call write_rwforc(model, histories, lsdyna_file_path(directory, job_id, "rwforc"), error)
       if (allocated(error)) return
+    end if
+    if (allocated(model%rigid_bodies)) then
+      if (wanted(model%output%rbdout_interval, model%output%rbdout_binary) .and. size(model%rigid_bodies) > 0) then
+        call write_rbdout(model, histories, lsdyna_file_path(directory, job_id, "rbdout"), error)
+        if (allocated(error)) return
+      end if
     end if
     if (allocated(model%contacts)) then
       if (wanted(model%output%rcforc_interval, model%output%rcforc_binary) .and. size(model%contacts) > 0) then
@@ -485,4 +491,104 @@ contains
     end do
     call finish_database(out, path, error)
   end subroutine write_rcforc
+
+  !> One rbdout line: a label right-aligned in 15 columns, then the values, %12.4E each.
+  subroutine rbdout_line(out, label, values)
+    type(text_buffer_t), intent(inout) :: out
+    character(len=*), intent(in) :: label
+    real(wp), intent(in) :: values(:)
+    character(len=15) :: padded
+    character(len=:), allocatable :: line
+    integer :: k
+    padded = label
+    line = adjustr(padded)
+    do k = 1, size(values)
+      line = line//c_exponential(values(k), 12, 4)
+    end do
+    call add_line(out, line)
+  end subroutine rbdout_line
+
+  !> rbdout: per sample the " r i g i d   b o d y   m o t i o n" line with the cycle and time,
+  !> then per rigid body (LS-DYNA's block): the centre of mass's coordinates, displacements,
+  !> velocities and accelerations with the rotations, angular velocities and accelerations
+  !> (global axes), the body's axes in global axes (rows a, b, c), and the same motion in the
+  !> body's axes.
+  subroutine write_rbdout(model, histories, path, error)
+    type(model_t), intent(in) :: model
+    type(history_set_t), intent(in) :: histories
+    character(len=*), intent(in) :: path
+    type(error_t), allocatable, intent(out) :: error
+    integer, allocatable :: body_series(:)
+    character(len=8) :: id_text, cycle_text
+    character(len=12), parameter :: titles(6) = [character(len=12) :: "x", "y", "z", "x-rot", "y-rot", "z-rot"]
+    character(len=12), parameter :: local_titles(6) = [character(len=12) :: "a", "b", "c", "a-rot", "b-rot", "c-rot"]
+    character(len=:), allocatable :: header, local_header
+    real(wp) :: axes(3, 3), displacement(6), velocity(6), acceleration(6)
+    type(text_buffer_t) :: out
+    integer :: k, j, i, row, rows
+    ! (the ids as an array expression: a component of an array of types is not contiguous)
+    if (.not. series_of(histories, "rbdout", [(model%rigid_bodies(k)%id, k = 1, size(model%rigid_bodies))], &
+                        body_series, rows)) return
+    ! the column titles end one column after their numbers (the header is 88 characters, where
+    ! readers that count characters from the body's line expect the coordinates)
+    header = "          global"
+    local_header = "                "
+    do j = 1, 6
+      header = header//adjustr(titles(j))
+      local_header = local_header//adjustr(local_titles(j))
+    end do
+    call start_database(model, out)
+    do row = 1, rows
+      associate (first => histories%series(body_series(1)))
+        write (cycle_text, '(i8)') nint(value_of(first, "cycle", row))
+        call add_line(out, "")
+        call add_line(out, "  r i g i d   b o d y   m o t i o n   a t  cycle="//cycle_text//"     time="// &
+          c_exponential(first%rows(1, row), 15, 7))
+      end associate
+      do k = 1, size(model%rigid_bodies)
+        associate (series => histories%series(body_series(k)))
+          write (id_text, '(i8)') model%rigid_bodies(k)%id
+          call add_line(out, "")
+          if (model%rigid_bodies(k)%part == 0) then
+            call add_line(out, " nodal rigid body"//id_text)
+          else
+            call add_line(out, " rigid body"//id_text)
+          end if
+          call add_line(out, header)
+          do j = 1, 3
+            displacement(j) = value_of(series, "displacement", row, j)
+            displacement(3 + j) = value_of(series, "rotation", row, j)
+            velocity(j) = value_of(series, "velocity", row, j)
+            velocity(3 + j) = value_of(series, "angular_velocity", row, j)
+            acceleration(j) = value_of(series, "acceleration", row, j)
+            acceleration(3 + j) = value_of(series, "angular_acceleration", row, j)
+          end do
+          ! axes(:, a): body axis a in global axes
+          do j = 1, 3
+            do i = 1, 3
+              axes(i, j) = value_of(series, "direction_cosines", row, 3*(j - 1) + i)
+            end do
+          end do
+          call rbdout_line(out, "coordinates:", [(value_of(series, "coordinates", row, j), j = 1, 3)])
+          call rbdout_line(out, "displacements:", displacement)
+          call rbdout_line(out, "velocities:", velocity)
+          call rbdout_line(out, "accelerations:", acceleration)
+          call add_line(out, " principal or user defined local coordinate direction vectors")
+          call add_line(out, local_header(1:52))
+          do j = 1, 3
+            call rbdout_line(out, "row "//achar(iachar("0") + j), axes(:, j))
+          end do
+          call add_line(out, " output in principal or user defined local coordinate directions")
+          call add_line(out, local_header)
+          call rbdout_line(out, "displacements:", [matmul(transpose(axes), displacement(1:3)), &
+                                                   matmul(transpose(axes), displacement(4:6))])
+          call rbdout_line(out, "velocities:", [matmul(transpose(axes), velocity(1:3)), &
+                                                matmul(transpose(axes), velocity(4:6))])
+          call rbdout_line(out, "accelerations:", [matmul(transpose(axes), acceleration(1:3)), &
+                                                   matmul(transpose(axes), acceleration(4:6))])
+        end associate
+      end do
+    end do
+    call finish_database(out, path, error)
+  end subroutine write_rbdout
 end module ascii_databases

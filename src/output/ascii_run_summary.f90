@@ -1,6 +1,7 @@
 !> LS-DYNA's run files beside results.h5: `d3hsp` (the model summary: controls, parts with
 !> their material, section, element counts and mass, the total mass, the time step
-!> information with the smallest stable steps by element kind, and the termination line) and
+!> information with LS-DYNA's 100 smallest element steps at the start and the smallest step
+!> of each element kind, the deck as read and the termination line) and
 !> `messag` (every warning and error the job printed, with file:line as the terminal showed
 !> them, and the termination line). Both are written at the end of the run (normal or error
 !> termination); the layout is in docs/output.md.
@@ -19,7 +20,10 @@ module ascii_run_summary
   implicit none
   private
 
-  public :: write_d3hsp, write_messag, termination_line
+  public :: write_d3hsp, write_messag, termination_line, initial_time_step_tables
+
+  !> Rows of d3hsp's table of the smallest element steps (LS-DYNA's "100 smallest timesteps").
+  integer, parameter :: smallest_rows = 100
 
 contains
 
@@ -228,9 +232,9 @@ contains
                       max(state%physical_mass, tiny(1.0_wp))))
   end subroutine write_parts
 
-  !> The first time step (glstat's first row), and the smallest stable step of each element
-  !> kind with its element at the start (cycle 0) and at the last cycle (LS-DYNA's table of the
-  !> smallest steps, here one row per element kind and the rigid bodies).
+  !> The first time step (glstat's first row), the tables of the start (initial_time_step_tables,
+  !> recorded at cycle 0) and the smallest stable step of each element kind with its element
+  !> at the last cycle.
   subroutine write_time_steps(out, model, state, histories, initial_time_steps)
     type(text_buffer_t), intent(inout) :: out
     type(model_t), intent(in) :: model
@@ -255,9 +259,6 @@ contains
     call control_line(out, "last stable time step (before TSSFAC)", real_field(state%stable_time_step))
     call add_line(out, "")
     if (len(initial_time_steps) > 0) then
-      call add_line(out, " s m a l l e s t   t i m e   s t e p s   (by element kind, cycle 0)")
-      call add_line(out, " ----------------------------------------------------------------------")
-      call add_line(out, "      stable step  element")
       call add_line(out, initial_time_steps(1:len(initial_time_steps) - 1))
       call add_line(out, "")
     end if
@@ -277,4 +278,72 @@ contains
       call add_line(out, trim(line))
     end if
   end subroutine write_time_steps
+
+  !> d3hsp's time step tables at the start (cycle 0), as text (lines ending in a new line):
+  !> LS-DYNA's "100 smallest timesteps" (element type, deck id, part id, stable step without
+  !> TSSFAC, smallest first; every group's list_time_steps, at the current configuration), then
+  !> the step of each element kind as the force call set it, with its element, and the rigid
+  !> bodies'.
+  function initial_time_step_tables(model, state) result(text)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(in) :: state
+    character(len=:), allocatable :: text
+    character(len=8) :: row_kind(smallest_rows)
+    integer :: row_id(smallest_rows), row_part(smallest_rows)
+    real(wp) :: row_step(smallest_rows)
+    character(len=:), allocatable :: kind
+    integer, allocatable :: element_ids(:), part_ids(:)
+    real(wp), allocatable :: steps(:)
+    character(len=80) :: line
+    integer :: k, j, rows, place
+    character(len=1), parameter :: eol = new_line("a")
+    ! the smallest first; among equal steps the earlier group and element first (an element
+    ! goes in after the rows with its step)
+    rows = 0
+    do k = 1, size(state%groups)
+      call state%groups(k)%group%list_time_steps(model, state%nodes, kind, element_ids, part_ids, steps)
+      do j = 1, size(steps)
+        if (.not. steps(j) < huge(1.0_wp)) cycle
+        if (rows == smallest_rows) then
+          if (.not. steps(j) < row_step(rows)) cycle
+        else
+          rows = rows + 1
+        end if
+        place = rows
+        do while (place > 1)
+          if (.not. steps(j) < row_step(place - 1)) exit
+          row_kind(place) = row_kind(place - 1)
+          row_id(place) = row_id(place - 1)
+          row_part(place) = row_part(place - 1)
+          row_step(place) = row_step(place - 1)
+          place = place - 1
+        end do
+        row_kind(place) = kind
+        row_id(place) = element_ids(j)
+        row_part(place) = part_ids(j)
+        row_step(place) = steps(j)
+      end do
+    end do
+    text = ""
+    if (rows > 0) then
+      text = text//"     100 smallest timesteps"//eol//"     ----------------------"//eol// &
+             "   element       number        part      timestep"//eol
+      do j = 1, rows
+        write (line, '(a10,i13,i12,a)') adjustr(row_kind(j)), row_id(j), row_part(j), c_exponential(row_step(j), 15, 7)
+        text = text//trim(line)//eol
+      end do
+      text = text//eol
+    end if
+    text = text//" s m a l l e s t   t i m e   s t e p s   (by element kind, cycle 0)"//eol// &
+           " ----------------------------------------------------------------------"//eol// &
+           "      stable step  element"//eol
+    do k = 1, size(state%groups)
+      associate (group => state%groups(k)%group)
+        if (group%critical_element <= 0) cycle
+        text = text//c_exponential(group%stable_time_step, 17, 5)//"  "//group%describe(model, group%critical_element)//eol
+      end associate
+    end do
+    if (size(state%rigid) > 0 .and. state%rigid_time_step < huge(1.0_wp)) &
+      text = text//c_exponential(state%rigid_time_step, 17, 5)//"  rigid bodies"//eol
+  end function initial_time_step_tables
 end module ascii_run_summary

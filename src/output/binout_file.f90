@@ -109,7 +109,32 @@ module binout_file
     binout_variable_t("rbdout", "global_dz", "displacement", 3, 1.0_wp, derived_none), &
     binout_variable_t("rbdout", "global_vx", "velocity", 1, 1.0_wp, derived_none), &
     binout_variable_t("rbdout", "global_vy", "velocity", 2, 1.0_wp, derived_none), &
-    binout_variable_t("rbdout", "global_vz", "velocity", 3, 1.0_wp, derived_none)]
+    binout_variable_t("rbdout", "global_vz", "velocity", 3, 1.0_wp, derived_none), &
+    ! (LS-DYNA's dircos_ij: component j of body axis i, the rows of rbdout's direction vectors)
+    binout_variable_t("rbdout", "global_x", "coordinates", 1, 1.0_wp, derived_none), &
+    binout_variable_t("rbdout", "global_y", "coordinates", 2, 1.0_wp, derived_none), &
+    binout_variable_t("rbdout", "global_z", "coordinates", 3, 1.0_wp, derived_none), &
+    binout_variable_t("rbdout", "global_ax", "acceleration", 1, 1.0_wp, derived_none), &
+    binout_variable_t("rbdout", "global_ay", "acceleration", 2, 1.0_wp, derived_none), &
+    binout_variable_t("rbdout", "global_az", "acceleration", 3, 1.0_wp, derived_none), &
+    binout_variable_t("rbdout", "global_rdx", "rotation", 1, 1.0_wp, derived_none), &
+    binout_variable_t("rbdout", "global_rdy", "rotation", 2, 1.0_wp, derived_none), &
+    binout_variable_t("rbdout", "global_rdz", "rotation", 3, 1.0_wp, derived_none), &
+    binout_variable_t("rbdout", "global_rvx", "angular_velocity", 1, 1.0_wp, derived_none), &
+    binout_variable_t("rbdout", "global_rvy", "angular_velocity", 2, 1.0_wp, derived_none), &
+    binout_variable_t("rbdout", "global_rvz", "angular_velocity", 3, 1.0_wp, derived_none), &
+    binout_variable_t("rbdout", "global_rax", "angular_acceleration", 1, 1.0_wp, derived_none), &
+    binout_variable_t("rbdout", "global_ray", "angular_acceleration", 2, 1.0_wp, derived_none), &
+    binout_variable_t("rbdout", "global_raz", "angular_acceleration", 3, 1.0_wp, derived_none), &
+    binout_variable_t("rbdout", "dircos_11", "direction_cosines", 1, 1.0_wp, derived_none), &
+    binout_variable_t("rbdout", "dircos_12", "direction_cosines", 2, 1.0_wp, derived_none), &
+    binout_variable_t("rbdout", "dircos_13", "direction_cosines", 3, 1.0_wp, derived_none), &
+    binout_variable_t("rbdout", "dircos_21", "direction_cosines", 4, 1.0_wp, derived_none), &
+    binout_variable_t("rbdout", "dircos_22", "direction_cosines", 5, 1.0_wp, derived_none), &
+    binout_variable_t("rbdout", "dircos_23", "direction_cosines", 6, 1.0_wp, derived_none), &
+    binout_variable_t("rbdout", "dircos_31", "direction_cosines", 7, 1.0_wp, derived_none), &
+    binout_variable_t("rbdout", "dircos_32", "direction_cosines", 8, 1.0_wp, derived_none), &
+    binout_variable_t("rbdout", "dircos_33", "direction_cosines", 9, 1.0_wp, derived_none)]
 
 contains
 

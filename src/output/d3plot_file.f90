@@ -22,6 +22,7 @@ module d3plot_file
   use model, only: model_t
   use element_group, only: shell_output_points
   use d3plot_states, only: d3plot_layout_t, state_word_count, fill_state_words, shell_extra_values, single
+  use d3plot_strains, only: solid_hencky_strains, shell_hencky_strains
   implicit none
   private
 
@@ -53,6 +54,10 @@ module d3plot_file
     integer, allocatable :: solid_part(:), shell_part(:), beam_part(:)  !< part numbers of the elements
     real(wp), allocatable :: shell_thickness(:)   !< the deck's (mean of the corners), for shells without points
     real(real32), allocatable :: words(:)         !< one state
+    !> with strains (layout%strains): the elements' nodes, (8, solids) and (4, shells), and the
+    !> tensors of a state, (6, solids) and (6, 2, shells)
+    integer, allocatable :: solid_nodes(:, :), shell_nodes(:, :)
+    real(wp), allocatable :: solid_strain(:, :), shell_strain(:, :, :)
   end type d3plot_file_t
 
 contains
@@ -215,10 +220,22 @@ contains
 
     if (.not. plot%is_open .or. plot%failed) return
     state_words = state_word_count(plot%layout)
-    call fill_state_words(plot%layout, time, globals, plot%reference + displacement, velocity, acceleration, &
-                          solid_stress, solid_plastic_strain, shell_stress, shell_plastic_strain, shell_extra, &
-                          beam_resultant, plot%solid_part, plot%shell_part, plot%beam_part, plot%words, &
-                          solid_eroded, shell_eroded, beam_failed)
+    if (plot%layout%strains) then
+      ! the strains measured from the geometry of the state (d3plot_strains); the shells'
+      ! thickness of the state is shell_extra's ninth value
+      call solid_hencky_strains(plot%reference, plot%reference + displacement, plot%solid_nodes, plot%solid_strain)
+      call shell_hencky_strains(plot%reference, plot%reference + displacement, plot%shell_nodes, shell_extra(9, :), &
+                                plot%shell_thickness, plot%shell_strain)
+      call fill_state_words(plot%layout, time, globals, plot%reference + displacement, velocity, acceleration, &
+                            solid_stress, solid_plastic_strain, shell_stress, shell_plastic_strain, shell_extra, &
+                            beam_resultant, plot%solid_part, plot%shell_part, plot%beam_part, plot%words, &
+                            solid_eroded, shell_eroded, beam_failed, plot%solid_strain, plot%shell_strain)
+    else
+      call fill_state_words(plot%layout, time, globals, plot%reference + displacement, velocity, acceleration, &
+                            solid_stress, solid_plastic_strain, shell_stress, shell_plastic_strain, shell_extra, &
+                            beam_resultant, plot%solid_part, plot%shell_part, plot%beam_part, plot%words, &
+                            solid_eroded, shell_eroded, beam_failed)
+    end if
     status = 0
     ! a new family file when this state would pass the limit (a file holds at least one state)
     if (plot%file_words > 0 .and. plot%file_words + state_words + 1 > plot%limit_words) &
@@ -267,10 +284,20 @@ contains
       if (allocated(model%parts)) layout%part_count = size(model%parts)
       layout%shell_layers = shell_output_points(model)
       layout%global_count = 6 + 2*layout%part_count
-      layout%solid_values = 7
+      layout%strains = model%output%element_strains
+      layout%solid_values = merge(13, 7, layout%strains)
       layout%beam_values = 6
-      layout%shell_values = 7*layout%shell_layers + shell_extra_values
+      layout%shell_values = 7*layout%shell_layers + shell_extra_values + merge(12, 0, layout%strains)
     end associate
+    if (plot%layout%strains) then
+      plot%solid_nodes = reshape([integer ::], [8, 0])
+      if (plot%layout%solid_count > 0) plot%solid_nodes = model%solid_nodes
+      plot%shell_nodes = reshape([integer ::], [4, 0])
+      if (plot%layout%shell_count > 0) plot%shell_nodes = model%shell_nodes
+      if (allocated(plot%solid_strain)) deallocate (plot%solid_strain)
+      if (allocated(plot%shell_strain)) deallocate (plot%shell_strain)
+      allocate (plot%solid_strain(6, plot%layout%solid_count), plot%shell_strain(6, 2, plot%layout%shell_count))
+    end if
     if (allocated(plot%reference)) deallocate (plot%reference)
     if (allocated(plot%shell_thickness)) deallocate (plot%shell_thickness)
     allocate (plot%reference(3, plot%layout%node_count))
@@ -338,7 +365,7 @@ contains
     control(32) = plot%layout%shell_count                       ! NEL4
     control(33) = shell_materials                               ! NUMMAT4
     control(34) = plot%layout%shell_values                      ! NV2D
-    control(35) = 0                                             ! NEIPH
+    control(35) = merge(6, 0, plot%layout%strains)              ! NEIPH: the solids' strains
     control(36) = 0                                             ! NEIPS
     control(37) = -(plot%layout%shell_layers + 10000)           ! MAXINT, with element deletion flags
     control(40) = numbering_word_count(plot%layout)             ! NARBS
@@ -347,6 +374,7 @@ contains
     control(46) = 1000                                          ! IOSHL(3): shell resultants
     control(47) = 1000                                          ! IOSHL(4): thickness, energy
     control(52) = plot%layout%part_count                        ! NMMAT
+    if (plot%layout%strains) control(57) = 10000                ! IDTDT: ISTRN, the strain tensors
     write (plot%unit, iostat=status, iomsg=message) control
     plot%file_words = 64
   end subroutine write_header

@@ -7,7 +7,9 @@
 !> per solid NV3D values (stress xx yy zz xy yz zx, effective plastic strain); per beam NV1D
 !> values (axial force, shear s, shear t, bending moment s, bending moment t, torsion); per
 !> shell NV2D values (per layer of MAXINT: stress xx yy zz xy yz zx, effective plastic
-!> strain; then the resultants, thickness and energy density, shell_extra_values); and the deletion flags of the solids, shells and beams (the element's part number
+!> strain; then the resultants, thickness and energy density, shell_extra_values; with ISTRN the
+!> strain tensors: solids 6 values after the plastic strain, shells 12, inner then outer
+!> surface, before the energy density); and the deletion flags of the solids, shells and beams (the element's part number
 !> while it is in the model, 0.0 once deleted), which LS-DYNA writes when MAXINT is given as
 !> -(MAXINT + 10000).
 module d3plot_states
@@ -31,7 +33,11 @@ module d3plot_states
     integer :: global_count = 0   !< NGLBV: 6 + 2 per part (internal, kinetic energy)
     integer :: solid_values = 7   !< NV3D
     integer :: beam_values = 6    !< NV1D
-    integer :: shell_values = 19  !< NV2D = MAXINT * 7 + 12
+    integer :: shell_values = 19  !< NV2D = MAXINT * 7 + 12 (+ 12 with strains)
+    !> ISTRN (*DATABASE_EXTENT_BINARY STRFLG = 1): a strain tensor per solid after its plastic
+    !> strain (NV3D = 13, as NEIPH = 6 extra values), two per shell (inner, outer surface) after
+    !> its thickness and the two element-dependent values, before the energy density
+    logical :: strains = .false.
   end type d3plot_layout_t
 
   !> After the layers, per shell (IOSHL(3) = IOSHL(4) = 1000): M_xx M_yy M_xy Q_x Q_y N_xx N_yy
@@ -57,10 +63,12 @@ contains
   !> values; `shell_stress` (6, MAXINT, shells) and `shell_plastic_strain` (MAXINT, shells) the
   !> layers; `beam_resultant` (6, beams) in crashfree's order N, Q_s, Q_t, T, M_s, M_t; the
   !> part numbers of the elements; the eroded flags 1 for an element out of the model (absent:
-  !> none is).
+  !> none is); with layout%strains the strain tensors, `solid_strain` (6, solids) and
+  !> `shell_strain` (6, 2, shells: inner, outer surface), xx yy zz xy yz zx.
   subroutine fill_state_words(layout, time, globals, coordinates, velocity, acceleration, solid_stress, &
                               solid_plastic_strain, shell_stress, shell_plastic_strain, shell_extra, beam_resultant, &
-                              solid_part, shell_part, beam_part, words, solid_eroded, shell_eroded, beam_failed)
+                              solid_part, shell_part, beam_part, words, solid_eroded, shell_eroded, beam_failed, &
+                              solid_strain, shell_strain)
     type(d3plot_layout_t), intent(in) :: layout
     real(wp), intent(in) :: time
     real(wp), intent(in) :: globals(:)
@@ -73,6 +81,7 @@ contains
     real(real32), intent(out) :: words(:)
     integer, intent(in), optional :: solid_eroded(:), shell_eroded(:)
     real(wp), intent(in), optional :: beam_failed(:)
+    real(wp), intent(in), optional :: solid_strain(:, :), shell_strain(:, :, :)
     integer(int64) :: next
     integer :: node, element, layer
     ! LS-DYNA's beam resultant order from crashfree's (N, Q_s, Q_t, T, M_s, M_t)
@@ -98,6 +107,7 @@ contains
     do element = 1, layout%solid_count
       words(next:next + 5) = single(solid_stress(:, element))
       words(next + 6) = single(solid_plastic_strain(element))
+      if (layout%strains .and. present(solid_strain)) words(next + 7:next + 12) = single(solid_strain(:, element))
       next = next + layout%solid_values
     end do
     do element = 1, layout%beam_count
@@ -110,8 +120,21 @@ contains
         words(next + 6) = single(shell_plastic_strain(layer, element))
         next = next + 7
       end do
-      words(next:next + shell_extra_values - 1) = single(shell_extra(:, element))
-      next = next + shell_extra_values
+      if (layout%strains) then
+        ! resultants, thickness, the two element-dependent values; the strains; the energy density
+        words(next:next + shell_extra_values - 2) = single(shell_extra(1:shell_extra_values - 1, element))
+        next = next + shell_extra_values - 1
+        if (present(shell_strain)) then
+          words(next:next + 5) = single(shell_strain(:, 1, element))
+          words(next + 6:next + 11) = single(shell_strain(:, 2, element))
+        end if
+        next = next + 12
+        words(next) = single(shell_extra(shell_extra_values, element))
+        next = next + 1
+      else
+        words(next:next + shell_extra_values - 1) = single(shell_extra(:, element))
+        next = next + shell_extra_values
+      end if
     end do
     ! deletion flags: solids, (thick shells: none), shells, beams; LS-DYNA writes the element's
     ! material (part) number, 0 for a deleted element

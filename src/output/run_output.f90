@@ -16,6 +16,7 @@ module run_output
   use spot_weld_constraints, only: failed_weld_count
   use ascii_databases, only: c_exponential
   use binout_file, only: binout_requested, binout_name, write_binout
+  use ascii_run_summary, only: initial_time_step_tables
   implicit none
   private
 
@@ -40,7 +41,7 @@ contains
     integer :: k
 
     if (state%cycle == 0 .and. .not. allocated(plan%initial_time_steps)) &
-      call record_initial_time_steps(model, state, plan)
+      plan%initial_time_steps = initial_time_step_tables(model, state)
     glstat_due = clock_due(plan%glstat, state%time, last)
     matsum_due = clock_due(plan%matsum, state%time, last)
     if (glstat_due) then
@@ -92,26 +93,6 @@ contains
         call write_binout(model, histories, binout_path(results), error)
     end if
   end subroutine write_due_output
-
-  !> The smallest stable step of each element kind at cycle 0 with its element, and the rigid
-  !> bodies' (d3hsp's time step table, which LS-DYNA writes at the start).
-  subroutine record_initial_time_steps(model, state, plan)
-    type(model_t), intent(in) :: model
-    type(explicit_state_t), intent(in) :: state
-    type(output_plan_t), intent(inout) :: plan
-    integer :: k
-    plan%initial_time_steps = ""
-    do k = 1, size(state%groups)
-      associate (group => state%groups(k)%group)
-        if (group%critical_element <= 0) cycle
-        plan%initial_time_steps = plan%initial_time_steps//c_exponential(group%stable_time_step, 17, 5)//"  "// &
-                                  group%describe(model, group%critical_element)//new_line("a")
-      end associate
-    end do
-    if (size(state%rigid) > 0 .and. state%rigid_time_step < huge(1.0_wp)) &
-      plan%initial_time_steps = plan%initial_time_steps//c_exponential(state%rigid_time_step, 17, 5)// &
-                                "  rigid bodies"//new_line("a")
-  end subroutine record_initial_time_steps
 
   !> binout beside the results file (results_file's DIR/JOBID.h5), named as LS-DYNA names it.
   function binout_path(results) result(path)
@@ -204,13 +185,13 @@ contains
     type(explicit_state_t), intent(in) :: state
     type(output_plan_t), intent(inout) :: plan
     type(history_set_t), intent(inout) :: histories
-    real(wp) :: row(13)
+    real(wp) :: row(37)
     integer :: k
     do k = 1, size(plan%rbdout_series)
       call rigid_body_history_row(model, k, state%rigid(k), state%nodes%acceleration, state%nodes%mass, state%time, &
                                   0.5_wp*state%time_step, state%time - plan%last_rbdout_time, plan%rigid_impulse(:, k), &
                                   row)
-      call append_history_row(histories%series(plan%rbdout_series(k)), row)
+      call append_history_row(histories%series(plan%rbdout_series(k)), [row, real(state%cycle, wp)])
     end do
     plan%last_rbdout_time = state%time
   end subroutine record_rigid_bodies

@@ -47,8 +47,8 @@ module output_plan
     real(wp), allocatable :: node_acceleration(:, :) !< physical accelerations (nodout)
     real(wp), allocatable :: part_kinetic(:), part_internal(:), part_hourglass(:)
     real(wp), allocatable :: part_momentum(:, :), part_mass(:), part_rigid_velocity(:, :)   !< matsum
-    !> d3hsp's table of the smallest stable steps at cycle 0, one line per element kind (not
-    !> kept in restart dumps: a continued run's d3hsp has the last cycle's only)
+    !> d3hsp's tables of the smallest stable steps at cycle 0 (ascii_run_summary; not kept in
+    !> restart dumps: a continued run's d3hsp has the last cycle's only)
     character(len=:), allocatable :: initial_time_steps
   end type output_plan_t
 
@@ -147,8 +147,11 @@ contains
         allocate (plan%rbdout_series(size(model%rigid_bodies)))
         do k = 1, size(model%rigid_bodies)
           write (label, '(i0)') model%rigid_bodies(k)%id
+          ! (the columns after angular_momentum came with LS-DYNA's rbdout file, appended)
           call add_history_series(histories, "rbdout/"//trim(label), [character(len=32) :: "time", &
-                                  "displacement", "velocity", "force", "angular_momentum"], [1, 3, 3, 3, 3], &
+                                  "displacement", "velocity", "force", "angular_momentum", "coordinates", &
+                                  "acceleration", "rotation", "angular_velocity", "angular_acceleration", &
+                                  "direction_cosines", "cycle"], [1, 3, 3, 3, 3, 3, 3, 3, 3, 3, 9, 1], &
                                   capacity, plan%rbdout_series(k))
         end do
       end if

@@ -559,12 +559,14 @@ contains
   !> between the half steps (as the nodal energies are measured): translation
   !> 1/2 M V- . V+, rotation 1/2 Pi . I^-1 Pi with Pi = R^T L, L = L- + dt/2 (moment now).
   subroutine rigid_body_energy(model, b, body, acceleration, mass, half_step, average_step, kinetic, momentum, &
-                               angular_momentum, velocity)
+                               angular_momentum, velocity, body_force, body_moment)
     type(model_t), intent(in) :: model
     integer, intent(in) :: b
     type(rigid_body_state_t), intent(in) :: body
     real(wp), intent(in) :: acceleration(:, :), mass(:), half_step, average_step
     real(wp), intent(out) :: kinetic, momentum(3), angular_momentum(3), velocity(3)
+    !> the resultant force and moment about the centre now (held dofs: their motion's)
+    real(wp), intent(out), optional :: body_force(3), body_moment(3)
     real(wp) :: force(3), moment(3), nodal(3), body_frame(3)
     integer :: k, node
     force = 0.0_wp
@@ -578,6 +580,8 @@ contains
     ! held dofs follow their constraint or motion, not the forces
     where (body%held(1:3)) force = body%mass*body%held_acceleration(1:3)
     if (any(body%held(4:6))) moment = 0.0_wp
+    if (present(body_force)) body_force = force
+    if (present(body_moment)) body_moment = moment
     velocity = body%velocity + half_step*force/body%mass
     momentum = body%mass*velocity
     angular_momentum = body%angular_momentum + half_step*moment
@@ -588,7 +592,11 @@ contains
 
   !> One rbdout row: time, displacement and velocity of the centre of mass, the force of the
   !> model on the body averaged over the interval since the last row (impulse / interval, so
-  !> that the history integrates to the impulse), angular momentum about the centre.
+  !> that the history integrates to the impulse), angular momentum about the centre; then
+  !> (LS-DYNA's rbdout) the centre's coordinates and acceleration, the rotation (the integral
+  !> of the angular velocity), the angular velocity and acceleration (global axes; Euler's
+  !> equations, I alpha = M - omega x L) and the body axes in global axes (direction cosines,
+  !> row by row: the global axes at the start, turned with the body).
   subroutine rigid_body_history_row(model, b, body, acceleration, mass, time, half_step, interval, sampled_impulse, &
                                     row)
     type(model_t), intent(in) :: model
@@ -596,10 +604,11 @@ contains
     type(rigid_body_state_t), intent(in) :: body
     real(wp), intent(in) :: acceleration(:, :), mass(:), time, half_step, interval
     real(wp), intent(inout) :: sampled_impulse(3)   !< the body's impulse at the last row; now at this one
-    real(wp), intent(out) :: row(13)
-    real(wp) :: kinetic, momentum(3), angular_momentum(3), velocity(3)
+    real(wp), intent(out) :: row(37)
+    real(wp) :: kinetic, momentum(3), angular_momentum(3), velocity(3), force(3), moment(3), omega(3)
+    real(wp) :: global_inverse_inertia(3, 3)
     call rigid_body_energy(model, b, body, acceleration, mass, half_step, 0.0_wp, kinetic, momentum, &
-                           angular_momentum, velocity)
+                           angular_momentum, velocity, force, moment)
     row(1) = time
     row(2:4) = body%centre - body%initial_centre
     row(5:7) = velocity
@@ -607,6 +616,15 @@ contains
     if (interval > 0.0_wp) row(8:10) = (body%impulse - sampled_impulse)/interval
     row(11:13) = angular_momentum
     sampled_impulse = body%impulse
+    global_inverse_inertia = matmul(body%rotation, matmul(body%inverse_inertia, transpose(body%rotation)))
+    omega = matmul(global_inverse_inertia, angular_momentum)
+    row(14:16) = body%centre
+    row(17:19) = force/body%mass
+    row(20:22) = body%rotation_angle
+    row(23:25) = omega
+    row(26:28) = matmul(global_inverse_inertia, moment - cross(omega, angular_momentum))
+    ! row k of the direction cosines: body axis k in global axes (column k of the rotation)
+    row(29:37) = reshape(body%rotation, [9])
   end subroutine rigid_body_history_row
 
   !> Cayley transform of the rotation vector a: (1 - [a]/2)^-1 (1 + [a]/2), orthogonal.

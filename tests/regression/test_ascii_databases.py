@@ -14,8 +14,9 @@ import re
 import subprocess
 
 import numpy as np
+import pytest
 
-from deck_writer import block_mesh, fields, nodes_card, solids_card, write_deck
+from deck_writer import block_mesh, fields, nodes_card, shells_card, solids_card, write_deck
 from test_contact import head_on_deck
 
 DENSITY = 7.85e-6        # kg/mm^3
@@ -327,3 +328,237 @@ def test_log_of_both_streams_is_in_order(tmp_path):
     summary = next(k for k, text in enumerate(lines) if text.startswith("model:"))
     progress = next(k for k, text in enumerate(lines) if text.strip().startswith("cycle"))
     assert lines[0].startswith("crashfree ") and 0 < warning < summary < progress
+
+
+# ------------------------------------------------------------------ d3hsp: 100 smallest timesteps
+
+SOLID_YOUNGS, SOLID_DENSITY, SOLID_SIZE = 210.0, 7.85e-6, 2.0                # steel cubes, nu = 0
+SHELL_YOUNGS, SHELL_DENSITY, SHELL_POISSON = 70.0, 2.7e-6, 0.33              # aluminium plate
+SHELL_WIDTHS, SHELL_HEIGHT = (1.2, 0.6, 1.0, 0.8), 1.5                       # columns, one row height
+TIME_STEP_SCALE = 0.8
+
+
+def time_step_deck(path):
+    """A 3 x 3 x 3 block of steel cubes (nu = 0, where the eigenvalue bound of the exposed
+    elements equals LS-DYNA's rule: every element's step is L / c, c = sqrt(E / rho)) and, far
+    from it, an aluminium plate of 4 x 3 shells whose columns have the widths SHELL_WIDTHS and
+    height 1.5 (L = area / longest side = the width; c = sqrt(E / (rho (1 - nu^2))))."""
+    solid_nodes, solid_elements = block_mesh((3, 3, 3), (3 * SOLID_SIZE,) * 3)
+    edges = np.concatenate([[0.0], np.cumsum(SHELL_WIDTHS)])
+    rows = np.arange(4) * SHELL_HEIGHT
+    plate_nodes = np.array([[x, y, 50.0] for x in edges for y in rows])
+    shells = [[i * 4 + j, (i + 1) * 4 + j, (i + 1) * 4 + j + 1, i * 4 + j + 1]
+              for i in range(len(SHELL_WIDTHS)) for j in range(3)]
+    count = len(solid_nodes)
+    deck = write_deck(
+        path,
+        "*TITLE\ntime steps by element",
+        "*CONTROL_TERMINATION\n" + fields(0.002),
+        "*CONTROL_TIMESTEP\n" + fields(0.0, TIME_STEP_SCALE),
+        "*DATABASE_GLSTAT\n" + fields(0.001),
+        "*PART\ncubes\n" + fields(1, 1, 1),
+        "*PART\nplate\n" + fields(2, 2, 2),
+        "*SECTION_SOLID\n" + fields(1, 1),
+        "*SECTION_SHELL\n" + fields(2, 2, 1.0, 2) + "\n" + fields(0.5, 0.5, 0.5, 0.5),
+        "*MAT_ELASTIC\n" + fields(1, SOLID_DENSITY, SOLID_YOUNGS, 0.0),
+        "*MAT_ELASTIC\n" + fields(2, SHELL_DENSITY, SHELL_YOUNGS, SHELL_POISSON),
+        nodes_card(np.vstack([solid_nodes, plate_nodes])),
+        solids_card(solid_elements, part_id=1, first_id=101),
+        shells_card(np.array(shells), part_id=2, first_id=501, first_node_id=count + 1),
+    )
+    shell_speed = np.sqrt(SHELL_YOUNGS / (SHELL_DENSITY * (1.0 - SHELL_POISSON ** 2)))
+    expected = [("shell", 501 + k, 2, SHELL_WIDTHS[k // 3] / shell_speed) for k in range(len(shells))]
+    expected += [("solid", 101 + k, 1, SOLID_SIZE / np.sqrt(SOLID_YOUNGS / SOLID_DENSITY))
+                 for k in range(len(solid_elements))]
+    expected.sort(key=lambda row: row[3])
+    return deck, expected
+
+
+def read_smallest_time_steps(path):
+    """d3hsp's table as LS-DYNA's readers take it: the rows start three lines below the line
+    holding "100 smallest timesteps" (a rule and the column header between); each row is
+    element type, number, part, time step, separated by blanks; the table ends at a blank line."""
+    lines = path.read_text().splitlines()
+    start = next(k for k, line in enumerate(lines) if " 100 smallest timesteps" in line) + 3
+    rows = []
+    for line in lines[start:]:
+        if not line.strip():
+            break
+        words = line.split()
+        rows.append((words[0], int(words[1]), int(words[-2]), float(words[-1])))
+    return rows
+
+
+def test_d3hsp_lists_the_smallest_element_time_steps(tmp_path, run_deck):
+    deck, expected = time_step_deck(tmp_path / "time_steps.k")
+    run = run_deck(deck)
+    assert run.status == 0, run.stderr
+    rows = read_smallest_time_steps(run.results.parent / "d3hsp")
+    # 12 shells + 27 solids: all of them, smallest first, each at its analytical step (the
+    # order among analytically equal steps follows their last bits: compared as sets)
+    assert len(rows) == len(expected) == 39
+    assert all(rows[k][3] <= rows[k + 1][3] for k in range(len(rows) - 1))
+    for step in sorted({row[3] for row in expected}):
+        places = [k for k, row in enumerate(expected) if row[3] == step]
+        assert {rows[k][:3] for k in places} == {expected[k][:3] for k in places}, step
+        for k in places:
+            assert abs(rows[k][3] - step) <= 1e-6 * step, (rows[k], step)
+    # the smallest is the step the run started with, over TSSFAC
+    with run.open() as results:
+        first_step = results["history/glstat/time_step"][0]
+    assert abs(rows[0][3] * TIME_STEP_SCALE - first_step) <= 1e-6 * first_step
+
+
+# ------------------------------------------------------------------ rbdout
+
+RIGID_SIZE = 10.0                        # mm, one rigid cube
+RIGID_ORIGIN = (5.0, -2.0, 1.0)
+RIGID_VELOCITY = (1.0, 0.5, -0.3)        # mm/ms
+RIGID_FORCE = (0.02, -0.01, 0.0)         # kN on the whole body (an eighth of it at each node)
+NODAL_BODY_VELOCITY = (0.0, 0.0, 2.0)    # mm/ms, a free *CONSTRAINED_NODAL_RIGID_BODY
+
+
+def rigid_body_deck(path, binary=""):
+    """A rigid cube (part 4) with an initial velocity pushed by a constant force: its centre
+    moves as x(t) = x0 + v0 t + F t^2 / (2 m); and far from it the eight nodes of an elastic
+    cube as a free nodal rigid body 9 at a constant velocity."""
+    nodes, elements = block_mesh((1, 1, 1), (RIGID_SIZE,) * 3, origin=RIGID_ORIGIN)
+    free_nodes, free_elements = block_mesh((1, 1, 1), (RIGID_SIZE,) * 3, origin=(50.0, 0.0, 0.0))
+    loads = "\n".join("*LOAD_NODE_SET\n" + fields(1, dof + 1, 1, RIGID_FORCE[dof] / 8.0)
+                      for dof in range(3) if RIGID_FORCE[dof] != 0.0)
+    return write_deck(
+        path,
+        "*TITLE\na pushed block",
+        "*CONTROL_TERMINATION\n" + fields(1.0),
+        "*DATABASE_GLSTAT\n" + fields(0.1),
+        "*DATABASE_RBDOUT\n" + fields(0.1, binary),
+        "*PART\nrigid cube\n" + fields(4, 1, 1),
+        "*SECTION_SOLID\n" + fields(1, 1),
+        "*MAT_RIGID\n" + fields(1, DENSITY, 200.0, 0.3) + "\n" + fields(0.0, 0.0, 0.0),
+        "*PART\nfree cube\n" + fields(5, 1, 2),
+        "*MAT_ELASTIC\n" + fields(2, DENSITY, 200.0, 0.3),
+        "*SET_NODE_LIST\n" + fields(3) + "\n" + fields(*range(9, 17)),
+        "*CONSTRAINED_NODAL_RIGID_BODY\n" + fields(9, 0, 3),
+        "*INITIAL_VELOCITY\n" + fields(3) + "\n" + fields(*NODAL_BODY_VELOCITY),
+        "*DEFINE_CURVE\n" + fields(1) + "\n" + fields(0.0, 1.0, width=20) + "\n" + fields(10.0, 1.0, width=20),
+        "*SET_NODE_LIST\n" + fields(1) + "\n" + fields(*range(1, 9)),
+        loads,
+        "*INITIAL_VELOCITY\n" + fields(1) + "\n" + fields(*RIGID_VELOCITY),
+        nodes_card(np.vstack([nodes, free_nodes])),
+        solids_card(elements, part_id=4) + "\n" +
+        solids_card(free_elements, part_id=5, first_id=2, first_node_id=9).split("\n", 1)[1],
+    )
+
+
+def read_rbdout(path):
+    """[(cycle, time, {body: {label: values}})]: per sample the "r i g i d   b o d y" line
+    (cycle in columns 50-57, time in 68-82), per body its id (columns 12-19 of " rigid body",
+    18-25 of " nodal rigid body"),
+    then lines of a label in columns 1-15 and values of 12 columns each from column 16; the
+    local-axes block's labels get the prefix "local ", the direction vectors' rows "row N"."""
+    samples, body, local = [], None, False
+    for line in path.read_text().splitlines():
+        if line.startswith("  r i g i d   b o d y   m o t i o n   a t  cycle="):
+            samples.append((int(line[49:57]), number(line[67:82]), {}))
+        elif line.startswith(" rigid body") or line.startswith(" nodal rigid body"):
+            body, local = int(line[11:19]) if line.startswith(" rigid") else int(line[17:25]), False
+            samples[-1][2][body] = {}
+        elif line.startswith(" output in principal"):
+            local = True
+        elif body is not None and line[:15].strip().endswith(":") or line[:15].strip().startswith("row "):
+            label = line[:15].strip().rstrip(":")
+            values = [number(line[15 + 12 * k:27 + 12 * k]) for k in range((len(line) - 15) // 12)]
+            samples[-1][2][body][("local " if local else "") + label] = np.array(values)
+    return samples
+
+
+def read_rbdout_by_offsets(path):
+    """The 48 numbers of each body block as the public MATLAB reader lsdyna.read.rbdout
+    (matlab-lsdyna) takes them: sscanf of a fixed format on the characters 91 to 1128 after the
+    body's id (so the line between the id and the coordinates must be 88 characters long)."""
+    text = path.read_text()
+    pattern = ""
+    for label, count in (("coordinates:", 3), ("displacements:", 6), ("velocities:", 6), ("accelerations:", 6),
+                         ("principal or user defined local coordinate direction vectors a b c", 0),
+                         ("row 1", 3), ("row 2", 3), ("row 3", 3),
+                         ("output in principal or user defined local coordinate directions "
+                          "a b c a-rot b-rot c-rot", 0),
+                         ("displacements:", 6), ("velocities:", 6), ("accelerations:", 6)):
+        pattern += r"\s*" + r"\s*".join(re.escape(word) for word in label.split())
+        pattern += r"\s*([-+]?[0-9.]+(?:E[-+][0-9]+)?)" * count
+    blocks = []
+    for match in re.finditer(r"^ (nodal )?rigid body\s*(\d+)", text, re.M):
+        found = re.match(pattern, text[match.end() + 90:match.end() + 1127])
+        assert found, text[match.end():match.end() + 200]
+        blocks.append(np.array([float(value) for value in found.groups()]))
+    return blocks
+
+
+def test_rbdout_equals_results_and_the_analytical_motion(tmp_path, run_deck):
+    # BINARY 3: the ASCII file and binout
+    run = run_deck(rigid_body_deck(tmp_path / "rigid.k", binary=3))
+    assert run.status == 0, run.stderr
+    samples = read_rbdout(run.results.parent / "rbdout")
+    with run.open() as results:
+        series = results["history/rbdout/4"]
+        columns = {name: series[name][...] for name in series}
+        free = {name: results["history/rbdout/9"][name][...] for name in ("displacement", "velocity")}
+    assert len(samples) == len(columns["time"]) >= 11
+    mass = DENSITY * RIGID_SIZE ** 3
+    force, velocity = np.array(RIGID_FORCE), np.array(RIGID_VELOCITY)
+    centre = np.array(RIGID_ORIGIN) + RIGID_SIZE / 2
+    for row, (cycle, time, bodies) in enumerate(samples):
+        body = bodies[4]
+        # the file equals results.h5 to its printed digits
+        assert cycle == columns["cycle"][row] and close(time, columns["time"][row], 7)
+        exact = {"coordinates": columns["coordinates"][row],
+                 "displacements": np.concatenate([columns["displacement"][row], columns["rotation"][row]]),
+                 "velocities": np.concatenate([columns["velocity"][row], columns["angular_velocity"][row]]),
+                 "accelerations": np.concatenate([columns["acceleration"][row],
+                                                  columns["angular_acceleration"][row]])}
+        for label, values in exact.items():
+            assert all(close(p, e, 4) for p, e in zip(body[label], values)), (label, body[label], values)
+        axes = columns["direction_cosines"][row].reshape(3, 3)
+        for k in range(3):
+            assert all(close(p, e, 4) for p, e in zip(body[f"row {k + 1}"], axes[k]))
+        # the body does not turn: its axes stay the global ones, the local values the global
+        for label in ("displacements", "velocities", "accelerations"):
+            assert np.allclose(body["local " + label], exact[label], rtol=1e-4, atol=1e-12), label
+        # physics: x(t) = x0 + v0 t + F t^2 / (2 m), a constant acceleration F / m, no rotation
+        time = columns["time"][row]
+        expected = velocity * time + force * time ** 2 / (2 * mass)
+        assert np.allclose(columns["displacement"][row], expected, rtol=1e-9, atol=1e-9 * RIGID_SIZE)
+        assert np.allclose(columns["coordinates"][row], centre + expected, rtol=1e-12)
+        assert np.allclose(columns["velocity"][row], velocity + force * time / mass, rtol=1e-9, atol=1e-12)
+        assert np.allclose(columns["acceleration"][row], force / mass, rtol=1e-9, atol=1e-12)
+        assert np.abs(columns["angular_velocity"][row]).max() < 1e-12
+        assert np.allclose(axes, np.eye(3), atol=1e-12)
+    assert columns["time"][-1] >= 1.0 and abs(columns["displacement"][-1, 0]) > 1.0
+    # the nodal rigid body: its own block, at its constant velocity
+    text = (run.results.parent / "rbdout").read_text()
+    assert text.count(" nodal rigid body       9") == text.count(" rigid body       4") == len(samples)
+    for row, (_, _, bodies) in enumerate(samples):
+        time = columns["time"][row]
+        assert np.allclose(free["displacement"][row], np.array(NODAL_BODY_VELOCITY) * time, rtol=1e-9, atol=1e-9)
+        assert all(close(p, e, 4) for p, e in zip(bodies[9]["displacements"][:3], free["displacement"][row]))
+        assert np.abs(bodies[9]["accelerations"]).max() < 1e-9
+    # a reader that counts characters finds the same numbers
+    blocks = read_rbdout_by_offsets(run.results.parent / "rbdout")
+    assert len(blocks) == 2 * len(samples)
+    for block, (_, _, bodies) in zip(blocks[::2], samples):
+        body = bodies[4]
+        assert np.array_equal(block[:21], np.concatenate([body["coordinates"], body["displacements"],
+                                                          body["velocities"], body["accelerations"]]))
+        assert np.array_equal(block[21:30], np.concatenate([body[f"row {k}"] for k in (1, 2, 3)]))
+    # binout's rbdout under LS-DYNA's names (lasso-python), the values of results.h5
+    lasso_binout = pytest.importorskip("lasso.dyna.binout")
+    binout = lasso_binout.Binout(str(run.results.parent / "binout"))
+    assert list(binout.read("rbdout", "ids")) == [4, 9]
+    for name, column in (("global_", "coordinates"), ("global_a", "acceleration"), ("global_rd", "rotation"),
+                         ("global_rv", "angular_velocity"), ("global_ra", "angular_acceleration")):
+        for axis, letter in enumerate("xyz"):
+            np.testing.assert_array_equal(binout.read("rbdout", name + letter)[:, 0], columns[column][:, axis])
+    for i in range(3):
+        for j in range(3):
+            np.testing.assert_array_equal(binout.read("rbdout", f"dircos_{i + 1}{j + 1}")[:, 0],
+                                          columns["direction_cosines"][:, 3 * i + j])

@@ -514,3 +514,95 @@ def test_paraview_lsdyna_reader_reads_the_states(tmp_path, run_deck):
         assert_close(vtk_to_numpy(block.GetCellData().GetArray("Stress")), last["solid_stress"][()],
                      "ParaView: solid stresses")
         assert abs(reader.GetTimeValue(len(names) - 1) - last.attrs["time"]) < 1e-6 * last.attrs["time"]
+
+
+STRETCH_RATE = 0.4          # 1/(mm ms): node velocity along x = STRETCH_RATE * x^2
+
+
+def stretched_deck(path):
+    """A 3 x 2 x 2 block of solids and, beside it, a 3 x 2 plate of shells, every node moved
+    along x at the prescribed velocity STRETCH_RATE x^2 and held in y and z (shells also in
+    rotation): element k between x = a and b has the centre derivative dx/dX = 1 + R t (a + b),
+    so its strain tensor is the analytical xx = ln(1 + R t (a + b)), yy = 0 and no shear; a
+    shell's zz is ln(t / t0) of its thickness."""
+    solid_nodes, solids = block_mesh((3, 2, 2), (3.0, 2.0, 2.0), origin=(1.0, 0.0, 0.0))
+    plate_nodes, shells = plate_mesh((3, 2), (3.0, 2.0))
+    plate_nodes = plate_nodes + [1.0, 0.0, 10.0]
+    nodes = np.vstack([solid_nodes, plate_nodes])
+    count = len(solid_nodes)
+    motions, spc = ["*BOUNDARY_PRESCRIBED_MOTION_NODE"], ["*BOUNDARY_SPC_NODE"]
+    for k, (x, _, _) in enumerate(nodes):
+        motions.append(fields(k + 1, 1, 0, 1, float(STRETCH_RATE * x * x)))
+        spc.append(fields(k + 1, 0, 0, 1, 1, *([1, 1, 1] if k >= count else [0, 0, 0])))
+    return write_deck(
+        path,
+        "*TITLE\nstretched",
+        "*CONTROL_TERMINATION\n" + fields(0.2),
+        "*DATABASE_BINARY_D3PLOT\n" + fields(0.05),
+        "*DATABASE_EXTENT_BINARY\n" + fields(0, 0, 3, 1),
+        "*PART\nblock\n" + fields(1, 1, 1),
+        "*PART\nplate\n" + fields(2, 2, 1),
+        "*SECTION_SOLID\n" + fields(1, 1),
+        "*SECTION_SHELL\n" + fields(2, 2, 1.0, 3) + "\n" + fields(*[0.1] * 4),
+        "*MAT_ELASTIC\n" + fields(1, DENSITY, 1.0, 0.3),
+        "*DEFINE_CURVE\n" + fields(1) + "\n" + fields(0.0, 1.0, width=20) + "\n" + fields(10.0, 1.0, width=20),
+        "\n".join(motions),
+        "\n".join(spc),
+        nodes_card(nodes),
+        solids_card(solids),
+        shells_card(shells, part_id=2, first_id=len(solids) + 1, first_node_id=count + 1),
+    ), nodes[solids], nodes[count:][shells]
+
+
+def test_element_strains_with_strflg(tmp_path, run_deck):
+    """*DATABASE_EXTENT_BINARY STRFLG = 1: lasso-python reads element_solid_strain and
+    element_shell_strain (inner and outer surface), equal to the analytical strain of every
+    element at every state (to single precision)."""
+    deck, solid_corners, shell_corners = stretched_deck(tmp_path / "stretched.k")
+    run = run_deck(deck)
+    assert run.status == 0, run.stderr
+    plot = D3plot(str(run.results.parent / "d3plot"))
+    times = plot.arrays[ArrayType.global_timesteps]
+    assert len(times) >= 4 and times[-1] >= 0.2
+    solid_strain = plot.arrays[ArrayType.element_solid_strain][:, :, 0, :]     # (states, solids, 6)
+    shell_strain = plot.arrays[ArrayType.element_shell_strain]                 # (states, shells, 2, 6)
+    assert solid_strain.shape == (len(times), 12, 6) and shell_strain.shape == (len(times), 6, 2, 6)
+    # the other fields keep their place: stresses, plastic strains, thickness
+    assert plot.arrays[ArrayType.element_solid_stress].shape == (len(times), 12, 1, 6)
+    thickness = plot.arrays[ArrayType.element_shell_thickness]
+    for corners, strain in ((solid_corners, solid_strain), (shell_corners[:, None], shell_strain)):
+        ends = corners[..., 0].min(axis=-1) + corners[..., 0].max(axis=-1)         # a + b per element
+        expected_xx = np.log1p(STRETCH_RATE * times[:, None] * ends.reshape(1, -1))
+        if strain.ndim == 4:
+            expected_xx = np.repeat(expected_xx[:, :, None], 2, axis=2)
+        assert_close(strain[..., 0], expected_xx, "strain xx", scale=expected_xx.max())
+        assert expected_xx.max() > 0.1
+        assert np.abs(strain[..., 1]).max() <= 2 * SINGLE * expected_xx.max()          # held in y
+        assert np.abs(strain[..., 3:]).max() <= 2 * SINGLE * expected_xx.max()         # no shear
+    # a solid held in y and z keeps zz = 0; a shell's zz is its thickness strain
+    assert np.abs(solid_strain[..., 2]).max() <= 2 * SINGLE * solid_strain[..., 0].max()
+    # (without *CONTROL_SHELL ISTUPD the shells keep their thickness, as LS-DYNA's do)
+    expected_zz = np.log(thickness / 0.1)
+    assert np.abs(shell_strain[:, :, :, 2] - expected_zz[:, :, None]).max() <= 2 * SINGLE * expected_xx.max()
+
+
+@pytest.mark.parametrize("value, message", [
+    (2, "field STRFLG: must be 0 or 1"),
+    (-1, "field STRFLG: must be 0 or 1"),
+    (11, "field STRFLG: ignored (its digits for the plastic and thermal strain tensors"),
+])
+def test_strain_flag_checked(tmp_path, run_deck, value, message):
+    """STRFLG: a last digit other than 0 or 1 is refused with its file:line; LS-DYNA's digits
+    for the plastic and thermal strain tensors get a warning and the strains are written."""
+    deck, _, _ = stretched_deck(tmp_path / "stretched.k")
+    deck.write_text(deck.read_text().replace("*DATABASE_EXTENT_BINARY\n" + fields(0, 0, 3, 1),
+                                             "*DATABASE_EXTENT_BINARY\n" + fields(0, 0, 3, value)))
+    line = deck.read_text().splitlines().index(fields(0, 0, 3, value)) + 1
+    run = run_deck(deck)
+    assert f"stretched.k:{line}: *DATABASE_EXTENT_BINARY: {message}" in run.stderr, run.stderr
+    if value == 11:
+        assert run.status == 0
+        plot = D3plot(str(run.results.parent / "d3plot"))
+        assert plot.arrays[ArrayType.element_solid_strain].shape[-1] == 6
+    else:
+        assert run.status == 2
