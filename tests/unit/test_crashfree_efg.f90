@@ -21,6 +21,7 @@ program test_crashfree_efg
                            cf_efg_to_physical, &
                            cf_efg_internal_energy, cf_efg_destroy, cf_efg_last_error, cf_efg_is_null, cf_efg_ok, &
                            cf_efg_error_argument, cf_efg_error_order, cf_efg_error_handle, cf_efg_error_geometry, &
+                           cf_efg_error_singular, &
                            cf_efg_material_law
   !$ use omp_lib, only: omp_get_max_threads, omp_set_num_threads
   implicit none
@@ -374,6 +375,13 @@ contains
     call cf_efg_destroy(part, status)
     call cf_efg_create(part, coordinates, hexahedra, [1.4_wp, 1.4_wp, 1.4_wp], 0, 4, status)
     call expect("create: integration 4", part, status, cf_efg_error_argument, "integration = 4")
+    call cf_efg_destroy(part, status)
+    ! spheres of 1.4 times the body diagonal reach too far for this block: a node's mass share
+    ! turns negative, the set-up refuses the part
+    call cf_efg_create(part, coordinates, hexahedra, [1.4_wp, 1.4_wp, 1.4_wp], 2, 1, status)
+    call cf_efg_set_up(part, status)
+    call expect("set-up: supports too large", part, status, cf_efg_error_singular, &
+                "cf_efg_set_up: 1 node(s) get a non-positive row-sum mass")
     call cf_efg_destroy(part, status)
 
     ! wrong order
