@@ -81,23 +81,28 @@ def scan(src: Path):
     return defined, uses
 
 
+def fortran_sources(src: Path):
+    """Every Fortran source of src/ (free form, preprocessed or not)."""
+    return sorted([*src.rglob("*.f90"), *src.rglob("*.F90")])
+
+
 def library_problems(src: Path):
     """Lines of the library's module closure that print, stop or open files; thread counts set
     outside src/app."""
     uses_of = {}
-    for path in sorted(src.rglob("*.f90")):
+    for path in fortran_sources(src):
         for line in path.read_text(errors="replace").splitlines():
             found = USE.match(line.split("!")[0])
             if found:
                 uses_of.setdefault(path, set()).add(found.group(1).lower())
     module_file = {}
-    for path in sorted(src.rglob("*.f90")):
+    for path in fortran_sources(src):
         for line in path.read_text(errors="replace").splitlines():
             found = MODULE.match(line.split("!")[0])
             if found:
                 module_file[found.group(1).lower()] = path
     closure = set()
-    pending = sorted((src / LIBRARY_FOLDER).glob("*.f90"))
+    pending = [path for path in fortran_sources(src) if path.parent == src / LIBRARY_FOLDER]
     while pending:
         path = pending.pop()
         if path in closure:
@@ -105,7 +110,7 @@ def library_problems(src: Path):
         closure.add(path)
         pending.extend(module_file[module] for module in uses_of.get(path, ()) if module in module_file)
     problems = []
-    for path in sorted(src.rglob("*.f90")):
+    for path in fortran_sources(src):
         relative = path.relative_to(src).as_posix()
         for number, line in enumerate(path.read_text(errors="replace").splitlines(), start=1):
             code = line.split("!")[0]
