@@ -19,16 +19,16 @@ other.
 - static (the linear static analysis) assembles element and EFG stiffness and writes its one
   state through output; the job (app) runs it or the explicit run.
 
+Every `use` of every src/**/*.f90 is checked (intrinsic and library modules such as hdf5 are
+not the project's and are skipped). Uses listed in ALLOWED_FOR_NOW are reported but do not fail
+the check; an entry that no longer occurs fails it, so that the list only shrinks. Prints every
+violation and exits with status 1 when there is one. Usage: check_layers.py [SRC_DIR]
+
 The embedding library (src/api and every module it uses, directly or not) never prints, never
 stops the process, never opens or writes files; and only the program (src/app) sets the OpenMP
 thread count. Both are checked on the code (comments left out): a `stop`, `error stop`, `print`,
 `write` to the terminal, `open` or C `fopen` in a module of the library's closure, or a call of
 `omp_set_num_threads` outside src/app, is a violation.
-
-Every `use` of every src/**/*.f90 is checked (intrinsic and library modules such as hdf5 are
-not the project's and are skipped). Uses listed in ALLOWED_FOR_NOW are reported but do not fail
-the check; an entry that no longer occurs fails it, so that the list only shrinks. Prints every
-violation and exits with status 1 when there is one. Usage: check_layers.py [SRC_DIR]
 """
 import re
 import sys
