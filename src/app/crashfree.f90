@@ -2,7 +2,7 @@
 !> The program only reads the command line; everything else lives in libcrashfree.
 program crashfree
   use command_line, only: run_options_t, command_argument_t, get_command_arguments, &
-                          parse_command_line, usage_text
+                          parse_command_line, usage_text, check_launch
   use error_handling, only: error_t
   use job, only: run_job
   use version, only: crashfree_version
@@ -28,6 +28,12 @@ program crashfree
     call c_exit(2_c_int)
   end if
   if (options%notes%count > 0) call write_notes(options%notes%text)
+  ! this program has no MPI: several processes started by mpirun would each run the whole job
+  call check_launch(mpi_built=.false., error=error)
+  if (allocated(error)) then
+    write (error_unit, '(a)') "crashfree: "//error%message
+    call c_exit(2_c_int)
+  end if
   if (options%show_help) then
     write (*, '(a)') usage_text()
     stop
