@@ -32,6 +32,7 @@ module run_summary
     !> rank computing each model solid, shell and beam (-1: in no block, e.g. of a rigid part:
     !> every rank does the rigid bodies)
     integer, allocatable :: solid_rank(:), shell_rank(:), beam_rank(:)
+    integer, allocatable :: node_rank(:)         !< rank owning each node (the model's order)
   end type partition_summary_t
 
   type :: run_summary_t

@@ -117,35 +117,37 @@ contains
 
   !> Estimated wall-clock cost of one lane of a block of the group named `name` for one cycle,
   !> in nanoseconds (one thread): the partition's weights. A meshfree lane is an integration
-  !> point, so a background cell weighs its points together.
+  !> point, so a background cell weighs its points together (8 per solid cell, 4 per shell cell).
   !>
-  !> Measured with `make bench`-style runs (release build, one thread, this machine), the
-  !> run summary's seconds of each group's force calls divided by its lanes and cycles:
+  !> Measured on this project's machine (release build, ncpu=1), each group's force-call seconds
+  !> from the run summary over its lanes and cycles:
   !>
-  !> | kind           | ns per lane per cycle | deck, command                                          |
-  !> |----------------|-----------------------|--------------------------------------------------------|
-  !> | solid          | 135                   | tools/make_bench_deck.py 60x60x8 (28,800 hexahedra), ncpu=1 |
-  !> | shell          | 170                   | tools/make_scaling_deck.py shells (see docs/parallel_scaling.md) |
-  !> | meshfree       | 1,000                 | inputs: meshfree bar, 8 points per cell                |
-  !> | meshfree shell | 1,500                 | inputs: meshfree plate                                 |
-  !> | beam           | 150                   | (few beams in any model; taken as a shell)             |
+  !> | kind           | ns per lane per cycle | run                                                   |
+  !> |----------------|-----------------------|-------------------------------------------------------|
+  !> | solid          | 150  | tools/make_bench_deck.py --cells 30 30 20 --cycles 200: 148.9 ns per hexahedron (README's make bench: 150) |
+  !> | shell          | 540  | inputs/side_impact/coupled.k: 538 ns per shell (NIP 2-3); the tube of make bench, NIP 5 MAT_024: 1,062 |
+  !> | meshfree       | 450  | make_bench_deck.py --cells 12 12 12 --efg-cells 12 (elastic-plastic, DX 1.2): 174 ns per point; side_impact's foam ribs: 1,150; the geometric mean |
+  !> | meshfree shell | 760  | inputs/side_impact/coupled.k: 3,034 ns per cell, 4 points per cell |
+  !> | beam           | 150  | not measured (few beams in a model): taken as a solid |
   !>
-  !> A kind not in the table weighs as a solid. Only the ratios matter to the partition.
+  !> The cost of a lane also depends on the material and the number of integration points; these
+  !> figures only set the ratios between kinds, which is what the partition needs. A kind not in
+  !> the table weighs as a solid.
   pure real(wp) function lane_cost(name)
     character(len=*), intent(in) :: name
     select case (trim(name))
     case ("solid")
-      lane_cost = 135.0_wp
+      lane_cost = 150.0_wp
     case ("shell")
-      lane_cost = 170.0_wp
+      lane_cost = 540.0_wp
     case ("meshfree")
-      lane_cost = 1000.0_wp
+      lane_cost = 450.0_wp
     case ("meshfree shell")
-      lane_cost = 1500.0_wp
+      lane_cost = 760.0_wp
     case ("beam")
       lane_cost = 150.0_wp
     case default
-      lane_cost = 135.0_wp
+      lane_cost = 150.0_wp
     end select
   end function lane_cost
 
@@ -189,6 +191,7 @@ contains
     if (rank_count > 1) then
       call rank_elements(model, groups, blocks, rank_count, element_rank, partition%report%by_metis)
       call owners_by_majority(blocks, element_rank, rank_count, block_owner)
+      call balance_owners(blocks, size(model%node_ids), rank_count, block_owner)
     end if
 
     allocate (partition%groups(size(groups)))
@@ -413,6 +416,80 @@ contains
     end do
   end subroutine owners_by_majority
 
+  !> Blocks are coarse (64 lanes; a meshfree block costs as much as 200 hexahedra), so the
+  !> majority rule can leave a rank a block or more above its METIS share. Improve it by single
+  !> moves: the rank of the largest cost (the lowest on a tie) hands one of its blocks to a rank
+  !> owning a block that shares a node with it (so domains stay compact) when that lowers the
+  !> larger of the two costs; of the possible moves the one leaving the smaller maximum (then the
+  !> lower block, then the lower rank). Stops when the largest rank has no such move. Serial and
+  !> in a fixed order: the same on every rank. At the end no boundary block of the largest rank
+  !> fits on a neighbour: its excess over that neighbour is below one block's cost.
+  subroutine balance_owners(blocks, node_count, rank_count, block_owner)
+    type(block_list_t), intent(in) :: blocks
+    integer, intent(in) :: node_count, rank_count
+    integer, intent(inout) :: block_owner(:)
+    integer, allocatable :: node_offsets(:), node_blocks(:), next_slot(:), seen_by(:)
+    real(wp), allocatable :: cost(:)
+    real(wp) :: best, after
+    integer :: k, slot, node, other, target, heaviest, best_block, best_target, move
+
+    ! node -> the blocks touching it
+    allocate (node_offsets(node_count + 1), next_slot(node_count))
+    node_offsets = 0
+    do slot = 1, size(blocks%node_list)
+      node = blocks%node_list(slot)
+      node_offsets(node + 1) = node_offsets(node + 1) + 1
+    end do
+    node_offsets(1) = 1
+    do node = 1, node_count
+      node_offsets(node + 1) = node_offsets(node + 1) + node_offsets(node)
+    end do
+    allocate (node_blocks(node_offsets(node_count + 1) - 1))
+    next_slot = node_offsets(1:node_count)
+    do k = 1, size(blocks%block_group)
+      do slot = blocks%node_offsets(k), blocks%node_offsets(k + 1) - 1
+        node = blocks%node_list(slot)
+        node_blocks(next_slot(node)) = k
+        next_slot(node) = next_slot(node) + 1
+      end do
+    end do
+
+    allocate (cost(0:rank_count - 1), seen_by(0:rank_count - 1))
+    cost = 0.0_wp
+    do k = 1, size(blocks%block_group)
+      cost(block_owner(k)) = cost(block_owner(k)) + blocks%block_cost(k)
+    end do
+    ! each move lowers the largest cost or the number of ranks at it: at most a few per block
+    do move = 1, 4*size(blocks%block_group)
+      heaviest = maxloc(cost, dim=1) - 1
+      best = cost(heaviest)
+      best_block = 0
+      best_target = -1
+      do k = 1, size(blocks%block_group)
+        if (block_owner(k) /= heaviest) cycle
+        seen_by = 0
+        do slot = blocks%node_offsets(k), blocks%node_offsets(k + 1) - 1
+          node = blocks%node_list(slot)
+          do other = node_offsets(node), node_offsets(node + 1) - 1
+            target = block_owner(node_blocks(other))
+            if (target == heaviest .or. seen_by(target) == 1) cycle
+            seen_by(target) = 1
+            after = max(cost(heaviest) - blocks%block_cost(k), cost(target) + blocks%block_cost(k))
+            if (after < best) then
+              best = after
+              best_block = k
+              best_target = target
+            end if
+          end do
+        end do
+      end do
+      if (best_block == 0) exit
+      cost(heaviest) = cost(heaviest) - blocks%block_cost(best_block)
+      cost(best_target) = cost(best_target) + blocks%block_cost(best_block)
+      block_owner(best_block) = best_target
+    end do
+  end subroutine balance_owners
+
   !> Each node to the lowest rank among the owners of the blocks touching it (rank 0 when none).
   subroutine own_nodes(node_count, blocks, block_owner, node_owner)
     integer, intent(in) :: node_count
@@ -532,6 +609,7 @@ contains
       end do
     end do
 
+    report%node_rank = node_owner
     report%imbalance = balance(report%rank_cost)
     report%computed_imbalance = balance(report%rank_computed_cost)
   contains
@@ -563,9 +641,10 @@ contains
     text = "domain partition: "//integer_text(report%rank_count)//" ranks, "//line//nl
     line = "  rank"
     do g = 1, size(report%kind_names)
-      line = line//pad(trim(report%kind_names(g))//"s", 16)
+      line = line//pad(trim(report%kind_names(g)), 16)
     end do
-    text = text//line//"   blocks    ghost   cost %  owned nodes  interface nodes"//nl
+    text = text//line//"   blocks    ghost   cost %  owned nodes  interface nodes"//nl// &
+           "  (elements per kind; meshfree: background cells)"//nl
     total = max(sum(report%rank_cost), tiny(1.0_wp))
     do r = 1, report%rank_count
       line = pad(integer_text(r - 1), 6)
