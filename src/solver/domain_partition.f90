@@ -416,22 +416,23 @@ contains
     end do
   end subroutine owners_by_majority
 
-  !> Blocks are coarse (64 lanes; a meshfree block costs as much as 200 hexahedra), so the
-  !> majority rule can leave a rank a block or more above its METIS share. Improve it by single
-  !> moves: the rank of the largest cost (the lowest on a tie) hands one of its blocks to a rank
-  !> owning a block that shares a node with it (so domains stay compact) when that lowers the
-  !> larger of the two costs; of the possible moves the one leaving the smaller maximum (then the
-  !> lower block, then the lower rank). Stops when the largest rank has no such move. Serial and
-  !> in a fixed order: the same on every rank. At the end no boundary block of the largest rank
-  !> fits on a neighbour: its excess over that neighbour is below one block's cost.
+  !> Blocks are coarse (64 lanes; a meshfree block costs as much as 200 hexahedra), and where a
+  !> part's blocks are strips of a structured mesh (element_ordering keeps them when they are
+  !> better for the colouring) METIS's regions cross many blocks and the majority rule can leave
+  !> a rank far from its share. Diffusion by single moves evens it out: in sweeps over the
+  !> blocks in order, a block goes from its owner to the cheapest rank (the lowest on a tie)
+  !> owning a block that shares a node with it (so domains stay compact) when the owner's cost
+  !> exceeds that rank's by more than the block's: each move lowers the sum of squared rank
+  !> costs, so the sweeps end; at the end every two neighbouring ranks differ by at most one
+  !> block's cost. Serial and in a fixed order: the same on every rank.
   subroutine balance_owners(blocks, node_count, rank_count, block_owner)
     type(block_list_t), intent(in) :: blocks
     integer, intent(in) :: node_count, rank_count
     integer, intent(inout) :: block_owner(:)
     integer, allocatable :: node_offsets(:), node_blocks(:), next_slot(:), seen_by(:)
     real(wp), allocatable :: cost(:)
-    real(wp) :: best, after
-    integer :: k, slot, node, other, target, heaviest, best_block, best_target, move
+    integer :: k, slot, node, other, target, source, best_target, sweep
+    logical :: moved
 
     ! node -> the blocks touching it
     allocate (node_offsets(node_count + 1), next_slot(node_count))
@@ -459,34 +460,42 @@ contains
     do k = 1, size(blocks%block_group)
       cost(block_owner(k)) = cost(block_owner(k)) + blocks%block_cost(k)
     end do
-    ! each move lowers the largest cost or the number of ranks at it: at most a few per block
-    do move = 1, 4*size(blocks%block_group)
-      heaviest = maxloc(cost, dim=1) - 1
-      best = cost(heaviest)
-      best_block = 0
-      best_target = -1
+    seen_by = 0
+    ! (a bound on the sweeps for safety; they end long before on any mesh tried)
+    do sweep = 1, 1000
+      moved = .false.
       do k = 1, size(blocks%block_group)
-        if (block_owner(k) /= heaviest) cycle
-        seen_by = 0
+        source = block_owner(k)
+        best_target = -1
         do slot = blocks%node_offsets(k), blocks%node_offsets(k + 1) - 1
           node = blocks%node_list(slot)
           do other = node_offsets(node), node_offsets(node + 1) - 1
             target = block_owner(node_blocks(other))
-            if (target == heaviest .or. seen_by(target) == 1) cycle
-            seen_by(target) = 1
-            after = max(cost(heaviest) - blocks%block_cost(k), cost(target) + blocks%block_cost(k))
-            if (after < best) then
-              best = after
-              best_block = k
+            if (target == source .or. seen_by(target) == k) cycle
+            seen_by(target) = k
+            if (best_target < 0) then
+              best_target = target
+            else if (cost(target) < cost(best_target) .or. &
+                     (cost(target) == cost(best_target) .and. target < best_target)) then
               best_target = target
             end if
           end do
         end do
+        ! seen_by holds block numbers: clear it for the next sweep's same block
+        do slot = blocks%node_offsets(k), blocks%node_offsets(k + 1) - 1
+          node = blocks%node_list(slot)
+          do other = node_offsets(node), node_offsets(node + 1) - 1
+            seen_by(block_owner(node_blocks(other))) = 0
+          end do
+        end do
+        if (best_target < 0) cycle
+        if (cost(source) - cost(best_target) <= blocks%block_cost(k)) cycle
+        cost(source) = cost(source) - blocks%block_cost(k)
+        cost(best_target) = cost(best_target) + blocks%block_cost(k)
+        block_owner(k) = best_target
+        moved = .true.
       end do
-      if (best_block == 0) exit
-      cost(heaviest) = cost(heaviest) - blocks%block_cost(best_block)
-      cost(best_target) = cost(best_target) + blocks%block_cost(best_block)
-      block_owner(best_block) = best_target
+      if (.not. moved) exit
     end do
   end subroutine balance_owners
 
