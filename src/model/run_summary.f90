@@ -16,6 +16,9 @@ module run_summary
   type :: partition_summary_t
     integer :: rank_count = 1
     logical :: by_metis = .false.                !< METIS k-way (else one rank, or the contiguous split)
+    !> "metis_kway_elements", "metis_kway_blocks" (domain_partition's choose_owners), "contiguous",
+    !> "one rank"
+    character(len=24) :: method = "one rank"
     !> the element kinds counted per rank, in engine order ("solid", "shell", "meshfree", ...)
     character(len=16), allocatable :: kind_names(:)
     integer, allocatable :: rank_elements(:, :)  !< (kinds, ranks) elements owned (meshfree: cells)

@@ -1486,7 +1486,7 @@ contains
         return
       end if
       call write_integer_attribute(group_id, path, "rank_count", partition%rank_count, error)
-      call write_string_attribute(group_id, path, "method", trim(merge("metis_kway", "contiguous", partition%by_metis)), &
+      call write_string_attribute(group_id, path, "method", trim(partition%method), &
                                   error)
       call write_real_attribute(group_id, path, "imbalance", partition%imbalance, error)
       call write_real_attribute(group_id, path, "computed_imbalance", partition%computed_imbalance, error)
