@@ -167,6 +167,7 @@ contains
     call close_results(results, summary, close_error)
     if (allocated(close_error)) exit_status = 1
     call print_summary(summary, settings, model%implicit_static)
+    if (run%exchange%rank_count > 1) call print_exchange_summary(run, summary%cycles)
     flush (output_unit)
     if (allocated(error)) call report("crashfree: error termination: "//error%message, messages)
     ! last: what the results file holds after a failed write
@@ -345,6 +346,19 @@ contains
     end if
     write (*, '(a)') "  results: "//options%output_dir//"/"//options%job_id//".h5 (and .xdmf for ParaView)"
   end subroutine print_summary
+
+  !> A distributed run: the seconds of the exchanges among the ranks (the first rank's), per
+  !> cycle, and the forces' volume.
+  subroutine print_exchange_summary(run, cycles)
+    type(run_state_t), intent(in) :: run
+    integer, intent(in) :: cycles
+    character(len=200) :: line
+    write (line, '(a,i0,a,f0.3,a,f0.3,a,i0,a,f0.1,a)') "  MPI: ", run%exchange%rank_count, " ranks, exchanges ", &
+      run%exchange%timer%seconds, " s (", 1.0e3_wp*run%exchange%timer%seconds/real(max(1, cycles), wp), &
+      " ms per cycle), block state brought together ", run%exchange%block_gathers, " times; forces ", &
+      8.0e-3_wp*real(size(run%exchange%receive), wp), " kB per cycle to each rank"
+    write (*, '(a)') trim(line)
+  end subroutine print_exchange_summary
 
   function count_text(value) result(text)
     integer, intent(in) :: value
