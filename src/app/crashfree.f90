@@ -2,11 +2,11 @@
 !> The program only reads the command line; everything else lives in libcrashfree.
 program crashfree
   use command_line, only: run_options_t, command_argument_t, get_command_arguments, &
-                          parse_command_line, usage_text
+                          parse_command_line, usage_text, check_launch
   use error_handling, only: error_t
   use job, only: run_job
   use version, only: crashfree_version
-  use rank_communication, only: start_ranks, finish_ranks, rank_index
+  use rank_communication, only: start_ranks, finish_ranks, rank_index, mpi_built
   use, intrinsic :: iso_c_binding, only: c_int
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
   implicit none
@@ -32,6 +32,12 @@ program crashfree
     call finish(2)
   end if
   if (options%notes%count > 0 .and. rank_index() == 0) call write_notes(options%notes%text)
+  ! a build without MPI that a launcher started several times would run the whole job in each
+  call check_launch(mpi_built=mpi_built, error=error)
+  if (allocated(error)) then
+    if (rank_index() == 0) write (error_unit, '(a)') "crashfree: "//error%message
+    call finish(2)
+  end if
   if (options%show_help) then
     if (rank_index() == 0) write (*, '(a)') usage_text()
     call finish(0)

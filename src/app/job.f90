@@ -14,6 +14,7 @@ module job
   use run_state, only: run_state_t
   use explicit_setup, only: set_up_run_state, set_up_warnings
   use explicit_run, only: run_explicit
+  use domain_partition, only: domain_partition_t, partition_domains, partition_text
   use static_analysis, only: run_static
   use results_file, only: results_file_t, open_results, close_results
   use run_summary, only: run_summary_t, status_normal, status_error
@@ -47,6 +48,7 @@ contains
     type(run_state_t) :: run
     type(results_file_t) :: results
     type(run_summary_t) :: summary
+    type(domain_partition_t) :: partition
     type(error_list_t) :: warnings
     type(error_t), allocatable :: error, close_error, ascii_error
     character(len=:), allocatable :: warning_text
@@ -96,6 +98,23 @@ contains
       call report("crashfree: "//error%message, messages)
       return
     end if
+    ! partition=N: the domain partition for N ranks, then stop after the set-up
+    if (settings%partition_ranks > 0) then
+      if (model%implicit_static) then
+        call report("crashfree: partition="//trim(count_text(settings%partition_ranks))//": the deck asks for "// &
+                    "the linear static analysis (*CONTROL_IMPLICIT_GENERAL), which runs on one rank", messages)
+        return
+      end if
+      call partition_domains(model, run%state%groups, settings%partition_ranks, 0, partition, error)
+      if (allocated(error)) then
+        call report("crashfree: "//error%message, messages)
+        return
+      end if
+      summary%partition = partition%report
+    else if (rank_total() > 1 .and. .not. model%implicit_static) then
+      ! a distributed run: the partition its set-up made
+      summary%partition = run%partition%report
+    end if
     ! (the first rank writes every file; the others wait for it to say whether it could)
     if (first_rank) call make_directory(settings%output_dir, error)
     if (allocated(error)) then
@@ -114,6 +133,7 @@ contains
     if (first_rank .and. .not. model%implicit_static) then
       call describe_model(model, run%state, summary)
       flush (output_unit)
+      if (summary%partition%rank_count > 1) write (*, '(a)', advance="no") partition_text(summary%partition)
     end if
     if (.not. model%implicit_static) then
       warning_text = set_up_warnings(model, run%state)
@@ -126,6 +146,9 @@ contains
 
     if (model%implicit_static) then
       call run_static(model, results, summary, error)
+    else if (settings%partition_ranks > 0) then
+      write (*, '(a)') "partition="//trim(count_text(settings%partition_ranks))// &
+        ": the partition only (results.h5 /run/partition, d3hsp); nothing was run"
     else
       ! from here on SIGINT / SIGTERM end the run after a cycle, with the results written (before,
       ! while the deck is read and the model set up, they end the process at once: nothing has

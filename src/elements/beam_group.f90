@@ -14,7 +14,7 @@ module beam_group
   use restart_file, only: restart_store_t, exchange_restart, exchange_restart_count
   use run_summary, only: run_summary_t
   use nodal_state, only: nodal_state_t
-  use element_group, only: element_group_t, element_results_t
+  use element_group, only: element_group_t, element_results_t, distinct_nodes, family_beam
   use element_work, only: append_marked_lanes, booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, &
                           raise_largest_scaling
   use beam_block, only: beam_block_t, build_beam_blocks, beam_block_masses, beam_block_time_steps, &
@@ -34,6 +34,9 @@ module beam_group
     type(gather_list_t) :: colours
   contains
     procedure :: element_count
+    procedure :: block_count
+    procedure :: block_nodes
+    procedure :: block_elements
     procedure :: scale_masses
     procedure :: lump_masses
     procedure :: add_internal_forces
@@ -63,6 +66,7 @@ contains
     select type (group)
     type is (beam_group_t)
       group%name = "beam"
+      group%element_family = family_beam
       call build_beam_blocks(model, group%blocks)
       count = size(group%blocks)
       allocate (group%nodal_mass(block_size, count), group%nodal_inertia(block_size, count), &
@@ -387,4 +391,26 @@ contains
     call exchange_restart(store, "degenerate_element", self%block_degenerate_element(block), error)
     call exchange_beam_block(store, "block", self%blocks(block), error)
   end subroutine exchange_block_state
+
+  integer function block_count(self)
+    class(beam_group_t), intent(in) :: self
+    block_count = size(self%blocks)
+  end function block_count
+
+  !> Both end nodes of the block's beams (the orientation node N3 serves the set-up only).
+  subroutine block_nodes(self, block, nodes)
+    class(beam_group_t), intent(in) :: self
+    integer, intent(in) :: block
+    integer, allocatable, intent(out) :: nodes(:)
+    associate (lanes => self%blocks(block)%element_count)
+      nodes = distinct_nodes(reshape(self%blocks(block)%nodes(1:lanes, 1:2), [lanes*2]))
+    end associate
+  end subroutine block_nodes
+
+  subroutine block_elements(self, block, elements)
+    class(beam_group_t), intent(in) :: self
+    integer, intent(in) :: block
+    integer, allocatable, intent(out) :: elements(:)
+    elements = self%blocks(block)%elements(1:self%blocks(block)%element_count)
+  end subroutine block_elements
 end module beam_group

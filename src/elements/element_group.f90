@@ -28,6 +28,13 @@ module element_group
   private
 
   public :: element_group_t, group_holder_t, element_results_t, distortion_t, shell_output_points
+  public :: distinct_nodes
+
+  !> Which list of the model a group's element numbers index (its header's `element_family`):
+  !> the solids (FE solids, and the meshfree parts' background cells), the shells (FE shells,
+  !> the meshfree shells' background cells) or the beams. The domain partition counts and
+  !> assigns elements by these lists.
+  integer, parameter, public :: family_solid = 1, family_shell = 2, family_beam = 3
 
   !> Elements folded inside out at a corner while their volume stays positive (distortion_check),
   !> checked at every output state.
@@ -73,6 +80,7 @@ module element_group
     logical :: step_not_finite = .false.           !< a block's step was NaN (comparisons skip it)
     integer :: failed_element = 0                  !< an element that inverted or degenerated (0: none)
     type(phase_timer_t) :: timer                   !< wall-clock time of its force calls
+    integer :: element_family = 0                  !< family_solid, family_shell or family_beam
     !> Erosion: an element that meets its material's failure criterion (erosion_criteria) or,
     !> with ERODE, whose step falls below `erosion_time_step`, leaves the force loops for good
     !> in the force call where it fails (no stress, forces, hourglass forces or step from then
@@ -117,6 +125,18 @@ module element_group
     !> back into a group built from the same deck (restart_file's exchange_restart); what the
     !> set-up derives from the deck is not stored.
     procedure(exchange_interface), deferred :: exchange_state
+    !> Set-up (domain partition): its blocks, the units of work a rank computes or not, in the
+    !> order its force call visits them (over all its parts, part after part).
+    procedure(block_count_interface), deferred :: block_count
+    !> Set-up (domain partition): the distinct nodes block `block` reads or adds forces (and
+    !> moments) into, ascending: its elements' corners; for a meshfree
+    !> block the pair nodes of all its points (the supports reach beyond one element layer) and
+    !> what else its force call adds into (the meshfree shells' cell corners and station rows).
+    procedure(block_nodes_interface), deferred :: block_nodes
+    !> Set-up (domain partition): the group's element numbers (element_family's list) of each
+    !> lane of block `block`: an element per lane, for meshfree blocks the background cell of
+    !> each integration point (a cell with several points is listed once per point).
+    procedure(block_elements_interface), deferred :: block_elements
     !> Optional: the failure message of `failed_element` (default: "<describe> inverted").
     procedure :: failure_text
     !> Optional: transform a nodal field from solver values to physical ones (meshfree parts).
@@ -238,6 +258,25 @@ module element_group
       character(len=*), intent(in) :: path
       type(error_t), allocatable, intent(inout) :: error
     end subroutine exchange_interface
+
+    integer function block_count_interface(self)
+      import :: element_group_t
+      class(element_group_t), intent(in) :: self
+    end function block_count_interface
+
+    subroutine block_nodes_interface(self, block, nodes)
+      import :: element_group_t
+      class(element_group_t), intent(in) :: self
+      integer, intent(in) :: block
+      integer, allocatable, intent(out) :: nodes(:)
+    end subroutine block_nodes_interface
+
+    subroutine block_elements_interface(self, block, elements)
+      import :: element_group_t
+      class(element_group_t), intent(in) :: self
+      integer, intent(in) :: block
+      integer, allocatable, intent(out) :: elements(:)
+    end subroutine block_elements_interface
 
     subroutine summary_interface(self, summary)
       import :: element_group_t, run_summary_t
@@ -370,6 +409,61 @@ contains
     logical, intent(in) :: wanted(:)
     real(wp), intent(inout) :: strain(:)
   end subroutine raise_nodal_plastic_strain
+
+  !> The distinct entries of `list`, ascending (block_nodes of every kind; set-up only).
+  pure function distinct_nodes(list) result(nodes)
+    integer, intent(in) :: list(:)
+    integer, allocatable :: nodes(:)
+    integer, allocatable :: sorted(:)
+    integer :: k, count
+    allocate (sorted(size(list)))
+    sorted(:) = list
+    call heap_sort(sorted)
+    allocate (nodes(size(sorted)))
+    count = 0
+    do k = 1, size(sorted)
+      if (count > 0) then
+        if (nodes(count) == sorted(k)) cycle
+      end if
+      count = count + 1
+      nodes(count) = sorted(k)
+    end do
+    nodes = nodes(1:count)
+  end function distinct_nodes
+
+  !> Ascending, in place (n log n whatever the input: a meshfree block lists thousands of pairs).
+  pure subroutine heap_sort(values)
+    integer, intent(inout) :: values(:)
+    integer :: last, first, held
+    do first = size(values)/2, 1, -1
+      call sift_down(values, first, size(values))
+    end do
+    do last = size(values), 2, -1
+      held = values(1)
+      values(1) = values(last)
+      values(last) = held
+      call sift_down(values, 1, last - 1)
+    end do
+  end subroutine heap_sort
+
+  pure subroutine sift_down(values, first, last)
+    integer, intent(inout) :: values(:)
+    integer, intent(in) :: first, last
+    integer :: parent, child, held
+    parent = first
+    held = values(parent)
+    do
+      child = 2*parent
+      if (child > last) exit
+      if (child < last) then
+        if (values(child + 1) > values(child)) child = child + 1
+      end if
+      if (values(child) <= held) exit
+      values(parent) = values(child)
+      parent = child
+    end do
+    values(parent) = held
+  end subroutine sift_down
 
   !> Layers written per shell to the d3plot (its MAXINT): LS-DYNA's default 3 (mid, inner and
   !> outer surface) when no shell section has more than 3 points (NIP), else the largest NIP

@@ -13,7 +13,7 @@ module shell_group
   use restart_file, only: restart_store_t, exchange_restart, exchange_restart_count
   use run_summary, only: run_summary_t
   use nodal_state, only: nodal_state_t
-  use element_group, only: element_group_t, element_results_t
+  use element_group, only: element_group_t, element_results_t, distinct_nodes, family_shell
   use element_work, only: append_marked_lanes, mark_lanes, booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, &
                           raise_largest_scaling
   use shell_block, only: shell_block_t, build_shell_blocks, shell_block_masses, shell_block_time_steps, &
@@ -33,6 +33,9 @@ module shell_group
     type(gather_list_t) :: colours
   contains
     procedure :: element_count
+    procedure :: block_count
+    procedure :: block_nodes
+    procedure :: block_elements
     procedure :: scale_masses
     procedure :: lump_masses
     procedure :: add_internal_forces
@@ -72,6 +75,7 @@ contains
     type(shell_group_t), intent(inout) :: group
     integer :: count
     group%name = "shell"
+    group%element_family = family_shell
     call build_shell_blocks(model, group%blocks)
     count = size(group%blocks)
     allocate (group%corner_mass(block_size, 4, count), group%corner_inertia(block_size, 4, count), &
@@ -457,4 +461,26 @@ contains
     call exchange_restart(store, "degenerate_element", self%block_degenerate_element(block), error)
     call exchange_shell_block(store, "block", self%blocks(block), error)
   end subroutine exchange_block_state
+
+  integer function block_count(self)
+    class(shell_group_t), intent(in) :: self
+    block_count = size(self%blocks)
+  end function block_count
+
+  !> The corner nodes of the block's elements (a degenerate element's repeated node once).
+  subroutine block_nodes(self, block, nodes)
+    class(shell_group_t), intent(in) :: self
+    integer, intent(in) :: block
+    integer, allocatable, intent(out) :: nodes(:)
+    associate (lanes => self%blocks(block)%element_count)
+      nodes = distinct_nodes(reshape(self%blocks(block)%nodes(1:lanes, 1:4), [lanes*4]))
+    end associate
+  end subroutine block_nodes
+
+  subroutine block_elements(self, block, elements)
+    class(shell_group_t), intent(in) :: self
+    integer, intent(in) :: block
+    integer, allocatable, intent(out) :: elements(:)
+    elements = self%blocks(block)%elements(1:self%blocks(block)%element_count)
+  end subroutine block_elements
 end module shell_group

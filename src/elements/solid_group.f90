@@ -10,7 +10,7 @@ module solid_group
   use restart_file, only: restart_store_t, exchange_restart, exchange_restart_count
   use run_summary, only: run_summary_t
   use nodal_state, only: nodal_state_t
-  use element_group, only: element_group_t, element_results_t, distortion_t
+  use element_group, only: element_group_t, element_results_t, distortion_t, distinct_nodes, family_solid
   use element_work, only: append_marked_lanes, mark_lanes, booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, &
                           raise_largest_scaling
   use solid_block, only: solid_block_t, build_solid_blocks, solid_block_corner_masses, solid_block_time_steps, &
@@ -30,6 +30,9 @@ module solid_group
     type(gather_list_t) :: colours                       !< colour -> blocks (CSR)
   contains
     procedure :: element_count
+    procedure :: block_count
+    procedure :: block_nodes
+    procedure :: block_elements
     procedure :: scale_masses
     procedure :: lump_masses
     procedure :: add_internal_forces
@@ -69,6 +72,7 @@ contains
     type(solid_group_t), intent(inout) :: group
     integer :: count
     group%name = "solid"
+    group%element_family = family_solid
     call build_solid_blocks(model, group%blocks)
     count = size(group%blocks)
     allocate (group%corner_mass(block_size, 8, count), group%block_time_step(count), &
@@ -409,4 +413,26 @@ contains
     call exchange_restart(store, "inverted_element", self%block_inverted_element(block), error)
     call exchange_solid_block(store, "block", self%blocks(block), error)
   end subroutine exchange_block_state
+
+  integer function block_count(self)
+    class(solid_group_t), intent(in) :: self
+    block_count = size(self%blocks)
+  end function block_count
+
+  !> The corner nodes of the block's elements (a degenerate element's repeated node once).
+  subroutine block_nodes(self, block, nodes)
+    class(solid_group_t), intent(in) :: self
+    integer, intent(in) :: block
+    integer, allocatable, intent(out) :: nodes(:)
+    associate (lanes => self%blocks(block)%element_count)
+      nodes = distinct_nodes(reshape(self%blocks(block)%nodes(1:lanes, 1:8), [lanes*8]))
+    end associate
+  end subroutine block_nodes
+
+  subroutine block_elements(self, block, elements)
+    class(solid_group_t), intent(in) :: self
+    integer, intent(in) :: block
+    integer, allocatable, intent(out) :: elements(:)
+    elements = self%blocks(block)%elements(1:self%blocks(block)%element_count)
+  end subroutine block_elements
 end module solid_group

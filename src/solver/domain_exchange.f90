@@ -61,8 +61,10 @@ contains
     integer :: k, r, node, filled
     exchange%rank = rank_index()
     exchange%rank_count = rank_total()
+    ! (one rank: no partition, every block computed as always)
+    if (exchange%rank_count == 1) return
     call partition_domains(model, groups, exchange%rank_count, exchange%rank, partition, error)
-    if (allocated(error) .or. exchange%rank_count == 1) return
+    if (allocated(error)) return
     do k = 1, size(groups)
       if (.not. groups(k)%group%distributes_blocks()) cycle
       groups(k)%group%computed = partition%groups(k)%computed
