@@ -375,11 +375,17 @@ contains
   subroutine print_exchange_summary(run, cycles)
     type(run_state_t), intent(in) :: run
     integer, intent(in) :: cycles
-    character(len=200) :: line
-    write (line, '(a,i0,a,f0.3,a,f0.3,a,i0,a,f0.1,a)') "  MPI: ", run%exchange%rank_count, " ranks, exchanges ", &
-      run%exchange%timer%seconds, " s (", 1.0e3_wp*run%exchange%timer%seconds/real(max(1, cycles), wp), &
-      " ms per cycle), block state brought together ", run%exchange%block_gathers, " times; forces ", &
-      8.0e-3_wp*real(size(run%exchange%receive), wp), " kB per cycle to each rank"
+    character(len=240) :: line
+    real(wp) :: per_cycle
+    per_cycle = 1.0e3_wp/real(max(1, cycles), wp)
+    write (line, '(a,i0,a,f0.3,a,f0.1,a,f0.3,a)') "  MPI: ", run%exchange%rank_count, &
+      " ranks; force exchange ", per_cycle*run%exchange%timer%seconds, " ms per cycle (", &
+      8.0e-3_wp*real(size(run%exchange%receive), wp), " kB to each rank), waiting for the slowest rank ", &
+      per_cycle*run%exchange%wait_timer%seconds, " ms per cycle"
+    write (*, '(a)') trim(line)
+    write (line, '(a,i0,a,f0.3,a,f0.1,a)') "  MPI: block state brought together ", run%exchange%block_gathers, &
+      " times (energies, output, dumps), ", run%exchange%gather_timer%seconds, " s, ", &
+      8.0e-6_wp*run%exchange%gathered_values, " MB received"
     write (*, '(a)') trim(line)
   end subroutine print_exchange_summary
 

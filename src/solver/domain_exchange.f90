@@ -20,7 +20,7 @@ module domain_exchange
   use restart_file, only: restart_store_t, start_memory_store
   use wall_clock, only: phase_timer_t, start_phase, stop_phase
   use domain_partition, only: domain_partition_t, partition_domains
-  use rank_communication, only: rank_index, rank_total, gather_reals, gather_fixed_reals
+  use rank_communication, only: rank_index, rank_total, gather_reals, gather_fixed_reals, barrier_ranks
   implicit none
   private
 
@@ -44,7 +44,11 @@ module domain_exchange
     integer :: gathered_cycle = -1              !< the cycle whose block state was last brought together
     integer :: block_gathers = 0                !< how often it was
     type(restart_store_t) :: store              !< this rank's blocks, packed for a gather
-    type(phase_timer_t) :: timer                !< wall-clock time of all exchanges
+    !> wall-clock time of the force and header exchanges; of the wait for the slowest rank before
+    !> them (a barrier: what the ranks' unequal work costs, kept apart from the communication);
+    !> of bringing the blocks together
+    type(phase_timer_t) :: timer, wait_timer, gather_timer
+    real(wp) :: gathered_values = 0.0_wp        !< values received by the block gathers, in all
   end type domain_exchange_t
 
 contains
@@ -104,6 +108,9 @@ contains
     type(domain_exchange_t), intent(inout) :: exchange
     integer :: k, node, first, at
     if (exchange%rank_count == 1) return
+    call start_phase(exchange%wait_timer)
+    call barrier_ranks()
+    call stop_phase(exchange%wait_timer)
     call start_phase(exchange%timer)
     first = exchange%node_offsets(exchange%rank + 1)
     !$omp parallel do schedule(static) default(shared) private(k, node, at)
@@ -212,7 +219,7 @@ contains
     integer, allocatable :: counts(:), offsets(:)
     integer :: k, b, r
     if (exchange%rank_count == 1 .or. exchange%gathered_cycle == cycle) return
-    call start_phase(exchange%timer)
+    call start_phase(exchange%gather_timer)
     call start_memory_store(exchange%store, .true.)
     do k = 1, size(groups)
       if (.not. groups(k)%group%distributes_blocks()) cycle
@@ -244,6 +251,7 @@ contains
     end do
     exchange%gathered_cycle = cycle
     exchange%block_gathers = exchange%block_gathers + 1
-    call stop_phase(exchange%timer)
+    exchange%gathered_values = exchange%gathered_values + real(sum(counts), wp)
+    call stop_phase(exchange%gather_timer)
   end subroutine gather_block_state
 end module domain_exchange

@@ -212,7 +212,7 @@ def test_first_rank_prints_and_too_many_ranks_are_refused(tmp_path):
     process = solver(2, [f"i={deck}", f"outdir={tmp_path / 'two'}"])
     assert process.returncode == 0, process.stdout + process.stderr
     assert process.stdout.count("normal termination") == 1, process.stdout
-    assert "on 2 MPI ranks of 1 thread(s)" in process.stdout and "  MPI: 2 ranks, exchanges" in process.stdout
+    assert "on 2 MPI ranks of 1 thread(s)" in process.stdout and "  MPI: 2 ranks; force exchange" in process.stdout
     tiny = impact_deck(tmp_path / "tiny.k")        # 125 hexahedra: 2 blocks
     process = solver(3, [f"i={tiny}", f"outdir={tmp_path / 'tiny'}"])
     assert process.returncode == 2, process.stdout + process.stderr
