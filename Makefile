@@ -58,13 +58,15 @@ vpath %.f90 $(sort $(dir $(ALL_SOURCES)))
 vpath %.F90 $(sort $(dir $(ALL_SOURCES)))
 
 .PHONY: all deps run taylor test unit regression bench clean debug verify fuzz layers
-# The release build is also published as bin/crashfree and lib/ (library and .mod files).
+# The release build is also published as bin/crashfree and lib/ (library and .mod files). (Checked
+# at every make, not by date: after `make MPI=no` the MPI build's older program is published again.)
 ifeq ($(MODE),release)
 all: bin/crashfree
+.PHONY: bin/crashfree
 bin/crashfree: $(PROGRAM)
 	@mkdir -p bin lib
-	@cp $(PROGRAM) bin/crashfree.new && mv -f bin/crashfree.new bin/crashfree
-	@cp $(LIBRARY) $(MOD)/*.mod lib/
+	@cmp -s $(PROGRAM) bin/crashfree || (cp $(PROGRAM) bin/crashfree.new && mv -f bin/crashfree.new bin/crashfree)
+	@cmp -s $(LIBRARY) lib/libcrashfree.a || cp $(LIBRARY) $(MOD)/*.mod lib/
 else
 all: $(PROGRAM)
 endif

@@ -20,7 +20,8 @@ module domain_exchange
   use restart_file, only: restart_store_t, start_memory_store
   use wall_clock, only: phase_timer_t, start_phase, stop_phase
   use domain_partition, only: domain_partition_t, partition_domains
-  use rank_communication, only: rank_index, rank_total, gather_reals, gather_fixed_reals, barrier_ranks
+  use rank_communication, only: rank_index, rank_total, gather_reals, gather_fixed_reals, barrier_ranks, abort_ranks
+  use text_format, only: integer_text
   implicit none
   private
 
@@ -248,6 +249,11 @@ contains
           if (partition%groups(k)%owner(b) == r) call groups(k)%group%exchange_block_state(reader, b, error)
         end do
       end do
+      ! (ranks that disagree on the blocks' shapes run different builds or decks: no result can
+      ! be trusted, and the others may wait for ever)
+      if (reader%position /= counts(r + 1)) &
+        call abort_ranks("block state from rank "//integer_text(r)//": "//integer_text(counts(r + 1))// &
+                         " values received, "//integer_text(reader%position)//" expected", 1)
     end do
     exchange%gathered_cycle = cycle
     exchange%block_gathers = exchange%block_gathers + 1
