@@ -383,8 +383,9 @@ contains
       8.0e-3_wp*real(size(run%exchange%receive), wp), " kB to each rank), waiting for the slowest rank ", &
       per_cycle*run%exchange%wait_timer%seconds, " ms per cycle"
     write (*, '(a)') trim(line)
-    write (line, '(a,i0,a,f0.3,a,f0.1,a)') "  MPI: block state brought together ", run%exchange%block_gathers, &
-      " times (energies, output, dumps), ", run%exchange%gather_timer%seconds, " s, ", &
+    write (line, '(a,i0,a,i0,a,f0.3,a,f0.1,a)') "  MPI: block state brought together ", run%exchange%block_gathers, &
+      " times (states, dumps, erosion), their energies alone ", run%exchange%energy_gathers, &
+      " times (energy checks, histories): ", run%exchange%gather_timer%seconds, " s, ", &
       8.0e-6_wp*run%exchange%gathered_values, " MB received"
     write (*, '(a)') trim(line)
   end subroutine print_exchange_summary

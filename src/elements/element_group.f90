@@ -173,6 +173,9 @@ module element_group
     !> Optional, with distributes_blocks: write or read the state of one block (as exchange_state
     !> does for all, into a store in memory), so that the ranks can bring their blocks together.
     procedure :: exchange_block_state
+    !> Optional, with distributes_blocks: the same for what add_energies and add_part_energies
+    !> read of one block (energies and powers), all that the energy checks and histories need.
+    procedure :: exchange_block_energies
     !> Whether this rank computes, or owns, block `block` (always, when not distributed).
     procedure, non_overridable :: computes, owns
   end type element_group_t
@@ -335,6 +338,13 @@ contains
     integer, intent(in) :: block
     type(error_t), allocatable, intent(inout) :: error
   end subroutine exchange_block_state
+
+  subroutine exchange_block_energies(self, store, block, error)
+    class(element_group_t), intent(inout) :: self
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: block
+    type(error_t), allocatable, intent(inout) :: error
+  end subroutine exchange_block_energies
 
   pure logical function computes(self, block)
     class(element_group_t), intent(in) :: self

@@ -45,6 +45,7 @@ module solid_group
     procedure :: exchange_state
     procedure :: distributes_blocks
     procedure :: exchange_block_state
+    procedure :: exchange_block_energies
     procedure :: failure_text
     procedure :: most_scaled
     procedure :: check_distortion
@@ -413,6 +414,18 @@ contains
     call exchange_restart(store, "inverted_element", self%block_inverted_element(block), error)
     call exchange_solid_block(store, "block", self%blocks(block), error)
   end subroutine exchange_block_state
+
+  !> One block's energies and powers (what add_energies and add_part_energies read).
+  subroutine exchange_block_energies(self, store, block, error)
+    class(solid_group_t), intent(inout) :: self
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: block
+    type(error_t), allocatable, intent(inout) :: error
+    call exchange_restart(store, "internal_energy", self%blocks(block)%internal_energy, error)
+    call exchange_restart(store, "hourglass_energy", self%blocks(block)%hourglass_energy, error)
+    call exchange_restart(store, "force_power", self%blocks(block)%force_power, error)
+    call exchange_restart(store, "hourglass_power", self%blocks(block)%hourglass_power, error)
+  end subroutine exchange_block_energies
 
   integer function block_count(self)
     class(solid_group_t), intent(in) :: self

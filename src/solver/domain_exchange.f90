@@ -26,6 +26,7 @@ module domain_exchange
   private
 
   public :: domain_exchange_t, set_up_domains, exchange_internal_forces, combine_group_headers, gather_block_state
+  public :: gather_block_energies
 
   !> Values per group in the header exchange: step, critical block, critical element, failed
   !> block, failed element, step not finite, newly eroded (owned blocks).
@@ -43,7 +44,9 @@ module domain_exchange
     real(wp), allocatable :: send(:), receive(:)
     real(wp), allocatable :: header_send(:), header_receive(:, :)
     integer :: gathered_cycle = -1              !< the cycle whose block state was last brought together
-    integer :: block_gathers = 0                !< how often it was
+    integer :: energies_cycle = -1              !< the cycle whose block energies were (or the whole state)
+    integer :: block_gathers = 0                !< how often the whole state was brought together
+    integer :: energy_gathers = 0               !< how often only the energies were
     type(restart_store_t) :: store              !< this rank's blocks, packed for a gather
     !> wall-clock time of the force and header exchanges; of the wait for the slowest rank before
     !> them (a barrier: what the ranks' unequal work costs, kept apart from the communication);
@@ -206,27 +209,60 @@ contains
   end subroutine combine_group_headers
 
   !> Bring every block's state to every rank from its owner (each rank's others are old): before
-  !> anything outside the force call reads block state (energies, output states, dumps, the
-  !> eroded elements). Once per cycle at most; nothing with one rank.
+  !> anything outside the force call reads block state (output states, dumps, the eroded
+  !> elements, the end of the run). Once per cycle at most; nothing with one rank.
   subroutine gather_block_state(groups, partition, exchange, cycle)
     type(group_holder_t), intent(inout) :: groups(:)
     type(domain_partition_t), intent(in) :: partition
     type(domain_exchange_t), intent(inout) :: exchange
     integer, intent(in) :: cycle
+    if (exchange%rank_count == 1 .or. exchange%gathered_cycle == cycle) return
+    call start_phase(exchange%gather_timer)
+    call bring_blocks_together(groups, partition, exchange, .false.)
+    exchange%gathered_cycle = cycle
+    exchange%energies_cycle = cycle
+    exchange%block_gathers = exchange%block_gathers + 1
+    call stop_phase(exchange%gather_timer)
+  end subroutine gather_block_state
+
+  !> The same for the blocks' energies and powers only (exchange_block_energies): what the energy
+  !> checks and the glstat and matsum histories read, a small part of a block's state.
+  subroutine gather_block_energies(groups, partition, exchange, cycle)
+    type(group_holder_t), intent(inout) :: groups(:)
+    type(domain_partition_t), intent(in) :: partition
+    type(domain_exchange_t), intent(inout) :: exchange
+    integer, intent(in) :: cycle
+    if (exchange%rank_count == 1 .or. exchange%energies_cycle == cycle) return
+    call start_phase(exchange%gather_timer)
+    call bring_blocks_together(groups, partition, exchange, .true.)
+    exchange%energies_cycle = cycle
+    exchange%energy_gathers = exchange%energy_gathers + 1
+    call stop_phase(exchange%gather_timer)
+  end subroutine gather_block_energies
+
+  !> The owners pack their blocks (whole, or their energies) into a store in memory, every rank
+  !> receives all stores (MPI_Allgatherv) and unpacks the blocks of the others, rank by rank.
+  subroutine bring_blocks_together(groups, partition, exchange, energies_only)
+    type(group_holder_t), intent(inout) :: groups(:)
+    type(domain_partition_t), intent(in) :: partition
+    type(domain_exchange_t), intent(inout) :: exchange
+    logical, intent(in) :: energies_only
     type(restart_store_t) :: reader
     type(error_t), allocatable :: error
     real(wp) :: length(1)
     real(wp), allocatable :: lengths(:, :), received(:)
     integer, allocatable :: counts(:), offsets(:)
     integer :: k, b, r
-    if (exchange%rank_count == 1 .or. exchange%gathered_cycle == cycle) return
-    call start_phase(exchange%gather_timer)
     call start_memory_store(exchange%store, .true.)
     do k = 1, size(groups)
       if (.not. groups(k)%group%distributes_blocks()) cycle
       do b = 1, size(partition%groups(k)%owner)
-        if (partition%groups(k)%owner(b) == exchange%rank) &
+        if (partition%groups(k)%owner(b) /= exchange%rank) cycle
+        if (energies_only) then
+          call groups(k)%group%exchange_block_energies(exchange%store, b, error)
+        else
           call groups(k)%group%exchange_block_state(exchange%store, b, error)
+        end if
       end do
     end do
     length(1) = real(exchange%store%position, wp)
@@ -246,7 +282,12 @@ contains
       do k = 1, size(groups)
         if (.not. groups(k)%group%distributes_blocks()) cycle
         do b = 1, size(partition%groups(k)%owner)
-          if (partition%groups(k)%owner(b) == r) call groups(k)%group%exchange_block_state(reader, b, error)
+          if (partition%groups(k)%owner(b) /= r) cycle
+          if (energies_only) then
+            call groups(k)%group%exchange_block_energies(reader, b, error)
+          else
+            call groups(k)%group%exchange_block_state(reader, b, error)
+          end if
         end do
       end do
       ! (ranks that disagree on the blocks' shapes run different builds or decks: no result can
@@ -255,9 +296,6 @@ contains
         call abort_ranks("block state from rank "//integer_text(r)//": "//integer_text(counts(r + 1))// &
                          " values received, "//integer_text(reader%position)//" expected", 1)
     end do
-    exchange%gathered_cycle = cycle
-    exchange%block_gathers = exchange%block_gathers + 1
     exchange%gathered_values = exchange%gathered_values + real(sum(counts), wp)
-    call stop_phase(exchange%gather_timer)
-  end subroutine gather_block_state
+  end subroutine bring_blocks_together
 end module domain_exchange

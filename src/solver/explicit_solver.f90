@@ -47,7 +47,7 @@ module explicit_solver
   use run_summary, only: run_summary_t
   use text_format, only: integer_text
   use wall_clock, only: start_phase, stop_phase
-  use domain_exchange, only: exchange_internal_forces, combine_group_headers, gather_block_state
+  use domain_exchange, only: exchange_internal_forces, combine_group_headers, gather_block_energies
   use rank_communication, only: largest_over_ranks
   implicit none
   private
@@ -66,7 +66,7 @@ contains
     if (.not. allocated(error)) call check_runaway_motion(model, run%state, 0.0_wp, error)
     if (allocated(error)) return
     call forces_and_next_step(model, run, 0.0_wp)
-    call gather_block_state(run%state%groups, run%partition, run%exchange, run%state%cycle)
+    call gather_block_energies(run%state%groups, run%partition, run%exchange, run%state%cycle)
     call measured_energies(model, run%state, run%energy_scratch, run%state%energy)
     run%state%energy%initial_total = total_energy(run%state%energy)
     call check_state(model, run, .true., error)
@@ -510,7 +510,7 @@ contains
     call check_elements(model, run%state, error)
     if (.not. allocated(error)) call check_time_step(model, run%state, run%state%stable_time_step, error)
     if (.not. allocated(error) .and. (last .or. mod(run%state%cycle, energy_check_interval) == 0)) then
-      call gather_block_state(run%state%groups, run%partition, run%exchange, run%state%cycle)
+      call gather_block_energies(run%state%groups, run%partition, run%exchange, run%state%cycle)
       call check_energy(model, run%state, run%energy_scratch, error)
       ! energies gone wrong in this cycle because a node ran away: name the node, as the next
       ! cycle's check would, rather than only the energies
