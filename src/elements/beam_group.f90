@@ -47,6 +47,9 @@ module beam_group
     procedure :: describe
     procedure :: add_to_summary
     procedure :: exchange_state
+    procedure :: distributes_blocks
+    procedure :: exchange_block_state
+    procedure :: exchange_block_energies
     procedure :: failure_text
     procedure :: most_scaled
     procedure :: newly_eroded_elements
@@ -160,6 +163,7 @@ contains
       !$omp parallel do schedule(dynamic, 2) default(shared) private(k, b, beam_force)
       do k = self%colours%offsets(colour), self%colours%offsets(colour + 1) - 1
         b = self%colours%corners(k)
+        if (.not. self%computes(b)) cycle
         call compute_beam_block(self%blocks(b), model%materials(self%blocks(b)%material), nodes%coordinates, &
                                 nodes%velocity, nodes%angular_velocity, step, beam_force, self%block_time_step(b), &
                                 self%block_critical_element(b), self%block_degenerate_element(b))
@@ -171,6 +175,7 @@ contains
     ! a failed weld is an eroded element of the group (element_group's erosion contract)
     self%newly_eroded = 0
     do b = 1, size(self%blocks)
+      if (.not. self%owns(b)) cycle
       self%newly_eroded = self%newly_eroded + count(self%blocks(b)%newly_failed(1:self%blocks(b)%element_count))
     end do
     self%eroded_count = self%eroded_count + self%newly_eroded
@@ -370,6 +375,33 @@ contains
     call exchange_restart(store, path//"/stress", block%stress, error)
     call exchange_restart(store, path//"/plastic_strain", block%plastic_strain, error)
   end subroutine exchange_beam_block
+  logical function distributes_blocks(self)
+    class(beam_group_t), intent(in) :: self
+    distributes_blocks = .true.
+  end function distributes_blocks
+
+  !> One block's state and its entries of the per-block step arrays (a store in memory: the
+  !> ranks of a distributed run bring their blocks together).
+  subroutine exchange_block_state(self, store, block, error)
+    class(beam_group_t), intent(inout) :: self
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: block
+    type(error_t), allocatable, intent(inout) :: error
+    call exchange_restart(store, "time_step", self%block_time_step(block), error)
+    call exchange_restart(store, "critical_element", self%block_critical_element(block), error)
+    call exchange_restart(store, "degenerate_element", self%block_degenerate_element(block), error)
+    call exchange_beam_block(store, "block", self%blocks(block), error)
+  end subroutine exchange_block_state
+
+  !> One block's energies and powers (what add_energies and add_part_energies read).
+  subroutine exchange_block_energies(self, store, block, error)
+    class(beam_group_t), intent(inout) :: self
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: block
+    type(error_t), allocatable, intent(inout) :: error
+    call exchange_restart(store, "internal_energy", self%blocks(block)%internal_energy, error)
+    call exchange_restart(store, "force_power", self%blocks(block)%force_power, error)
+  end subroutine exchange_block_energies
 
   integer function block_count(self)
     class(beam_group_t), intent(in) :: self

@@ -91,6 +91,14 @@ module element_group
     integer :: newly_eroded = 0                    !< elements eroded by the last force call
     integer :: eroded_count = 0                    !< elements eroded so far
     real(wp) :: erosion_time_step = 0.0_wp         !< ERODE: DTMIN x the first step (0: off), set by the solver
+    !> Distributed runs (docs/parallel.md), for kinds whose blocks are shared out among the ranks
+    !> (distributes_blocks): the blocks this rank computes (its own and those on a node it owns)
+    !> and those it owns. Not allocated (one rank, or a kind computed whole on every rank): all.
+    !> The header then covers the computed blocks only, and newly_eroded the owned ones; the
+    !> solver makes both global.
+    logical, allocatable :: computed(:), owned(:)
+    integer :: critical_block = 0                  !< the block of critical_element (0: none, or not by block)
+    integer :: failed_block = 0                    !< the block of failed_element (0: none, or not by block)
   contains
     !> Once before the first cycle: its element count (0: the group is dropped).
     procedure(count_interface), deferred :: element_count
@@ -159,6 +167,17 @@ module element_group
     !> Optional (shells): raise `strain(node)`, at the nodes `wanted` flags, to the largest
     !> effective plastic strain of its elements on the node (spot welds failing by EP).
     procedure :: raise_nodal_plastic_strain
+    !> Optional (kinds whose blocks the ranks share out): true; the kind then skips the blocks
+    !> `computed` leaves out in its force call and implements exchange_block_state.
+    procedure :: distributes_blocks
+    !> Optional, with distributes_blocks: write or read the state of one block (as exchange_state
+    !> does for all, into a store in memory), so that the ranks can bring their blocks together.
+    procedure :: exchange_block_state
+    !> Optional, with distributes_blocks: the same for what add_energies and add_part_energies
+    !> read of one block (energies and powers), all that the energy checks and histories need.
+    procedure :: exchange_block_energies
+    !> Whether this rank computes, or owns, block `block` (always, when not distributed).
+    procedure, non_overridable :: computes, owns
   end type element_group_t
 
   !> An array element holding one group of any kind.
@@ -288,16 +307,58 @@ contains
     integer :: b
     self%stable_time_step = huge(1.0_wp)
     self%critical_element = 0
+    self%critical_block = 0
     self%failed_element = 0
+    self%failed_block = 0
+    self%step_not_finite = .false.
     do b = 1, size(block_time_step)
+      ! (a block another rank computes holds an old step)
+      if (.not. self%computes(b)) cycle
       if (block_time_step(b) < self%stable_time_step) then
         self%stable_time_step = block_time_step(b)
         self%critical_element = block_critical_element(b)
+        self%critical_block = b
       end if
-      if (self%failed_element == 0) self%failed_element = block_failed_element(b)
+      if (self%failed_element == 0 .and. block_failed_element(b) /= 0) then
+        self%failed_element = block_failed_element(b)
+        self%failed_block = b
+      end if
+      if (block_time_step(b) /= block_time_step(b)) self%step_not_finite = .true.
     end do
-    self%step_not_finite = any(block_time_step /= block_time_step)
   end subroutine header_from_blocks
+
+  logical function distributes_blocks(self)
+    class(element_group_t), intent(in) :: self
+    distributes_blocks = .false.
+  end function distributes_blocks
+
+  subroutine exchange_block_state(self, store, block, error)
+    class(element_group_t), intent(inout) :: self
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: block
+    type(error_t), allocatable, intent(inout) :: error
+  end subroutine exchange_block_state
+
+  subroutine exchange_block_energies(self, store, block, error)
+    class(element_group_t), intent(inout) :: self
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: block
+    type(error_t), allocatable, intent(inout) :: error
+  end subroutine exchange_block_energies
+
+  pure logical function computes(self, block)
+    class(element_group_t), intent(in) :: self
+    integer, intent(in) :: block
+    computes = .true.
+    if (allocated(self%computed)) computes = self%computed(block)
+  end function computes
+
+  pure logical function owns(self, block)
+    class(element_group_t), intent(in) :: self
+    integer, intent(in) :: block
+    owns = .true.
+    if (allocated(self%owned)) owns = self%owned(block)
+  end function owns
 
   subroutine to_physical(self, field, physical)
     class(element_group_t), intent(in) :: self

@@ -43,6 +43,9 @@ module solid_group
     procedure :: describe
     procedure :: add_to_summary
     procedure :: exchange_state
+    procedure :: distributes_blocks
+    procedure :: exchange_block_state
+    procedure :: exchange_block_energies
     procedure :: failure_text
     procedure :: most_scaled
     procedure :: check_distortion
@@ -156,6 +159,7 @@ contains
       !$omp parallel do schedule(dynamic, 2) default(shared) private(k, b, block_force)
       do k = self%colours%offsets(colour), self%colours%offsets(colour + 1) - 1
         b = self%colours%corners(k)
+        if (.not. self%computes(b)) cycle
         call compute_solid_block(self%blocks(b), model%materials(self%blocks(b)%material), &
                                  nodes%coordinates, nodes%velocity, step, block_force, &
                                  self%block_time_step(b), self%block_critical_element(b), &
@@ -167,7 +171,9 @@ contains
     end do
     call self%header_from_blocks(self%block_time_step, self%block_critical_element, self%block_inverted_element)
     self%newly_eroded = 0
+    ! (distributed: the blocks this rank owns; the solver adds the ranks' counts)
     do b = 1, size(self%blocks)
+      if (.not. self%owns(b)) cycle
       self%newly_eroded = self%newly_eroded + count(self%blocks(b)%newly_eroded)
     end do
     self%eroded_count = self%eroded_count + self%newly_eroded
@@ -391,6 +397,35 @@ contains
     call exchange_restart(store, path//"/eroded", block%eroded, error)
     call exchange_restart(store, path//"/newly_eroded", block%newly_eroded, error)
   end subroutine exchange_solid_block
+  logical function distributes_blocks(self)
+    class(solid_group_t), intent(in) :: self
+    distributes_blocks = .true.
+  end function distributes_blocks
+
+  !> One block's state and its entries of the per-block step arrays (a store in memory: the
+  !> ranks of a distributed run bring their blocks together).
+  subroutine exchange_block_state(self, store, block, error)
+    class(solid_group_t), intent(inout) :: self
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: block
+    type(error_t), allocatable, intent(inout) :: error
+    call exchange_restart(store, "time_step", self%block_time_step(block), error)
+    call exchange_restart(store, "critical_element", self%block_critical_element(block), error)
+    call exchange_restart(store, "inverted_element", self%block_inverted_element(block), error)
+    call exchange_solid_block(store, "block", self%blocks(block), error)
+  end subroutine exchange_block_state
+
+  !> One block's energies and powers (what add_energies and add_part_energies read).
+  subroutine exchange_block_energies(self, store, block, error)
+    class(solid_group_t), intent(inout) :: self
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: block
+    type(error_t), allocatable, intent(inout) :: error
+    call exchange_restart(store, "internal_energy", self%blocks(block)%internal_energy, error)
+    call exchange_restart(store, "hourglass_energy", self%blocks(block)%hourglass_energy, error)
+    call exchange_restart(store, "force_power", self%blocks(block)%force_power, error)
+    call exchange_restart(store, "hourglass_power", self%blocks(block)%hourglass_power, error)
+  end subroutine exchange_block_energies
 
   integer function block_count(self)
     class(solid_group_t), intent(in) :: self
