@@ -7,7 +7,9 @@
 !>   exactly the blocks it owns and those touching a node it owns, so every block touching a
 !>   node is computed on the node's owner (the meshfree blocks' nodes reach beyond their cells);
 !>   every element is on one rank and the counts per rank add up;
-!> - more ranks than blocks: an error naming both numbers.
+!> - more ranks than blocks: an error naming both numbers;
+!> - check_launch: a build without MPI that a launcher started as several processes
+!>   (OMPI_COMM_WORLD_SIZE or PMI_SIZE above 1) is refused; one process, or an MPI build, is not.
 program test_domain_partition
   use kinds, only: wp
   use testing, only: test_suite_t, check, finish_suite
@@ -19,7 +21,25 @@ program test_domain_partition
   use run_state, only: run_state_t
   use explicit_setup, only: set_up_run_state
   use domain_partition, only: domain_partition_t, partition_domains
+  use command_line, only: check_launch
+  use rank_communication, only: start_ranks, finish_ranks
+  use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
   implicit none
+
+  interface
+    function c_setenv(name, value, overwrite) bind(c, name="setenv") result(status)
+      import :: c_char, c_int
+      character(kind=c_char), intent(in) :: name(*), value(*)
+      integer(c_int), value :: overwrite
+      integer(c_int) :: status
+    end function c_setenv
+
+    function c_unsetenv(name) bind(c, name="unsetenv") result(status)
+      import :: c_char, c_int
+      character(kind=c_char), intent(in) :: name(*)
+      integer(c_int) :: status
+    end function c_unsetenv
+  end interface
 
   type(test_suite_t) :: suite
   character(len=:), allocatable :: directory
@@ -27,6 +47,8 @@ program test_domain_partition
   type(run_state_t) :: run
   integer :: ranks
 
+  ! (an MPI build's set-up asks MPI for the ranks: one rank here)
+  call start_ranks()
   suite%name = "domain_partition"
   directory = make_scratch_directory("crashfree_test_domain_partition")
   if (set_up_mixed_model(model, run)) then
@@ -36,6 +58,8 @@ program test_domain_partition
     end do
     call test_too_many_ranks()
   end if
+  call test_launch()
+  call finish_ranks()
   call finish_suite(suite)
 
 contains
@@ -127,6 +151,31 @@ contains
     call check(suite, "8 ranks for 7 blocks: the message names both", &
                index(error%message, "8 ranks") > 0 .and. index(error%message, "7 element blocks") > 0, error%message)
   end subroutine test_too_many_ranks
+
+  subroutine test_launch()
+    type(error_t), allocatable :: error
+    integer(c_int) :: status
+    status = c_unsetenv("OMPI_COMM_WORLD_SIZE"//c_null_char)
+    status = c_unsetenv("PMI_SIZE"//c_null_char)
+    call check_launch(.false., error)
+    call check(suite, "launch: started alone, no launcher variables: runs", .not. allocated(error))
+    status = c_setenv("PMI_SIZE"//c_null_char, "1"//c_null_char, 1_c_int)
+    call check_launch(.false., error)
+    call check(suite, "launch: one process under a launcher: runs", .not. allocated(error))
+    status = c_setenv("OMPI_COMM_WORLD_SIZE"//c_null_char, "3"//c_null_char, 1_c_int)
+    call check_launch(.false., error)
+    call check(suite, "launch: 3 processes of a build without MPI: refused", allocated(error))
+    if (allocated(error)) call check(suite, "launch: the message names the count and what to do", &
+                                     index(error%message, "3 processes") > 0 .and. index(error%message, "mpirun") > 0, &
+                                     error%message)
+    call check_launch(.true., error)
+    call check(suite, "launch: 3 processes of an MPI build: runs", .not. allocated(error))
+    status = c_unsetenv("OMPI_COMM_WORLD_SIZE"//c_null_char)
+    status = c_setenv("PMI_SIZE"//c_null_char, "2"//c_null_char, 1_c_int)
+    call check_launch(.false., error)
+    call check(suite, "launch: PMI_SIZE 2 (MPICH, Slurm) without MPI: refused", allocated(error))
+    status = c_unsetenv("PMI_SIZE"//c_null_char)
+  end subroutine test_launch
 
   integer function block_total(partition)
     type(domain_partition_t), intent(in) :: partition
