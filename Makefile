@@ -10,7 +10,7 @@
 #   make test       install what is missing, build, layer check, unit tests (debug build) and
 #                   regression tests
 #   make layers     check that each folder of src/ uses only the folders below it
-#   make bench      performance figures (ns per element per cycle)
+#   make bench      performance figures (ns per element per cycle; MPI scaling: tools/bench_mpi.sh)
 #   make verify     verification studies (patch test, cantilever): docs/verification.md (NCPU=n)
 #   make MODE=debug checked build in build/debug
 #   make MPI=no     the one-rank build without MPI (in build/MODE-serial); by default MPI is used when
@@ -157,6 +157,7 @@ bench: deps
 	@$(MAKE) --no-print-directory all
 	@bash tools/bench.sh
 	@bash tools/bench_contact.sh
+	@bash tools/bench_mpi.sh
 
 # Verification studies: write the decks, run every case (NCPU threads each, default 1), then
 # write docs/verification.md and its plots (also when a case failed; the exit status says so).

@@ -16,6 +16,9 @@ module run_summary
   type :: partition_summary_t
     integer :: rank_count = 1
     logical :: by_metis = .false.                !< METIS k-way (else one rank, or the contiguous split)
+    !> "metis_kway_elements", "metis_kway_blocks" (domain_partition's choose_owners), "contiguous",
+    !> "one rank"
+    character(len=24) :: method = "one rank"
     !> the element kinds counted per rank, in engine order ("solid", "shell", "meshfree", ...)
     character(len=16), allocatable :: kind_names(:)
     integer, allocatable :: rank_elements(:, :)  !< (kinds, ranks) elements owned (meshfree: cells)
@@ -32,6 +35,7 @@ module run_summary
     !> rank computing each model solid, shell and beam (-1: in no block, e.g. of a rigid part:
     !> every rank does the rigid bodies)
     integer, allocatable :: solid_rank(:), shell_rank(:), beam_rank(:)
+    integer, allocatable :: node_rank(:)         !< rank owning each node (the model's order)
   end type partition_summary_t
 
   type :: run_summary_t

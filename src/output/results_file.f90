@@ -1463,7 +1463,7 @@ contains
   !> first) its elements by kind (`rank_elements`, columns in `kind_names`' order), blocks,
   !> ghost blocks, owned and interface nodes, estimated cost (ns per cycle, owned blocks and with
   !> the ghost blocks); per solid, shell and beam (the mesh's order) the rank computing it, -1
-  !> for none (rigid parts: every rank). Attributes: rank_count, method, imbalance (max / mean
+  !> for none (rigid parts: every rank); per node the rank owning it. Attributes: rank_count, method, imbalance (max / mean
   !> cost), computed_imbalance. A continued run replaces the earlier run's.
   subroutine write_partition(file_id, summary, error)
     integer(hid_t), intent(in) :: file_id
@@ -1486,7 +1486,7 @@ contains
         return
       end if
       call write_integer_attribute(group_id, path, "rank_count", partition%rank_count, error)
-      call write_string_attribute(group_id, path, "method", trim(merge("metis_kway", "contiguous", partition%by_metis)), &
+      call write_string_attribute(group_id, path, "method", trim(partition%method), &
                                   error)
       call write_real_attribute(group_id, path, "imbalance", partition%imbalance, error)
       call write_real_attribute(group_id, path, "computed_imbalance", partition%computed_imbalance, error)
@@ -1501,6 +1501,7 @@ contains
       call write_integer_dataset_1d(group_id, path, "solid_rank", partition%solid_rank, error)
       call write_integer_dataset_1d(group_id, path, "shell_rank", partition%shell_rank, error)
       call write_integer_dataset_1d(group_id, path, "beam_rank", partition%beam_rank, error)
+      call write_integer_dataset_1d(group_id, path, "node_rank", partition%node_rank, error)
       call h5gclose_f(group_id, status)
     end associate
   end subroutine write_partition

@@ -23,7 +23,8 @@
 !>
 !> Elements in no block (rigid parts: the rigid bodies are replicated) get rank -1 in the report.
 module domain_partition
-  use, intrinsic :: iso_c_binding, only: c_int, c_int32_t, c_float, c_ptr, c_null_ptr, c_associated, c_f_pointer
+  use, intrinsic :: iso_c_binding, only: c_int, c_int32_t, c_float, c_ptr, c_null_ptr, c_associated, c_f_pointer, &
+                                         c_loc
   use kinds, only: wp
   use model, only: model_t
   use error_handling, only: error_t, make_error
@@ -117,35 +118,37 @@ contains
 
   !> Estimated wall-clock cost of one lane of a block of the group named `name` for one cycle,
   !> in nanoseconds (one thread): the partition's weights. A meshfree lane is an integration
-  !> point, so a background cell weighs its points together.
+  !> point, so a background cell weighs its points together (8 per solid cell, 4 per shell cell).
   !>
-  !> Measured with `make bench`-style runs (release build, one thread, this machine), the
-  !> run summary's seconds of each group's force calls divided by its lanes and cycles:
+  !> Measured on this project's machine (release build, ncpu=1), each group's force-call seconds
+  !> from the run summary over its lanes and cycles:
   !>
-  !> | kind           | ns per lane per cycle | deck, command                                          |
-  !> |----------------|-----------------------|--------------------------------------------------------|
-  !> | solid          | 135                   | tools/make_bench_deck.py 60x60x8 (28,800 hexahedra), ncpu=1 |
-  !> | shell          | 170                   | tools/make_scaling_deck.py shells (see docs/parallel_scaling.md) |
-  !> | meshfree       | 1,000                 | inputs: meshfree bar, 8 points per cell                |
-  !> | meshfree shell | 1,500                 | inputs: meshfree plate                                 |
-  !> | beam           | 150                   | (few beams in any model; taken as a shell)             |
+  !> | kind           | ns per lane per cycle | run                                                   |
+  !> |----------------|-----------------------|-------------------------------------------------------|
+  !> | solid          | 150  | tools/make_bench_deck.py --cells 30 30 20 --cycles 200: 148.9 ns per hexahedron (README's make bench: 150) |
+  !> | shell          | 540  | inputs/side_impact/coupled.k: 538 ns per shell (NIP 2-3); the tube of make bench, NIP 5 MAT_024: 1,062 |
+  !> | meshfree       | 450  | make_bench_deck.py --cells 12 12 12 --efg-cells 12 (elastic-plastic, DX 1.2): 174 ns per point; side_impact's foam ribs: 1,150; the geometric mean |
+  !> | meshfree shell | 760  | inputs/side_impact/coupled.k: 3,034 ns per cell, 4 points per cell |
+  !> | beam           | 150  | not measured (few beams in a model): taken as a solid |
   !>
-  !> A kind not in the table weighs as a solid. Only the ratios matter to the partition.
+  !> The cost of a lane also depends on the material and the number of integration points; these
+  !> figures only set the ratios between kinds, which is what the partition needs. A kind not in
+  !> the table weighs as a solid.
   pure real(wp) function lane_cost(name)
     character(len=*), intent(in) :: name
     select case (trim(name))
     case ("solid")
-      lane_cost = 135.0_wp
+      lane_cost = 150.0_wp
     case ("shell")
-      lane_cost = 170.0_wp
+      lane_cost = 540.0_wp
     case ("meshfree")
-      lane_cost = 1000.0_wp
+      lane_cost = 450.0_wp
     case ("meshfree shell")
-      lane_cost = 1500.0_wp
+      lane_cost = 760.0_wp
     case ("beam")
       lane_cost = 150.0_wp
     case default
-      lane_cost = 135.0_wp
+      lane_cost = 150.0_wp
     end select
   end function lane_cost
 
@@ -159,7 +162,7 @@ contains
     type(domain_partition_t), intent(out) :: partition
     type(error_t), allocatable, intent(out) :: error
     type(block_list_t) :: blocks
-    integer, allocatable :: element_rank(:), block_owner(:)
+    integer, allocatable :: block_owner(:)
     integer :: block_total, element_total, g, k
 
     if (rank_count < 1 .or. rank < 0 .or. rank >= max(rank_count, 1)) then
@@ -186,10 +189,8 @@ contains
     allocate (block_owner(block_total))
     block_owner = 0
     partition%report%by_metis = .false.
-    if (rank_count > 1) then
-      call rank_elements(model, groups, blocks, rank_count, element_rank, partition%report%by_metis)
-      call owners_by_majority(blocks, element_rank, rank_count, block_owner)
-    end if
+    partition%report%method = "one rank"
+    if (rank_count > 1) call choose_owners(model, groups, blocks, rank_count, block_owner, partition%report)
 
     allocate (partition%groups(size(groups)))
     do g = 1, size(groups)
@@ -208,6 +209,143 @@ contains
     end do
     call report_partition(model, groups, blocks, block_owner, partition%node_owner, rank_count, partition%report)
   end subroutine partition_domains
+
+  !> The block owners of the better of two partitions, both METIS k-way with the same costs and
+  !> both evened out by balance_owners: (a) the element graph, each block to the rank owning most
+  !> of its lanes; (b) the graph of the blocks themselves (adjacent when they share nodes, edges
+  !> weighted by the nodes shared). (a) follows the mesh finely, but where a part's blocks are
+  !> strips or pencils of a structured mesh (element_ordering keeps a deck's order when its
+  !> blocks colour better) METIS's boundaries cut through many blocks and the majority rule makes
+  !> them ragged: on the 513,600-element scaling deck at 16 ranks a domain's interface was 3.6
+  !> times that of a clean cut. (b) cuts between whole blocks. Kept: the one whose largest
+  !> computed cost (owned and ghost blocks: what a rank does in stage 1) is smaller, (a) on a tie.
+  !> Without METIS (no edge, refused): a contiguous split of the elements in block order.
+  subroutine choose_owners(model, groups, blocks, rank_count, block_owner, report)
+    type(model_t), intent(in) :: model
+    type(group_holder_t), intent(in) :: groups(:)
+    type(block_list_t), intent(in) :: blocks
+    integer, intent(in) :: rank_count
+    integer, intent(inout) :: block_owner(:)
+    type(partition_summary_t), intent(inout) :: report
+    type(partition_summary_t) :: by_elements, by_blocks
+    integer, allocatable :: lane_rank(:), block_graph_owner(:), node_owner(:), node_offsets(:), node_blocks(:)
+    logical :: element_metis, block_metis
+
+    call node_block_lists(blocks, size(model%node_ids), node_offsets, node_blocks)
+    call rank_elements(model, groups, blocks, rank_count, lane_rank, element_metis)
+    call owners_by_majority(blocks, lane_rank, rank_count, block_owner)
+    call balance_owners(blocks, node_offsets, node_blocks, rank_count, block_owner)
+    report%by_metis = element_metis
+    report%method = merge("metis_kway_elements", "contiguous         ", element_metis)
+
+    allocate (block_graph_owner(size(block_owner)))
+    call metis_block_ranks(blocks, node_offsets, node_blocks, rank_count, block_graph_owner, block_metis)
+    if (.not. block_metis) return
+    call balance_owners(blocks, node_offsets, node_blocks, rank_count, block_graph_owner)
+    call own_nodes(size(model%node_ids), blocks, block_owner, node_owner)
+    call report_partition(model, groups, blocks, block_owner, node_owner, rank_count, by_elements)
+    call own_nodes(size(model%node_ids), blocks, block_graph_owner, node_owner)
+    call report_partition(model, groups, blocks, block_graph_owner, node_owner, rank_count, by_blocks)
+    if (maxval(by_blocks%rank_computed_cost) < maxval(by_elements%rank_computed_cost) .or. .not. element_metis) then
+      block_owner = block_graph_owner
+      report%by_metis = .true.
+      report%method = "metis_kway_blocks"
+    end if
+  end subroutine choose_owners
+
+  !> METIS k-way on the graph of the blocks (adjacent when they share a node; edge weight: the
+  !> nodes they share; vertex weight: the block's cost). `ok` false when it has no edge or METIS
+  !> refuses.
+  subroutine metis_block_ranks(blocks, node_offsets, node_blocks, rank_count, block_owner, ok)
+    type(block_list_t), intent(in) :: blocks
+    integer, intent(in) :: node_offsets(:), node_blocks(:), rank_count
+    integer, intent(out) :: block_owner(:)
+    logical, intent(out) :: ok
+    integer(idx_t), allocatable, target :: offsets(:), neighbours(:), edge_weight(:)
+    integer(idx_t), allocatable :: vertex_weight(:), options(:), piece(:)
+    integer, allocatable :: shared(:), met(:)
+    integer :: k, slot, other, neighbour, met_count, edge_count, m
+    integer(idx_t) :: edge_cut
+    integer(c_int) :: status
+    type(signal_mask_t) :: signal_mask
+
+    ok = .false.
+    associate (block_count => size(blocks%block_group))
+      allocate (offsets(block_count + 1), shared(block_count), met(block_count), vertex_weight(block_count), &
+                neighbours(0), edge_weight(0))
+      shared = 0
+      offsets(1) = 0
+      edge_count = 0
+      do k = 1, block_count
+        met_count = 0
+        do slot = blocks%node_offsets(k), blocks%node_offsets(k + 1) - 1
+          associate (node => blocks%node_list(slot))
+            do other = node_offsets(node), node_offsets(node + 1) - 1
+              neighbour = node_blocks(other)
+              if (neighbour == k) cycle
+              if (shared(neighbour) == 0) then
+                met_count = met_count + 1
+                met(met_count) = neighbour
+              end if
+              shared(neighbour) = shared(neighbour) + 1
+            end do
+          end associate
+        end do
+        if (edge_count + met_count > size(neighbours)) then
+          neighbours = [neighbours, (0_idx_t, m=1, max(edge_count + met_count, 2*size(neighbours)) - size(neighbours))]
+          edge_weight = [edge_weight, (0_idx_t, m=1, size(neighbours) - size(edge_weight))]
+        end if
+        do m = 1, met_count
+          neighbours(edge_count + m) = int(met(m) - 1, idx_t)
+          edge_weight(edge_count + m) = int(shared(met(m)), idx_t)
+          shared(met(m)) = 0
+        end do
+        edge_count = edge_count + met_count
+        offsets(k + 1) = int(edge_count, idx_t)
+        vertex_weight(k) = int(max(1.0_wp, 10.0_wp*blocks%block_cost(k)), idx_t)
+      end do
+      if (edge_count == 0) return
+      allocate (options(metis_option_count), piece(block_count))
+      call hold_termination_signal(signal_mask)
+      status = metis_set_default_options(options)
+      options(metis_option_seed + 1) = metis_seed
+      options(metis_option_numbering + 1) = 0
+      status = metis_part_graph_kway(int(block_count, idx_t), 1_idx_t, c_loc(offsets), c_loc(neighbours), &
+                                     vertex_weight, c_null_ptr, c_loc(edge_weight), int(rank_count, idx_t), &
+                                     c_null_ptr, c_null_ptr, options, edge_cut, piece)
+      call release_held_signals(signal_mask)
+      ok = status == metis_ok
+      if (ok) block_owner = int(piece)
+    end associate
+  end subroutine metis_block_ranks
+
+  !> node -> the blocks touching it: node_blocks(node_offsets(n) : node_offsets(n+1)-1).
+  subroutine node_block_lists(blocks, node_count, node_offsets, node_blocks)
+    type(block_list_t), intent(in) :: blocks
+    integer, intent(in) :: node_count
+    integer, allocatable, intent(out) :: node_offsets(:), node_blocks(:)
+    integer, allocatable :: next_slot(:)
+    integer :: k, slot, node
+    allocate (node_offsets(node_count + 1), next_slot(node_count))
+    node_offsets = 0
+    do slot = 1, size(blocks%node_list)
+      node = blocks%node_list(slot)
+      node_offsets(node + 1) = node_offsets(node + 1) + 1
+    end do
+    node_offsets(1) = 1
+    do node = 1, node_count
+      node_offsets(node + 1) = node_offsets(node + 1) + node_offsets(node)
+    end do
+    allocate (node_blocks(node_offsets(node_count + 1) - 1))
+    next_slot = node_offsets(1:node_count)
+    do k = 1, size(blocks%block_group)
+      do slot = blocks%node_offsets(k), blocks%node_offsets(k + 1) - 1
+        node = blocks%node_list(slot)
+        node_blocks(next_slot(node)) = k
+        next_slot(node) = next_slot(node) + 1
+      end do
+    end do
+  end subroutine node_block_lists
 
   !> Every block of every group in one list, with its lanes' elements, its nodes and its cost.
   subroutine list_blocks(groups, blocks)
@@ -413,6 +551,68 @@ contains
     end do
   end subroutine owners_by_majority
 
+  !> Blocks are coarse (64 lanes; a meshfree block costs as much as 200 hexahedra), and where a
+  !> part's blocks are strips of a structured mesh (element_ordering keeps them when they are
+  !> better for the colouring) METIS's regions cross many blocks and the majority rule can leave
+  !> a rank far from its share. Diffusion by single moves evens it out: in sweeps over the
+  !> blocks in order, a block goes from its owner to the cheapest rank (the lowest on a tie)
+  !> owning a block that shares a node with it (so domains stay compact) when the owner's cost
+  !> exceeds that rank's by more than the block's: each move lowers the sum of squared rank
+  !> costs, so the sweeps end; at the end every two neighbouring ranks differ by at most one
+  !> block's cost. Serial and in a fixed order: the same on every rank.
+  subroutine balance_owners(blocks, node_offsets, node_blocks, rank_count, block_owner)
+    type(block_list_t), intent(in) :: blocks
+    integer, intent(in) :: node_offsets(:), node_blocks(:), rank_count
+    integer, intent(inout) :: block_owner(:)
+    integer, allocatable :: seen_by(:)
+    real(wp), allocatable :: cost(:)
+    integer :: k, slot, node, other, target, source, best_target, sweep
+    logical :: moved
+
+    allocate (cost(0:rank_count - 1), seen_by(0:rank_count - 1))
+    cost = 0.0_wp
+    do k = 1, size(blocks%block_group)
+      cost(block_owner(k)) = cost(block_owner(k)) + blocks%block_cost(k)
+    end do
+    seen_by = 0
+    ! (a bound on the sweeps for safety; they end long before on any mesh tried)
+    do sweep = 1, 1000
+      moved = .false.
+      do k = 1, size(blocks%block_group)
+        source = block_owner(k)
+        best_target = -1
+        do slot = blocks%node_offsets(k), blocks%node_offsets(k + 1) - 1
+          node = blocks%node_list(slot)
+          do other = node_offsets(node), node_offsets(node + 1) - 1
+            target = block_owner(node_blocks(other))
+            if (target == source .or. seen_by(target) == k) cycle
+            seen_by(target) = k
+            if (best_target < 0) then
+              best_target = target
+            else if (cost(target) < cost(best_target) .or. &
+                     (cost(target) == cost(best_target) .and. target < best_target)) then
+              best_target = target
+            end if
+          end do
+        end do
+        ! seen_by holds block numbers: clear it for the next sweep's same block
+        do slot = blocks%node_offsets(k), blocks%node_offsets(k + 1) - 1
+          node = blocks%node_list(slot)
+          do other = node_offsets(node), node_offsets(node + 1) - 1
+            seen_by(block_owner(node_blocks(other))) = 0
+          end do
+        end do
+        if (best_target < 0) cycle
+        if (cost(source) - cost(best_target) <= blocks%block_cost(k)) cycle
+        cost(source) = cost(source) - blocks%block_cost(k)
+        cost(best_target) = cost(best_target) + blocks%block_cost(k)
+        block_owner(k) = best_target
+        moved = .true.
+      end do
+      if (.not. moved) exit
+    end do
+  end subroutine balance_owners
+
   !> Each node to the lowest rank among the owners of the blocks touching it (rank 0 when none).
   subroutine own_nodes(node_count, blocks, block_owner, node_owner)
     integer, intent(in) :: node_count
@@ -532,6 +732,7 @@ contains
       end do
     end do
 
+    report%node_rank = node_owner
     report%imbalance = balance(report%rank_cost)
     report%computed_imbalance = balance(report%rank_computed_cost)
   contains
@@ -555,17 +756,20 @@ contains
       text = "domain partition: one rank (everything computed here)"//nl
       return
     end if
-    if (report%by_metis) then
+    if (report%method == "metis_kway_elements") then
       line = "METIS k-way on the element graph, weighted by cost"
+    else if (report%method == "metis_kway_blocks") then
+      line = "METIS k-way on the graph of the element blocks, weighted by cost"
     else
       line = "contiguous split by cost (METIS could not partition the element graph)"
     end if
     text = "domain partition: "//integer_text(report%rank_count)//" ranks, "//line//nl
     line = "  rank"
     do g = 1, size(report%kind_names)
-      line = line//pad(trim(report%kind_names(g))//"s", 16)
+      line = line//pad(trim(report%kind_names(g)), 16)
     end do
-    text = text//line//"   blocks    ghost   cost %  owned nodes  interface nodes"//nl
+    text = text//line//"   blocks    ghost   cost %  owned nodes  interface nodes"//nl// &
+           "  (elements per kind; meshfree: background cells)"//nl
     total = max(sum(report%rank_cost), tiny(1.0_wp))
     do r = 1, report%rank_count
       line = pad(integer_text(r - 1), 6)
