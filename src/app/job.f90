@@ -93,6 +93,11 @@ contains
       return
     end if
     if (restart%resuming) call check_restart_deck(restart, settings%deck, sources, error)
+    if (model%implicit_static .and. rank_total() > 1 .and. .not. allocated(error)) then
+      call report("crashfree: the deck asks for the linear static analysis (*CONTROL_IMPLICIT_GENERAL), which "// &
+                  "runs on one rank: run it without mpirun", messages)
+      return
+    end if
     if (.not. (model%implicit_static .or. allocated(error))) call set_up_run_state(model, run, error)
     if (allocated(error)) then
       call report("crashfree: "//error%message, messages)

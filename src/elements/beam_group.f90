@@ -375,6 +375,8 @@ contains
     call exchange_restart(store, path//"/stress", block%stress, error)
     call exchange_restart(store, path//"/plastic_strain", block%plastic_strain, error)
   end subroutine exchange_beam_block
+
+  !> Its blocks are shared out among the ranks of a distributed run (docs/parallel.md).
   logical function distributes_blocks(self)
     class(beam_group_t), intent(in) :: self
     distributes_blocks = .true.

@@ -445,6 +445,8 @@ contains
     call exchange_restart(store, path//"/newly_eroded", block%newly_eroded, error)
     call exchange_restart(store, path//"/point_failed", block%point_failed, error)
   end subroutine exchange_shell_block
+
+  !> Its blocks are shared out among the ranks of a distributed run (docs/parallel.md).
   logical function distributes_blocks(self)
     class(shell_group_t), intent(in) :: self
     distributes_blocks = .true.

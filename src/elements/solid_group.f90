@@ -397,6 +397,8 @@ contains
     call exchange_restart(store, path//"/eroded", block%eroded, error)
     call exchange_restart(store, path//"/newly_eroded", block%newly_eroded, error)
   end subroutine exchange_solid_block
+
+  !> Its blocks are shared out among the ranks of a distributed run (docs/parallel.md).
   logical function distributes_blocks(self)
     class(solid_group_t), intent(in) :: self
     distributes_blocks = .true.

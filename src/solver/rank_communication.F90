@@ -1,8 +1,10 @@
 !> The one module that talks to MPI (mpi_f08): the ranks of a distributed run (docs/parallel.md).
 !> Built with CRASHFREE_MPI (the Makefile defines it when Open MPI's mpifort is installed) it
 !> calls MPI; without it, it is the one-rank version of the same interface, so that the rest of
-!> the engine never asks whether MPI is there. A binary built with MPI and started without
-!> mpirun runs as one rank (MPI's singleton start).
+!> the engine never asks whether MPI is there. A binary built with MPI and started without a
+!> launcher (mpirun, srun) does not start MPI at all and runs as one rank: MPI's singleton start
+!> would spawn a helper process and cost a fraction of a second for nothing. Every routine asks
+!> MPI whether it was started (MPI_Initialized: allowed at any time) rather than keep a flag.
 !>
 !> Everything here is collective over all ranks unless said otherwise: every rank must make the
 !> same calls in the same order. The exchanges only move values, they add nothing: the sums that
@@ -21,7 +23,7 @@ module rank_communication
   private
 
   public :: start_ranks, finish_ranks, rank_index, rank_total, mpi_built, barrier_ranks
-  public :: gather_reals, gather_fixed_reals, largest_over_ranks, integer_sum_over_ranks, any_rank
+  public :: gather_reals, gather_fixed_reals, largest_over_ranks, any_rank
   public :: broadcast_text, abort_ranks
 
   !> Whether this binary was built with MPI (mpirun -np N runs N ranks) or is one rank only.
@@ -33,24 +35,49 @@ module rank_communication
 
 contains
 
-  !> Start MPI (once per process, before anything else: the program calls it). OpenMP threads
-  !> run inside a rank; only the thread that started MPI calls it (FUNNELED).
+  !> Start MPI when a launcher started this process (once, before anything else: the program
+  !> calls it). OpenMP threads run inside a rank; only the thread that started MPI calls it
+  !> (FUNNELED).
   subroutine start_ranks()
 #ifdef CRASHFREE_MPI
-    logical :: started
     integer :: provided
-    call MPI_Initialized(started)
-    if (.not. started) call MPI_Init_thread(MPI_THREAD_FUNNELED, provided)
+    if (mpi_running() .or. .not. launched()) return
+    call MPI_Init_thread(MPI_THREAD_FUNNELED, provided)
 #endif
   end subroutine start_ranks
 
-  !> End MPI (the program calls it last, on every rank).
-  subroutine finish_ranks()
+#ifdef CRASHFREE_MPI
+  !> Whether a launcher started this process: Open MPI's mpirun, or a PMI one (MPICH's Hydra,
+  !> Slurm's srun), each set these.
+  logical function launched()
+    character(len=16) :: setting
+    integer :: length, status, k
+    character(len=20), parameter :: names(4) = [character(len=20) :: "OMPI_COMM_WORLD_SIZE", "PMI_SIZE", &
+                                                 "PMIX_RANK", "PMI_RANK"]
+    launched = .false.
+    do k = 1, size(names)
+      call get_environment_variable(trim(names(k)), setting, length, status)
+      if (status == 0 .or. status == -1) launched = .true.
+    end do
+  end function launched
+#endif
+
+  !> Whether MPI is started and not yet finished (then the exchanges talk to the other ranks).
+  logical function mpi_running()
 #ifdef CRASHFREE_MPI
     logical :: started, finished
     call MPI_Initialized(started)
     call MPI_Finalized(finished)
-    if (started .and. .not. finished) call MPI_Finalize()
+    mpi_running = started .and. .not. finished
+#else
+    mpi_running = .false.
+#endif
+  end function mpi_running
+
+  !> End MPI (the program calls it last, on every rank).
+  subroutine finish_ranks()
+#ifdef CRASHFREE_MPI
+    if (mpi_running()) call MPI_Finalize()
 #endif
   end subroutine finish_ranks
 
@@ -58,7 +85,7 @@ contains
   integer function rank_index()
     rank_index = 0
 #ifdef CRASHFREE_MPI
-    call MPI_Comm_rank(MPI_COMM_WORLD, rank_index)
+    if (mpi_running()) call MPI_Comm_rank(MPI_COMM_WORLD, rank_index)
 #endif
   end function rank_index
 
@@ -66,14 +93,14 @@ contains
   integer function rank_total()
     rank_total = 1
 #ifdef CRASHFREE_MPI
-    call MPI_Comm_size(MPI_COMM_WORLD, rank_total)
+    if (mpi_running()) call MPI_Comm_size(MPI_COMM_WORLD, rank_total)
 #endif
   end function rank_total
 
   !> Wait until every rank got here.
   subroutine barrier_ranks()
 #ifdef CRASHFREE_MPI
-    call MPI_Barrier(MPI_COMM_WORLD)
+    if (mpi_running()) call MPI_Barrier(MPI_COMM_WORLD)
 #endif
   end subroutine barrier_ranks
 
@@ -85,11 +112,13 @@ contains
     integer, intent(in), contiguous :: counts(:), offsets(:)
     real(wp), intent(inout), contiguous :: receive(:)
 #ifdef CRASHFREE_MPI
-    call MPI_Allgatherv(send, counts(rank_index() + 1), MPI_DOUBLE_PRECISION, receive, counts, offsets, &
-                        MPI_DOUBLE_PRECISION, MPI_COMM_WORLD)
-#else
-    receive(offsets(1) + 1:offsets(1) + counts(1)) = send(1:counts(1))
+    if (mpi_running()) then
+      call MPI_Allgatherv(send, counts(rank_index() + 1), MPI_DOUBLE_PRECISION, receive, counts, offsets, &
+                          MPI_DOUBLE_PRECISION, MPI_COMM_WORLD)
+      return
+    end if
 #endif
+    receive(offsets(1) + 1:offsets(1) + counts(1)) = send(1:counts(1))
   end subroutine gather_reals
 
   !> Every rank's `send` (the same size on all) into `receive(:, rank + 1)` on every rank.
@@ -97,11 +126,13 @@ contains
     real(wp), intent(in), contiguous :: send(:)
     real(wp), intent(inout), contiguous :: receive(:, :)
 #ifdef CRASHFREE_MPI
-    call MPI_Allgather(send, size(send), MPI_DOUBLE_PRECISION, receive, size(send), MPI_DOUBLE_PRECISION, &
-                       MPI_COMM_WORLD)
-#else
-    receive(:, 1) = send
+    if (mpi_running()) then
+      call MPI_Allgather(send, size(send), MPI_DOUBLE_PRECISION, receive, size(send), MPI_DOUBLE_PRECISION, &
+                         MPI_COMM_WORLD)
+      return
+    end if
 #endif
+    receive(:, 1) = send
   end subroutine gather_fixed_reals
 
   !> values(k) becomes the largest values(k) of all ranks (exact: a maximum does not depend on
@@ -109,24 +140,17 @@ contains
   subroutine largest_over_ranks(values)
     real(wp), intent(inout), contiguous :: values(:)
 #ifdef CRASHFREE_MPI
-    call MPI_Allreduce(MPI_IN_PLACE, values, size(values), MPI_DOUBLE_PRECISION, MPI_MAX, MPI_COMM_WORLD)
+    if (mpi_running()) call MPI_Allreduce(MPI_IN_PLACE, values, size(values), MPI_DOUBLE_PRECISION, MPI_MAX, &
+                                          MPI_COMM_WORLD)
 #endif
   end subroutine largest_over_ranks
-
-  !> values(k) becomes the sum of values(k) over the ranks (integers: exact in any order).
-  subroutine integer_sum_over_ranks(values)
-    integer, intent(inout), contiguous :: values(:)
-#ifdef CRASHFREE_MPI
-    call MPI_Allreduce(MPI_IN_PLACE, values, size(values), MPI_INTEGER, MPI_SUM, MPI_COMM_WORLD)
-#endif
-  end subroutine integer_sum_over_ranks
 
   !> Whether `flag` is true on some rank.
   logical function any_rank(flag)
     logical, intent(in) :: flag
     any_rank = flag
 #ifdef CRASHFREE_MPI
-    call MPI_Allreduce(flag, any_rank, 1, MPI_LOGICAL, MPI_LOR, MPI_COMM_WORLD)
+    if (mpi_running()) call MPI_Allreduce(flag, any_rank, 1, MPI_LOGICAL, MPI_LOR, MPI_COMM_WORLD)
 #endif
   end function any_rank
 
@@ -136,6 +160,10 @@ contains
     integer, intent(in) :: root
 #ifdef CRASHFREE_MPI
     integer :: length(1)
+    if (.not. mpi_running()) then
+      if (root /= 0 .or. .not. allocated(text)) text = ""
+      return
+    end if
     length = 0
     if (rank_index() == root .and. allocated(text)) length = len(text)
     call MPI_Bcast(length, 1, MPI_INTEGER, root, MPI_COMM_WORLD)
@@ -165,7 +193,7 @@ contains
     end if
     flush (error_unit)
 #ifdef CRASHFREE_MPI
-    call MPI_Abort(MPI_COMM_WORLD, status)
+    if (mpi_running()) call MPI_Abort(MPI_COMM_WORLD, status)
 #endif
     ! (Fortran 2008's error stop takes a constant)
     if (status == 2) error stop 2

@@ -29,7 +29,7 @@ from test_threads import (DENSITY, MODULUS, POISSON, TANGENT, YIELD, _first_diff
                           contact_deck, meshfree_deck, rigid_deck)
 
 RANK_COUNTS = (1, 2, 3)
-CYCLES = 200
+CYCLES = 100
 # what may differ between runs on different numbers of ranks (besides /timing)
 RUN_ATTRIBUTES_ALLOWED_TO_DIFFER = {"threads", "run_id"}
 RANK_REPORT = "run/partition"
@@ -151,14 +151,14 @@ def test_contact_model_is_identical_on_one_two_and_three_ranks(tmp_path):
 
 def test_contact_model_with_two_threads_per_rank(tmp_path):
     """Two ranks of two threads each: the same file as one rank of two threads."""
-    deck = shortened(contact_deck(tmp_path / "contact.k"), 100)
+    deck = shortened(contact_deck(tmp_path / "contact.k"))
     assert_same_on_every_rank_count(deck, tmp_path, counts=(2,), threads=2)
 
 
 def test_meshfree_model_is_identical_on_one_two_and_three_ranks(tmp_path):
     """test_threads' coupled EFG / FE bar against a rigid wall (the meshfree part is computed
     on every rank, the finite elements are shared out)."""
-    deck = shortened(meshfree_deck(tmp_path / "meshfree.k"))
+    deck = shortened(meshfree_deck(tmp_path / "meshfree.k"), 60)
     reference = assert_same_on_every_rank_count(deck, tmp_path)
     with h5py.File(reference, "r") as results:
         assert results["history/matsum/1/internal_energy"][-1] > 0.0
@@ -168,7 +168,7 @@ def test_meshfree_model_is_identical_on_one_two_and_three_ranks(tmp_path):
 def test_eroding_shells_are_identical_on_one_two_and_three_ranks(tmp_path):
     """The contact model with a brittle steel (FS 0.5 %): the plate's shells fail on impact; the
     failed elements, their order and their energy are the same on every rank count."""
-    deck = shortened(brittle(contact_deck(tmp_path / "erode.k"), 0.005), 150)
+    deck = shortened(brittle(contact_deck(tmp_path / "erode.k"), 0.005))
     reference = assert_same_on_every_rank_count(deck, tmp_path)
     with h5py.File(reference, "r") as results:
         eroded = results["history/glstat/eroded_elements"][...]
@@ -185,11 +185,11 @@ def test_rigid_body_model_is_identical_on_one_two_and_three_ranks(tmp_path):
 
 
 def test_restart_on_another_number_of_ranks(tmp_path):
-    """Dumps every 50 cycles of the contact model on 2 ranks; the second continued on 3 ranks
+    """Dumps every 30 cycles of the contact model on 2 ranks; the second continued on 3 ranks
     and the third on 1 rank (alone) give the uninterrupted run's file."""
     deck = shortened(contact_deck(tmp_path / "contact.k"))
     text = deck.read_text()
-    deck.write_text(text.replace("*PART\n", "*DATABASE_BINARY_D3DUMP\n" + fields(50) + "\n*PART\n", 1))
+    deck.write_text(text.replace("*PART\n", "*DATABASE_BINARY_D3DUMP\n" + fields(30) + "\n*PART\n", 1))
     reference = run(deck, tmp_path / "alone", None)
     dumped = run(deck, tmp_path / "two", 2)
     assert not results_difference(reference, dumped)
