@@ -161,7 +161,7 @@ contains
 
   !> The partition of the model's element groups (`groups`, in element_groups' order, set up)
   !> over `rank_count` ranks as seen from rank `rank` (module comment). Error: a rank count
-  !> below 1 or above the number of blocks.
+  !> below 1, or several ranks and more of them than blocks.
   subroutine partition_domains(model, groups, rank_count, rank, partition, error)
     type(model_t), intent(in) :: model
     type(group_holder_t), intent(in) :: groups(:)
@@ -183,7 +183,8 @@ contains
     do g = 1, size(groups)
       element_total = element_total + groups(g)%group%element_count()
     end do
-    if (rank_count > block_total) then
+    ! (one rank takes any model, also one whose elements are all rigid: no block)
+    if (rank_count > 1 .and. rank_count > block_total) then
       call make_error(error, "domain partition: "//integer_text(rank_count)//" ranks are more than the model's "// &
                       integer_text(block_total)//" element blocks ("//integer_text(element_total)// &
                       " elements, at most 64 of one part per block); use at most "//integer_text(block_total)// &
