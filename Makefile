@@ -10,18 +10,30 @@
 #   make test       install what is missing, build, layer check, unit tests (debug build) and
 #                   regression tests
 #   make layers     check that each folder of src/ uses only the folders below it
-#   make bench      performance figures (ns per element per cycle)
+#   make bench      performance figures (ns per element per cycle; MPI scaling: tools/bench_mpi.sh)
 #   make verify     verification studies (patch test, cantilever): docs/verification.md (NCPU=n)
 #   make MODE=debug checked build in build/debug
+#   make MPI=no     the one-rank build without MPI (in build/MODE-serial); by default MPI is used when
+#                   Open MPI's mpifort is installed (docs/parallel.md: mpirun -np N bin/crashfree ...)
 MODE ?= release
-FC := gfortran
+MPI ?= $(if $(shell command -v mpifort 2>/dev/null),yes,no)
+# With MPI everything is compiled by the mpifort wrapper (the same gfortran underneath) and the
+# preprocessed sources (*.F90: the communication module) see CRASHFREE_MPI; without it they
+# compile to the one-rank version of the same interface.
+ifeq ($(MPI),yes)
+  FC := mpifort
+  PREPROCESSOR_FLAGS := -DCRASHFREE_MPI
+else
+  FC := gfortran
+  PREPROCESSOR_FLAGS :=
+endif
 PYTHON ?= python3
 
 HDF5_INCLUDE ?= /usr/include/hdf5/serial
 HDF5_LIBDIR ?= /usr/lib/x86_64-linux-gnu/hdf5/serial
 LIBS := -L$(HDF5_LIBDIR) -lhdf5_fortran -lhdf5 -lmetis -llapack -lblas
 
-BUILD ?= build/$(MODE)
+BUILD ?= build/$(MODE)$(if $(filter no,$(MPI)),-serial)
 OBJ := $(BUILD)/obj
 MOD := $(BUILD)/mod
 ifeq ($(MODE),debug)
@@ -35,8 +47,8 @@ LIBRARY := $(BUILD)/lib/libcrashfree.a
 PROGRAM := $(BUILD)/bin/crashfree
 FFLAGS += -J$(MOD) -I$(MOD) -I$(HDF5_INCLUDE)
 
-LIBRARY_SOURCES := $(sort $(shell find src -name '*.f90' ! -path 'src/app/crashfree.f90'))
-LIBRARY_OBJECTS := $(patsubst %.f90,$(OBJ)/%.o,$(notdir $(LIBRARY_SOURCES)))
+LIBRARY_SOURCES := $(sort $(shell find src \( -name '*.f90' -o -name '*.F90' \) ! -path 'src/app/crashfree.f90'))
+LIBRARY_OBJECTS := $(addprefix $(OBJ)/,$(addsuffix .o,$(basename $(notdir $(LIBRARY_SOURCES)))))
 TEST_SUPPORT := tests/unit/testing.f90 tests/unit/fixtures.f90
 TEST_SOURCES := $(sort $(wildcard tests/unit/test_*.f90))
 TEST_PROGRAMS := $(patsubst tests/unit/%.f90,$(BUILD)/tests/%,$(TEST_SOURCES))
@@ -46,15 +58,18 @@ C_TEST_PROGRAMS := $(patsubst tests/unit/%.c,$(BUILD)/tests/%,$(C_TEST_SOURCES))
 ALL_SOURCES := $(LIBRARY_SOURCES) src/app/crashfree.f90 $(TEST_SUPPORT) $(TEST_SOURCES)
 
 vpath %.f90 $(sort $(dir $(ALL_SOURCES)))
+vpath %.F90 $(sort $(dir $(ALL_SOURCES)))
 
 .PHONY: all deps run taylor test unit regression bench clean debug verify fuzz layers
-# The release build is also published as bin/crashfree and lib/ (library and .mod files).
+# The release build is also published as bin/crashfree and lib/ (library and .mod files). (Checked
+# at every make, not by date: after `make MPI=no` the MPI build's older program is published again.)
 ifeq ($(MODE),release)
 all: bin/crashfree
+.PHONY: bin/crashfree
 bin/crashfree: $(PROGRAM)
 	@mkdir -p bin lib
-	@cp $(PROGRAM) bin/crashfree.new && mv -f bin/crashfree.new bin/crashfree
-	@cp $(LIBRARY) $(MOD)/*.mod lib/
+	@cmp -s $(PROGRAM) bin/crashfree || (cp $(PROGRAM) bin/crashfree.new && mv -f bin/crashfree.new bin/crashfree)
+	@cmp -s $(LIBRARY) lib/libcrashfree.a || cp $(LIBRARY) $(MOD)/*.mod lib/
 else
 all: $(PROGRAM)
 endif
@@ -62,12 +77,17 @@ endif
 $(OBJ)/%.o: %.f90 | $(OBJ) $(MOD)
 	$(FC) $(FFLAGS) $(SOURCE_FLAGS) -c $< -o $@
 
+$(OBJ)/%.o: %.F90 | $(OBJ) $(MOD)
+	$(FC) $(FFLAGS) $(PREPROCESSOR_FLAGS) $(SOURCE_FLAGS) -c $< -o $@
+
 # The keyword readers share one interface (deck_keyword_table's keyword_reader): not every
 # reader needs every argument. (`private`: not passed on to the modules they use.)
 $(OBJ)/deck_%.o: private SOURCE_FLAGS := -Wno-unused-dummy-argument
 # Likewise the element kinds: every group implements element_group's procedures, not every kind
 # needs every argument (meshfree parts have no hourglass energy, no mass scaling).
 $(OBJ)/element_group.o $(OBJ)/%_group.o: private SOURCE_FLAGS := -Wno-unused-dummy-argument
+# The one-rank version of the communication module leaves its arguments alone.
+$(OBJ)/rank_communication.o: private SOURCE_FLAGS := -Wno-unused-dummy-argument
 
 $(OBJ) $(MOD) $(BUILD)/tests $(dir $(LIBRARY)) $(dir $(PROGRAM)):
 	@mkdir -p $@
@@ -146,6 +166,7 @@ bench: deps
 	@$(MAKE) --no-print-directory all
 	@bash tools/bench.sh
 	@bash tools/bench_contact.sh
+	@bash tools/bench_mpi.sh
 
 # Verification studies: write the decks, run every case (NCPU threads each, default 1), then
 # write docs/verification.md and its plots (also when a case failed; the exit status says so).

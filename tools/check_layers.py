@@ -19,7 +19,7 @@ other.
 - static (the linear static analysis) assembles element and EFG stiffness and writes its one
   state through output; the job (app) runs it or the explicit run.
 
-Every `use` of every src/**/*.f90 is checked (intrinsic and library modules such as hdf5 are
+Every `use` of every src/**/*.f90 (and preprocessed *.F90) is checked (intrinsic and library modules such as hdf5 are
 not the project's and are skipped). Uses listed in ALLOWED_FOR_NOW are reported but do not fail
 the check; an entry that no longer occurs fails it, so that the list only shrinks. Prints every
 violation and exits with status 1 when there is one. Usage: check_layers.py [SRC_DIR]
@@ -68,7 +68,7 @@ def scan(src: Path):
     """Module -> folder, and (file, line number, module used) for every use statement."""
     defined = {}
     uses = []
-    for path in sorted(src.rglob("*.f90")):
+    for path in sorted([*src.rglob("*.f90"), *src.rglob("*.F90")]):
         relative = path.relative_to(src).as_posix()
         for number, line in enumerate(path.read_text(errors="replace").splitlines(), start=1):
             code = line.split("!")[0]

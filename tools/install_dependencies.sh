@@ -4,14 +4,24 @@
 # ParaView's readers and off-screen pictures (postproc/render_state.py, tests/regression/
 # test_paraview.py) come with the `vtk` package of PyPI; it draws without a display through EGL,
 # which Mesa's libraries give on a machine without a GPU (libegl1, libegl-mesa0, libgl1-mesa-dri).
+# MPI domains (docs/parallel_scaling.md): Open MPI's compiler wrapper mpifort and launcher mpirun
+# (libopenmpi-dev, openmpi-bin), installed also when the packages are there but the commands are
+# not on the PATH.
 set -euo pipefail
 
 debian_packages=(gfortran make libhdf5-dev libmetis-dev liblapack-dev libopenblas-dev python3 python3-pip
-                 libegl1 libegl-mesa0 libgl1-mesa-dri)
+                 libegl1 libegl-mesa0 libgl1-mesa-dri libopenmpi-dev openmpi-bin)
 missing=()
 for package in "${debian_packages[@]}"; do
   dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")
 done
+if ! command -v mpifort >/dev/null || ! command -v mpirun >/dev/null; then
+  for package in libopenmpi-dev openmpi-bin; do
+    [[ " ${missing[*]} " == *" $package "* ]] || missing+=("$package")
+  done
+  # installed but not on the PATH: reinstall puts the alternatives (mpifort, mpirun) back
+  reinstall_mpi=1
+fi
 if ((${#missing[@]})); then
   echo "crashfree: installing Debian packages: ${missing[*]}"
   sudo_prefix=""
@@ -19,6 +29,15 @@ if ((${#missing[@]})); then
   export DEBIAN_FRONTEND=noninteractive
   $sudo_prefix apt-get update -qq
   $sudo_prefix apt-get install -y -qq "${missing[@]}" >/dev/null
+  if [ -n "${reinstall_mpi:-}" ] && ! command -v mpifort >/dev/null; then
+    $sudo_prefix apt-get install -y -qq --reinstall libopenmpi-dev openmpi-bin >/dev/null
+  fi
+fi
+# the check that the MPI build can go ahead (as the Python imports below)
+if ! command -v mpifort >/dev/null || ! command -v mpirun >/dev/null; then
+  echo "crashfree: Open MPI's mpifort and mpirun are still missing after installing libopenmpi-dev and" \
+       "openmpi-bin: the MPI build cannot be made" >&2
+  exit 1
 fi
 
 python=${PYTHON:-python3}

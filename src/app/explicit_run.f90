@@ -13,9 +13,12 @@ module explicit_run
   use results_file, only: results_file_t
   use run_summary, only: run_summary_t
   use restart_control, only: restart_control_t, write_due_dumps, resume_run
-  use stop_signals, only: received_stop_signal, progress_line_requested, signal_name
+  use stop_signals, only: received_stop_signal, progress_line_requested, signal_name, signal_terminate
   use progress_report, only: start_progress, report_progress
   use wall_clock, only: start_phase, stop_phase
+  use output_plan, only: clock_is_due
+  use domain_exchange, only: gather_block_state, gather_block_energies
+  use rank_communication, only: any_rank
   implicit none
   private
 
@@ -49,11 +52,12 @@ contains
     end if
     call check_distortion(model, run, finished)
     call output(model, run, results, finished, output_error)
+    call share_output_failure(output_error)
     if (allocated(output_error)) then
       finished = .true.
       if (.not. allocated(error)) call move_alloc(output_error, error)
     end if
-    call start_progress(run%progress, model%end_time, model%end_cycle)
+    if (run%exchange%rank == 0) call start_progress(run%progress, model%end_time, model%end_cycle)
 
     do while (.not. finished)
       call advance_and_check(model, run, finished, error)
@@ -65,9 +69,11 @@ contains
       if (clean) call write_due_dumps(restart, model, run, summary%setup_s, results, allocated(error), finished, error)
       call check_distortion(model, run, finished)
       call output(model, run, results, finished, output_error)
+      call share_output_failure(output_error)
       if (allocated(output_error)) exit
-      call report_progress(run%progress, run%state%cycle, run%state%time, run%state%time_step, &
-                           finished .or. progress_line_requested())
+      if (run%exchange%rank == 0) &
+        call report_progress(run%progress, run%state%cycle, run%state%time, run%state%time_step, &
+                             finished .or. progress_line_requested())
     end do
 
     if (allocated(output_error) .and. .not. allocated(error)) call move_alloc(output_error, error)
@@ -82,7 +88,9 @@ contains
     character(len=40) :: text
     integer :: number
     number = received_stop_signal()
-    if (number == 0) return
+    ! (every rank stops after the same cycle; mpirun passes a signal to all, not at one instant)
+    if (.not. any_rank(number /= 0)) return
+    if (number == 0) number = signal_terminate
     write (text, '(es12.5,a,i0)') state%time, ", cycle ", state%cycle
     call make_error(error, "stopped by "//signal_name(number)//" at time "//trim(adjustl(text))// &
                     ": the results hold the run up to this time")
@@ -95,8 +103,23 @@ contains
     logical, intent(in) :: last
     type(error_t), allocatable, intent(out) :: error
     call start_phase(run%timers(phase_output))
+    ! a distributed run: the blocks' state from their owners when the output reads it (the
+    ! histories only their energies)
+    if (clock_is_due(run%plan%states, run%state%time, last)) then
+      call gather_block_state(run%state%groups, run%partition, run%exchange, run%state%cycle)
+    else if (clock_is_due(run%plan%glstat, run%state%time, last) .or. clock_is_due(run%plan%matsum, run%state%time, last)) then
+      call gather_block_energies(run%state%groups, run%partition, run%exchange, run%state%cycle)
+    end if
+    ! (and all of it at the end: d3hsp, the summary)
+    if (last) call gather_block_state(run%state%groups, run%partition, run%exchange, run%state%cycle)
     call write_due_output(model, run%state, run%plan, run%histories, run%energy_scratch, results, last, error)
     call stop_phase(run%timers(phase_output))
   end subroutine output
 
+  !> Only the first rank writes files: a failure there ends the run on every rank.
+  subroutine share_output_failure(error)
+    type(error_t), allocatable, intent(inout) :: error
+    if (any_rank(allocated(error)) .and. .not. allocated(error)) &
+      call make_error(error, "the first rank could not write the output")
+  end subroutine share_output_failure
 end module explicit_run

@@ -14,6 +14,7 @@ module job
   use run_state, only: run_state_t
   use explicit_setup, only: set_up_run_state, set_up_warnings
   use explicit_run, only: run_explicit
+  use domain_partition, only: domain_partition_t, partition_domains, partition_text
   use static_analysis, only: run_static
   use results_file, only: results_file_t, open_results, close_results
   use run_summary, only: run_summary_t, status_normal, status_error
@@ -27,6 +28,7 @@ module job
   use ascii_run_summary, only: write_d3hsp, write_messag
   use restart_control, only: restart_control_t, prepare_restart, check_restart_deck, set_up_restart_control, &
                              continue_restart_results, count_earlier_run
+  use rank_communication, only: rank_index, rank_total, any_rank
   use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
   !$ use omp_lib, only: omp_set_num_threads, omp_get_max_threads
   implicit none
@@ -46,12 +48,14 @@ contains
     type(run_state_t) :: run
     type(results_file_t) :: results
     type(run_summary_t) :: summary
+    type(domain_partition_t) :: partition
     type(error_list_t) :: warnings
     type(error_t), allocatable :: error, close_error, ascii_error
     character(len=:), allocatable :: warning_text
     character(len=:), allocatable :: messages    !< every warning and error printed (messag)
     character(len=:), allocatable :: warning_lines   !< the warnings among them (/run/warnings)
     logical :: output_ready
+    logical :: first_rank    !< a distributed run: only the first rank prints and writes files
     real(wp) :: started
 
     started = seconds_now()
@@ -59,6 +63,7 @@ contains
     messages = ""
     warning_lines = ""
     output_ready = .false.
+    first_rank = rank_index() == 0
     ! r=: the deck, output directory and job of the dump unless given
     settings = options
     if (allocated(settings%restart_file)) &
@@ -68,8 +73,13 @@ contains
       return
     end if
     summary%threads = select_threads(settings%threads)
-    write (*, '(a)') "crashfree "//crashfree_version//": "//settings%deck//" on "//trim(count_text(summary%threads))// &
-      " thread(s)"
+    if (first_rank .and. rank_total() > 1) then
+      write (*, '(a)') "crashfree "//crashfree_version//": "//settings%deck//" on "//trim(count_text(rank_total()))// &
+        " MPI ranks of "//trim(count_text(summary%threads))//" thread(s)"
+    else if (first_rank) then
+      write (*, '(a)') "crashfree "//crashfree_version//": "//settings%deck//" on "//trim(count_text(summary%threads))// &
+        " thread(s)"
+    end if
     flush (output_unit)
 
     call read_deck(settings%deck, model, warnings, error, settings%ignore_unknown, sources)
@@ -83,31 +93,54 @@ contains
       return
     end if
     if (restart%resuming) call check_restart_deck(restart, settings%deck, sources, error)
+    if (model%implicit_static .and. rank_total() > 1 .and. .not. allocated(error)) then
+      call report("crashfree: the deck asks for the linear static analysis (*CONTROL_IMPLICIT_GENERAL), which "// &
+                  "runs on one rank: run it without mpirun", messages)
+      return
+    end if
     if (.not. (model%implicit_static .or. allocated(error))) call set_up_run_state(model, run, error)
     if (allocated(error)) then
       call report("crashfree: "//error%message, messages)
       return
     end if
-    call make_directory(settings%output_dir, error)
+    ! partition=N: the domain partition for N ranks, then stop after the set-up
+    if (settings%partition_ranks > 0) then
+      if (model%implicit_static) then
+        call report("crashfree: partition="//trim(count_text(settings%partition_ranks))//": the deck asks for "// &
+                    "the linear static analysis (*CONTROL_IMPLICIT_GENERAL), which runs on one rank", messages)
+        return
+      end if
+      call partition_domains(model, run%state%groups, settings%partition_ranks, 0, partition, error)
+      if (allocated(error)) then
+        call report("crashfree: "//error%message, messages)
+        return
+      end if
+      summary%partition = partition%report
+    else if (rank_total() > 1 .and. .not. model%implicit_static) then
+      ! a distributed run: the partition its set-up made
+      summary%partition = run%partition%report
+    end if
+    ! (the first rank writes every file; the others wait for it to say whether it could)
+    if (first_rank) call make_directory(settings%output_dir, error)
     if (allocated(error)) then
       call report("crashfree: "//error%message, messages)
-      return
-    end if
-    if (restart%resuming) then
+    else if (first_rank .and. restart%resuming) then
       call continue_restart_results(restart, results, settings%output_dir, settings%job_id, model, summary%threads, &
                                     error, d3plot_scale=settings%binary_file_scale)
-    else
+      if (allocated(error)) call report("crashfree: "//error%message, messages)
+    else if (first_rank) then
       call open_results(results, settings%output_dir, settings%job_id, model, summary%threads, error, &
                         d3plot_scale=settings%binary_file_scale)
+      if (allocated(error)) call report("crashfree: "//error%message, messages)
     end if
-    if (allocated(error)) then
-      call report("crashfree: "//error%message, messages)
-      return
-    end if
-    output_ready = .true.
-    if (.not. model%implicit_static) then
+    if (any_rank(allocated(error))) return
+    output_ready = first_rank
+    if (first_rank .and. .not. model%implicit_static) then
       call describe_model(model, run%state, summary)
       flush (output_unit)
+      if (summary%partition%rank_count > 1) write (*, '(a)', advance="no") partition_text(summary%partition)
+    end if
+    if (.not. model%implicit_static) then
       warning_text = set_up_warnings(model, run%state)
       if (len(warning_text) > 0) then
         call report(warning_text, messages)
@@ -118,6 +151,9 @@ contains
 
     if (model%implicit_static) then
       call run_static(model, results, summary, error)
+    else if (settings%partition_ranks > 0) then
+      write (*, '(a)') "partition="//trim(count_text(settings%partition_ranks))// &
+        ": the partition only (results.h5 /run/partition, d3hsp); nothing was run"
     else
       ! from here on SIGINT / SIGTERM end the run after a cycle, with the results written (before,
       ! while the deck is read and the model set up, they end the process at once: nothing has
@@ -146,6 +182,8 @@ contains
       exit_status = 0
     end if
     summary%warnings = warning_lines
+    ! the other ranks of a distributed run are done: the first writes and prints what follows
+    if (.not. first_rank) return
     ! LS-DYNA's ASCII files the deck asks for, from the histories of the whole run, and d3hsp
     if (.not. model%implicit_static) then
       call write_ascii_databases(model, run%histories, settings%output_dir, settings%job_id, ascii_error)
@@ -157,6 +195,7 @@ contains
     call close_results(results, summary, close_error)
     if (allocated(close_error)) exit_status = 1
     call print_summary(summary, settings, model%implicit_static)
+    if (run%exchange%rank_count > 1) call print_exchange_summary(run, summary%cycles)
     flush (output_unit)
     if (allocated(error)) call report("crashfree: error termination: "//error%message, messages)
     ! last: what the results file holds after a failed write
@@ -200,9 +239,13 @@ contains
   subroutine report(text, messages)
     character(len=*), intent(in) :: text
     character(len=:), allocatable, intent(inout) :: messages
-    flush (output_unit)
-    write (error_unit, '(a)') text
-    flush (error_unit)
+    ! (every rank of a distributed run reads the same deck and meets the same errors: the first
+    ! says so)
+    if (rank_index() == 0) then
+      flush (output_unit)
+      write (error_unit, '(a)') text
+      flush (error_unit)
+    end if
     messages = messages//text//new_line("a")
   end subroutine report
 
@@ -331,6 +374,26 @@ contains
     end if
     write (*, '(a)') "  results: "//options%output_dir//"/"//options%job_id//".h5 (and .xdmf for ParaView)"
   end subroutine print_summary
+
+  !> A distributed run: the seconds of the exchanges among the ranks (the first rank's), per
+  !> cycle, and the forces' volume.
+  subroutine print_exchange_summary(run, cycles)
+    type(run_state_t), intent(in) :: run
+    integer, intent(in) :: cycles
+    character(len=240) :: line
+    real(wp) :: per_cycle
+    per_cycle = 1.0e3_wp/real(max(1, cycles), wp)
+    write (line, '(a,i0,a,f0.3,a,f0.1,a,f0.3,a)') "  MPI: ", run%exchange%rank_count, &
+      " ranks; force exchange ", per_cycle*run%exchange%timer%seconds, " ms per cycle (", &
+      8.0e-3_wp*real(size(run%exchange%receive), wp), " kB to each rank), waiting for the slowest rank ", &
+      per_cycle*run%exchange%wait_timer%seconds, " ms per cycle"
+    write (*, '(a)') trim(line)
+    write (line, '(a,i0,a,i0,a,f0.3,a,f0.1,a)') "  MPI: block state brought together ", run%exchange%block_gathers, &
+      " times (states, dumps, erosion), their energies alone ", run%exchange%energy_gathers, &
+      " times (energy checks, histories): ", run%exchange%gather_timer%seconds, " s, ", &
+      8.0e-6_wp*run%exchange%gathered_values, " MB received"
+    write (*, '(a)') trim(line)
+  end subroutine print_exchange_summary
 
   function count_text(value) result(text)
     integer, intent(in) :: value

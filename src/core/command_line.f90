@@ -10,7 +10,7 @@ module command_line
   private
 
   public :: run_options_t, command_argument_t, parse_command_line, usage_text
-  public :: get_command_arguments
+  public :: get_command_arguments, launched_rank_count, check_launch
 
   !> One argument as the shell passed it, whatever its length.
   type :: command_argument_t
@@ -26,6 +26,9 @@ module command_line
     integer :: threads = 0                         !< ncpu= (0: OMP_NUM_THREADS, else all cores)
     !> x=: d3plot family file size in multiples of 512^2 words (LS-DYNA's default 7)
     integer :: binary_file_scale = 7
+    !> partition=N: compute and report the domain partition for N MPI ranks after the set-up,
+    !> then stop without running (as LS-DYNA MPP's decomposition-only runs); 0: run
+    integer :: partition_ranks = 0
     logical :: ignore_unknown = .false.            !< --ignore-unknown
     logical :: show_help = .false.
     logical :: show_version = .false.
@@ -107,6 +110,9 @@ contains
       case ("x")
         call read_file_scale(value, options, error)
         if (allocated(error)) return
+      case ("partition")
+        call read_partition_ranks(value, options, error)
+        if (allocated(error)) return
       case default
         note = ignored_argument_note(key)
         if (len(note) == 0) then
@@ -167,6 +173,58 @@ contains
     end if
   end subroutine read_file_scale
 
+  !> partition=N: a positive whole number of ranks.
+  subroutine read_partition_ranks(value, options, error)
+    character(len=*), intent(in) :: value
+    type(run_options_t), intent(inout) :: options
+    type(error_t), allocatable, intent(out) :: error
+    integer :: status
+    status = 1
+    if (verify(value, "0123456789") == 0 .and. len(value) >= 1 .and. len(value) <= 6) &
+      read (value, *, iostat=status) options%partition_ranks
+    if (status /= 0 .or. options%partition_ranks < 1) then
+      call make_error(error, "command line: partition='"//value//"' is not a positive whole number (the number "// &
+                      "of MPI ranks to partition the model for)")
+    end if
+  end subroutine read_partition_ranks
+
+  !> The number of processes an MPI launcher (mpirun, mpiexec, srun) started this one among,
+  !> read from the environment it sets: Open MPI's OMPI_COMM_WORLD_SIZE, else PMI_SIZE (MPICH,
+  !> Intel MPI, Slurm); 1 when started without a launcher.
+  integer function launched_rank_count()
+    character(len=32) :: setting
+    integer :: length, status, count
+    launched_rank_count = 1
+    call get_environment_variable("OMPI_COMM_WORLD_SIZE", setting, length, status)
+    if (status /= 0) call get_environment_variable("PMI_SIZE", setting, length, status)
+    if (status /= 0) return
+    read (setting, *, iostat=status) count
+    if (status == 0 .and. count > 1) launched_rank_count = count
+  end function launched_rank_count
+
+  !> A program built without MPI (`mpi_built` false) that an MPI launcher started as one of
+  !> several processes would run the whole job once per process, all writing the same files:
+  !> an error naming the process count and what to do. `mpi_built` true: no error (the MPI
+  !> runtime itself then tells the ranks apart).
+  subroutine check_launch(mpi_built, error)
+    logical, intent(in) :: mpi_built
+    type(error_t), allocatable, intent(out) :: error
+    integer :: count
+    if (mpi_built) return
+    count = launched_rank_count()
+    if (count <= 1) return
+    call make_error(error, "this crashfree was built without MPI, and an MPI launcher started it as "// &
+                    trim(count_text(count))//" processes (OMPI_COMM_WORLD_SIZE / PMI_SIZE), which would each "// &
+                    "run the whole job and write the same files: run it without mpirun (ncpu= sets the threads), "// &
+                    "or rebuild with MPI (tools/install_dependencies.sh installs Open MPI, then make)")
+  contains
+    pure function count_text(value) result(text)
+      integer, intent(in) :: value
+      character(len=12) :: text
+      write (text, '(i0)') value
+    end function count_text
+  end subroutine check_launch
+
   !> Why LS-DYNA's argument `key`= is not used here ("" for a key LS-DYNA does not have
   !> either, which is an error).
   pure function ignored_argument_note(key) result(note)
@@ -174,7 +232,10 @@ contains
     character(len=:), allocatable :: note
     select case (key)
     case ("memory", "memory2")
-      note = "crashfree sizes its memory from the model"
+      ! LS-DYNA: memory= words of memory for the run (MPP: for the first rank, which decomposes
+      ! the model), memory2= words for each of the other ranks
+      note = "LS-DYNA's memory in words (memory2=: per MPP rank after the first); crashfree sizes its "// &
+             "memory from the model"
     case ("s")
       note = "LS-DYNA's interface segment save file; crashfree writes none"
     case ("d")
@@ -185,7 +246,9 @@ contains
     case ("g")
       note = "results go to DIR/results.h5, see outdir= and jobid="
     case ("pfile")
-      note = "no MPP partitioning; OpenMP threads are set with ncpu="
+      ! LS-DYNA MPP: a file of decomposition settings (method, region weights, ...)
+      note = "LS-DYNA MPP's decomposition control file; crashfree partitions the model itself "// &
+             "(METIS, weighted by element cost; partition=N shows the partition for N ranks)"
     case ("ncycle")
       note = "an LS-DYNA option crashfree does not use"
     case default
@@ -213,6 +276,8 @@ contains
            "                  and job)"//nl// &
            "  --ignore-unknown  warn about unknown keywords and skip them instead of stopping (a"//nl// &
            "                  keyword crashfree reads, with an option it lacks, still stops)"//nl// &
+           "  partition=N     compute and print the domain partition for N MPI ranks (also in"//nl// &
+           "                  results.h5 /run/partition and d3hsp), then stop without running"//nl// &
            "  memory= memory2= d=nodump s= o= g= ncycle= pfile=   LS-DYNA's: accepted, not used"//nl//nl// &
            "Results: DIR/results.h5 (HDF5, see README) and DIR/results.xdmf for ParaView."//nl// &
            "Signals: SIGINT/SIGTERM stop after the cycle with a restart dump, SIGUSR1 writes a dump"//nl// &

@@ -11,6 +11,8 @@ module message_log
   !> Lines printed so far, each ended by a new line.
   type :: message_log_t
     character(len=:), allocatable :: text
+    !> kept, not printed: the ranks other than the first of a distributed run, which print nothing
+    logical :: quiet = .false.
   end type message_log_t
 
 contains
@@ -20,8 +22,10 @@ contains
   subroutine log_message(log, line)
     type(message_log_t), intent(inout) :: log
     character(len=*), intent(in) :: line
-    write (output_unit, '(a)') line
-    flush (output_unit)
+    if (.not. log%quiet) then
+      write (output_unit, '(a)') line
+      flush (output_unit)
+    end if
     if (.not. allocated(log%text)) log%text = ""
     log%text = log%text//line//new_line("a")
   end subroutine log_message

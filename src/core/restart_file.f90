@@ -43,6 +43,7 @@ module restart_file
   public :: open_restart_store, close_restart_store, restart_entry_exists
   public :: write_restart, read_restart, read_restart_resized, exchange_restart, exchange_restart_resized
   public :: write_restart_attribute, read_restart_attribute, exchange_restart_count
+  public :: start_memory_store
 
   !> An open dump, being written or read.
   type :: restart_store_t
@@ -51,6 +52,12 @@ module restart_file
     logical :: writing = .false.
     character(len=:), allocatable :: path             !< the dump's name
     character(len=:), allocatable :: temporary_path   !< written here, then renamed to `path`
+    !> In memory (start_memory_store): the values go into `memory` one after another instead of
+    !> a file, and are read back in the same order (names are not kept). A distributed run
+    !> moves element blocks between ranks this way with the groups' own exchange routines.
+    logical :: in_memory = .false.
+    real(wp), allocatable :: memory(:)                !< the values so far (integers and logicals as reals)
+    integer :: position = 0                           !< values written, or read, so far
   end type restart_store_t
 
   !> Store a value under a path: real(wp) of rank 0-4, integer of rank 0-3, logical of rank
@@ -617,7 +624,9 @@ contains
     character(len=*), intent(in) :: name
     real(wp), intent(inout) :: value
     type(error_t), allocatable, intent(inout) :: error
-    if (store%writing) then
+    if (store%in_memory) then
+      call memory_reals_scalar(store, value)
+    else if (store%writing) then
       call write_restart(store, name, value, error)
     else
       call read_restart(store, name, value, error)
@@ -629,7 +638,9 @@ contains
     character(len=*), intent(in) :: name
     real(wp), intent(inout), contiguous :: value(:)
     type(error_t), allocatable, intent(inout) :: error
-    if (store%writing) then
+    if (store%in_memory) then
+      call memory_reals(store, value, size(value))
+    else if (store%writing) then
       call write_restart(store, name, value, error)
     else
       call read_restart(store, name, value, error)
@@ -641,7 +652,9 @@ contains
     character(len=*), intent(in) :: name
     real(wp), intent(inout), contiguous :: value(:, :)
     type(error_t), allocatable, intent(inout) :: error
-    if (store%writing) then
+    if (store%in_memory) then
+      call memory_reals(store, value, size(value))
+    else if (store%writing) then
       call write_restart(store, name, value, error)
     else
       call read_restart(store, name, value, error)
@@ -653,7 +666,9 @@ contains
     character(len=*), intent(in) :: name
     real(wp), intent(inout), contiguous :: value(:, :, :)
     type(error_t), allocatable, intent(inout) :: error
-    if (store%writing) then
+    if (store%in_memory) then
+      call memory_reals(store, value, size(value))
+    else if (store%writing) then
       call write_restart(store, name, value, error)
     else
       call read_restart(store, name, value, error)
@@ -665,7 +680,9 @@ contains
     character(len=*), intent(in) :: name
     real(wp), intent(inout), contiguous :: value(:, :, :, :)
     type(error_t), allocatable, intent(inout) :: error
-    if (store%writing) then
+    if (store%in_memory) then
+      call memory_reals(store, value, size(value))
+    else if (store%writing) then
       call write_restart(store, name, value, error)
     else
       call read_restart(store, name, value, error)
@@ -677,7 +694,9 @@ contains
     character(len=*), intent(in) :: name
     integer, intent(inout) :: value
     type(error_t), allocatable, intent(inout) :: error
-    if (store%writing) then
+    if (store%in_memory) then
+      call memory_integers_scalar(store, value)
+    else if (store%writing) then
       call write_restart(store, name, value, error)
     else
       call read_restart(store, name, value, error)
@@ -689,7 +708,9 @@ contains
     character(len=*), intent(in) :: name
     integer, intent(inout), contiguous :: value(:)
     type(error_t), allocatable, intent(inout) :: error
-    if (store%writing) then
+    if (store%in_memory) then
+      call memory_integers(store, value, size(value))
+    else if (store%writing) then
       call write_restart(store, name, value, error)
     else
       call read_restart(store, name, value, error)
@@ -701,7 +722,9 @@ contains
     character(len=*), intent(in) :: name
     integer, intent(inout), contiguous :: value(:, :)
     type(error_t), allocatable, intent(inout) :: error
-    if (store%writing) then
+    if (store%in_memory) then
+      call memory_integers(store, value, size(value))
+    else if (store%writing) then
       call write_restart(store, name, value, error)
     else
       call read_restart(store, name, value, error)
@@ -713,7 +736,9 @@ contains
     character(len=*), intent(in) :: name
     integer, intent(inout), contiguous :: value(:, :, :)
     type(error_t), allocatable, intent(inout) :: error
-    if (store%writing) then
+    if (store%in_memory) then
+      call memory_integers(store, value, size(value))
+    else if (store%writing) then
       call write_restart(store, name, value, error)
     else
       call read_restart(store, name, value, error)
@@ -725,7 +750,9 @@ contains
     character(len=*), intent(in) :: name
     logical, intent(inout) :: value
     type(error_t), allocatable, intent(inout) :: error
-    if (store%writing) then
+    if (store%in_memory) then
+      call memory_logicals_scalar(store, value)
+    else if (store%writing) then
       call write_restart(store, name, value, error)
     else
       call read_restart(store, name, value, error)
@@ -737,7 +764,9 @@ contains
     character(len=*), intent(in) :: name
     logical, intent(inout) :: value(:)
     type(error_t), allocatable, intent(inout) :: error
-    if (store%writing) then
+    if (store%in_memory) then
+      call memory_logicals(store, value, size(value))
+    else if (store%writing) then
       call write_restart(store, name, value, error)
     else
       call read_restart(store, name, value, error)
@@ -749,7 +778,9 @@ contains
     character(len=*), intent(in) :: name
     logical, intent(inout) :: value(:, :)
     type(error_t), allocatable, intent(inout) :: error
-    if (store%writing) then
+    if (store%in_memory) then
+      call memory_logicals(store, value, size(value))
+    else if (store%writing) then
       call write_restart(store, name, value, error)
     else
       call read_restart(store, name, value, error)
@@ -791,6 +822,101 @@ contains
       call read_restart_resized(store, name, value, error)
     end if
   end subroutine exchange_integer_resized_1
+
+  ! ---------------------------------------------------------------------------------------------
+  ! In memory
+
+  !> Start a store in memory: empty for writing, or (`writing` false) reading `memory` from its
+  !> first value.
+  subroutine start_memory_store(store, writing)
+    type(restart_store_t), intent(inout) :: store
+    logical, intent(in) :: writing
+    store%in_memory = .true.
+    store%writing = writing
+    store%is_open = .true.
+    store%position = 0
+    if (.not. allocated(store%memory)) allocate (store%memory(1024))
+  end subroutine start_memory_store
+
+  !> Room for `count` more values (doubling: a store is filled once per exchange).
+  subroutine reserve_memory(store, count)
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: count
+    real(wp), allocatable :: grown(:)
+    if (store%position + count <= size(store%memory)) return
+    allocate (grown(max(2*size(store%memory), store%position + count)))
+    grown(1:store%position) = store%memory(1:store%position)
+    call move_alloc(grown, store%memory)
+  end subroutine reserve_memory
+
+  !> Append `count` reals, or take them back in order.
+  subroutine memory_reals(store, values, count)
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: count
+    real(wp), intent(inout) :: values(count)
+    if (store%writing) then
+      call reserve_memory(store, count)
+      store%memory(store%position + 1:store%position + count) = values
+    else
+      values = store%memory(store%position + 1:store%position + count)
+    end if
+    store%position = store%position + count
+  end subroutine memory_reals
+
+  subroutine memory_reals_scalar(store, value)
+    type(restart_store_t), intent(inout) :: store
+    real(wp), intent(inout) :: value
+    real(wp) :: values(1)
+    values(1) = value
+    call memory_reals(store, values, 1)
+    value = values(1)
+  end subroutine memory_reals_scalar
+
+  !> Integers as reals (exact below 2**53).
+  subroutine memory_integers(store, values, count)
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: count
+    integer, intent(inout) :: values(count)
+    if (store%writing) then
+      call reserve_memory(store, count)
+      store%memory(store%position + 1:store%position + count) = real(values, wp)
+    else
+      values = nint(store%memory(store%position + 1:store%position + count))
+    end if
+    store%position = store%position + count
+  end subroutine memory_integers
+
+  subroutine memory_integers_scalar(store, value)
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(inout) :: value
+    integer :: values(1)
+    values(1) = value
+    call memory_integers(store, values, 1)
+    value = values(1)
+  end subroutine memory_integers_scalar
+
+  !> Logicals as 1 and 0.
+  subroutine memory_logicals(store, values, count)
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: count
+    logical, intent(inout) :: values(count)
+    if (store%writing) then
+      call reserve_memory(store, count)
+      store%memory(store%position + 1:store%position + count) = merge(1.0_wp, 0.0_wp, values)
+    else
+      values = store%memory(store%position + 1:store%position + count) > 0.5_wp
+    end if
+    store%position = store%position + count
+  end subroutine memory_logicals
+
+  subroutine memory_logicals_scalar(store, value)
+    type(restart_store_t), intent(inout) :: store
+    logical, intent(inout) :: value
+    logical :: values(1)
+    values(1) = value
+    call memory_logicals(store, values, 1)
+    value = values(1)
+  end subroutine memory_logicals_scalar
 
   ! ---------------------------------------------------------------------------------------------
   ! Header attributes (on the root group)
@@ -1216,7 +1342,11 @@ contains
     integer :: stored
     character(len=24) :: stored_text, count_text
     if (allocated(error)) return
-    if (store%writing) then
+    if (store%in_memory) then
+      ! (a store in memory is read by the same model that wrote it)
+      stored = count
+      call memory_integers_scalar(store, stored)
+    else if (store%writing) then
       call write_restart(store, path, count, error)
     else
       stored = -1

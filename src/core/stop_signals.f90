@@ -22,6 +22,7 @@ module stop_signals
   private
 
   public :: catch_stop_signals, received_stop_signal, progress_line_requested, dump_requested, signal_name
+  public :: signal_terminate
 
   !> Linux signal numbers (x86-64, aarch64).
   integer(c_int), parameter :: signal_interrupt = 2, signal_terminate = 15, signal_user1 = 10, &

@@ -11,7 +11,7 @@ module efg_group
   use restart_file, only: restart_store_t, exchange_restart, exchange_restart_count
   use model, only: model_t, formulation_efg, boundary_full_transformation, integration_gauss_conventional
   use nodal_state, only: nodal_state_t
-  use element_group, only: element_group_t, element_results_t
+  use element_group, only: element_group_t, element_results_t, distinct_nodes, family_solid
   use particle_rows, only: particle_rows_t, append_particle_rows
   use element_work, only: booked_energy, add_kinetic_energy
   use efg_part, only: efg_part_t
@@ -28,6 +28,9 @@ module efg_group
     integer :: failed_part = 0                     !< the part of failed_element (model part index)
   contains
     procedure :: element_count
+    procedure :: block_count
+    procedure :: block_nodes
+    procedure :: block_elements
     procedure :: scale_masses
     procedure :: lump_masses
     procedure :: add_internal_forces
@@ -71,6 +74,7 @@ contains
     logical, allocatable :: used(:)
 
     group%name = "meshfree"
+    group%element_family = family_solid
     allocate (used(size(model%parts)))
     used = .false.
     do k = 1, size(model%solid_part)
@@ -342,6 +346,7 @@ contains
     call exchange_restart(store, path//"/seconds", self%timer%seconds, error)
   end subroutine exchange_state
 
+  !> Blocks of all its parts, part after part (the order of its force call).
   !> One meshfree part: each point block's stresses, history, energies and powers, the points'
   !> W P, and the blocks' last steps (the geometry, shape functions and gradients are rebuilt).
   subroutine exchange_meshfree(store, path, solver, error)
@@ -409,4 +414,51 @@ contains
     part_ids = part_ids(1:count)
     steps = steps(1:count)
   end subroutine list_time_steps
+  integer function block_count(self)
+    class(efg_group_t), intent(in) :: self
+    integer :: p
+    block_count = 0
+    do p = 1, size(self%parts)
+      block_count = block_count + size(self%parts(p)%blocks)
+    end do
+  end function block_count
+
+  !> The pair nodes of all the block's points: its force call reads and adds into them.
+  subroutine block_nodes(self, block, nodes)
+    class(efg_group_t), intent(in) :: self
+    integer, intent(in) :: block
+    integer, allocatable, intent(out) :: nodes(:)
+    integer :: p, local
+    call find_block(self, block, p, local)
+    associate (geometry => self%parts(p)%geometry, first => self%parts(p)%blocks(local)%first_point, &
+               points => self%parts(p)%blocks(local)%point_count)
+      nodes = distinct_nodes(geometry%pair_node(geometry%point_offsets(first):geometry%point_offsets(first + points) - 1))
+    end associate
+  end subroutine block_nodes
+
+  !> The background cell (model solid index) of each point of the block.
+  subroutine block_elements(self, block, elements)
+    class(efg_group_t), intent(in) :: self
+    integer, intent(in) :: block
+    integer, allocatable, intent(out) :: elements(:)
+    integer :: p, local
+    call find_block(self, block, p, local)
+    associate (geometry => self%parts(p)%geometry, first => self%parts(p)%blocks(local)%first_point, &
+               points => self%parts(p)%blocks(local)%point_count)
+      elements = geometry%point_cell(first:first + points - 1)
+    end associate
+  end subroutine block_elements
+
+  !> The part and its own block number of the group's block `block`.
+  subroutine find_block(self, block, part, local)
+    type(efg_group_t), intent(in) :: self
+    integer, intent(in) :: block
+    integer, intent(out) :: part, local
+    local = block
+    do part = 1, size(self%parts)
+      if (local <= size(self%parts(part)%blocks)) return
+      local = local - size(self%parts(part)%blocks)
+    end do
+    error stop "efg_group: block number beyond the group's blocks"
+  end subroutine find_block
 end module efg_group

@@ -63,7 +63,7 @@ module efg_shell_forces
 
   public :: efg_shell_block_t, efg_shell_solver_t, set_up_efg_shell_solver, compute_efg_shell_forces
   public :: efg_shell_cell_results, efg_shell_nodal_masses, transform_shell_to_physical, transpose_shell_to_generalized
-  public :: efg_shell_rotary_factor, raise_corner_plastic_strain
+  public :: efg_shell_rotary_factor, raise_corner_plastic_strain, stations_per_cell
   public :: efg_shell_cell_time_steps
 
   !> Transverse shear stations of a cell: corners 1-4, midpoints 5-8 of the edges 1-2, 2-3, 3-4, 4-1.

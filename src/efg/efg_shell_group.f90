@@ -22,14 +22,15 @@ module efg_shell_group
   use restart_file, only: restart_store_t, exchange_restart, exchange_restart_count
   use model, only: model_t, formulation_efg
   use nodal_state, only: nodal_state_t
-  use element_group, only: element_group_t, element_results_t
+  use element_group, only: element_group_t, element_results_t, distinct_nodes, family_shell
   use particle_rows, only: particle_rows_t, append_particle_rows
   use element_work, only: booked_energy, add_kinetic_energy
   use efg_shell_part, only: efg_shell_part_t
   use efg_shell_setup, only: build_efg_shell_part
   use efg_shell_forces, only: efg_shell_solver_t, set_up_efg_shell_solver, compute_efg_shell_forces, &
                               efg_shell_cell_results, efg_shell_nodal_masses, transform_shell_to_physical, &
-                              transpose_shell_to_generalized, raise_corner_plastic_strain, efg_shell_cell_time_steps
+                              transpose_shell_to_generalized, raise_corner_plastic_strain, stations_per_cell, &
+                              efg_shell_cell_time_steps
   implicit none
   private
 
@@ -46,6 +47,9 @@ module efg_shell_group
     integer :: failed_part = 0                     !< the part of failed_element (model part index)
   contains
     procedure :: element_count
+    procedure :: block_count
+    procedure :: block_nodes
+    procedure :: block_elements
     procedure :: scale_masses
     procedure :: lump_masses
     procedure :: add_internal_forces
@@ -89,6 +93,7 @@ contains
     integer :: part, count, k
 
     group%name = "meshfree shell"
+    group%element_family = family_shell
     allocate (used(size(model%parts)))
     used = .false.
     if (allocated(model%shell_part)) then
@@ -444,6 +449,7 @@ contains
     call exchange_restart(store, path//"/seconds", self%timer%seconds, error)
   end subroutine exchange_state
 
+  !> Blocks of all its parts, part after part (the order of its force call).
   subroutine exchange_part(store, path, solver, error)
     type(restart_store_t), intent(inout) :: store
     character(len=*), intent(in) :: path
@@ -504,4 +510,59 @@ contains
       end associate
     end do
   end subroutine list_time_steps
+  integer function block_count(self)
+    class(efg_shell_group_t), intent(in) :: self
+    integer :: p
+    block_count = 0
+    do p = 1, size(self%parts)
+      block_count = block_count + size(self%parts(p)%blocks)
+    end do
+  end function block_count
+
+  !> The pair nodes of all the block's points, its cells' corners and station rows: its force
+  !> call reads and adds into them.
+  subroutine block_nodes(self, block, nodes)
+    class(efg_shell_group_t), intent(in) :: self
+    integer, intent(in) :: block
+    integer, allocatable, intent(out) :: nodes(:)
+    integer :: p, local
+    call find_block(self, block, p, local)
+    associate (geometry => self%parts(p)%geometry, first => self%parts(p)%blocks(local)%first_point, &
+               points => self%parts(p)%blocks(local)%point_count)
+      associate (solver => self%parts(p), cells => self%parts(p)%blocks(local))
+        nodes = distinct_nodes([geometry%pair_node(geometry%point_offsets(first):geometry%point_offsets(first + points) - 1), &
+                                solver%station_node(solver%station_offsets(stations_per_cell*(cells%first_cell - 1) + 1): &
+                                                    solver%station_offsets(stations_per_cell*(cells%first_cell + &
+                                                                                              cells%cell_count - 1) + 1) - 1), &
+                                reshape(solver%cell_nodes(:, cells%first_cell:cells%first_cell + cells%cell_count - 1), &
+                                        [4*cells%cell_count])])
+      end associate
+    end associate
+  end subroutine block_nodes
+
+  !> The background cell (model shell index) of each point of the block.
+  subroutine block_elements(self, block, elements)
+    class(efg_shell_group_t), intent(in) :: self
+    integer, intent(in) :: block
+    integer, allocatable, intent(out) :: elements(:)
+    integer :: p, local
+    call find_block(self, block, p, local)
+    associate (geometry => self%parts(p)%geometry, first => self%parts(p)%blocks(local)%first_point, &
+               points => self%parts(p)%blocks(local)%point_count)
+      elements = geometry%cells(geometry%point_cell(first:first + points - 1))
+    end associate
+  end subroutine block_elements
+
+  !> The part and its own block number of the group's block `block`.
+  subroutine find_block(self, block, part, local)
+    type(efg_shell_group_t), intent(in) :: self
+    integer, intent(in) :: block
+    integer, intent(out) :: part, local
+    local = block
+    do part = 1, size(self%parts)
+      if (local <= size(self%parts(part)%blocks)) return
+      local = local - size(self%parts(part)%blocks)
+    end do
+    error stop "efg_shell_group: block number beyond the group's blocks"
+  end subroutine find_block
 end module efg_shell_group

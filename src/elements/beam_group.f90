@@ -14,7 +14,7 @@ module beam_group
   use restart_file, only: restart_store_t, exchange_restart, exchange_restart_count
   use run_summary, only: run_summary_t
   use nodal_state, only: nodal_state_t
-  use element_group, only: element_group_t, element_results_t
+  use element_group, only: element_group_t, element_results_t, distinct_nodes, family_beam
   use element_work, only: append_marked_lanes, booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, &
                           raise_largest_scaling
   use beam_block, only: beam_block_t, build_beam_blocks, beam_block_masses, beam_block_time_steps, &
@@ -34,6 +34,9 @@ module beam_group
     type(gather_list_t) :: colours
   contains
     procedure :: element_count
+    procedure :: block_count
+    procedure :: block_nodes
+    procedure :: block_elements
     procedure :: scale_masses
     procedure :: lump_masses
     procedure :: add_internal_forces
@@ -44,6 +47,9 @@ module beam_group
     procedure :: describe
     procedure :: add_to_summary
     procedure :: exchange_state
+    procedure :: distributes_blocks
+    procedure :: exchange_block_state
+    procedure :: exchange_block_energies
     procedure :: failure_text
     procedure :: most_scaled
     procedure :: newly_eroded_elements
@@ -62,6 +68,7 @@ contains
     select type (group)
     type is (beam_group_t)
       group%name = "beam"
+      group%element_family = family_beam
       call build_beam_blocks(model, group%blocks)
       count = size(group%blocks)
       allocate (group%nodal_mass(block_size, count), group%nodal_inertia(block_size, count), &
@@ -157,6 +164,7 @@ contains
       !$omp parallel do schedule(dynamic, 2) default(shared) private(k, b, beam_force)
       do k = self%colours%offsets(colour), self%colours%offsets(colour + 1) - 1
         b = self%colours%corners(k)
+        if (.not. self%computes(b)) cycle
         call compute_beam_block(self%blocks(b), model%materials(self%blocks(b)%material), nodes%coordinates, &
                                 nodes%velocity, nodes%angular_velocity, step, beam_force, self%block_time_step(b), &
                                 self%block_critical_element(b), self%block_degenerate_element(b))
@@ -168,6 +176,7 @@ contains
     ! a failed weld is an eroded element of the group (element_group's erosion contract)
     self%newly_eroded = 0
     do b = 1, size(self%blocks)
+      if (.not. self%owns(b)) cycle
       self%newly_eroded = self%newly_eroded + count(self%blocks(b)%newly_failed(1:self%blocks(b)%element_count))
     end do
     self%eroded_count = self%eroded_count + self%newly_eroded
@@ -399,4 +408,54 @@ contains
       end associate
     end do
   end subroutine list_time_steps
+  !> Its blocks are shared out among the ranks of a distributed run (docs/parallel.md).
+  logical function distributes_blocks(self)
+    class(beam_group_t), intent(in) :: self
+    distributes_blocks = .true.
+  end function distributes_blocks
+
+  !> One block's state and its entries of the per-block step arrays (a store in memory: the
+  !> ranks of a distributed run bring their blocks together).
+  subroutine exchange_block_state(self, store, block, error)
+    class(beam_group_t), intent(inout) :: self
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: block
+    type(error_t), allocatable, intent(inout) :: error
+    call exchange_restart(store, "time_step", self%block_time_step(block), error)
+    call exchange_restart(store, "critical_element", self%block_critical_element(block), error)
+    call exchange_restart(store, "degenerate_element", self%block_degenerate_element(block), error)
+    call exchange_beam_block(store, "block", self%blocks(block), error)
+  end subroutine exchange_block_state
+
+  !> One block's energies and powers (what add_energies and add_part_energies read).
+  subroutine exchange_block_energies(self, store, block, error)
+    class(beam_group_t), intent(inout) :: self
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: block
+    type(error_t), allocatable, intent(inout) :: error
+    call exchange_restart(store, "internal_energy", self%blocks(block)%internal_energy, error)
+    call exchange_restart(store, "force_power", self%blocks(block)%force_power, error)
+  end subroutine exchange_block_energies
+
+  integer function block_count(self)
+    class(beam_group_t), intent(in) :: self
+    block_count = size(self%blocks)
+  end function block_count
+
+  !> Both end nodes of the block's beams (the orientation node N3 serves the set-up only).
+  subroutine block_nodes(self, block, nodes)
+    class(beam_group_t), intent(in) :: self
+    integer, intent(in) :: block
+    integer, allocatable, intent(out) :: nodes(:)
+    associate (lanes => self%blocks(block)%element_count)
+      nodes = distinct_nodes(reshape(self%blocks(block)%nodes(1:lanes, 1:2), [lanes*2]))
+    end associate
+  end subroutine block_nodes
+
+  subroutine block_elements(self, block, elements)
+    class(beam_group_t), intent(in) :: self
+    integer, intent(in) :: block
+    integer, allocatable, intent(out) :: elements(:)
+    elements = self%blocks(block)%elements(1:self%blocks(block)%element_count)
+  end subroutine block_elements
 end module beam_group

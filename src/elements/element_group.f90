@@ -28,6 +28,13 @@ module element_group
   private
 
   public :: element_group_t, group_holder_t, element_results_t, distortion_t, shell_output_points
+  public :: distinct_nodes
+
+  !> Which list of the model a group's element numbers index (its header's `element_family`):
+  !> the solids (FE solids, and the meshfree parts' background cells), the shells (FE shells,
+  !> the meshfree shells' background cells) or the beams. The domain partition counts and
+  !> assigns elements by these lists.
+  integer, parameter, public :: family_solid = 1, family_shell = 2, family_beam = 3
 
   !> Elements folded inside out at a corner while their volume stays positive (distortion_check),
   !> checked at every output state.
@@ -73,6 +80,7 @@ module element_group
     logical :: step_not_finite = .false.           !< a block's step was NaN (comparisons skip it)
     integer :: failed_element = 0                  !< an element that inverted or degenerated (0: none)
     type(phase_timer_t) :: timer                   !< wall-clock time of its force calls
+    integer :: element_family = 0                  !< family_solid, family_shell or family_beam
     !> Erosion: an element that meets its material's failure criterion (erosion_criteria) or,
     !> with ERODE, whose step falls below `erosion_time_step`, leaves the force loops for good
     !> in the force call where it fails (no stress, forces, hourglass forces or step from then
@@ -83,6 +91,14 @@ module element_group
     integer :: newly_eroded = 0                    !< elements eroded by the last force call
     integer :: eroded_count = 0                    !< elements eroded so far
     real(wp) :: erosion_time_step = 0.0_wp         !< ERODE: DTMIN x the first step (0: off), set by the solver
+    !> Distributed runs (docs/parallel.md), for kinds whose blocks are shared out among the ranks
+    !> (distributes_blocks): the blocks this rank computes (its own and those on a node it owns)
+    !> and those it owns. Not allocated (one rank, or a kind computed whole on every rank): all.
+    !> The header then covers the computed blocks only, and newly_eroded the owned ones; the
+    !> solver makes both global.
+    logical, allocatable :: computed(:), owned(:)
+    integer :: critical_block = 0                  !< the block of critical_element (0: none, or not by block)
+    integer :: failed_block = 0                    !< the block of failed_element (0: none, or not by block)
   contains
     !> Once before the first cycle: its element count (0: the group is dropped).
     procedure(count_interface), deferred :: element_count
@@ -109,6 +125,18 @@ module element_group
     !> back into a group built from the same deck (restart_file's exchange_restart); what the
     !> set-up derives from the deck is not stored.
     procedure(exchange_interface), deferred :: exchange_state
+    !> Set-up (domain partition): its blocks, the units of work a rank computes or not, in the
+    !> order its force call visits them (over all its parts, part after part).
+    procedure(block_count_interface), deferred :: block_count
+    !> Set-up (domain partition): the distinct nodes block `block` reads or adds forces (and
+    !> moments) into, ascending: its elements' corners; for a meshfree
+    !> block the pair nodes of all its points (the supports reach beyond one element layer) and
+    !> what else its force call adds into (the meshfree shells' cell corners and station rows).
+    procedure(block_nodes_interface), deferred :: block_nodes
+    !> Set-up (domain partition): the group's element numbers (element_family's list) of each
+    !> lane of block `block`: an element per lane, for meshfree blocks the background cell of
+    !> each integration point (a cell with several points is listed once per point).
+    procedure(block_elements_interface), deferred :: block_elements
     !> Optional: the failure message of `failed_element` (default: "<describe> inverted").
     procedure :: failure_text
     !> Optional: transform a nodal field from solver values to physical ones (meshfree parts).
@@ -143,6 +171,17 @@ module element_group
     !> at the current configuration, with its deck id and part id, from the routines that give
     !> the engine its step (default: none).
     procedure :: list_time_steps
+    !> Optional (kinds whose blocks the ranks share out): true; the kind then skips the blocks
+    !> `computed` leaves out in its force call and implements exchange_block_state.
+    procedure :: distributes_blocks
+    !> Optional, with distributes_blocks: write or read the state of one block (as exchange_state
+    !> does for all, into a store in memory), so that the ranks can bring their blocks together.
+    procedure :: exchange_block_state
+    !> Optional, with distributes_blocks: the same for what add_energies and add_part_energies
+    !> read of one block (energies and powers), all that the energy checks and histories need.
+    procedure :: exchange_block_energies
+    !> Whether this rank computes, or owns, block `block` (always, when not distributed).
+    procedure, non_overridable :: computes, owns
   end type element_group_t
 
   !> An array element holding one group of any kind.
@@ -227,6 +266,25 @@ module element_group
       type(error_t), allocatable, intent(inout) :: error
     end subroutine exchange_interface
 
+    integer function block_count_interface(self)
+      import :: element_group_t
+      class(element_group_t), intent(in) :: self
+    end function block_count_interface
+
+    subroutine block_nodes_interface(self, block, nodes)
+      import :: element_group_t
+      class(element_group_t), intent(in) :: self
+      integer, intent(in) :: block
+      integer, allocatable, intent(out) :: nodes(:)
+    end subroutine block_nodes_interface
+
+    subroutine block_elements_interface(self, block, elements)
+      import :: element_group_t
+      class(element_group_t), intent(in) :: self
+      integer, intent(in) :: block
+      integer, allocatable, intent(out) :: elements(:)
+    end subroutine block_elements_interface
+
     subroutine summary_interface(self, summary)
       import :: element_group_t, run_summary_t
       class(element_group_t), intent(in) :: self
@@ -253,16 +311,58 @@ contains
     integer :: b
     self%stable_time_step = huge(1.0_wp)
     self%critical_element = 0
+    self%critical_block = 0
     self%failed_element = 0
+    self%failed_block = 0
+    self%step_not_finite = .false.
     do b = 1, size(block_time_step)
+      ! (a block another rank computes holds an old step)
+      if (.not. self%computes(b)) cycle
       if (block_time_step(b) < self%stable_time_step) then
         self%stable_time_step = block_time_step(b)
         self%critical_element = block_critical_element(b)
+        self%critical_block = b
       end if
-      if (self%failed_element == 0) self%failed_element = block_failed_element(b)
+      if (self%failed_element == 0 .and. block_failed_element(b) /= 0) then
+        self%failed_element = block_failed_element(b)
+        self%failed_block = b
+      end if
+      if (block_time_step(b) /= block_time_step(b)) self%step_not_finite = .true.
     end do
-    self%step_not_finite = any(block_time_step /= block_time_step)
   end subroutine header_from_blocks
+
+  logical function distributes_blocks(self)
+    class(element_group_t), intent(in) :: self
+    distributes_blocks = .false.
+  end function distributes_blocks
+
+  subroutine exchange_block_state(self, store, block, error)
+    class(element_group_t), intent(inout) :: self
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: block
+    type(error_t), allocatable, intent(inout) :: error
+  end subroutine exchange_block_state
+
+  subroutine exchange_block_energies(self, store, block, error)
+    class(element_group_t), intent(inout) :: self
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: block
+    type(error_t), allocatable, intent(inout) :: error
+  end subroutine exchange_block_energies
+
+  pure logical function computes(self, block)
+    class(element_group_t), intent(in) :: self
+    integer, intent(in) :: block
+    computes = .true.
+    if (allocated(self%computed)) computes = self%computed(block)
+  end function computes
+
+  pure logical function owns(self, block)
+    class(element_group_t), intent(in) :: self
+    integer, intent(in) :: block
+    owns = .true.
+    if (allocated(self%owned)) owns = self%owned(block)
+  end function owns
 
   subroutine to_physical(self, field, physical)
     class(element_group_t), intent(in) :: self
@@ -336,6 +436,60 @@ contains
     kind = ""
     allocate (element_ids(0), part_ids(0), steps(0))
   end subroutine list_time_steps
+  !> The distinct entries of `list`, ascending (block_nodes of every kind; set-up only).
+  pure function distinct_nodes(list) result(nodes)
+    integer, intent(in) :: list(:)
+    integer, allocatable :: nodes(:)
+    integer, allocatable :: sorted(:)
+    integer :: k, count
+    allocate (sorted(size(list)))
+    sorted(:) = list
+    call heap_sort(sorted)
+    allocate (nodes(size(sorted)))
+    count = 0
+    do k = 1, size(sorted)
+      if (count > 0) then
+        if (nodes(count) == sorted(k)) cycle
+      end if
+      count = count + 1
+      nodes(count) = sorted(k)
+    end do
+    nodes = nodes(1:count)
+  end function distinct_nodes
+
+  !> Ascending, in place (n log n whatever the input: a meshfree block lists thousands of pairs).
+  pure subroutine heap_sort(values)
+    integer, intent(inout) :: values(:)
+    integer :: last, first, held
+    do first = size(values)/2, 1, -1
+      call sift_down(values, first, size(values))
+    end do
+    do last = size(values), 2, -1
+      held = values(1)
+      values(1) = values(last)
+      values(last) = held
+      call sift_down(values, 1, last - 1)
+    end do
+  end subroutine heap_sort
+
+  pure subroutine sift_down(values, first, last)
+    integer, intent(inout) :: values(:)
+    integer, intent(in) :: first, last
+    integer :: parent, child, held
+    parent = first
+    held = values(parent)
+    do
+      child = 2*parent
+      if (child > last) exit
+      if (child < last) then
+        if (values(child + 1) > values(child)) child = child + 1
+      end if
+      if (values(child) <= held) exit
+      values(parent) = values(child)
+      parent = child
+    end do
+    values(parent) = held
+  end subroutine sift_down
 
   !> Layers written per shell to the d3plot (its MAXINT): LS-DYNA's default 3 (mid, inner and
   !> outer surface) when no shell section has more than 3 points (NIP), else the largest NIP

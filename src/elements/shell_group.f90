@@ -13,7 +13,7 @@ module shell_group
   use restart_file, only: restart_store_t, exchange_restart, exchange_restart_count
   use run_summary, only: run_summary_t
   use nodal_state, only: nodal_state_t
-  use element_group, only: element_group_t, element_results_t
+  use element_group, only: element_group_t, element_results_t, distinct_nodes, family_shell
   use element_work, only: append_marked_lanes, mark_lanes, booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, &
                           raise_largest_scaling
   use shell_block, only: shell_block_t, build_shell_blocks, shell_block_masses, shell_block_time_steps, &
@@ -33,6 +33,9 @@ module shell_group
     type(gather_list_t) :: colours
   contains
     procedure :: element_count
+    procedure :: block_count
+    procedure :: block_nodes
+    procedure :: block_elements
     procedure :: scale_masses
     procedure :: lump_masses
     procedure :: add_internal_forces
@@ -43,6 +46,9 @@ module shell_group
     procedure :: describe
     procedure :: add_to_summary
     procedure :: exchange_state
+    procedure :: distributes_blocks
+    procedure :: exchange_block_state
+    procedure :: exchange_block_energies
     procedure :: failure_text
     procedure :: most_scaled
     procedure :: thinnest
@@ -71,6 +77,7 @@ contains
     type(shell_group_t), intent(inout) :: group
     integer :: count
     group%name = "shell"
+    group%element_family = family_shell
     call build_shell_blocks(model, group%blocks)
     count = size(group%blocks)
     allocate (group%corner_mass(block_size, 4, count), group%corner_inertia(block_size, 4, count), &
@@ -156,6 +163,7 @@ contains
       !$omp parallel do schedule(dynamic, 2) default(shared) private(k, b, shell_force)
       do k = self%colours%offsets(colour), self%colours%offsets(colour + 1) - 1
         b = self%colours%corners(k)
+        if (.not. self%computes(b)) cycle
         call compute_shell_block(self%blocks(b), model%materials(self%blocks(b)%material), nodes%coordinates, &
                                  nodes%velocity, nodes%angular_velocity, step, shell_force, self%block_time_step(b), &
                                  self%block_critical_element(b), self%block_degenerate_element(b))
@@ -166,7 +174,9 @@ contains
     end do
     call self%header_from_blocks(self%block_time_step, self%block_critical_element, self%block_degenerate_element)
     self%newly_eroded = 0
+    ! (distributed: the blocks this rank owns; the solver adds the ranks' counts)
     do b = 1, size(self%blocks)
+      if (.not. self%owns(b)) cycle
       self%newly_eroded = self%newly_eroded + count(self%blocks(b)%newly_eroded)
     end do
     self%eroded_count = self%eroded_count + self%newly_eroded
@@ -182,6 +192,8 @@ contains
     real(wp) :: point_strain(block_size), largest(block_size)
     integer :: b, point, lane, corner, node
     do b = 1, size(self%blocks)
+      ! (a distributed run takes the largest over the ranks: each has its computed blocks current)
+      if (.not. self%computes(b)) cycle
       associate (block => self%blocks(b))
         largest = 0.0_wp
         do point = 1, block%point_count
@@ -469,4 +481,56 @@ contains
     part_ids = part_ids(1:count)
     steps = steps(1:count)
   end subroutine list_time_steps
+  !> Its blocks are shared out among the ranks of a distributed run (docs/parallel.md).
+  logical function distributes_blocks(self)
+    class(shell_group_t), intent(in) :: self
+    distributes_blocks = .true.
+  end function distributes_blocks
+
+  !> One block's state and its entries of the per-block step arrays (a store in memory: the
+  !> ranks of a distributed run bring their blocks together).
+  subroutine exchange_block_state(self, store, block, error)
+    class(shell_group_t), intent(inout) :: self
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: block
+    type(error_t), allocatable, intent(inout) :: error
+    call exchange_restart(store, "time_step", self%block_time_step(block), error)
+    call exchange_restart(store, "critical_element", self%block_critical_element(block), error)
+    call exchange_restart(store, "degenerate_element", self%block_degenerate_element(block), error)
+    call exchange_shell_block(store, "block", self%blocks(block), error)
+  end subroutine exchange_block_state
+
+  !> One block's energies and powers (what add_energies and add_part_energies read).
+  subroutine exchange_block_energies(self, store, block, error)
+    class(shell_group_t), intent(inout) :: self
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: block
+    type(error_t), allocatable, intent(inout) :: error
+    call exchange_restart(store, "internal_energy", self%blocks(block)%internal_energy, error)
+    call exchange_restart(store, "hourglass_energy", self%blocks(block)%hourglass_energy, error)
+    call exchange_restart(store, "force_power", self%blocks(block)%force_power, error)
+    call exchange_restart(store, "hourglass_power", self%blocks(block)%hourglass_power, error)
+  end subroutine exchange_block_energies
+
+  integer function block_count(self)
+    class(shell_group_t), intent(in) :: self
+    block_count = size(self%blocks)
+  end function block_count
+
+  !> The corner nodes of the block's elements (a degenerate element's repeated node once).
+  subroutine block_nodes(self, block, nodes)
+    class(shell_group_t), intent(in) :: self
+    integer, intent(in) :: block
+    integer, allocatable, intent(out) :: nodes(:)
+    associate (lanes => self%blocks(block)%element_count)
+      nodes = distinct_nodes(reshape(self%blocks(block)%nodes(1:lanes, 1:4), [lanes*4]))
+    end associate
+  end subroutine block_nodes
+
+  subroutine block_elements(self, block, elements)
+    class(shell_group_t), intent(in) :: self
+    integer, intent(in) :: block
+    integer, allocatable, intent(out) :: elements(:)
+    elements = self%blocks(block)%elements(1:self%blocks(block)%element_count)
+  end subroutine block_elements
 end module shell_group

@@ -10,7 +10,7 @@ module solid_group
   use restart_file, only: restart_store_t, exchange_restart, exchange_restart_count
   use run_summary, only: run_summary_t
   use nodal_state, only: nodal_state_t
-  use element_group, only: element_group_t, element_results_t, distortion_t
+  use element_group, only: element_group_t, element_results_t, distortion_t, distinct_nodes, family_solid
   use element_work, only: append_marked_lanes, mark_lanes, booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, &
                           raise_largest_scaling
   use solid_block, only: solid_block_t, build_solid_blocks, solid_block_corner_masses, solid_block_time_steps, &
@@ -30,6 +30,9 @@ module solid_group
     type(gather_list_t) :: colours                       !< colour -> blocks (CSR)
   contains
     procedure :: element_count
+    procedure :: block_count
+    procedure :: block_nodes
+    procedure :: block_elements
     procedure :: scale_masses
     procedure :: lump_masses
     procedure :: add_internal_forces
@@ -40,6 +43,9 @@ module solid_group
     procedure :: describe
     procedure :: add_to_summary
     procedure :: exchange_state
+    procedure :: distributes_blocks
+    procedure :: exchange_block_state
+    procedure :: exchange_block_energies
     procedure :: failure_text
     procedure :: most_scaled
     procedure :: check_distortion
@@ -68,6 +74,7 @@ contains
     type(solid_group_t), intent(inout) :: group
     integer :: count
     group%name = "solid"
+    group%element_family = family_solid
     call build_solid_blocks(model, group%blocks)
     count = size(group%blocks)
     allocate (group%corner_mass(block_size, 8, count), group%block_time_step(count), &
@@ -153,6 +160,7 @@ contains
       !$omp parallel do schedule(dynamic, 2) default(shared) private(k, b, block_force)
       do k = self%colours%offsets(colour), self%colours%offsets(colour + 1) - 1
         b = self%colours%corners(k)
+        if (.not. self%computes(b)) cycle
         call compute_solid_block(self%blocks(b), model%materials(self%blocks(b)%material), &
                                  nodes%coordinates, nodes%velocity, step, block_force, &
                                  self%block_time_step(b), self%block_critical_element(b), &
@@ -164,7 +172,9 @@ contains
     end do
     call self%header_from_blocks(self%block_time_step, self%block_critical_element, self%block_inverted_element)
     self%newly_eroded = 0
+    ! (distributed: the blocks this rank owns; the solver adds the ranks' counts)
     do b = 1, size(self%blocks)
+      if (.not. self%owns(b)) cycle
       self%newly_eroded = self%newly_eroded + count(self%blocks(b)%newly_eroded)
     end do
     self%eroded_count = self%eroded_count + self%newly_eroded
@@ -424,4 +434,56 @@ contains
     part_ids = part_ids(1:count)
     steps = steps(1:count)
   end subroutine list_time_steps
+  !> Its blocks are shared out among the ranks of a distributed run (docs/parallel.md).
+  logical function distributes_blocks(self)
+    class(solid_group_t), intent(in) :: self
+    distributes_blocks = .true.
+  end function distributes_blocks
+
+  !> One block's state and its entries of the per-block step arrays (a store in memory: the
+  !> ranks of a distributed run bring their blocks together).
+  subroutine exchange_block_state(self, store, block, error)
+    class(solid_group_t), intent(inout) :: self
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: block
+    type(error_t), allocatable, intent(inout) :: error
+    call exchange_restart(store, "time_step", self%block_time_step(block), error)
+    call exchange_restart(store, "critical_element", self%block_critical_element(block), error)
+    call exchange_restart(store, "inverted_element", self%block_inverted_element(block), error)
+    call exchange_solid_block(store, "block", self%blocks(block), error)
+  end subroutine exchange_block_state
+
+  !> One block's energies and powers (what add_energies and add_part_energies read).
+  subroutine exchange_block_energies(self, store, block, error)
+    class(solid_group_t), intent(inout) :: self
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: block
+    type(error_t), allocatable, intent(inout) :: error
+    call exchange_restart(store, "internal_energy", self%blocks(block)%internal_energy, error)
+    call exchange_restart(store, "hourglass_energy", self%blocks(block)%hourglass_energy, error)
+    call exchange_restart(store, "force_power", self%blocks(block)%force_power, error)
+    call exchange_restart(store, "hourglass_power", self%blocks(block)%hourglass_power, error)
+  end subroutine exchange_block_energies
+
+  integer function block_count(self)
+    class(solid_group_t), intent(in) :: self
+    block_count = size(self%blocks)
+  end function block_count
+
+  !> The corner nodes of the block's elements (a degenerate element's repeated node once).
+  subroutine block_nodes(self, block, nodes)
+    class(solid_group_t), intent(in) :: self
+    integer, intent(in) :: block
+    integer, allocatable, intent(out) :: nodes(:)
+    associate (lanes => self%blocks(block)%element_count)
+      nodes = distinct_nodes(reshape(self%blocks(block)%nodes(1:lanes, 1:8), [lanes*8]))
+    end associate
+  end subroutine block_nodes
+
+  subroutine block_elements(self, block, elements)
+    class(solid_group_t), intent(in) :: self
+    integer, intent(in) :: block
+    integer, allocatable, intent(out) :: elements(:)
+    elements = self%blocks(block)%elements(1:self%blocks(block)%element_count)
+  end subroutine block_elements
 end module solid_group

@@ -5,10 +5,38 @@ module run_summary
   implicit none
   private
 
-  public :: run_summary_t
+  public :: run_summary_t, partition_summary_t
 
   character(len=*), parameter, public :: status_normal = "normal termination"
   character(len=*), parameter, public :: status_error = "error termination"
+
+  !> The domain partition of an MPI run, or of `partition=N` (domain_partition): what the
+  !> set-up prints and results.h5 (/run/partition) and d3hsp record. Per rank (0-based, index
+  !> rank + 1) and per element of the model's lists; empty for one rank.
+  type :: partition_summary_t
+    integer :: rank_count = 1
+    logical :: by_metis = .false.                !< METIS k-way (else one rank, or the contiguous split)
+    !> "metis_kway_elements", "metis_kway_blocks" (domain_partition's choose_owners), "contiguous",
+    !> "one rank"
+    character(len=24) :: method = "one rank"
+    !> the element kinds counted per rank, in engine order ("solid", "shell", "meshfree", ...)
+    character(len=16), allocatable :: kind_names(:)
+    integer, allocatable :: rank_elements(:, :)  !< (kinds, ranks) elements owned (meshfree: cells)
+    integer, allocatable :: rank_blocks(:)       !< blocks owned
+    integer, allocatable :: rank_ghost_blocks(:) !< blocks computed but owned by another rank
+    integer, allocatable :: rank_owned_nodes(:)  !< nodes owned (their forces sent each cycle)
+    !> nodes on the domain's interface: touched by a block it owns and by a block another rank
+    !> owns (a neighbour exchange would send or receive these each cycle)
+    integer, allocatable :: rank_interface_nodes(:)
+    real(wp), allocatable :: rank_cost(:)        !< estimated ns per cycle of its owned blocks
+    real(wp), allocatable :: rank_computed_cost(:) !< the same with its ghost blocks
+    real(wp) :: imbalance = 1.0_wp               !< max / mean of rank_cost
+    real(wp) :: computed_imbalance = 1.0_wp      !< max / mean of rank_computed_cost
+    !> rank computing each model solid, shell and beam (-1: in no block, e.g. of a rigid part:
+    !> every rank does the rigid bodies)
+    integer, allocatable :: solid_rank(:), shell_rank(:), beam_rank(:)
+    integer, allocatable :: node_rank(:)         !< rank owning each node (the model's order)
+  end type partition_summary_t
 
   type :: run_summary_t
     character(len=:), allocatable :: status      !< status_normal or status_error
@@ -39,5 +67,6 @@ module run_summary
     !> seconds of each phase of the explicit cycle (/timing phase_<name>_s; none for a static run)
     character(len=16), allocatable :: phase_names(:)
     real(wp), allocatable :: phase_seconds(:)
+    type(partition_summary_t) :: partition       !< MPI domains (one rank: rank_count 1, nothing else)
   end type run_summary_t
 end module run_summary

@@ -6,6 +6,7 @@
 !> them, and the termination line). Both are written at the end of the run (normal or error
 !> termination); the layout is in docs/output.md.
 module ascii_run_summary
+  use domain_partition, only: partition_text
   use kinds, only: wp
   use error_handling, only: error_t
   use model, only: model_t
@@ -78,6 +79,7 @@ contains
     call write_controls(out, model)
     call write_parts(out, model, state)
     call write_time_steps(out, model, state, histories, initial_time_steps)
+    if (summary%partition%rank_count > 1) call write_partition(out, summary)
     if (present(sources)) call echo_deck(out, sources)
     call add_line(out, "")
     write (cycles, '(i0)') summary%cycles
@@ -90,6 +92,25 @@ contains
     end if
     call finish_database(out, lsdyna_file_path(directory, job_id, "d3hsp"), error)
   end subroutine write_d3hsp
+
+  !> The domain partition of an MPI run (or partition=N), as printed at set-up.
+  subroutine write_partition(out, summary)
+    type(text_buffer_t), intent(inout) :: out
+    type(run_summary_t), intent(in) :: summary
+    character(len=:), allocatable :: text
+    integer :: start, finish
+    call add_line(out, "")
+    call add_line(out, " d o m a i n   p a r t i t i o n")
+    call add_line(out, "")
+    text = partition_text(summary%partition)
+    start = 1
+    do while (start <= len(text))
+      finish = index(text(start:), new_line("a")) + start - 1
+      if (finish < start) finish = len(text) + 1
+      call add_line(out, " "//text(start:finish - 1))
+      start = finish + 1
+    end do
+  end subroutine write_partition
 
   !> The input as read, file by file (LS-DYNA's d3hsp echoes its input too): each file's text
   !> under a line naming it. A file that cannot be read any more is named as such.

@@ -38,6 +38,8 @@ module restart_control
                           write_restart_attribute, read_restart_attribute
   use run_state_dump, only: exchange_run_state, exchange_results_progress, exchange_history_set
   use stop_signals, only: dump_requested, received_stop_signal, signal_name
+  use domain_exchange, only: gather_block_state
+  use rank_communication, only: any_rank
   use wall_clock, only: seconds_now
   implicit none
   private
@@ -123,7 +125,8 @@ contains
     character(len=:), allocatable :: path
     logical :: requested
 
-    requested = dump_requested()
+    ! (a SIGUSR1 that reached one rank: all write, or rather bring their blocks to the first)
+    requested = any_rank(dump_requested())
     if (stopped) then
       path = write_dump(dump_name(control, control%dump_number + 1), signal_name(received_stop_signal()), .false.)
       if (len(path) > 0) error%message = error%message//"; restart dump "//path//" written (bin/crashfree r="// &
@@ -150,6 +153,18 @@ contains
       type(error_t), allocatable :: failure
       character(len=40) :: text
       written = ""
+      ! a distributed run: the blocks from their owners, then the first rank writes the dump (the
+      ! same file for any number of ranks; a run may continue from it on another number)
+      call gather_block_state(run%state%groups, run%partition, run%exchange, run%state%cycle)
+      if (run%exchange%rank /= 0) then
+        written = name
+        if (running) then
+          control%running_number = control%running_number + 1
+        else
+          control%dump_number = control%dump_number + 1
+        end if
+        return
+      end if
       call sign_deck(control, failure)
       if (.not. allocated(failure)) call create_restart_store(store, name, failure)
       if (.not. allocated(failure)) then
@@ -332,7 +347,8 @@ contains
     call close_restart_store(control%source)
     if (allocated(error)) return
     write (text, '(es12.5,a,i0)') run%state%time, ", cycle ", run%state%cycle
-    write (output_unit, '(a)') "continuing from restart dump "//control%source%path//" at time "//trim(adjustl(text))
+    if (run%exchange%rank == 0) &
+      write (output_unit, '(a)') "continuing from restart dump "//control%source%path//" at time "//trim(adjustl(text))
   end subroutine resume_run
 
   !> A restarted run's wall and set-up time include the earlier runs' up to the dump.

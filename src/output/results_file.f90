@@ -1456,7 +1456,55 @@ contains
                                  summary%worst_corner_jacobian_element, error)
     call h5gclose_f(group_id, status)
     call write_warnings(file_id, summary, error)
+    call write_partition(file_id, summary, error)
   end subroutine write_run_end
+
+  !> `/run/partition` (MPI runs and partition=N; nothing for one rank): per rank (rows, rank 0
+  !> first) its elements by kind (`rank_elements`, columns in `kind_names`' order), blocks,
+  !> ghost blocks, owned and interface nodes, estimated cost (ns per cycle, owned blocks and with
+  !> the ghost blocks); per solid, shell and beam (the mesh's order) the rank computing it, -1
+  !> for none (rigid parts: every rank); per node the rank owning it. Attributes: rank_count, method, imbalance (max / mean
+  !> cost), computed_imbalance. A continued run replaces the earlier run's.
+  subroutine write_partition(file_id, summary, error)
+    integer(hid_t), intent(in) :: file_id
+    type(run_summary_t), intent(in) :: summary
+    type(error_t), allocatable, intent(inout) :: error
+    character(len=*), parameter :: path = "/run/partition"
+    integer(hid_t) :: group_id
+    integer :: status
+    logical :: exists
+    if (allocated(error)) return
+    associate (partition => summary%partition)
+      if (partition%rank_count <= 1 .or. .not. allocated(partition%rank_blocks)) return
+      call h5lexists_f(file_id, path, exists, status)
+      if (status == 0 .and. exists) call h5ldelete_f(file_id, path, status)
+      call create_group_path(file_id, path, error)
+      if (allocated(error)) return
+      call h5gopen_f(file_id, path, group_id, status)
+      if (status /= 0) then
+        call make_error(error, "cannot open group "//path)
+        return
+      end if
+      call write_integer_attribute(group_id, path, "rank_count", partition%rank_count, error)
+      call write_string_attribute(group_id, path, "method", trim(partition%method), &
+                                  error)
+      call write_real_attribute(group_id, path, "imbalance", partition%imbalance, error)
+      call write_real_attribute(group_id, path, "computed_imbalance", partition%computed_imbalance, error)
+      call write_string_dataset(group_id, "kind_names", partition%kind_names, error)
+      call write_integer_dataset_2d(group_id, path, "rank_elements", partition%rank_elements, error)
+      call write_integer_dataset_1d(group_id, path, "rank_blocks", partition%rank_blocks, error)
+      call write_integer_dataset_1d(group_id, path, "rank_ghost_blocks", partition%rank_ghost_blocks, error)
+      call write_integer_dataset_1d(group_id, path, "rank_owned_nodes", partition%rank_owned_nodes, error)
+      call write_integer_dataset_1d(group_id, path, "rank_interface_nodes", partition%rank_interface_nodes, error)
+      call write_real_dataset_1d(group_id, path, "rank_cost", partition%rank_cost, error)
+      call write_real_dataset_1d(group_id, path, "rank_computed_cost", partition%rank_computed_cost, error)
+      call write_integer_dataset_1d(group_id, path, "solid_rank", partition%solid_rank, error)
+      call write_integer_dataset_1d(group_id, path, "shell_rank", partition%shell_rank, error)
+      call write_integer_dataset_1d(group_id, path, "beam_rank", partition%beam_rank, error)
+      call write_integer_dataset_1d(group_id, path, "node_rank", partition%node_rank, error)
+      call h5gclose_f(group_id, status)
+    end associate
+  end subroutine write_partition
 
   !> `/run/warnings`: one string per warning line the run printed (an empty dataset when there
   !> were none); a continued run replaces the earlier run's.

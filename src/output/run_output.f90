@@ -84,7 +84,9 @@ contains
     if (clock_due(plan%rwforc, state%time, last)) call record_wall_forces(model, state, plan, histories)
     if (clock_due(plan%rcforc, state%time, last)) call record_contact_forces(state, plan, histories)
     if (clock_due(plan%rbdout, state%time, last)) call record_rigid_bodies(model, state, plan, histories)
-    ! the state and the history rows recorded since the previous one, as one commit
+    ! the state and the history rows recorded since the previous one, as one commit (a file the
+    ! run has open: in a distributed run only the first rank writes)
+    if (.not. results%is_open) return
     if (states_due) call write_current_state(model, state, plan, histories, results, &
                                              d3plot_globals(model, state, plan, scratch), error)
     ! binout (BINARY 2 or 3), written whole: at the last output and the states 1, 2, 4, 8, ...

@@ -19,6 +19,7 @@ module explicit_setup
   use rigid_bodies, only: set_up_rigid_bodies, add_node_masses
   use spot_weld_constraints, only: set_up_spot_welds
   use tied_contact, only: set_up_tied_contacts
+  use domain_exchange, only: set_up_domains
   implicit none
   private
 
@@ -35,6 +36,10 @@ contains
     if (allocated(error)) return
     call plan_output(model, run%histories, run%plan)
     allocate (run%energy_scratch(5, chunk_count(run%state%nodes%count)))
+    ! the ranks of a distributed run share out the element blocks (one rank: all of them)
+    call set_up_domains(model, run%state%groups, run%state%nodes, run%partition, run%exchange, error)
+    ! (the first rank prints what the run says; the others keep it quietly)
+    run%state%messages%quiet = run%exchange%rank /= 0
   end subroutine set_up_run_state
 
   subroutine set_up_explicit_state(model, state, error)

@@ -47,6 +47,8 @@ module explicit_solver
   use run_summary, only: run_summary_t
   use text_format, only: integer_text
   use wall_clock, only: start_phase, stop_phase
+  use domain_exchange, only: exchange_internal_forces, combine_group_headers, gather_block_energies
+  use rank_communication, only: largest_over_ranks
   implicit none
   private
 
@@ -64,6 +66,7 @@ contains
     if (.not. allocated(error)) call check_runaway_motion(model, run%state, 0.0_wp, error)
     if (allocated(error)) return
     call forces_and_next_step(model, run, 0.0_wp)
+    call gather_block_energies(run%state%groups, run%partition, run%exchange, run%state%cycle)
     call measured_energies(model, run%state, run%energy_scratch, run%state%energy)
     run%state%energy%initial_total = total_energy(run%state%energy)
     call check_state(model, run, .true., error)
@@ -127,6 +130,9 @@ contains
     call start_phase(run%timers(phase_internal_forces))
     call compute_internal_forces(model, run%state%groups, run%state%nodes, step)
     call stop_phase(run%timers(phase_internal_forces))
+    ! a distributed run: the owned nodes' forces to every rank, the groups' headers made global
+    call exchange_internal_forces(run%state%nodes, run%exchange)
+    call combine_group_headers(run%state%groups, run%partition, run%exchange, run%state%cycle)
     call start_phase(run%timers(phase_erosion))
     call erode_elements(model, run%state)
     call stop_phase(run%timers(phase_erosion))
@@ -315,6 +321,8 @@ contains
         call state%groups(k)%group%raise_nodal_plastic_strain(model, state%plastic_weld_node, &
                                                               state%weld_node_plastic_strain)
       end do
+      ! a distributed run: each rank raised with the blocks it computes (a maximum: exact)
+      call largest_over_ranks(state%weld_node_plastic_strain)
     end if
     call advance_spot_welds(model, state%welds, state%time, step, average_step, state%nodes%coordinates, &
                             state%nodes%angular_acceleration, state%nodes%rotary_inertia, state%nodes%velocity, &
@@ -502,6 +510,7 @@ contains
     call check_elements(model, run%state, error)
     if (.not. allocated(error)) call check_time_step(model, run%state, run%state%stable_time_step, error)
     if (.not. allocated(error) .and. (last .or. mod(run%state%cycle, energy_check_interval) == 0)) then
+      call gather_block_energies(run%state%groups, run%partition, run%exchange, run%state%cycle)
       call check_energy(model, run%state, run%energy_scratch, error)
       ! energies gone wrong in this cycle because a node ran away: name the node, as the next
       ! cycle's check would, rather than only the energies

@@ -12,6 +12,8 @@ module run_state
   use element_group, only: distortion_t
   use wall_clock, only: phase_timer_t
   use progress_report, only: progress_t
+  use domain_partition, only: domain_partition_t
+  use domain_exchange, only: domain_exchange_t
   implicit none
   private
 
@@ -37,5 +39,8 @@ module run_state
     real(wp), allocatable :: energy_scratch(:, :)   !< (5, chunks of nodes) for measured energies
     type(phase_timer_t) :: timers(phase_count)
     type(progress_t) :: progress
+    type(domain_partition_t) :: partition
+    !> the exchanges among the ranks of a distributed run (docs/parallel.md; none with one rank)
+    type(domain_exchange_t) :: exchange
   end type run_state_t
 end module run_state

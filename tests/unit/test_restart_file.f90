@@ -10,7 +10,7 @@ program test_restart_file
   use restart_file, only: restart_store_t, create_restart_store, commit_restart_store, discard_restart_store, &
                           open_restart_store, close_restart_store, write_restart, read_restart, &
                           read_restart_resized, exchange_restart, write_restart_attribute, read_restart_attribute, &
-                          restart_entry_exists
+                          restart_entry_exists, start_memory_store
   use deck_signature, only: fnv1a_hash, hash_text
   use testing, only: test_suite_t, check, finish_suite
   implicit none
@@ -24,10 +24,52 @@ program test_restart_file
   call test_read_checks(directory//"/values")
   call test_discarded_dump_keeps_the_previous_file(directory//"/kept")
   call test_fnv1a()
+  call test_memory_round_trip()
   call execute_command_line("rm -rf '"//directory//"'")
   call finish_suite(suite)
 
 contains
+
+  !> A store in memory (how the ranks of a distributed run move blocks): values of every kind
+  !> and rank back bit for bit in the order written, past the first buffer's size.
+  subroutine test_memory_round_trip()
+    type(restart_store_t) :: store, reader
+    type(error_t), allocatable :: error
+    real(wp) :: scalar, large(3, 2000), scalar_in, large_in(3, 2000)
+    integer :: count, table(2, 3), count_in, table_in(2, 3), k
+    logical :: flags(3), flags_in(3)
+    call random_number(large)
+    large(1, 1) = -0.0_wp
+    large(2, 1) = huge(1.0_wp)
+    scalar = -tiny(1.0_wp)
+    count = -huge(1)
+    table = reshape([(k - 3, k=1, 6)], [2, 3])
+    flags = [.true., .false., .true.]
+    call start_memory_store(store, .true.)
+    call exchange_restart(store, "scalar", scalar, error)
+    call exchange_restart(store, "large", large, error)
+    call exchange_restart(store, "count", count, error)
+    call exchange_restart(store, "table", table, error)
+    call exchange_restart(store, "flags", flags, error)
+    call check(suite, "memory: written", .not. allocated(error) .and. store%position == 1 + 6000 + 1 + 6 + 3)
+    reader%memory = store%memory(1:store%position)
+    call start_memory_store(reader, .false.)
+    scalar_in = 0.0_wp
+    large_in = 1.0_wp
+    count_in = 0
+    table_in = 0
+    flags_in = .false.
+    call exchange_restart(reader, "scalar", scalar_in, error)
+    call exchange_restart(reader, "large", large_in, error)
+    call exchange_restart(reader, "count", count_in, error)
+    call exchange_restart(reader, "table", table_in, error)
+    call exchange_restart(reader, "flags", flags_in, error)
+    call check(suite, "memory: read in order", .not. allocated(error) .and. reader%position == store%position)
+    call check(suite, "memory: reals bit for bit", scalar_in == scalar .and. all(large_in == large) .and. &
+               sign(1.0_wp, large_in(1, 1)) < 0.0_wp)
+    call check(suite, "memory: integers and logicals", count_in == count .and. all(table_in == table) .and. &
+               all(flags_in .eqv. flags))
+  end subroutine test_memory_round_trip
 
   subroutine test_values_round_trip(path)
     character(len=*), intent(in) :: path

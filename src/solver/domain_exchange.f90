@@ -1,0 +1,301 @@
+!> The exchanges of a distributed run (stage 1 of docs/parallel.md): every rank holds the whole
+!> model and run state; the ranks share out the element blocks of the kinds that distribute them
+!> (FE solids, shells, beams), each computing its own blocks and those on a node it owns. After
+!> the force phase the ranks hand each other the forces of the nodes they own, and the rest of
+!> the cycle runs on every rank alike.
+!>
+!> Why the results do not depend on the number of ranks: a node receives its element forces
+!> group by group, within a group colour by colour (element_groups), an order the global blocks
+!> fix. The rank that owns a node computes every block on it, so it adds the node's force in
+!> exactly that order; the exchange only copies it. The headers (stable step, failed element,
+!> eroded elements) are made global with the one-rank tie rules, and the block state that the
+!> output, the checks and the dumps read is brought together from the owners first
+!> (gather_block_state), only when it is read.
+module domain_exchange
+  use kinds, only: wp
+  use error_handling, only: error_t
+  use model, only: model_t
+  use nodal_state, only: nodal_state_t
+  use element_group, only: group_holder_t
+  use restart_file, only: restart_store_t, start_memory_store
+  use wall_clock, only: phase_timer_t, start_phase, stop_phase
+  use domain_partition, only: domain_partition_t, partition_domains
+  use rank_communication, only: rank_index, rank_total, gather_reals, gather_fixed_reals, barrier_ranks, abort_ranks
+  use text_format, only: integer_text
+  implicit none
+  private
+
+  public :: domain_exchange_t, set_up_domains, exchange_internal_forces, combine_group_headers, gather_block_state
+  public :: gather_block_energies
+
+  !> Values per group in the header exchange: step, critical block, critical element, failed
+  !> block, failed element, step not finite, newly eroded (owned blocks).
+  integer, parameter :: header_values = 7
+
+  !> What the exchanges need, set up once (the force exchange allocates nothing per cycle).
+  type :: domain_exchange_t
+    integer :: rank = 0                         !< this rank, 0-based
+    integer :: rank_count = 1                   !< ranks of the run (1: no exchange at all)
+    !> every rank's owned nodes, ascending, rank after rank: rank r's are
+    !> rank_nodes(node_offsets(r + 1):node_offsets(r + 2) - 1)
+    integer, allocatable :: rank_nodes(:), node_offsets(:)
+    integer :: values_per_node = 3              !< force; with rotations + moment, normal sum, area sum
+    integer, allocatable :: value_counts(:), value_offsets(:)   !< per rank, for the force exchange
+    real(wp), allocatable :: send(:), receive(:)
+    real(wp), allocatable :: header_send(:), header_receive(:, :)
+    integer :: gathered_cycle = -1              !< the cycle whose block state was last brought together
+    integer :: energies_cycle = -1              !< the cycle whose block energies were (or the whole state)
+    integer :: block_gathers = 0                !< how often the whole state was brought together
+    integer :: energy_gathers = 0               !< how often only the energies were
+    type(restart_store_t) :: store              !< this rank's blocks, packed for a gather
+    !> wall-clock time of the force and header exchanges; of the wait for the slowest rank before
+    !> them (a barrier: what the ranks' unequal work costs, kept apart from the communication);
+    !> of bringing the blocks together
+    type(phase_timer_t) :: timer, wait_timer, gather_timer
+    real(wp) :: gathered_values = 0.0_wp        !< values received by the block gathers, in all
+  end type domain_exchange_t
+
+contains
+
+  !> Partition the model (domain_partition) among the ranks of the run and set up the exchanges.
+  !> One rank: nothing is shared out and nothing will be exchanged.
+  subroutine set_up_domains(model, groups, nodes, partition, exchange, error)
+    type(model_t), intent(in) :: model
+    type(group_holder_t), intent(inout) :: groups(:)
+    type(nodal_state_t), intent(in) :: nodes
+    type(domain_partition_t), intent(out) :: partition
+    type(domain_exchange_t), intent(out) :: exchange
+    type(error_t), allocatable, intent(out) :: error
+    integer :: k, r, node, filled
+    exchange%rank = rank_index()
+    exchange%rank_count = rank_total()
+    ! (one rank: no partition, every block computed as always)
+    if (exchange%rank_count == 1) return
+    call partition_domains(model, groups, exchange%rank_count, exchange%rank, partition, error)
+    if (allocated(error)) return
+    do k = 1, size(groups)
+      if (.not. groups(k)%group%distributes_blocks()) cycle
+      groups(k)%group%computed = partition%groups(k)%computed
+      groups(k)%group%owned = partition%groups(k)%owner == exchange%rank
+    end do
+    allocate (exchange%node_offsets(exchange%rank_count + 1), exchange%rank_nodes(nodes%count))
+    exchange%node_offsets(1) = 1
+    do r = 0, exchange%rank_count - 1
+      exchange%node_offsets(r + 2) = exchange%node_offsets(r + 1) + count(partition%node_owner == r)
+    end do
+    do r = 0, exchange%rank_count - 1
+      filled = exchange%node_offsets(r + 1)
+      do node = 1, nodes%count
+        if (partition%node_owner(node) /= r) cycle
+        exchange%rank_nodes(filled) = node
+        filled = filled + 1
+      end do
+    end do
+    exchange%values_per_node = merge(10, 3, nodes%rotational)
+    allocate (exchange%value_counts(exchange%rank_count), exchange%value_offsets(exchange%rank_count))
+    do r = 1, exchange%rank_count
+      exchange%value_counts(r) = exchange%values_per_node*(exchange%node_offsets(r + 1) - exchange%node_offsets(r))
+      exchange%value_offsets(r) = exchange%values_per_node*(exchange%node_offsets(r) - 1)
+    end do
+    allocate (exchange%send(max(1, exchange%value_counts(exchange%rank + 1))), &
+              exchange%receive(exchange%values_per_node*nodes%count))
+    allocate (exchange%header_send(header_values*size(groups)), &
+              exchange%header_receive(header_values*size(groups), exchange%rank_count))
+  end subroutine set_up_domains
+
+  !> After the groups added their forces: every rank sends the nodal arrays the groups fill
+  !> (forces; with rotations also moments and the shells' normal and area sums) at the nodes it
+  !> owns, complete there, and takes the others' at theirs. Every rank then holds the one-rank
+  !> arrays, bit for bit.
+  subroutine exchange_internal_forces(nodes, exchange)
+    type(nodal_state_t), intent(inout) :: nodes
+    type(domain_exchange_t), intent(inout) :: exchange
+    integer :: k, node, first, at
+    if (exchange%rank_count == 1) return
+    call start_phase(exchange%wait_timer)
+    call barrier_ranks()
+    call stop_phase(exchange%wait_timer)
+    call start_phase(exchange%timer)
+    first = exchange%node_offsets(exchange%rank + 1)
+    !$omp parallel do schedule(static) default(shared) private(k, node, at)
+    do k = first, exchange%node_offsets(exchange%rank + 2) - 1
+      node = exchange%rank_nodes(k)
+      at = (k - first)*exchange%values_per_node
+      exchange%send(at + 1:at + 3) = nodes%internal_force(:, node)
+      if (exchange%values_per_node > 3) then
+        exchange%send(at + 4:at + 6) = nodes%internal_moment(:, node)
+        exchange%send(at + 7:at + 9) = nodes%shell_normal_sum(:, node)
+        exchange%send(at + 10) = nodes%shell_area_sum(node)
+      end if
+    end do
+    !$omp end parallel do
+    call gather_reals(exchange%send, exchange%value_counts, exchange%value_offsets, exchange%receive)
+    ! (the receive buffer holds the ranks' nodes in rank_nodes' order)
+    !$omp parallel do schedule(static) default(shared) private(k, node, at)
+    do k = 1, size(exchange%rank_nodes)
+      node = exchange%rank_nodes(k)
+      at = (k - 1)*exchange%values_per_node
+      nodes%internal_force(:, node) = exchange%receive(at + 1:at + 3)
+      if (exchange%values_per_node > 3) then
+        nodes%internal_moment(:, node) = exchange%receive(at + 4:at + 6)
+        nodes%shell_normal_sum(:, node) = exchange%receive(at + 7:at + 9)
+        nodes%shell_area_sum(node) = exchange%receive(at + 10)
+      end if
+    end do
+    !$omp end parallel do
+    call stop_phase(exchange%timer)
+  end subroutine exchange_internal_forces
+
+  !> The headers of the distributed groups from all ranks, made global with the one-rank rules:
+  !> the smallest step, on a tie the first block (the group's own order: the same element as one
+  !> rank picks); the failed element of the first block with one; a step that is not a number
+  !> anywhere; the eroded elements of all ranks (then the blocks are brought together, so that
+  !> every rank lists and marks the same elements). Groups computed whole on every rank already
+  !> hold the global header. `cycle` is the state's cycle (for gather_block_state).
+  subroutine combine_group_headers(groups, partition, exchange, cycle)
+    type(group_holder_t), intent(inout) :: groups(:)
+    type(domain_partition_t), intent(in) :: partition
+    type(domain_exchange_t), intent(inout) :: exchange
+    integer, intent(in) :: cycle
+    integer :: k, r, at, newly_eroded
+    real(wp) :: step, block
+    logical :: eroded
+    if (exchange%rank_count == 1) return
+    call start_phase(exchange%timer)
+    do k = 1, size(groups)
+      at = header_values*(k - 1)
+      associate (group => groups(k)%group)
+        exchange%header_send(at + 1:at + header_values) = [group%stable_time_step, real(group%critical_block, wp), &
+          real(group%critical_element, wp), real(group%failed_block, wp), real(group%failed_element, wp), &
+          merge(1.0_wp, 0.0_wp, group%step_not_finite), real(group%newly_eroded, wp)]
+      end associate
+    end do
+    call gather_fixed_reals(exchange%header_send, exchange%header_receive)
+    call stop_phase(exchange%timer)
+    eroded = .false.
+    do k = 1, size(groups)
+      associate (group => groups(k)%group, values => exchange%header_receive(header_values*(k - 1) + 1:, :))
+        if (.not. group%distributes_blocks()) cycle
+        group%stable_time_step = huge(1.0_wp)
+        group%critical_block = 0
+        group%critical_element = 0
+        group%failed_block = 0
+        group%failed_element = 0
+        group%step_not_finite = .false.
+        newly_eroded = 0
+        do r = 1, exchange%rank_count
+          step = values(1, r)
+          block = values(2, r)
+          if (step < group%stable_time_step .or. &
+              (step == group%stable_time_step .and. step < huge(1.0_wp) .and. block < group%critical_block)) then
+            group%stable_time_step = step
+            group%critical_block = nint(block)
+            group%critical_element = nint(values(3, r))
+          end if
+          if (values(4, r) > 0.0_wp .and. (group%failed_block == 0 .or. values(4, r) < group%failed_block)) then
+            group%failed_block = nint(values(4, r))
+            group%failed_element = nint(values(5, r))
+          end if
+          if (values(6, r) > 0.0_wp) group%step_not_finite = .true.
+          newly_eroded = newly_eroded + nint(values(7, r))
+        end do
+        ! the group counted its own blocks' eroded elements into eroded_count
+        group%eroded_count = group%eroded_count - group%newly_eroded + newly_eroded
+        group%newly_eroded = newly_eroded
+        if (newly_eroded > 0) eroded = .true.
+      end associate
+    end do
+    if (eroded) call gather_block_state(groups, partition, exchange, cycle)
+  end subroutine combine_group_headers
+
+  !> Bring every block's state to every rank from its owner (each rank's others are old): before
+  !> anything outside the force call reads block state (output states, dumps, the eroded
+  !> elements, the end of the run). Once per cycle at most; nothing with one rank.
+  subroutine gather_block_state(groups, partition, exchange, cycle)
+    type(group_holder_t), intent(inout) :: groups(:)
+    type(domain_partition_t), intent(in) :: partition
+    type(domain_exchange_t), intent(inout) :: exchange
+    integer, intent(in) :: cycle
+    if (exchange%rank_count == 1 .or. exchange%gathered_cycle == cycle) return
+    call start_phase(exchange%gather_timer)
+    call bring_blocks_together(groups, partition, exchange, .false.)
+    exchange%gathered_cycle = cycle
+    exchange%energies_cycle = cycle
+    exchange%block_gathers = exchange%block_gathers + 1
+    call stop_phase(exchange%gather_timer)
+  end subroutine gather_block_state
+
+  !> The same for the blocks' energies and powers only (exchange_block_energies): what the energy
+  !> checks and the glstat and matsum histories read, a small part of a block's state.
+  subroutine gather_block_energies(groups, partition, exchange, cycle)
+    type(group_holder_t), intent(inout) :: groups(:)
+    type(domain_partition_t), intent(in) :: partition
+    type(domain_exchange_t), intent(inout) :: exchange
+    integer, intent(in) :: cycle
+    if (exchange%rank_count == 1 .or. exchange%energies_cycle == cycle) return
+    call start_phase(exchange%gather_timer)
+    call bring_blocks_together(groups, partition, exchange, .true.)
+    exchange%energies_cycle = cycle
+    exchange%energy_gathers = exchange%energy_gathers + 1
+    call stop_phase(exchange%gather_timer)
+  end subroutine gather_block_energies
+
+  !> The owners pack their blocks (whole, or their energies) into a store in memory, every rank
+  !> receives all stores (MPI_Allgatherv) and unpacks the blocks of the others, rank by rank.
+  subroutine bring_blocks_together(groups, partition, exchange, energies_only)
+    type(group_holder_t), intent(inout) :: groups(:)
+    type(domain_partition_t), intent(in) :: partition
+    type(domain_exchange_t), intent(inout) :: exchange
+    logical, intent(in) :: energies_only
+    type(restart_store_t) :: reader
+    type(error_t), allocatable :: error
+    real(wp) :: length(1)
+    real(wp), allocatable :: lengths(:, :), received(:)
+    integer, allocatable :: counts(:), offsets(:)
+    integer :: k, b, r
+    call start_memory_store(exchange%store, .true.)
+    do k = 1, size(groups)
+      if (.not. groups(k)%group%distributes_blocks()) cycle
+      do b = 1, size(partition%groups(k)%owner)
+        if (partition%groups(k)%owner(b) /= exchange%rank) cycle
+        if (energies_only) then
+          call groups(k)%group%exchange_block_energies(exchange%store, b, error)
+        else
+          call groups(k)%group%exchange_block_state(exchange%store, b, error)
+        end if
+      end do
+    end do
+    length(1) = real(exchange%store%position, wp)
+    allocate (lengths(1, exchange%rank_count), counts(exchange%rank_count), offsets(exchange%rank_count))
+    call gather_fixed_reals(length, lengths)
+    counts = nint(lengths(1, :))
+    offsets(1) = 0
+    do r = 2, exchange%rank_count
+      offsets(r) = offsets(r - 1) + counts(r - 1)
+    end do
+    allocate (received(max(1, sum(counts))))
+    call gather_reals(exchange%store%memory(1:max(1, exchange%store%position)), counts, offsets, received)
+    do r = 0, exchange%rank_count - 1
+      if (r == exchange%rank) cycle
+      reader%memory = received(offsets(r + 1) + 1:offsets(r + 1) + max(1, counts(r + 1)))
+      call start_memory_store(reader, .false.)
+      do k = 1, size(groups)
+        if (.not. groups(k)%group%distributes_blocks()) cycle
+        do b = 1, size(partition%groups(k)%owner)
+          if (partition%groups(k)%owner(b) /= r) cycle
+          if (energies_only) then
+            call groups(k)%group%exchange_block_energies(reader, b, error)
+          else
+            call groups(k)%group%exchange_block_state(reader, b, error)
+          end if
+        end do
+      end do
+      ! (ranks that disagree on the blocks' shapes run different builds or decks: no result can
+      ! be trusted, and the others may wait for ever)
+      if (reader%position /= counts(r + 1)) &
+        call abort_ranks("block state from rank "//integer_text(r)//": "//integer_text(counts(r + 1))// &
+                         " values received, "//integer_text(reader%position)//" expected", 1)
+    end do
+    exchange%gathered_values = exchange%gathered_values + real(sum(counts), wp)
+  end subroutine bring_blocks_together
+end module domain_exchange

@@ -1,0 +1,76 @@
+#!/usr/bin/env python3
+"""The tables of tools/bench_mpi.sh from its directory: the timed runs (ranks_N/results.h5) and
+the partitions (partition_N/results.h5, /run/partition).
+
+    python3 tools/bench_mpi_report.py DIRECTORY
+"""
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+# what a stage-2 neighbour exchange would send per interface node: its force and moment (6 reals)
+DOUBLES_PER_NODE = 6
+# what stage 1's allgatherv sends per owned node (domain_exchange): 3 force components, 10 with
+# shell nodes (moments, the normal and area sums)
+STAGE_1_REALS = {False: 3, True: 10}
+
+
+def cycle_seconds(path):
+    """Seconds of the cycle's phases (output excluded), cycles, elements."""
+    with h5py.File(path, "r") as results:
+        timing = results["timing"].attrs
+        phases = sum(float(timing[name]) for name in timing if name.startswith("phase_") and name != "phase_output_s")
+        return phases, int(timing["cycles"]), int(timing["fe_elements"])
+
+
+def main():
+    directory = Path(sys.argv[1])
+    print("Timed runs (ncpu=1 per rank):")
+    print(f"{'ranks':>6} {'cycles':>7} {'s per cycle':>12} {'ns per element per cycle':>25} {'efficiency':>11}")
+    single = None
+    for ranks in (1, 2):
+        path = directory / f"ranks_{ranks}" / "results.h5"
+        if not path.exists():
+            print(f"{ranks:>6}   (not run)")
+            continue
+        seconds, cycles, elements = cycle_seconds(path)
+        per_cycle = seconds / max(cycles, 1)
+        if ranks == 1:
+            single = per_cycle
+        efficiency = f"{single / (ranks * per_cycle):.2f}" if single else "-"
+        print(f"{ranks:>6} {cycles:>7} {per_cycle:>12.4f} {1e9 * per_cycle / elements:>25.1f} {efficiency:>11}")
+        log = directory / f"ranks_{ranks}.log"
+        if ranks > 1 and log.exists():
+            for line in log.read_text().splitlines():
+                if line.strip().startswith("MPI:"):
+                    print("        " + line.strip())
+
+    print()
+    print("Partitions (partition=N; costs estimated from the per-kind lane costs):")
+    header = (f"{'ranks':>6} {'imbalance':>9} {'with ghosts':>11} {'blocks/rank':>11} {'ghost mean':>10} "
+              f"{'ghost max':>9} {'owned nodes':>11} {'interface mean':>14} {'interface max':>13} "
+              f"{'interface/owned':>15} {'stage-2 kB/cycle':>16} {'stage-1 kB/cycle':>16}")
+    print(header)
+    for path in sorted(directory.glob("partition_*/results.h5"), key=lambda p: int(p.parent.name.split("_")[1])):
+        with h5py.File(path, "r") as results:
+            partition = results["run/partition"]
+            ranks = int(partition.attrs["rank_count"])
+            blocks = partition["rank_blocks"][()]
+            ghosts = partition["rank_ghost_blocks"][()]
+            owned = partition["rank_owned_nodes"][()]
+            interface = partition["rank_interface_nodes"][()]
+            nodes = owned.sum()
+            shells = "mesh/shells" in results and len(results["mesh/shells/ids"]) > 0
+            # stage 1: each rank receives every other rank's owned nodes (allgatherv)
+            stage_1 = (nodes - owned.min()) * STAGE_1_REALS[shells] * 8 / 1024
+            stage_2 = interface.max() * DOUBLES_PER_NODE * 8 / 1024
+            print(f"{ranks:>6} {partition.attrs['imbalance']:>9.3f} {partition.attrs['computed_imbalance']:>11.3f} "
+                  f"{blocks.mean():>11.1f} {ghosts.mean():>10.1f} {ghosts.max():>9d} {owned.mean():>11.0f} "
+                  f"{interface.mean():>14.0f} {interface.max():>13d} {interface.mean() / owned.mean():>15.3f} "
+                  f"{stage_2:>16.1f} {stage_1:>16.1f}")
+
+
+if __name__ == "__main__":
+    main()
