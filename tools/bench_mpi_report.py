@@ -10,7 +10,11 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-DOUBLES_PER_NODE = 6   # forces and moments of a node, 8 bytes each
+# what a stage-2 neighbour exchange would send per interface node: its force and moment (6 reals)
+DOUBLES_PER_NODE = 6
+# what stage 1's allgatherv sends per owned node (domain_exchange): 3 force components, 10 with
+# shell nodes (moments, the normal and area sums)
+STAGE_1_REALS = {False: 3, True: 10}
 
 
 def cycle_seconds(path):
@@ -37,6 +41,11 @@ def main():
             single = per_cycle
         efficiency = f"{single / (ranks * per_cycle):.2f}" if single else "-"
         print(f"{ranks:>6} {cycles:>7} {per_cycle:>12.4f} {1e9 * per_cycle / elements:>25.1f} {efficiency:>11}")
+        log = directory / f"ranks_{ranks}.log"
+        if ranks > 1 and log.exists():
+            for line in log.read_text().splitlines():
+                if line.strip().startswith("MPI:"):
+                    print("        " + line.strip())
 
     print()
     print("Partitions (partition=N; costs estimated from the per-kind lane costs):")
@@ -53,8 +62,9 @@ def main():
             owned = partition["rank_owned_nodes"][()]
             interface = partition["rank_interface_nodes"][()]
             nodes = owned.sum()
+            shells = "mesh/shells" in results and len(results["mesh/shells/ids"]) > 0
             # stage 1: each rank receives every other rank's owned nodes (allgatherv)
-            stage_1 = (nodes - owned.min()) * DOUBLES_PER_NODE * 8 / 1024
+            stage_1 = (nodes - owned.min()) * STAGE_1_REALS[shells] * 8 / 1024
             stage_2 = interface.max() * DOUBLES_PER_NODE * 8 / 1024
             print(f"{ranks:>6} {partition.attrs['imbalance']:>9.3f} {partition.attrs['computed_imbalance']:>11.3f} "
                   f"{blocks.mean():>11.1f} {ghosts.mean():>10.1f} {ghosts.max():>9d} {owned.mean():>11.0f} "

@@ -350,7 +350,8 @@ contains
         "node numbering", warnings)
     else if (index(name, "CONTROL_MPP_") == 1) then
       call note_not_acted_upon(deck, block, [character(len=1) :: ], "it sets up LS-DYNA's MPP "// &
-        "domain decomposition and files; crashfree runs one process on OpenMP threads", warnings)
+        "domain decomposition and files; crashfree partitions the model itself for mpirun (METIS, "// &
+        "weighted by element cost; partition=N shows it) and writes one set of files", warnings)
     else
       call note_not_acted_upon(deck, block, [character(len=1) :: ], "crashfree has no use "// &
         "for it", warnings)
