@@ -78,7 +78,9 @@ contains
       groups(k)%group%computed = partition%groups(k)%computed
       groups(k)%group%owned = partition%groups(k)%owner == exchange%rank
     end do
-    allocate (exchange%node_offsets(exchange%rank_count + 1), exchange%rank_nodes(nodes%count))
+    ! (every node has an owner; a node without one would only get no force from the others)
+    allocate (exchange%node_offsets(exchange%rank_count + 1), &
+              exchange%rank_nodes(count(partition%node_owner >= 0 .and. partition%node_owner < exchange%rank_count)))
     exchange%node_offsets(1) = 1
     do r = 0, exchange%rank_count - 1
       exchange%node_offsets(r + 2) = exchange%node_offsets(r + 1) + count(partition%node_owner == r)
@@ -98,7 +100,7 @@ contains
       exchange%value_offsets(r) = exchange%values_per_node*(exchange%node_offsets(r) - 1)
     end do
     allocate (exchange%send(max(1, exchange%value_counts(exchange%rank + 1))), &
-              exchange%receive(exchange%values_per_node*nodes%count))
+              exchange%receive(exchange%values_per_node*size(exchange%rank_nodes)))
     allocate (exchange%header_send(header_values*size(groups)), &
               exchange%header_receive(header_values*size(groups), exchange%rank_count))
   end subroutine set_up_domains

@@ -2,7 +2,7 @@
 of the one-rank run bit for bit, for N = 1, 2, 3 ranks and with 2 threads per rank, on a contact
 model, a coupled meshfree / finite element model, a shell model with elements that erode and a
 rigid-body model; a run continued from a restart dump on another number of ranks gives the
-uninterrupted run's file. Every dataset and attribute is compared (test_threads'
+uninterrupted run's file, also after SIGTERM to mpirun (every rank stops after the same cycle). Every dataset and attribute is compared (test_threads'
 comparison) but /timing, the /run attributes that may differ between runs (threads, run_id)
 and /run/partition, the partition report, which says how the ranks shared the model out.
 
@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import os
 import shutil
+import signal
 import subprocess
 from pathlib import Path
 
@@ -218,3 +219,27 @@ def test_first_rank_prints_and_too_many_ranks_are_refused(tmp_path):
     assert process.returncode == 2, process.stdout + process.stderr
     assert "ranks are more than the model's" in process.stderr, process.stderr
     assert process.stderr.count("ranks are more than the model's") == 1, process.stderr
+
+
+def test_sigterm_to_mpirun_stops_every_rank_after_the_same_cycle(tmp_path):
+    """A batch system's time limit: SIGTERM to mpirun, which passes it to the ranks (not at one
+    instant). Every rank stops after the same cycle, the first writes a restart dump and says so
+    once (exit status 1); the dump continued on 3 ranks gives the uninterrupted run's file."""
+    deck = shortened(contact_deck(tmp_path / "contact.k"), 600)
+    reference = run(deck, tmp_path / "alone", None)
+    output = tmp_path / "stopped"
+    process = subprocess.Popen(["mpirun", "--oversubscribe", "-np", "2", str(BINARY), f"i={deck}", f"outdir={output}",
+                                "ncpu=1"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               env=environment(1))
+    for line in process.stdout:
+        if line.split() and line.split()[0].isdigit():      # the first progress line: cycles are running
+            break
+    process.send_signal(signal.SIGTERM)
+    stdout, stderr = process.communicate(timeout=300)
+    assert process.returncode == 1, stdout + stderr
+    assert stderr.count("stopped by SIGTERM") == 1, stderr
+    assert (output / "d3dump01").exists(), stderr
+    continued = solver(3, [f"r={output / 'd3dump01'}"])
+    assert continued.returncode == 0, continued.stdout + continued.stderr
+    difference = results_difference(reference, output / "results.h5")
+    assert not difference, f"stopped on 2 ranks, continued on 3: {difference}"
