@@ -13,6 +13,10 @@
 #   make bench      performance figures (ns per element per cycle)
 #   make verify     verification studies (patch test, cantilever): docs/verification.md (NCPU=n)
 #   make MODE=debug checked build in build/debug
+#   make install    the embedding library (lib/libcrashfree_efg.a), its header, Fortran module and
+#                   pkg-config file crashfree-efg.pc under PREFIX (default /usr/local); docs/embedding.md
+#   make examples   install into build/release/install, then build the host codes of examples/
+#                   against it with pkg-config only (build/release/examples)
 MODE ?= release
 FC := gfortran
 PYTHON ?= python3
@@ -32,6 +36,10 @@ else
             -Wno-maybe-uninitialized
 endif
 LIBRARY := $(BUILD)/lib/libcrashfree.a
+# The embedding library (docs/embedding.md): the API modules of src/api and the project modules
+# they use (tools/library_objects.py writes EFG_LIBRARY_OBJECTS), nothing that needs HDF5 or METIS.
+EFG_LIBRARY := $(BUILD)/lib/libcrashfree_efg.a
+EFG_API_SOURCES := $(sort $(wildcard src/api/crashfree_efg*.f90))
 PROGRAM := $(BUILD)/bin/crashfree
 FFLAGS += -J$(MOD) -I$(MOD) -I$(HDF5_INCLUDE)
 
@@ -45,15 +53,15 @@ ALL_SOURCES := $(LIBRARY_SOURCES) src/app/crashfree.f90 $(TEST_SUPPORT) $(TEST_S
 vpath %.f90 $(sort $(dir $(ALL_SOURCES)))
 
 .PHONY: all deps run taylor test unit regression bench clean debug verify fuzz layers
-# The release build is also published as bin/crashfree and lib/ (library and .mod files).
+# The release build is also published as bin/crashfree and lib/ (libraries and .mod files).
 ifeq ($(MODE),release)
 all: bin/crashfree
-bin/crashfree: $(PROGRAM)
+bin/crashfree: $(PROGRAM) $(EFG_LIBRARY)
 	@mkdir -p bin lib
 	@cp $(PROGRAM) bin/crashfree.new && mv -f bin/crashfree.new bin/crashfree
-	@cp $(LIBRARY) $(MOD)/*.mod lib/
+	@cp $(LIBRARY) $(EFG_LIBRARY) $(MOD)/*.mod lib/
 else
-all: $(PROGRAM)
+all: $(PROGRAM) $(EFG_LIBRARY)
 endif
 
 $(OBJ)/%.o: %.f90 | $(OBJ) $(MOD)
@@ -83,9 +91,47 @@ $(BUILD)/deps.mk: $(ALL_SOURCES) tools/fortran_deps.py
 	@mkdir -p $(BUILD)
 	@$(PYTHON) tools/fortran_deps.py $(OBJ) $(ALL_SOURCES) > $@
 
+$(BUILD)/efg_library.mk: $(LIBRARY_SOURCES) tools/library_objects.py
+	@mkdir -p $(BUILD)
+	@$(PYTHON) tools/library_objects.py EFG_LIBRARY_OBJECTS $(OBJ) $(EFG_API_SOURCES) -- $(LIBRARY_SOURCES) > $@
+
 ifeq ($(filter deps clean,$(MAKECMDGOALS)),)
 include $(BUILD)/deps.mk
+include $(BUILD)/efg_library.mk
 endif
+
+$(EFG_LIBRARY): $(EFG_LIBRARY_OBJECTS) | $(dir $(EFG_LIBRARY))
+	@rm -f $@
+	ar rcs $@ $^
+
+# make install PREFIX=DIR: the embedding library, its C header, its Fortran module (gfortran's
+# .mod files are compiler-specific: include/crashfree/, apart from the header) and the
+# pkg-config file, whose Libs name the static library's own dependencies (tools/crashfree-efg.pc.in).
+# Only the API's own .mod is installed: a host needs no other, and the internal module names
+# (kinds, model, ...) would collide with a host's own.
+PREFIX ?= /usr/local
+CRASHFREE_VERSION := $(shell sed -n 's/.*crashfree_version *= *"\([^"]*\)".*/\1/p' src/core/version.f90)
+INSTALL_PREFIX = $(abspath $(PREFIX))
+.PHONY: install examples
+install: $(EFG_LIBRARY)
+	@mkdir -p $(DESTDIR)$(INSTALL_PREFIX)/lib/pkgconfig $(DESTDIR)$(INSTALL_PREFIX)/include/crashfree
+	cp $(EFG_LIBRARY) $(DESTDIR)$(INSTALL_PREFIX)/lib/
+	cp include/crashfree_efg.h $(DESTDIR)$(INSTALL_PREFIX)/include/
+	cp $(MOD)/crashfree_efg.mod $(DESTDIR)$(INSTALL_PREFIX)/include/crashfree/
+	sed -e 's|@PREFIX@|$(INSTALL_PREFIX)|g' -e 's|@VERSION@|$(CRASHFREE_VERSION)|g' \
+	    tools/crashfree-efg.pc.in > $(DESTDIR)$(INSTALL_PREFIX)/lib/pkgconfig/crashfree-efg.pc
+
+# make examples: install into EXAMPLES_PREFIX, then build the two host codes of examples/ with
+# their own Makefiles, which know the library only through pkg-config.
+EXAMPLES_PREFIX ?= $(BUILD)/install
+EXAMPLES_OUT ?= $(BUILD)/examples
+examples:
+	@$(MAKE) --no-print-directory install PREFIX=$(EXAMPLES_PREFIX)
+	@mkdir -p $(EXAMPLES_OUT)
+	PKG_CONFIG_PATH=$(abspath $(EXAMPLES_PREFIX))/lib/pkgconfig $(MAKE) --no-print-directory -C examples/host_fortran \
+	    OUT=$(abspath $(EXAMPLES_OUT))
+	PKG_CONFIG_PATH=$(abspath $(EXAMPLES_PREFIX))/lib/pkgconfig $(MAKE) --no-print-directory -C examples/host_c \
+	    OUT=$(abspath $(EXAMPLES_OUT))
 
 deps:
 	@bash tools/install_dependencies.sh
