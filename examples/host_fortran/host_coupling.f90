@@ -41,10 +41,10 @@ contains
     type(host_model_t), intent(inout) :: model
     integer(c_int), intent(in) :: status
     character(len=*), intent(in) :: call_name
-    character(len=512) :: message
+    character(len=:), allocatable :: message
     if (status == 0) return
     call cf_efg_last_error(model%part, message)
-    write (*, '(a)') "host_fortran: "//call_name//" failed (status "//trim(adjustl(text(status)))//"): "//trim(message)
+    write (*, '(a)') "host_fortran: "//call_name//" failed (status "//trim(adjustl(text(status)))//"): "//message
     error stop 1
   end subroutine check
 
@@ -101,7 +101,8 @@ contains
     call check(model, status, "cf_efg_set_up")
     call cf_efg_set_elastic(model%part, young, poisson, status)
     call check(model, status, "cf_efg_set_elastic")
-    call cf_efg_counts(model%part, model%counts(1), model%counts(2), model%counts(3), model%counts(4))
+    call cf_efg_counts(model%part, model%counts(1), model%counts(2), model%counts(3), model%counts(4), status)
+    call check(model, status, "cf_efg_counts")
 
     ! lumped masses: the host's elements, then the part's row sums
     allocate (model%mass(node_count), model%part_mass(size(model%part_node)))

@@ -68,6 +68,7 @@ contains
                                                            -0.002_c_double, 0.005_c_double, 0.008_c_double], [3, 3])
     type(host_mesh_t) :: mesh
     type(host_model_t) :: model
+    integer(c_int) :: status
     type(host_solids_t) :: meshfree_cells
     logical, allocatable :: meshfree(:), driven(:)
     real(c_double), allocatable :: exact(:, :), physical(:, :)
@@ -112,7 +113,8 @@ contains
     allocate (physical(3, size(exact, 2)))
     call physical_field(model, model%velocity, physical)
     write (*, '(a, es25.16e3)') "velocity_error", maxval(abs(physical - exact))/maxval(abs(exact))
-    call cf_efg_destroy(model%part)
+    call cf_efg_destroy(model%part, status)
+    call check(model, status, "cf_efg_destroy")
   end subroutine patch_test
 
   !> v += step a with a = -f / m (no external forces here).
@@ -135,6 +137,7 @@ contains
     real(c_double), parameter :: pi = 3.14159265358979323846_c_double
     type(host_mesh_t) :: mesh
     type(host_model_t) :: model
+    integer(c_int) :: status
     logical, allocatable :: meshfree(:), supported(:), driven(:)
     real(c_double), allocatable :: physical(:, :)
     real(c_double) :: stable_dt, dt, previous_dt, time, pulse
@@ -183,7 +186,8 @@ contains
       write (*, '(a, 3(1x, es25.16e3))') "sample", time - 0.5_c_double*dt, physical(1, incident_probe), &
         physical(1, transmitted_probe)
     end do
-    call cf_efg_destroy(model%part)
+    call cf_efg_destroy(model%part, status)
+    call check(model, status, "cf_efg_destroy")
   end subroutine coupled_bar
 
   !> An all-meshfree block of 5 x 4 x 4 perturbed 1 mm cells (box kernel, DX 1.5) at rest, a
@@ -194,6 +198,7 @@ contains
     real(c_double), intent(in) :: step
     type(host_mesh_t) :: mesh
     type(host_model_t) :: model
+    integer(c_int) :: status
     logical, allocatable :: meshfree(:), marked(:)
     real(c_double), allocatable :: acceleration(:, :), physical(:, :)
     real(c_double) :: stable_dt, x, y, z
@@ -238,7 +243,8 @@ contains
       write (*, '(a, 1x, i0, 13(1x, es25.16e3))') "node", node, mesh%coordinates(:, node), model%velocity(:, node), &
         model%mass(node), model%force(:, node), physical(:, node)
     end do
-    call cf_efg_destroy(model%part)
+    call cf_efg_destroy(model%part, status)
+    call check(model, status, "cf_efg_destroy")
   end subroutine one_force_call
 
   !> ns per integration point per call of cf_efg_internal_force on a block of cells^3 meshfree
@@ -274,7 +280,8 @@ contains
     call sort(seconds)
     write (*, '(a, 1x, i0)') "integration_points", model%counts(4)
     write (*, '(a, f12.3)') "ns_per_point_call", 1.0e9_c_double*seconds((calls + 1)/2)/model%counts(4)
-    call cf_efg_destroy(model%part)
+    call cf_efg_destroy(model%part, status)
+    call check(model, status, "cf_efg_destroy")
   end subroutine bench
 
   !> Insertion sort (a few hundred values).
