@@ -10,7 +10,7 @@
 #   make test       install what is missing, build, layer check, unit tests (debug build) and
 #                   regression tests
 #   make layers     check that each folder of src/ uses only the folders below it
-#   make bench      performance figures (ns per element per cycle)
+#   make bench      performance figures (ns per element per cycle; the embedding API: tools/bench_api.sh)
 #   make verify     verification studies (patch test, cantilever): docs/verification.md (NCPU=n)
 #   make MODE=debug checked build in build/debug
 #   make install    the embedding library (lib/libcrashfree_efg.a), its header, Fortran module and
@@ -183,6 +183,7 @@ bench: deps
 	@$(MAKE) --no-print-directory all
 	@bash tools/bench.sh
 	@bash tools/bench_contact.sh
+	@bash tools/bench_api.sh
 
 # Verification studies: write the decks, run every case (NCPU threads each, default 1), then
 # write docs/verification.md and its plots (also when a case failed; the exit status says so).

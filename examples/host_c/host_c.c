@@ -592,9 +592,12 @@ static void bench(int cells_per_side, int calls)
         check(&model, status, "cf_efg_internal_force");
         seconds[c] = (double)(finish.tv_sec - start.tv_sec) + 1.0e-9 * (double)(finish.tv_nsec - start.tv_nsec);
     }
+    double total = 0;
+    for (int c = 0; c < calls; c++) total += seconds[c];
     qsort(seconds, calls, sizeof(double), compare_doubles);
     printf("integration_points %d\n", model.counts[3]);
     printf("ns_per_point_call %12.3f\n", 1.0e9 * seconds[(calls + 1) / 2 - 1] / model.counts[3]);
+    printf("ns_per_point_call_mean %12.3f\n", 1.0e9 * total / calls / model.counts[3]);
     cf_efg_destroy(&model.part);
 }
 
