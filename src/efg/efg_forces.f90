@@ -33,6 +33,7 @@ module efg_forces
   use block_colouring, only: colour_blocks_by_node_lists
   use model, only: model_t, material_t
   use efg_part, only: efg_part_t
+  use efg_host_law, only: host_law_t
   use material_dispatch, only: material_history_count, initialize_material_history, update_material_block, &
                                rotate_material_history, material_plastic_strain
   use objective_rotation, only: incremental_rotation, rotate_symmetric_tensors
@@ -43,7 +44,7 @@ module efg_forces
   implicit none
   private
 
-  public :: efg_solver_t, set_up_efg_solver, compute_efg_forces, efg_point_results
+  public :: efg_solver_t, set_up_efg_solver, set_up_efg_state, compute_efg_forces, efg_point_results
   public :: transform_to_physical
 
   !> Up to block_size consecutive integration points of one part and their state.
@@ -68,44 +69,80 @@ module efg_forces
     type(gather_list_t) :: block_colours          !< colour -> blocks; blocks of one colour share no node
     real(wp), allocatable :: block_time_step(:)
     integer, allocatable :: block_critical_point(:), block_inverted_point(:)
+    !> A host code's law (crashfree_efg): when associated it replaces the material dispatch;
+    !> the blocks' history is then (points of the block, k)
+    type(host_law_t) :: host_law
   end type efg_solver_t
 
 contains
 
-  !> Blocks, material state and the node -> pair list of one part whose geometry is built.
+  !> Blocks, material state and the node -> pair list of one part of the model whose geometry
+  !> is built (through set_up_efg_state, with the part's material and bulk viscosity).
   subroutine set_up_efg_solver(model, geometry, solver)
     type(model_t), intent(in) :: model
     type(efg_part_t), intent(in) :: geometry
     type(efg_solver_t), intent(out) :: solver
+    type(host_law_t) :: no_host_law
+    associate (part => model%parts(geometry%part), material => model%materials(geometry%material))
+      call set_up_efg_state(geometry, model%coordinates, model%solid_nodes, material, material%density, &
+                            part%bulk_quadratic, part%bulk_linear, no_host_law, size(model%node_ids), solver)
+    end associate
+  end subroutine set_up_efg_solver
+
+  !> Blocks, material state and the node -> pair list of one part whose geometry is built:
+  !> `point_cell` of the geometry indexes `hexahedra(8, :)` (indices into `coordinates`),
+  !> `node_count` nodes take the forces. The law is `host_law` when it is associated, else
+  !> `material` (its history initialized by the material dispatch).
+  subroutine set_up_efg_state(geometry, coordinates, hexahedra, material, density, bulk_quadratic, bulk_linear, &
+                              host_law, node_count, solver)
+    type(efg_part_t), intent(in) :: geometry
+    real(wp), intent(in) :: coordinates(:, :)
+    integer, intent(in) :: hexahedra(:, :)
+    type(material_t), intent(in) :: material
+    real(wp), intent(in) :: density, bulk_quadratic, bulk_linear
+    type(host_law_t), intent(in) :: host_law
+    integer, intent(in) :: node_count
+    type(efg_solver_t), intent(out) :: solver
     integer :: point_count, block_count, b, history_count, k, g
     real(wp) :: element_edges(block_size, 6)
+    logical :: hosted
 
     solver%geometry = geometry
-    associate (part => model%parts(geometry%part), material => model%materials(geometry%material))
-      solver%density = material%density
-      solver%bulk_quadratic = part%bulk_quadratic
-      solver%bulk_linear = part%bulk_linear
+    solver%host_law = host_law
+    hosted = associated(host_law%update)
+    solver%density = density
+    solver%bulk_quadratic = bulk_quadratic
+    solver%bulk_linear = bulk_linear
+    if (hosted) then
+      history_count = host_law%history_count
+    else
       history_count = material_history_count(material)
-      point_count = size(geometry%point_volume)
-      block_count = (point_count + block_size - 1)/block_size
-      allocate (solver%blocks(block_count))
-      do b = 1, block_count
-        solver%blocks(b)%first_point = (b - 1)*block_size + 1
-        solver%blocks(b)%point_count = min(block_size, point_count - (b - 1)*block_size)
-        allocate (solver%blocks(b)%history(block_size, max(history_count, 1)))
+    end if
+    point_count = size(geometry%point_volume)
+    block_count = (point_count + block_size - 1)/block_size
+    allocate (solver%blocks(block_count))
+    do b = 1, block_count
+      solver%blocks(b)%first_point = (b - 1)*block_size + 1
+      solver%blocks(b)%point_count = min(block_size, point_count - (b - 1)*block_size)
+      if (hosted) then
+        ! the host's law sees exactly the block's points: (n, k), contiguous
+        allocate (solver%blocks(b)%history(solver%blocks(b)%point_count, max(history_count, 1)))
         solver%blocks(b)%history = 0.0_wp
-        ! material axes of AOPT 0 (honeycombs) from the edges 1-2 and 1-4 of each point's cell
-        do k = 1, solver%blocks(b)%point_count
-          g = solver%blocks(b)%first_point + k - 1
-          associate (corners => model%solid_nodes(:, geometry%point_cell(g)))
-            element_edges(k, 1:3) = model%coordinates(:, corners(2)) - model%coordinates(:, corners(1))
-            element_edges(k, 4:6) = model%coordinates(:, corners(4)) - model%coordinates(:, corners(1))
-          end associate
-        end do
-        call initialize_material_history(material, solver%blocks(b)%point_count, solver%blocks(b)%history, &
-                                         element_edges)
+        cycle
+      end if
+      allocate (solver%blocks(b)%history(block_size, max(history_count, 1)))
+      solver%blocks(b)%history = 0.0_wp
+      ! material axes of AOPT 0 (honeycombs) from the edges 1-2 and 1-4 of each point's cell
+      do k = 1, solver%blocks(b)%point_count
+        g = solver%blocks(b)%first_point + k - 1
+        associate (corners => hexahedra(:, geometry%point_cell(g)))
+          element_edges(k, 1:3) = coordinates(:, corners(2)) - coordinates(:, corners(1))
+          element_edges(k, 4:6) = coordinates(:, corners(4)) - coordinates(:, corners(1))
+        end associate
       end do
-    end associate
+      call initialize_material_history(material, solver%blocks(b)%point_count, solver%blocks(b)%history, &
+                                       element_edges)
+    end do
     allocate (solver%point_stress(9, point_count))
     solver%point_stress = 0.0_wp
     call sum_cell_volumes(geometry, solver%point_cell_volume)
@@ -114,8 +151,8 @@ contains
     solver%block_time_step = huge(1.0_wp)
     solver%block_critical_point = 0
     solver%block_inverted_point = 0
-    call colour_efg_blocks(size(model%node_ids), solver)
-  end subroutine set_up_efg_solver
+    call colour_efg_blocks(node_count, solver)
+  end subroutine set_up_efg_state
 
   !> Colours the blocks by the nodes of their points' pairs (each node listed once per block).
   subroutine colour_efg_blocks(node_count, solver)
@@ -188,7 +225,7 @@ contains
           !$omp do schedule(dynamic, 1)
           do k = colours%offsets(colour), colours%offsets(colour + 1) - 1
             b = colours%corners(k)
-            call compute_efg_block(material, solver%geometry, solver%point_cell_volume, solver%density, &
+            call compute_efg_block(material, solver%host_law, solver%geometry, solver%point_cell_volume, solver%density, &
                                    solver%bulk_quadratic, solver%bulk_linear, solver%blocks(b), displacement, &
                                    velocity, dt, solver%point_stress, solver%block_time_step(b), &
                                    solver%block_critical_point(b), solver%block_inverted_point(b))
@@ -203,7 +240,7 @@ contains
         do k = colours%offsets(colour), colours%offsets(colour + 1) - 1
           b = colours%corners(k)
           if (fused) then
-            call compute_efg_block(material, solver%geometry, solver%point_cell_volume, solver%density, &
+            call compute_efg_block(material, solver%host_law, solver%geometry, solver%point_cell_volume, solver%density, &
                                    solver%bulk_quadratic, solver%bulk_linear, solver%blocks(b), displacement, &
                                    velocity, dt, solver%point_stress, solver%block_time_step(b), &
                                    solver%block_critical_point(b), solver%block_inverted_point(b))
@@ -249,10 +286,11 @@ contains
   end subroutine add_block_forces
 
   !> One block of integration points.
-  subroutine compute_efg_block(material, geometry, point_cell_volume, density, bulk_quadratic, bulk_linear, &
-                               block, displacement, velocity, dt, point_stress, critical_time_step, critical_point, &
-                               inverted_point)
+  subroutine compute_efg_block(material, host_law, geometry, point_cell_volume, density, bulk_quadratic, &
+                               bulk_linear, block, displacement, velocity, dt, point_stress, critical_time_step, &
+                               critical_point, inverted_point)
     type(material_t), intent(in) :: material
+    type(host_law_t), intent(in) :: host_law
     type(efg_part_t), intent(in) :: geometry
     real(wp), intent(in) :: point_cell_volume(:)
     real(wp), intent(in) :: density, bulk_quadratic, bulk_linear
@@ -284,8 +322,13 @@ contains
     ! the same objective update and material routines as the finite elements
     call incremental_rotation(nel, spin_increment, rotation)
     call rotate_symmetric_tensors(nel, rotation, block%stress)
-    call rotate_material_history(material, nel, rotation, block%history)
-    call update_material_block(material, nel, dt, strain_increment, block%stress, block%history, wave_modulus)
+    if (associated(host_law%update)) then
+      call update_with_host_law(host_law, nel, strain_increment, spin_increment, block%stress, block%history, &
+                                wave_modulus)
+    else
+      call rotate_material_history(material, nel, rotation, block%history)
+      call update_material_block(material, nel, dt, strain_increment, block%stress, block%history, wave_modulus)
+    end if
 
     ! bulk viscosity on the current cell around the point, energy, time step
     inverted_point = 0
@@ -335,6 +378,37 @@ contains
       end if
     end do
   end subroutine compute_efg_block
+
+  !> The host's law on the block's nel points (see efg_host_law): the lanes are copied to arrays
+  !> of leading dimension nel (fixed-size buffers: nothing is allocated), the stress back.
+  subroutine update_with_host_law(host_law, nel, strain_increment, spin_increment, stress, history, wave_modulus)
+    type(host_law_t), intent(in) :: host_law
+    integer, intent(in) :: nel
+    real(wp), intent(in) :: strain_increment(block_size, 6), spin_increment(block_size, 3)
+    real(wp), intent(inout) :: stress(block_size, 6)
+    real(wp), intent(inout), contiguous :: history(:, :)
+    real(wp), intent(out) :: wave_modulus(block_size)
+    real(wp) :: lane_strain(block_size*6), lane_spin(block_size*3), lane_stress(block_size*6)
+    integer :: i, j
+    do j = 1, 6
+      do i = 1, nel
+        lane_strain(i + nel*(j - 1)) = strain_increment(i, j)
+        lane_stress(i + nel*(j - 1)) = stress(i, j)
+      end do
+    end do
+    do j = 1, 3
+      do i = 1, nel
+        lane_spin(i + nel*(j - 1)) = spin_increment(i, j)
+      end do
+    end do
+    call host_law%update(nel, lane_strain, lane_spin, lane_stress, history, host_law%context)
+    do j = 1, 6
+      do i = 1, nel
+        stress(i, j) = lane_stress(i + nel*(j - 1))
+      end do
+    end do
+    wave_modulus(1:nel) = host_law%wave_modulus
+  end subroutine update_with_host_law
 
   !> Fbar at the end of the step, its rate, J, J at mid-step and the velocity gradient at
   !> mid-step (row-major: gradient(3 (i - 1) + j) = dv_i / dx_j).
@@ -505,21 +579,19 @@ contains
 
   !> Physical values at the interior particles (eq. 16): physical(:, J) = sum_I Psi_I(X_J)
   !> field(:, I). Other nodes are left as they are (Gamma nodes carry physical values).
-  subroutine transform_to_physical(solver, field, physical)
-    type(efg_solver_t), intent(in) :: solver
+  subroutine transform_to_physical(geometry, field, physical)
+    type(efg_part_t), intent(in) :: geometry
     real(wp), intent(in) :: field(:, :)
     real(wp), intent(inout) :: physical(:, :)
     integer :: j, k
     real(wp) :: value(3)
-    associate (geometry => solver%geometry)
-      do j = 1, size(geometry%particles)
-        value = 0.0_wp
-        do k = geometry%transform_offsets(j), geometry%transform_offsets(j + 1) - 1
-          value = value + geometry%transform_value(k)*field(:, geometry%transform_node(k))
-        end do
-        physical(:, geometry%particles(j)) = value
+    do j = 1, size(geometry%particles)
+      value = 0.0_wp
+      do k = geometry%transform_offsets(j), geometry%transform_offsets(j + 1) - 1
+        value = value + geometry%transform_value(k)*field(:, geometry%transform_node(k))
       end do
-    end associate
+      physical(:, geometry%particles(j)) = value
+    end do
   end subroutine transform_to_physical
 
   !> Cell stress (mean of its points) and effective plastic strain into the element arrays.

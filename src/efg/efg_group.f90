@@ -270,7 +270,7 @@ contains
     real(wp), intent(inout) :: physical(:, :)
     integer :: k
     do k = 1, size(self%parts)
-      call transform_to_physical(self%parts(k), field, physical)
+      call transform_to_physical(self%parts(k)%geometry, field, physical)
     end do
   end subroutine to_physical
 

@@ -19,7 +19,7 @@ module efg_setup
                    integration_gauss_conventional
   use efg_part, only: efg_part_t
   use efg_cell_geometry, only: subcell_volumes, largest_face_area, vertex_parametric, cell_gauss_rule
-  use efg_supports, only: part_supports_t, build_part_supports
+  use efg_supports, only: part_supports_t, build_cell_supports
   use efg_neighbour_search, only: particle_grid_t, build_particle_grid
   use efg_shape_functions, only: cell_shape_context_t, prepare_cell_context
   use efg_smoothed_gradient, only: cell_smoothed_gradients, cell_gauss_gradients
@@ -28,7 +28,7 @@ module efg_setup
   implicit none
   private
 
-  public :: build_efg_part
+  public :: build_efg_part, build_cell_efg_part
 
   !> Largest |M alpha - b| accepted as round-off. It is about 1e-15 when the support rule of
   !> formulation section 2 holds; anything near this bound means a particle needed by b does not
@@ -57,32 +57,61 @@ contains
 
   !> Build the precomputed data `efg` of part `part` (an index into model%parts whose formulation
   !> is EFG). On failure `error` names the part and, where it applies, the element or node and the
-  !> likely cause; `efg` is then still filled as far as it was built.
+  !> likely cause; `efg` is then still filled as far as it was built. The part's solids go to
+  !> build_cell_efg_part, the one set-up of every meshfree solid part (the library crashfree_efg
+  !> calls it with a host code's arrays).
   subroutine build_efg_part(model, part, efg, error)
     type(model_t), intent(in) :: model
     integer, intent(in) :: part
+    type(efg_part_t), intent(out) :: efg
+    type(error_t), allocatable, intent(out) :: error
+    integer, allocatable :: cells(:)
+    integer :: cell
+
+    call check_section(model, part, error)
+    if (allocated(error)) return
+    cells = pack([(cell, cell=1, size(model%solid_part))], model%solid_part == part)
+    if (size(cells) == 0) then
+      call make_error(error, "EFG part "//integer_text(model%parts(part)%id)//" has no solid elements")
+      return
+    end if
+    associate (section => model%sections(model%parts(part)%section))
+      call build_cell_efg_part(model%coordinates, model%solid_nodes(:, cells), cells, section%support_scale, &
+                               section%kernel, section%domain_integration, &
+                               section%boundary_treatment == boundary_full_transformation, [integer ::], &
+                               "EFG part "//integer_text(model%parts(part)%id), "element", &
+                               model%solid_ids(cells), model%node_ids, efg, error)
+    end associate
+    efg%part = part
+    efg%material = model%parts(part)%material
+  end subroutine build_efg_part
+
+  !> Build the precomputed data `efg` of the meshfree part made of the cells `hexahedra(8, m)`
+  !> (indices into `coordinates(3, :)`, LS-DYNA node order). The nodes keep their index into
+  !> `coordinates`; each cell's points are labelled `cell_labels(k)` (`point_cell`). `marked`
+  !> nodes are Gamma nodes besides the surface. Messages start with `where` and name a cell
+  !> `cell_word` `cell_ids(k)` and a node `node_ids(j)`. On failure `error` says what is wrong;
+  !> `efg` is then still filled as far as it was built.
+  subroutine build_cell_efg_part(coordinates, hexahedra, cell_labels, support_scale, kernel, domain_integration, &
+                                 full_transformation, marked, where, cell_word, cell_ids, node_ids, efg, error)
+    real(wp), intent(in) :: coordinates(:, :)
+    integer, intent(in) :: hexahedra(:, :), cell_labels(:)
+    real(wp), intent(in) :: support_scale(3)
+    integer, intent(in) :: kernel, domain_integration
+    logical, intent(in) :: full_transformation
+    integer, intent(in) :: marked(:)
+    character(len=*), intent(in) :: where, cell_word
+    integer, intent(in) :: cell_ids(:), node_ids(:)
     type(efg_part_t), intent(out) :: efg
     type(error_t), allocatable, intent(out) :: error
     type(part_supports_t) :: supports
     type(particle_grid_t) :: grid
     type(cell_result_t), allocatable :: results(:)
     real(wp) :: started
-    integer :: k, domain_integration
+    integer :: k
 
     started = seconds_now()
-    call check_section(model, part, error)
-    if (allocated(error)) return
-    associate (section => model%sections(model%parts(part)%section))
-      efg%part = part
-      efg%material = model%parts(part)%material
-      call build_part_supports(model, part, section%support_scale, section%kernel, &
-                               section%boundary_treatment == boundary_full_transformation, supports)
-      if (size(supports%cells) == 0) then
-        call make_error(error, "EFG part "//integer_text(model%parts(part)%id)//" has no solid elements")
-        return
-      end if
-      domain_integration = section%domain_integration
-    end associate
+    call build_cell_supports(coordinates, hexahedra, support_scale, kernel, full_transformation, marked, supports)
     efg%gamma_nodes = supports%gamma_nodes
     efg%particles = supports%particles
     efg%surface_nodes = supports%surface_nodes
@@ -93,18 +122,19 @@ contains
     allocate (results(size(supports%cells)))
     !$omp parallel do schedule(dynamic, 4)
     do k = 1, size(supports%cells)
-      call process_cell(model, supports, grid, domain_integration, supports%cells(k), results(k))
+      call process_cell(coordinates, hexahedra, supports, grid, domain_integration, supports%cells(k), results(k))
     end do
     !$omp end parallel do
 
-    call assemble(supports, results, efg)
-    call check_results(model, part, supports, results, efg, error)
+    call assemble(supports, cell_labels, results, efg)
+    call check_results(where, cell_word, cell_ids, node_ids, support_scale, kernel, supports, results, efg, error)
     efg%setup_seconds = seconds_now() - started
-  end subroutine build_efg_part
+  end subroutine build_cell_efg_part
 
   !> Everything one cell contributes: points, pairs, mass shares and transformation rows.
-  subroutine process_cell(model, supports, grid, domain_integration, cell, result)
-    type(model_t), intent(in) :: model
+  subroutine process_cell(coordinates, hexahedra, supports, grid, domain_integration, cell, result)
+    real(wp), intent(in) :: coordinates(:, :)
+    integer, intent(in) :: hexahedra(:, :)
     type(part_supports_t), intent(in) :: supports
     type(particle_grid_t), intent(in) :: grid
     integer, intent(in) :: domain_integration, cell
@@ -115,7 +145,7 @@ contains
     real(wp) :: volumes(8), largest_area
     integer :: n, g, k, pair, vertex, particle, row_count, total, order, points
 
-    call prepare_cell_context(supports, grid, model%coordinates, model%solid_nodes(:, cell), cell, context)
+    call prepare_cell_context(supports, grid, coordinates, hexahedra(:, cell), cell, context)
     n = context%node_count
     volumes = subcell_volumes(context%vertices)
     largest_area = largest_face_area(context%vertices)
@@ -174,7 +204,7 @@ contains
     ! transformation rows of the particles this cell owns
     row_count = 0
     do vertex = 1, 8
-      particle = supports%particle_of_node(model%solid_nodes(vertex, cell))
+      particle = supports%particle_of_node(hexahedra(vertex, cell))
       if (particle == 0) cycle
       if (supports%owner_cell(particle) == cell) row_count = row_count + 1
     end do
@@ -184,7 +214,7 @@ contains
     row_count = 0
     total = 0
     do vertex = 1, 8
-      particle = supports%particle_of_node(model%solid_nodes(vertex, cell))
+      particle = supports%particle_of_node(hexahedra(vertex, cell))
       if (particle == 0) cycle
       if (supports%owner_cell(particle) /= cell) cycle
       if (any(result%row_particle(1:row_count) == particle)) cycle
@@ -200,8 +230,9 @@ contains
   end subroutine process_cell
 
   !> Concatenate the cells' contributions in cell order.
-  subroutine assemble(supports, results, efg)
+  subroutine assemble(supports, cell_labels, results, efg)
     type(part_supports_t), intent(in) :: supports
+    integer, intent(in) :: cell_labels(:)
     type(cell_result_t), intent(in) :: results(:)
     type(efg_part_t), intent(inout) :: efg
     integer, allocatable :: part_node(:), row_start(:), row_length(:), row_cell(:)
@@ -228,7 +259,7 @@ contains
       efg%pair_gradient(:, first:pair) = results(k)%pair_gradient
       do g = 1, size(results(k)%point_volume)
         point = point + 1
-        efg%point_cell(point) = supports%cells(k)
+        efg%point_cell(point) = cell_labels(supports%cells(k))
         efg%point_volume(point) = results(k)%point_volume(g)
         efg%point_length(point) = results(k)%point_length
         efg%point_offsets(point + 1) = efg%point_offsets(point) + results(k)%pair_count(g)
@@ -337,21 +368,22 @@ contains
   end subroutine check_section
 
   !> Inverted cells, moment residuals above round-off, non-positive masses.
-  subroutine check_results(model, part, supports, results, efg, error)
-    type(model_t), intent(in) :: model
-    integer, intent(in) :: part
+  subroutine check_results(where, cell_word, cell_ids, node_ids, support_scale, kernel, supports, results, efg, error)
+    character(len=*), intent(in) :: where, cell_word
+    integer, intent(in) :: cell_ids(:), node_ids(:)
+    real(wp), intent(in) :: support_scale(3)
+    integer, intent(in) :: kernel
     type(part_supports_t), intent(in) :: supports
     type(cell_result_t), intent(in) :: results(:)
     type(efg_part_t), intent(in) :: efg
     type(error_t), allocatable, intent(out) :: error
-    character(len=:), allocatable :: where, listed
+    character(len=:), allocatable :: listed
     real(wp) :: worst
     integer :: k, worst_cell, bad, j
 
-    where = "EFG part "//integer_text(model%parts(part)%id)
     do k = 1, size(results)
       if (any(results(k)%point_volume <= 0.0_wp)) then
-        call make_error(error, where//": element "//integer_text(model%solid_ids(supports%cells(k)))// &
+        call make_error(error, where//": "//cell_word//" "//integer_text(cell_ids(supports%cells(k)))// &
                         " has a non-positive (sub-)cell volume: it is inverted or degenerate")
         return
       end if
@@ -366,7 +398,7 @@ contains
       end if
     end do
     if (worst > moment_residual_tolerance) then
-      call make_error(error, where//": element "//integer_text(model%solid_ids(supports%cells(worst_cell)))// &
+      call make_error(error, where//": "//cell_word//" "//integer_text(cell_ids(supports%cells(worst_cell)))// &
                       ": the moment equations M alpha = b are not solved to round-off (residual "// &
                       scientific_text(worst, 3)//"): b(X) is not in the range of M(X), so an interior vertex of "// &
                       "the cell does not cover it; each particle's support must be DX times the largest "// &
@@ -379,17 +411,15 @@ contains
     do j = 1, size(efg%mass_volume)
       if (efg%mass_volume(j) > 0.0_wp) cycle
       bad = bad + 1
-      if (bad <= 5) listed = listed//" "//integer_text(model%node_ids(efg%mass_node(j)))// &
+      if (bad <= 5) listed = listed//" "//integer_text(node_ids(efg%mass_node(j)))// &
                              " ("//scientific_text(efg%mass_volume(j), 3)//")"
     end do
     if (bad > 0) then
-      associate (section => model%sections(model%parts(part)%section))
-        call make_error(error, where//": "//integer_text(bad)//" node(s) get a non-positive row-sum mass; "// &
-                        "node id (volume share):"//listed//". Likely cause: the supports are too large "// &
-                        "for the part's thickness (DX "//fixed_text(section%support_scale(1), 2)//", "// &
-                        trim(merge("spherical", "box      ", section%kernel == kernel_cubic_sphere))// &
-                        " kernel): reduce DX or use the box kernel (ISPLINE 0)")
-      end associate
+      call make_error(error, where//": "//integer_text(bad)//" node(s) get a non-positive row-sum mass; "// &
+                      "node id (volume share):"//listed//". Likely cause: the supports are too large "// &
+                      "for the part's thickness (DX "//fixed_text(support_scale(1), 2)//", "// &
+                      trim(merge("spherical", "box      ", kernel == kernel_cubic_sphere))// &
+                      " kernel): reduce DX or use the box kernel (ISPLINE 0)")
     end if
   end subroutine check_results
 end module efg_setup

@@ -21,19 +21,21 @@ module efg_supports
   implicit none
   private
 
-  public :: part_supports_t, build_part_supports
+  public :: part_supports_t, build_part_supports, build_cell_supports
 
   !> The nodes of one meshfree part, their classes and the particles' supports.
   type :: part_supports_t
     integer :: kernel = 0                            !< ISPLINE
     logical :: full_transformation = .false.         !< IEBT 1: every node is a particle
-    integer, allocatable :: cells(:)                 !< model solid indices of the part, ascending
+    integer, allocatable :: cells(:)                 !< the part's cells, ascending (model solid indices;
+                                                     !< build_cell_supports: 1..m)
     integer, allocatable :: nodes(:)                 !< model node indices of the part, ascending
     integer, allocatable :: surface_nodes(:)         !< model node indices on the part's surface, ascending
     integer, allocatable :: gamma_nodes(:)           !< model node indices, ascending
     integer, allocatable :: particles(:)             !< model node indices, ascending
     integer, allocatable :: particle_of_node(:)      !< (model nodes): particle number, 0 for others
     integer, allocatable :: owner_cell(:)            !< (particles): first part cell having it as a vertex
+                                                     !< (numbered as `cells`)
     real(wp), allocatable :: particle_coordinates(:, :) !< (3, particles)
     real(wp), allocatable :: particle_radius(:, :)   !< (3, particles): a_Ik (sphere: a_I three times)
   end type part_supports_t
@@ -41,13 +43,38 @@ module efg_supports
 contains
 
   !> Cells, nodes, Gamma nodes, particles and support radii of part `part` of `model`, with the
-  !> section's DX DY DZ, ISPLINE and IEBT.
+  !> section's DX DY DZ, ISPLINE and IEBT: the part's solids handed to build_cell_supports, whose
+  !> local cell numbers are turned back into model solid indices (`cells`, `owner_cell`).
   subroutine build_part_supports(model, part, support_scale, kernel, full_transformation, supports)
     type(model_t), intent(in) :: model
     integer, intent(in) :: part
     real(wp), intent(in) :: support_scale(3)
     integer, intent(in) :: kernel
     logical, intent(in) :: full_transformation
+    type(part_supports_t), intent(out) :: supports
+    integer, allocatable :: cells(:)
+    integer :: cell
+
+    cells = pack([(cell, cell=1, size(model%solid_part))], model%solid_part == part)
+    call build_cell_supports(model%coordinates, model%solid_nodes(:, cells), support_scale, kernel, &
+                             full_transformation, [integer ::], supports)
+    supports%cells = cells(supports%cells)
+    where (supports%owner_cell > 0) supports%owner_cell = cells(max(supports%owner_cell, 1))
+  end subroutine build_part_supports
+
+  !> Cells, nodes, Gamma nodes, particles and support radii of the part made of the cells
+  !> `hexahedra(8, m)` (indices into `coordinates(3, :)`, LS-DYNA node order): the cells are
+  !> numbered 1..m (`cells`, `owner_cell`), the nodes keep their index into `coordinates`.
+  !> The nodes `marked` (indices into `coordinates`) are Gamma nodes besides the part's surface
+  !> (a host code's interfaces and supports inside the part); unless `full_transformation`.
+  subroutine build_cell_supports(coordinates, hexahedra, support_scale, kernel, full_transformation, marked, &
+                                 supports)
+    real(wp), intent(in) :: coordinates(:, :)
+    integer, intent(in) :: hexahedra(:, :)
+    real(wp), intent(in) :: support_scale(3)
+    integer, intent(in) :: kernel
+    logical, intent(in) :: full_transformation
+    integer, intent(in) :: marked(:)
     type(part_supports_t), intent(out) :: supports
     integer, allocatable :: node_local(:)
     logical, allocatable :: on_boundary(:)
@@ -56,14 +83,14 @@ contains
 
     supports%kernel = kernel
     supports%full_transformation = full_transformation
-    supports%cells = pack([(cell, cell=1, size(model%solid_part))], model%solid_part == part)
-    model_node_count = size(model%coordinates, 2)
+    supports%cells = [(cell, cell=1, size(hexahedra, 2))]
+    model_node_count = size(coordinates, 2)
 
     ! part nodes, ascending, and the model -> part numbering
     allocate (node_local(model_node_count))
     node_local = 0
     do k = 1, size(supports%cells)
-      node_local(model%solid_nodes(:, supports%cells(k))) = 1
+      node_local(hexahedra(:, k)) = 1
     end do
     count = 0
     do j = 1, model_node_count
@@ -77,7 +104,11 @@ contains
       if (node_local(j) /= 0) supports%nodes(node_local(j)) = j
     end do
 
-    call find_boundary_nodes(model%solid_nodes, supports%cells, node_local, count, on_boundary)
+    call find_boundary_nodes(hexahedra, supports%cells, node_local, count, on_boundary)
+    ! nodes of the part a caller marks keep FE functions as well
+    do k = 1, size(marked)
+      if (node_local(marked(k)) > 0) on_boundary(node_local(marked(k))) = .true.
+    end do
     ! the surface is kept for the essential conditions of IEBT 1, where it holds no Gamma node
     supports%surface_nodes = pack(supports%nodes, on_boundary)
     if (full_transformation) on_boundary = .false.
@@ -90,13 +121,12 @@ contains
       supports%particle_of_node(supports%particles(particle)) = particle
     end do
 
-    call neighbour_extents(model%coordinates, model%solid_nodes, supports%cells, node_local, count, &
-                           kernel, extent)
+    call neighbour_extents(coordinates, hexahedra, supports%cells, node_local, count, kernel, extent)
     allocate (supports%particle_coordinates(3, size(supports%particles)))
     allocate (supports%particle_radius(3, size(supports%particles)))
     do particle = 1, size(supports%particles)
       j = supports%particles(particle)
-      supports%particle_coordinates(:, particle) = model%coordinates(:, j)
+      supports%particle_coordinates(:, particle) = coordinates(:, j)
       if (kernel == kernel_cubic_sphere) then
         supports%particle_radius(:, particle) = support_scale(1)*extent(1, node_local(j))
       else
@@ -109,13 +139,13 @@ contains
     supports%owner_cell = 0
     do k = 1, size(supports%cells)
       do a = 1, 8
-        particle = supports%particle_of_node(model%solid_nodes(a, supports%cells(k)))
+        particle = supports%particle_of_node(hexahedra(a, k))
         if (particle > 0) then
-          if (supports%owner_cell(particle) == 0) supports%owner_cell(particle) = supports%cells(k)
+          if (supports%owner_cell(particle) == 0) supports%owner_cell(particle) = k
         end if
       end do
     end do
-  end subroutine build_part_supports
+  end subroutine build_cell_supports
 
   !> Mark the part nodes (part numbering) that lie on a face of a part cell that no other part
   !> cell shares. Faces are bucketed by their smallest node so matching stays linear.
