@@ -5,7 +5,9 @@
  *   host_c patch [support kernel]   explicit patch test (v = A X), velocity error after 100 cycles
  *   host_c bar                      a pulse along a bar, host elements for x < 50, meshfree beyond
  *   host_c forces DT                one internal force call of an all-meshfree block
- *   host_c bench CELLS CALLS        ns per integration point per call of cf_efg_internal_force */
+ *   host_c bench CELLS CALLS        ns per integration point per call of cf_efg_internal_force
+ *   host_c misuse                   calls in error (null, destroyed handles, wrong order, bad
+ *                                   arrays): each status and message, one line each */
 /* clock_gettime */
 #define _POSIX_C_SOURCE 199309L
 #include <math.h>
@@ -601,15 +603,71 @@ static void bench(int cells_per_side, int calls)
     cf_efg_destroy(&model.part);
 }
 
+/* one misuse: its status and the library's message on one line */
+static void report(const char *name, const cf_efg_part *part, int status)
+{
+    char message[512];
+    cf_efg_last_error(part, message, sizeof message);
+    printf("misuse %s %d %s\n", name, status, message);
+}
+
+/* calls a host code should not make, each answered with a status and a message (never a crash) */
+static void misuse(void)
+{
+    host_mesh mesh;
+    int cells[3] = {3, 3, 3};
+    double support[3] = {1.5, 1.5, 1.5}, small[3] = {1.5, 1.0, 1.5}, force[3 * 64] = {0}, step;
+    block_mesh(cells, 1.0, 0.0, 1, &mesh);
+    int n = mesh.node_count, m = mesh.element_count;
+    cf_efg_part *part = NULL;
+
+    report("null_handle", NULL, cf_efg_set_up(NULL));
+    report("null_coordinates", part, cf_efg_create(&part, n, NULL, m, mesh.hexahedra, support, 0, 1));
+    cf_efg_destroy(&part);
+    report("wrong_size", part, cf_efg_create(&part, -1, mesh.coordinates, m, mesh.hexahedra, support, 0, 1));
+    cf_efg_destroy(&part);
+    int *wrong = malloc(sizeof(int) * 8 * m);
+    memcpy(wrong, mesh.hexahedra, sizeof(int) * 8 * m);
+    wrong[8 * 16 + 2] = n + 7; /* hexahedra(3, 17) */
+    report("node_out_of_range", part, cf_efg_create(&part, n, mesh.coordinates, m, wrong, support, 0, 1));
+    cf_efg_destroy(&part);
+    memcpy(wrong, mesh.hexahedra, sizeof(int) * 8 * m);
+    for (int a = 0; a < 4; a++) { /* hexahedron 5 inside out: its two faces swapped */
+        wrong[8 * 4 + a] = mesh.hexahedra[8 * 4 + a + 4];
+        wrong[8 * 4 + a + 4] = mesh.hexahedra[8 * 4 + a];
+    }
+    report("inside_out", part, cf_efg_create(&part, n, mesh.coordinates, m, wrong, support, 0, 1));
+    cf_efg_destroy(&part);
+    report("support_not_above_one", part, cf_efg_create(&part, n, mesh.coordinates, m, mesh.hexahedra, small, 0, 1));
+    cf_efg_destroy(&part);
+    report("kernel", part, cf_efg_create(&part, n, mesh.coordinates, m, mesh.hexahedra, support, 1, 1));
+    cf_efg_destroy(&part);
+    cf_efg_create(&part, n, mesh.coordinates, m, mesh.hexahedra, support, 0, 1);
+    report("create_on_live_handle", part, cf_efg_create(&part, n, mesh.coordinates, m, mesh.hexahedra, support, 0, 1));
+    int outside = n + 1;
+    report("mark_out_of_range", part, cf_efg_mark_boundary(part, 1, &outside));
+    report("force_before_set_up", part, cf_efg_internal_force(part, force, force, 0.0, force, &step));
+    cf_efg_set_up(part);
+    report("set_up_twice", part, cf_efg_set_up(part));
+    report("force_without_law", part, cf_efg_internal_force(part, force, force, 0.0, force, &step));
+    report("elastic_poisson", part, cf_efg_set_elastic(part, 210.0, 0.5));
+    report("null_force", part, cf_efg_internal_force(part, force, force, 0.0, NULL, &step));
+    cf_efg_destroy(&part);
+    report("destroyed_handle", part, cf_efg_set_up(part));
+    report("destroy_twice", part, cf_efg_destroy(&part));
+    free(wrong);
+}
+
 int main(int argc, char **argv)
 {
     const char *mode = argc > 1 ? argv[1] : "";
     if (strcmp(mode, "patch") == 0) patch_test(argc > 2 ? atof(argv[2]) : 1.5, argc > 3 ? atoi(argv[3]) : 0);
     else if (strcmp(mode, "bar") == 0) coupled_bar();
     else if (strcmp(mode, "forces") == 0) one_force_call(argc > 2 ? strtod(argv[2], NULL) : 0.0);
+    else if (strcmp(mode, "misuse") == 0) misuse();
     else if (strcmp(mode, "bench") == 0) bench(argc > 2 ? atoi(argv[2]) : 20, argc > 3 ? atoi(argv[3]) : 50);
     else {
-        printf("usage: host_c patch [support kernel] | bar | forces DT | bench CELLS CALLS\n");
+        printf("usage: host_c patch [support kernel] | bar | forces DT | bench CELLS CALLS | misuse\n");
         return 2;
     }
     return 0;

@@ -13,7 +13,10 @@ with pkg-config only. Their runs must show:
 - the same part as a keyword deck: the solver's accelerations after its first cycle equal the
   host's -f/m from one cf_efg_internal_force call to round-off, and its step is 0.9 times the
   part's stable step;
-- the C and the Fortran host give the same numbers, and one or two threads the same bits.
+- the C and the Fortran host give the same numbers, and one or two threads the same bits;
+- calls in error through the C interface (null and destroyed handles, null arrays, a node that
+  does not exist, an inside-out hexahedron, support <= 1, the wrong order) each give their
+  status and a message naming the argument, with the release and the checked debug library.
 """
 import os
 import subprocess
@@ -28,14 +31,25 @@ from deck_writer import efg_section, fields, nodes_card, solids_card, write_deck
 HOSTS = ["host_fortran", "host_c"]
 
 
-@pytest.fixture(scope="module")
-def hosts(tmp_path_factory):
-    """The installed prefix and the two host programs built against it."""
-    prefix = tmp_path_factory.mktemp("prefix")
-    built = subprocess.run(["make", "--no-print-directory", "-s", "examples", f"EXAMPLES_PREFIX={prefix}",
-                            f"EXAMPLES_OUT={prefix / 'bin'}"], cwd=REPOSITORY, capture_output=True, text=True)
+def install_and_build(prefix, mode):
+    built = subprocess.run(["make", "--no-print-directory", "-s", f"MODE={mode}", "examples",
+                            f"EXAMPLES_PREFIX={prefix}", f"EXAMPLES_OUT={prefix / 'bin'}"], cwd=REPOSITORY,
+                           capture_output=True, text=True, timeout=1800)
     assert built.returncode == 0, built.stdout + built.stderr
     return prefix
+
+
+@pytest.fixture(scope="module")
+def hosts(tmp_path_factory):
+    """The installed prefix (release library) and the two host programs built against it."""
+    return install_and_build(tmp_path_factory.mktemp("prefix"), "release")
+
+
+@pytest.fixture(scope="module")
+def debug_hosts(tmp_path_factory):
+    """The same with the checked library of MODE=debug (-fcheck=all, -ffpe-trap): `make test`
+    has built its objects for the unit tests already."""
+    return install_and_build(tmp_path_factory.mktemp("debug_prefix"), "debug")
 
 
 def run_host(prefix, host, *arguments, threads=1):
@@ -161,3 +175,34 @@ def test_c_and_fortran_hosts_agree(hosts):
 @pytest.mark.parametrize("host", HOSTS)
 def test_one_and_two_threads_give_the_same_bits(hosts, host):
     assert run_host(hosts, host, "forces", 1.0e-4, threads=1) == run_host(hosts, host, "forces", 1.0e-4, threads=2)
+
+
+# host_c misuse: each call in error, the status it must give and a word its message must hold
+MISUSE = {
+    "null_handle": (3, "null"),
+    "null_coordinates": (1, "coordinates"),
+    "wrong_size": (1, "coordinates"),
+    "node_out_of_range": (1, "hexahedra(3, 17)"),
+    "inside_out": (4, "hexahedra(:, 5)"),
+    "support_not_above_one": (1, "support(2)"),
+    "kernel": (1, "kernel"),
+    "create_on_live_handle": (2, "already created"),
+    "mark_out_of_range": (1, "nodes(1)"),
+    "force_before_set_up": (2, "cf_efg_set_up first"),
+    "set_up_twice": (2, "cf_efg_set_up"),
+    "force_without_law": (2, "material law"),
+    "elastic_poisson": (1, "poisson"),
+    "null_force": (1, "force"),
+    "destroyed_handle": (3, "null"),
+    "destroy_twice": (3, "null"),
+}
+
+
+@pytest.mark.parametrize("build", ["hosts", "debug_hosts"], ids=["release", "debug"])
+def test_c_calls_in_error_give_a_status_and_a_message(request, build):
+    prefix = request.getfixturevalue(build)
+    found = {words[0]: (int(words[1]), " ".join(words[2:])) for words in rows(run_host(prefix, "host_c", "misuse"))["misuse"]}
+    assert found.keys() == MISUSE.keys()
+    for case, (status, word) in MISUSE.items():
+        assert found[case][0] == status, f"{case}: status {found[case][0]} ({found[case][1]})"
+        assert word in found[case][1], f"{case}: the message does not name {word!r}: {found[case][1]}"
