@@ -48,6 +48,9 @@ LIBRARY_OBJECTS := $(patsubst %.f90,$(OBJ)/%.o,$(notdir $(LIBRARY_SOURCES)))
 TEST_SUPPORT := tests/unit/testing.f90 tests/unit/fixtures.f90
 TEST_SOURCES := $(sort $(wildcard tests/unit/test_*.f90))
 TEST_PROGRAMS := $(patsubst tests/unit/%.f90,$(BUILD)/tests/%,$(TEST_SOURCES))
+# C unit tests of the embedding library's C interface (include/crashfree_efg.h)
+C_TEST_SOURCES := $(sort $(wildcard tests/unit/test_*.c))
+C_TEST_PROGRAMS := $(patsubst tests/unit/%.c,$(BUILD)/tests/%,$(C_TEST_SOURCES))
 ALL_SOURCES := $(LIBRARY_SOURCES) src/app/crashfree.f90 $(TEST_SUPPORT) $(TEST_SOURCES)
 
 vpath %.f90 $(sort $(dir $(ALL_SOURCES)))
@@ -86,6 +89,12 @@ $(PROGRAM): $(OBJ)/crashfree.o $(LIBRARY) | $(dir $(PROGRAM))
 
 $(BUILD)/tests/%: $(OBJ)/%.o $(OBJ)/testing.o $(OBJ)/fixtures.o $(LIBRARY) | $(BUILD)/tests
 	$(FC) $(FFLAGS) $< $(OBJ)/testing.o $(OBJ)/fixtures.o $(LIBRARY) $(LIBS) -o $@
+
+# A C test is compiled as a C host compiles against the header, and linked with the Fortran
+# run-time and OpenMP (the gfortran driver), as a C host links the library.
+$(C_TEST_PROGRAMS): $(BUILD)/tests/%: tests/unit/%.c include/crashfree_efg.h $(LIBRARY) | $(BUILD)/tests
+	$(CC) -std=c99 -Wall -Wextra -pedantic -g -Iinclude -c $< -o $@.o
+	$(FC) -fopenmp $@.o $(LIBRARY) $(LIBS) -o $@
 
 $(BUILD)/deps.mk: $(ALL_SOURCES) tools/fortran_deps.py
 	@mkdir -p $(BUILD)
@@ -140,8 +149,8 @@ debug:
 	@$(MAKE) --no-print-directory MODE=debug all
 
 # Unit tests: every tests/unit/test_*.f90 program; prints the sum of their counts.
-unit: $(TEST_PROGRAMS)
-	@bash tools/run_unit_tests.sh $(TEST_PROGRAMS)
+unit: $(TEST_PROGRAMS) $(C_TEST_PROGRAMS)
+	@bash tools/run_unit_tests.sh $(TEST_PROGRAMS) $(C_TEST_PROGRAMS)
 
 regression: all
 	@$(PYTHON) -m pytest -q tests/regression

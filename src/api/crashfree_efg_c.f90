@@ -34,10 +34,10 @@ contains
     integer(c_int), value, intent(in) :: node_count, hexahedron_count, kernel, integration
     type(c_ptr), value, intent(in) :: coordinates, hexahedra, support
     type(cf_efg_part), pointer :: handle
-    real(c_double), pointer :: coordinate_values(:, :), support_values(:)
-    integer(c_int), pointer :: hexahedron_values(:, :)
-    real(c_double), target :: no_reals(0, 0), no_support(0)
-    integer(c_int), target :: no_integers(0, 0)
+    real(c_double), pointer, contiguous :: coordinate_values(:, :), support_values(:)
+    integer(c_int), pointer, contiguous :: hexahedron_values(:, :)
+    real(c_double), target :: no_reals(3, 0), no_support(0)
+    integer(c_int), target :: no_integers(8, 0)
 
     if (c_associated(part)) then
       ! a live handle: the Fortran procedure reports the order error into it
@@ -62,7 +62,7 @@ contains
     type(c_ptr), value, intent(in) :: part, nodes
     integer(c_int), value, intent(in) :: count
     type(cf_efg_part), pointer :: handle
-    integer(c_int), pointer :: node_values(:)
+    integer(c_int), pointer, contiguous :: node_values(:)
     integer(c_int), target :: no_nodes(0)
     if (.not. handle_of(part, handle, cf_efg_mark_boundary_c)) return
     if (count < 0 .or. (count > 0 .and. .not. c_associated(nodes))) then
@@ -103,7 +103,7 @@ contains
     type(c_ptr), value, intent(in) :: part, mass
     real(c_double), value, intent(in) :: density
     type(cf_efg_part), pointer :: handle
-    real(c_double), pointer :: mass_values(:)
+    real(c_double), pointer, contiguous :: mass_values(:)
     real(c_double), target :: no_values(0)
     if (.not. handle_of(part, handle, cf_efg_lumped_mass_c)) return
     mass_values => no_values
@@ -160,7 +160,7 @@ contains
     real(c_double), value, intent(in) :: dt
     real(c_double), intent(out) :: stable_dt
     type(cf_efg_part), pointer :: handle
-    real(c_double), pointer :: displacement_values(:, :), velocity_values(:, :), force_values(:, :)
+    real(c_double), pointer, contiguous :: displacement_values(:, :), velocity_values(:, :), force_values(:, :)
     real(c_double), target :: no_displacement(3, 0), no_velocity(3, 0), no_force(3, 0)
     stable_dt = huge(1.0_c_double)
     if (.not. handle_of(part, handle, cf_efg_internal_force_c)) return
@@ -178,7 +178,7 @@ contains
   integer(c_int) function cf_efg_to_physical_c(part, generalized, physical) bind(c, name="cf_efg_to_physical")
     type(c_ptr), value, intent(in) :: part, generalized, physical
     type(cf_efg_part), pointer :: handle
-    real(c_double), pointer :: generalized_values(:, :), physical_values(:, :)
+    real(c_double), pointer, contiguous :: generalized_values(:, :), physical_values(:, :)
     real(c_double), target :: no_generalized(3, 0), no_physical(3, 0)
     if (.not. handle_of(part, handle, cf_efg_to_physical_c)) return
     generalized_values => no_generalized
@@ -252,7 +252,7 @@ contains
   subroutine nodal_field(handle, address, field)
     type(cf_efg_part), intent(in) :: handle
     type(c_ptr), intent(in) :: address
-    real(c_double), pointer, intent(inout) :: field(:, :)
+    real(c_double), pointer, contiguous, intent(inout) :: field(:, :)
     if (.not. c_associated(address)) return
     call c_f_pointer(address, field, [3, cf_efg_node_count(handle)])
   end subroutine nodal_field
