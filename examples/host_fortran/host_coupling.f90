@@ -82,7 +82,7 @@ contains
     model%part_node = pack([(node, node=1, node_count)], in_part)
     model%local_node(model%part_node) = [(node, node=1, size(model%part_node))]
     part_hexahedra = reshape(model%local_node(reshape(mesh%hexahedra(:, pack([(e, e=1, size(meshfree))], meshfree)), &
-                                                      [8*count_true(meshfree)])), [8, count_true(meshfree)])
+                                                      [8*count(meshfree)])), [8, count(meshfree)])
     call cf_efg_create(model%part, mesh%coordinates(:, model%part_node), part_hexahedra, &
                        [support, support, support], kernel, 1_c_int, status)
     call check(model, status, "cf_efg_create")
@@ -157,11 +157,6 @@ contains
     call check(model, status, "cf_efg_to_physical")
     physical(:, model%part_node) = model%part_force
   end subroutine physical_field
-
-  pure integer function count_true(mask)
-    logical, intent(in) :: mask(:)
-    count_true = count(mask)
-  end function count_true
 
   function text(value) result(string)
     integer(c_int), intent(in) :: value
