@@ -57,7 +57,7 @@ contains
     real(c_double), intent(in) :: density, young, poisson, support
     integer(c_int), intent(in) :: kernel
     type(host_model_t), intent(out) :: model
-    integer :: node_count, e, count, node
+    integer :: node_count, e, marked_count, node
     logical, allocatable :: in_part(:), in_host(:)
     integer(c_int), allocatable :: part_hexahedra(:, :), boundary(:)
     integer(c_int) :: status
@@ -87,15 +87,15 @@ contains
                        [support, support, support], kernel, 1_c_int, status)
     call check(model, status, "cf_efg_create")
     ! interface nodes (shared with host elements) and the host's supports and driven nodes
-    count = 0
+    marked_count = 0
     allocate (boundary(size(model%part_node)))
     do node = 1, size(model%part_node)
       if (in_host(model%part_node(node)) .or. marked(model%part_node(node))) then
-        count = count + 1
-        boundary(count) = node
+        marked_count = marked_count + 1
+        boundary(marked_count) = node
       end if
     end do
-    call cf_efg_mark_boundary(model%part, boundary(1:count), status)
+    call cf_efg_mark_boundary(model%part, boundary(1:marked_count), status)
     call check(model, status, "cf_efg_mark_boundary")
     call cf_efg_set_up(model%part, status)
     call check(model, status, "cf_efg_set_up")
