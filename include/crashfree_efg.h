@@ -16,6 +16,8 @@
  * The law and the density may be given any time before the first cf_efg_internal_force and are
  * fixed after it.
  *
+ * Arrays of one call must not overlap (the library reads its inputs while it writes its outputs).
+ *
  * Arrays are column-major as in Fortran, node by node: coordinates[3*n] holds x, y, z of node 1,
  * then of node 2, ...; hexahedra[8*m] holds the 8 node indices of hexahedron 1, then of
  * hexahedron 2, ...: 1-BASED indices into the nodes, LS-DYNA's node order (nodes 1-4 one face,
@@ -33,8 +35,8 @@
  * one thread at a time. Inside a call the library uses OpenMP with the caller's settings (it
  * never sets the thread count); results are bit-identical for any thread count.
  *
- * Link: the Fortran library and its run-time (gfortran, OpenMP, LAPACK), e.g. through
- * pkg-config crashfree-efg.
+ * Link: the Fortran library and its run-time, e.g. through pkg-config crashfree-efg; by hand
+ * libcrashfree.a -lgfortran -lgomp -llapack -lblas -lm (or link with gfortran -fopenmp).
  */
 #ifndef CRASHFREE_EFG_H
 #define CRASHFREE_EFG_H
@@ -132,7 +134,9 @@ int cf_efg_set_material_callback(cf_efg_part *part, cf_efg_material_law callback
    displacement[3*n] at the end of the step and velocity[3*n] at its middle (d^{n+1},
    v^{n+1/2}): generalized values at particles, nodal values at boundary nodes. dt is the step
    just taken (0 on the first call). *stable_dt: the part's stable time step, without a safety
-   factor (scale it, e.g. by 0.9). Stresses and history stay in the part. */
+   factor (scale it, e.g. by 0.9). Stresses and history stay in the part. On a failure during the
+   computation (CF_EFG_ERROR_GEOMETRY: an inverted point; CF_EFG_ERROR_MATERIAL) force holds
+   partial sums: end the run. */
 int cf_efg_internal_force(cf_efg_part *part, const double *displacement, const double *velocity, double dt,
                           double *force, double *stable_dt);
 

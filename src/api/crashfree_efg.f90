@@ -409,6 +409,8 @@ contains
   !> tensor-valued history); the history starts at zero. `wave_modulus` > 0 is the law's largest
   !> constrained modulus K + 4/3 G (the stable step uses it). The callback may run on several
   !> threads at once for different blocks: it must only touch its arguments (and read context).
+  !> It must be a module or external procedure with bind(C) (kept as a pointer: it must outlive
+  !> this call).
   subroutine cf_efg_set_material_callback(part, callback, context, history_count, wave_modulus, status)
     type(cf_efg_part), intent(inout) :: part
     procedure(cf_efg_material_law) :: callback
@@ -446,7 +448,9 @@ contains
   !> `velocity(3, n)` at its middle (central differences: d^{n+1}, v^{n+1/2}), generalized values
   !> at the particles, nodal values at the boundary nodes. `dt` is the step just taken (0 on the
   !> first call). Returns the part's stable time step `stable_dt` (without a safety factor: the
-  !> host scales it, e.g. by 0.9). The stresses and history stay in the part.
+  !> host scales it, e.g. by 0.9). The stresses and history stay in the part. On a failure during
+  !> the computation (cf_efg_error_geometry: an inverted point; cf_efg_error_material) `force`
+  !> holds partial sums: the host ends its run.
   subroutine cf_efg_internal_force(part, displacement, velocity, dt, force, stable_dt, status)
     type(cf_efg_part), intent(inout) :: part
     real(c_double), intent(in), contiguous :: displacement(:, :), velocity(:, :)

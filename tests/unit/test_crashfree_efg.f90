@@ -36,7 +36,9 @@ program test_crashfree_efg
   call block_mesh(coordinates, hexahedra)
   call test_counts_and_mass()
   call test_transformation()
-  call test_patch()
+  call test_patch([integer ::])
+  ! interior nodes marked as boundary (Gamma) nodes: FE functions inside the part
+  call test_patch([node_at(2, 2, 2), node_at(1, 2, 3), node_at(3, 1, 2)])
   call test_callback()
   call test_plastic_energy()
   call test_misuse()
@@ -80,16 +82,26 @@ contains
     end do
   end subroutine block_mesh
 
+  pure integer function node_at(i, j, k)
+    integer, intent(in) :: i, j, k
+    node_at = 1 + i + side_nodes*(j + side_nodes*k)
+  end function node_at
+
   !> A part of the block, set up, with the given kernel and integration (support 1.4 for the
   !> box kernel, 1.1 for the sphere: its radius already reaches the cells' far corners).
-  subroutine new_part(part, kernel, integration)
+  subroutine new_part(part, kernel, integration, marked)
     type(cf_efg_part), intent(inout) :: part
     integer, intent(in) :: kernel, integration
+    integer, intent(in), optional :: marked(:)
     integer(c_int) :: status
     real(wp) :: support
     support = merge(1.1_wp, 1.4_wp, kernel == 2)
     call cf_efg_create(part, coordinates, hexahedra, [support, support, support], kernel, integration, status)
     call check(suite, "create: status ok", status == cf_efg_ok, error_text(part))
+    if (present(marked)) then
+      call cf_efg_mark_boundary(part, marked, status)
+      call check(suite, "mark boundary: status ok", status == cf_efg_ok, error_text(part))
+    end if
     call cf_efg_set_up(part, status)
     call check(suite, "set up: status ok", status == cf_efg_ok, error_text(part))
   end subroutine new_part
@@ -160,9 +172,12 @@ contains
 
   !> Uniaxial stress sigma_xx = E e from one step of a diagonal linear field whose mid-step
   !> strain increments are (e, -nu e, -nu e): the forces of the nodes on x = 1 add up to
-  !> P_xx A = F_yy F_zz E e, those on x = 0 to minus that, interior forces vanish.
-  subroutine test_patch()
+  !> P_xx A = F_yy F_zz E e, those on x = 0 to minus that, interior forces vanish (at the
+  !> particles and at the interior nodes `marked` as boundary nodes).
+  subroutine test_patch(marked)
+    integer, intent(in) :: marked(:)
     type(cf_efg_part) :: part
+    integer(c_int) :: nodes, particles, boundary_nodes, points
     real(wp), parameter :: strain = 1.0e-3_wp, dt = 1.0e-4_wp
     real(wp) :: displacement(3, node_count), velocity(3, node_count), force(3, node_count), mass(node_count)
     real(wp) :: increment(3), stretch(3), stable_dt, right(3), left(3), interior, largest, expected, energy
@@ -175,7 +190,10 @@ contains
       displacement(:, j) = stretch*coordinates(:, j)
     end do
     velocity = displacement/dt
-    call new_part(part, 0, 1)
+    call new_part(part, 0, 1, marked)
+    call cf_efg_counts(part, nodes, particles, boundary_nodes, points, status)
+    call check(suite, "patch: marked nodes are boundary nodes", particles == (cells_per_side - 1)**3 - size(marked) &
+               .and. boundary_nodes == node_count - particles)
     call cf_efg_lumped_mass(part, density, mass, status)
     call cf_efg_set_elastic(part, young, poisson, status)
     call check(suite, "patch: set_elastic", status == cf_efg_ok)
@@ -383,9 +401,11 @@ contains
     call check(suite, "misuse: "//name//": message names the argument", index(message, words) > 0, message)
   end subroutine expect
 
-  !> Masses and three calls' forces with 1 and 3 threads: bit-identical.
+  !> Masses and three calls' forces with 1 and 3 threads: bit-identical. Then two parts at the
+  !> same time on two threads of the caller (each part from one thread): the same results again.
   subroutine test_threads()
-    real(wp) :: mass(node_count, 2), force(3, node_count, 2), stable(2), energy(2)
+    real(wp) :: mass(node_count, 4), force(3, node_count, 4), stable(4), energy(4)
+    integer(c_int) :: status(4)
     integer :: run, threads
     mass = 0.0_wp
     force = 0.0_wp
@@ -395,36 +415,53 @@ contains
     !$ threads = omp_get_max_threads()
     do run = 1, 2
       !$ call omp_set_num_threads(merge(1, 3, run == 1))
-      call forces_of_three_calls(mass(:, run), force(:, :, run), stable(run), energy(run))
+      call forces_of_three_calls(mass(:, run), force(:, :, run), stable(run), energy(run), status(run))
     end do
+    !$ call omp_set_num_threads(2)
+    !$omp parallel sections default(shared)
+    !$omp section
+    call forces_of_three_calls(mass(:, 3), force(:, :, 3), stable(3), energy(3), status(3))
+    !$omp section
+    call forces_of_three_calls(mass(:, 4), force(:, :, 4), stable(4), energy(4), status(4))
+    !$omp end parallel sections
     !$ call omp_set_num_threads(threads)
+    call check(suite, "threads: every call succeeded", all(status == cf_efg_ok))
     call check(suite, "threads: masses bit-identical for 1 and 3 threads", all(mass(:, 1) == mass(:, 2)))
     call check(suite, "threads: forces bit-identical for 1 and 3 threads", all(force(:, :, 1) == force(:, :, 2)))
     call check(suite, "threads: stable step and energy bit-identical", stable(1) == stable(2) .and. &
                energy(1) == energy(2))
+    call check(suite, "threads: two parts on two threads at once, bit-identical", &
+               all(force(:, :, 3) == force(:, :, 1)) .and. all(force(:, :, 4) == force(:, :, 1)) .and. &
+               all(mass(:, 3) == mass(:, 1)) .and. all(mass(:, 4) == mass(:, 1)) .and. &
+               all(energy(3:4) == energy(1)) .and. all(stable(3:4) == stable(1)))
   end subroutine test_threads
 
-  subroutine forces_of_three_calls(mass, force, stable_dt, energy)
+  !> Set up a part, its masses, the plastic law and three internal-force calls (no check here:
+  !> it runs on several threads at once).
+  subroutine forces_of_three_calls(mass, force, stable_dt, energy, status)
     real(wp), intent(out) :: mass(node_count), force(3, node_count), stable_dt, energy
+    integer(c_int), intent(out) :: status
     type(cf_efg_part) :: part
     real(wp) :: displacement(3, node_count), velocity(3, node_count), dt
-    integer(c_int) :: status
+    integer(c_int) :: call_status(7)
     integer :: j, step
-    call new_part(part, 2, 1)
-    call cf_efg_lumped_mass(part, density, mass, status)
-    call cf_efg_set_plastic_kinematic(part, young, poisson, 0.2_wp, 1.0_wp, 0.5_wp, status)
+    call cf_efg_create(part, coordinates, hexahedra, [1.1_wp, 1.1_wp, 1.1_wp], 2, 1, call_status(1))
+    call cf_efg_set_up(part, call_status(2))
+    call cf_efg_lumped_mass(part, density, mass, call_status(3))
+    call cf_efg_set_plastic_kinematic(part, young, poisson, 0.2_wp, 1.0_wp, 0.5_wp, call_status(4))
     dt = 1.0e-3_wp
     force = 0.0_wp
+    stable_dt = 0.0_wp
     do step = 1, 3
       do j = 1, node_count
         velocity(:, j) = [coordinates(2, j)**2, -coordinates(1, j)*coordinates(3, j), sin(coordinates(1, j))]
         displacement(:, j) = step*dt*velocity(:, j)
       end do
-      call cf_efg_internal_force(part, displacement, velocity, dt, force, stable_dt, status)
+      call cf_efg_internal_force(part, displacement, velocity, dt, force, stable_dt, call_status(5))
     end do
-    call check(suite, "threads: internal force status", status == cf_efg_ok, error_text(part))
-    call cf_efg_internal_energy(part, energy, status)
-    call cf_efg_destroy(part, status)
+    call cf_efg_internal_energy(part, energy, call_status(6))
+    call cf_efg_destroy(part, call_status(7))
+    status = maxval(call_status)
   end subroutine forces_of_three_calls
 end program test_crashfree_efg
 
