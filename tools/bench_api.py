@@ -7,7 +7,8 @@ same nodes. One thread each (OMP_NUM_THREADS=1, ncpu=1). Runs alternate, solver 
 REPEAT times; the figures are nanoseconds per integration point per call:
   - solver: the meshfree group's timer of the run summary (/timing efg_s) over CALLS force calls
     (cycle 0 and CALLS - 1 cycles), the mean over its calls;
-  - host: the mean (and the median) of CALLS timed calls of cf_efg_internal_force.
+  - host: the mean (and the median) of CALLS timed calls of cf_efg_internal_force, after a first
+    untimed call that builds the part's run-time state (the solver builds it during its set-up).
     bench_api.py --host build/release/examples/host_fortran --solver bin/crashfree
                  --directory build/bench/api [--cells 16] [--calls 100] [--repeat 3]
 """
