@@ -2,8 +2,10 @@
  * prescribed velocity) that makes one region of its mesh meshfree through crashfree's C
  * interface (crashfree_efg.h, docs/embedding.md). The same model as examples/host_fortran, mode
  * for mode, with the same output lines. Units: mm, ms, kg, kN (GPa for stresses).
- *   host_c patch [support kernel]   explicit patch test (v = A X), velocity error after 100 cycles
- *   host_c bar                      a pulse along a bar, host elements for x < 50, meshfree beyond
+ *   host_c patch [support kernel [host-law]]
+ *                                   explicit patch test (v = A X), velocity error after 100 cycles
+ *   host_c bar [host-law]           a pulse along a bar, host elements for x < 50, meshfree beyond
+ *   (host-law: the part uses the host's elastic law through the material callback)
  *   host_c forces DT                one internal force call of an all-meshfree block
  *   host_c bench CELLS CALLS        ns per integration point per call of cf_efg_internal_force
  *   host_c misuse                   calls in error (null, destroyed handles, wrong order, bad
@@ -287,6 +289,26 @@ static double add_solid_forces(host_solids *solids, const double *displacement, 
     return stable_dt;
 }
 
+/* the host's elastic law as the part's material callback (cf_efg_material_law): on a block of n
+ * points, column-major (n, 6), the stress (already rotated by the library) plus the elastic
+ * increment; context points to the law's constants. The same law as the host's elements. */
+typedef struct {
+    double lame, shear;
+} host_elastic;
+
+static void host_elastic_law(int n, const double *strain_increment, const double *spin, double *stress, double *history,
+                             void *context)
+{
+    const host_elastic *law = context;
+    (void)spin;    /* the library has rotated the stress */
+    (void)history; /* an elastic law keeps none */
+    for (int i = 0; i < n; i++) {
+        double trace = strain_increment[i] + strain_increment[i + n] + strain_increment[i + 2 * n];
+        for (int j = 0; j < 3; j++) stress[i + n * j] += law->lame * trace + 2 * law->shear * strain_increment[i + n * j];
+        for (int j = 3; j < 6; j++) stress[i + n * j] += 2 * law->shear * strain_increment[i + n * j];
+    }
+}
+
 /* ---------- the coupling (as host_coupling.f90) ---------- */
 
 typedef struct {
@@ -299,6 +321,7 @@ typedef struct {
     double *displacement, *velocity, *force;
     double *part_displacement, *part_velocity, *part_force;
     int counts[4];
+    host_elastic law; /* the callback's context when the part uses the host's law */
 } host_model;
 
 /* stops the host with the library's message when status is not 0 */
@@ -311,8 +334,10 @@ static void check(const host_model *model, int status, const char *call)
     exit(1);
 }
 
+/* the part's law: the library's elastic law, or with host_law the host's own through the callback
+   (model must then stay where it is while the part lives: the context points into it) */
 static void set_up_model(const host_mesh *mesh, const int *meshfree, const int *marked, double poisson, double support,
-                         int kernel, host_model *model)
+                         int kernel, int host_law, host_model *model)
 {
     int node_count = mesh->node_count;
     int *in_part = calloc(node_count, sizeof(int)), *in_host = calloc(node_count, sizeof(int));
@@ -352,7 +377,15 @@ static void set_up_model(const host_mesh *mesh, const int *meshfree, const int *
         if (in_host[model->part_node[p]] || marked[model->part_node[p]]) boundary[count++] = p + 1;
     check(model, cf_efg_mark_boundary(model->part, count, boundary), "cf_efg_mark_boundary");
     check(model, cf_efg_set_up(model->part), "cf_efg_set_up");
-    check(model, cf_efg_set_elastic(model->part, young, poisson), "cf_efg_set_elastic");
+    if (host_law) {
+        model->law.shear = young / (2 * (1 + poisson));
+        model->law.lame = young * poisson / ((1 + poisson) * (1 - 2 * poisson));
+        check(model, cf_efg_set_material_callback(model->part, host_elastic_law, &model->law, 0,
+                                                  model->law.lame + 2 * model->law.shear),
+              "cf_efg_set_material_callback");
+    } else {
+        check(model, cf_efg_set_elastic(model->part, young, poisson), "cf_efg_set_elastic");
+    }
     check(model, cf_efg_counts(model->part, &model->counts[0], &model->counts[1], &model->counts[2], &model->counts[3]),
           "cf_efg_counts");
     /* lumped masses: the host's elements, then the part's row sums */
@@ -419,7 +452,7 @@ static void advance(host_model *model, double step)
 
 /* ---------- the modes ---------- */
 
-static void patch_test(double support, int kernel)
+static void patch_test(double support, int kernel, int host_law)
 {
     static const double gradient[3][3] = {{0.010, 0.004, -0.002}, {0.003, -0.006, 0.005}, {-0.001, 0.002, 0.008}};
     host_mesh mesh;
@@ -432,7 +465,7 @@ static void patch_test(double support, int kernel)
     for (int k = 0; k <= cells[2]; k++)
         for (int j = 0; j <= cells[1]; j++)
             for (int i = 0; i <= cells[0]; i++) driven[node_index(&mesh, i, j, k) - 1] = on_block_boundary(&mesh, i, j, k);
-    set_up_model(&mesh, meshfree, driven, 0.3, support, kernel, &model);
+    set_up_model(&mesh, meshfree, driven, 0.3, support, kernel, host_law, &model);
     /* the part's mass against density times its cells' volume (the host integrates them) */
     host_solids cells_of_part;
     int *part_nodes = malloc(sizeof(int) * 8 * part_elements), next = 0;
@@ -475,7 +508,7 @@ static void patch_test(double support, int kernel)
     cf_efg_destroy(&model.part);
 }
 
-static void coupled_bar(void)
+static void coupled_bar(int host_law)
 {
     const double duration = 0.004, end_time = 0.023, pi = 3.14159265358979323846;
     host_mesh mesh;
@@ -492,7 +525,7 @@ static void coupled_bar(void)
             driven[node_index(&mesh, 0, j, k) - 1] = 1;
         }
     /* the supported nodes are the part's: marked as boundary nodes (nodal values) */
-    set_up_model(&mesh, meshfree, supported, 0.0, 1.5, 0, &model);
+    set_up_model(&mesh, meshfree, supported, 0.0, 1.5, 0, host_law, &model);
     int incident_probe = node_index(&mesh, 20, 0, 0) - 1, transmitted_probe = node_index(&mesh, 75, 1, 1) - 1;
     printf("counts %d %d %d %d\n", model.counts[0], model.counts[1], model.counts[2], model.counts[3]);
     printf("wave_speed %.16e\n", sqrt(young / density));
@@ -527,7 +560,7 @@ static void one_force_call(double step)
     block_mesh(cells, 1.0, 0.25, 7, &mesh);
     int *meshfree = malloc(sizeof(int) * mesh.element_count), *marked = calloc(mesh.node_count, sizeof(int));
     for (int e = 0; e < mesh.element_count; e++) meshfree[e] = 1;
-    set_up_model(&mesh, meshfree, marked, 0.3, 1.5, 0, &model);
+    set_up_model(&mesh, meshfree, marked, 0.3, 1.5, 0, 0, &model);
     for (int k = 0; k <= cells[2]; k++)
         for (int j = 0; j <= cells[1]; j++)
             for (int i = 0; i <= cells[0]; i++) {
@@ -579,7 +612,7 @@ static void bench(int cells_per_side, int calls)
     int *meshfree = malloc(sizeof(int) * mesh.element_count), *marked = calloc(mesh.node_count, sizeof(int));
     double *seconds = malloc(sizeof(double) * calls), part_dt;
     for (int e = 0; e < mesh.element_count; e++) meshfree[e] = 1;
-    set_up_model(&mesh, meshfree, marked, 0.3, 1.2, 0, &model);
+    set_up_model(&mesh, meshfree, marked, 0.3, 1.2, 0, 0, &model);
     for (int k = 0; k < 3 * mesh.node_count; k++) {
         model.part_displacement[k] = 1.0e-3 * sin(mesh.coordinates[k]);
         model.part_velocity[k] = 1.0e-1 * cos(mesh.coordinates[k]);
@@ -666,13 +699,14 @@ static void misuse(void)
 int main(int argc, char **argv)
 {
     const char *mode = argc > 1 ? argv[1] : "";
-    if (strcmp(mode, "patch") == 0) patch_test(argc > 2 ? atof(argv[2]) : 1.5, argc > 3 ? atoi(argv[3]) : 0);
-    else if (strcmp(mode, "bar") == 0) coupled_bar();
+    if (strcmp(mode, "patch") == 0)
+        patch_test(argc > 2 ? atof(argv[2]) : 1.5, argc > 3 ? atoi(argv[3]) : 0, argc > 4 && strcmp(argv[4], "host-law") == 0);
+    else if (strcmp(mode, "bar") == 0) coupled_bar(argc > 2 && strcmp(argv[2], "host-law") == 0);
     else if (strcmp(mode, "forces") == 0) one_force_call(argc > 2 ? strtod(argv[2], NULL) : 0.0);
     else if (strcmp(mode, "misuse") == 0) misuse();
     else if (strcmp(mode, "bench") == 0) bench(argc > 2 ? atoi(argv[2]) : 20, argc > 3 ? atoi(argv[3]) : 50);
     else {
-        printf("usage: host_c patch [support kernel] | bar | forces DT | bench CELLS CALLS | misuse\n");
+        printf("usage: host_c patch [support kernel [host-law]] | bar [host-law] | forces DT | bench CELLS CALLS | misuse\n");
         return 2;
     }
     return 0;

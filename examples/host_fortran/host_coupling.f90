@@ -8,12 +8,13 @@
 !>     interior particles), the part adds its internal forces, the host scatters them;
 !>   - the host's step is the smaller of its elements' and the part's stable steps.
 module host_coupling
-  use, intrinsic :: iso_c_binding, only: c_double, c_int
+  use, intrinsic :: iso_c_binding, only: c_double, c_int, c_loc
   use crashfree_efg, only: cf_efg_part, cf_efg_create, cf_efg_mark_boundary, cf_efg_set_up, cf_efg_counts, &
-                           cf_efg_lumped_mass, cf_efg_set_elastic, cf_efg_internal_force, cf_efg_to_physical, &
-                           cf_efg_last_error
+                           cf_efg_lumped_mass, cf_efg_set_elastic, cf_efg_set_material_callback, &
+                           cf_efg_internal_force, cf_efg_to_physical, cf_efg_last_error
   use host_mesh, only: host_mesh_t
-  use host_hexahedra, only: host_solids_t, set_up_solids, add_solid_masses, add_solid_forces
+  use host_hexahedra, only: host_solids_t, set_up_solids, add_solid_masses, add_solid_forces, host_elastic_t, &
+                            host_elastic_law
   implicit none
   private
 
@@ -31,6 +32,9 @@ module host_coupling
     real(c_double), allocatable :: displacement(:, :), velocity(:, :), force(:, :)
     real(c_double), allocatable :: part_displacement(:, :), part_velocity(:, :), part_force(:, :)
     integer(c_int) :: counts(4) = 0                 !< nodes, particles, boundary nodes, integration points
+    !> the host's law constants when the part uses the host's law (the callback's context: a
+    !> pointer, so that its address stays valid while the part lives)
+    type(host_elastic_t), pointer :: law => null()
     real(c_double) :: density = 0.0_c_double
   end type host_model_t
 
@@ -49,13 +53,16 @@ contains
   end subroutine check
 
   !> Builds the model: cells with `meshfree(e)` form the meshfree part (kernel 0 box, 2 sphere;
-  !> normalized support `support` in each direction; modified SCNI), the others are host elements; `marked(node)` lists host nodes the
-  !> part must keep as boundary nodes besides those it shares with host elements.
-  subroutine set_up_model(mesh, meshfree, marked, density, young, poisson, support, kernel, model)
+  !> normalized support `support` in each direction; modified SCNI), the others are host
+  !> elements; `marked(node)` lists host nodes the part must keep as boundary nodes besides those
+  !> it shares with host elements. The part's law: crashfree's elastic law, or with `host_law`
+  !> the host's own (host_elastic_law) through the material callback.
+  subroutine set_up_model(mesh, meshfree, marked, density, young, poisson, support, kernel, host_law, model)
     type(host_mesh_t), intent(in) :: mesh
     logical, intent(in) :: meshfree(:), marked(:)
     real(c_double), intent(in) :: density, young, poisson, support
     integer(c_int), intent(in) :: kernel
+    logical, intent(in) :: host_law
     type(host_model_t), intent(out) :: model
     integer :: node_count, e, marked_count, node
     logical, allocatable :: in_part(:), in_host(:)
@@ -99,8 +106,18 @@ contains
     call check(model, status, "cf_efg_mark_boundary")
     call cf_efg_set_up(model%part, status)
     call check(model, status, "cf_efg_set_up")
-    call cf_efg_set_elastic(model%part, young, poisson, status)
-    call check(model, status, "cf_efg_set_elastic")
+    if (host_law) then
+      ! the host's own law through the callback (the same elastic law as its elements)
+      allocate (model%law)
+      model%law%shear = young/(2.0_c_double*(1.0_c_double + poisson))
+      model%law%lame = young*poisson/((1.0_c_double + poisson)*(1.0_c_double - 2.0_c_double*poisson))
+      call cf_efg_set_material_callback(model%part, host_elastic_law, c_loc(model%law), 0_c_int, &
+                                        model%law%lame + 2.0_c_double*model%law%shear, status)
+      call check(model, status, "cf_efg_set_material_callback")
+    else
+      call cf_efg_set_elastic(model%part, young, poisson, status)
+      call check(model, status, "cf_efg_set_elastic")
+    end if
     call cf_efg_counts(model%part, model%counts(1), model%counts(2), model%counts(3), model%counts(4), status)
     call check(model, status, "cf_efg_counts")
 

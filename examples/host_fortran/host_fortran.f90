@@ -1,12 +1,15 @@
 !> An explicit host code of its own (hexahedra, central differences, a support and a prescribed
 !> velocity) that makes one region of its mesh meshfree through crashfree's API (module
 !> crashfree_efg, docs/embedding.md). Units: mm, ms, kg, kN (GPa for stresses). Modes:
-!>   host_fortran patch [support kernel]   explicit patch test: v = A X on every node and on the
+!>   host_fortran patch [support kernel [host-law]]
+!>                                         explicit patch test: v = A X on every node and on the
 !>                                         block's surface; prints the largest velocity error
 !>                                         after 100 cycles and the error of the part's mass
-!>   host_fortran bar                      a stress pulse runs along a bar, finite elements for
+!>   host_fortran bar [host-law]           a stress pulse runs along a bar, finite elements for
 !>                                         x < 50 mm, meshfree beyond, the far end supported;
 !>                                         prints the probes' velocities in time
+!>   (host-law: the part uses the host's own elastic law through the material callback instead
+!>   of the library's)
 !>   host_fortran forces DT                one internal force call of an all-meshfree block with
 !>                                         a velocity on its surface nodes, displacement DT v;
 !>                                         prints the hexahedra and each node's mass, force and
@@ -27,15 +30,16 @@ program host_fortran
   call get_command_argument(1, mode)
   select case (trim(mode))
   case ("patch")
-    call patch_test(real_argument(2, 1.5_c_double), int(real_argument(3, 0.0_c_double), c_int))
+    call patch_test(real_argument(2, 1.5_c_double), int(real_argument(3, 0.0_c_double), c_int), host_law_argument(4))
   case ("bar")
-    call coupled_bar()
+    call coupled_bar(host_law_argument(2))
   case ("forces")
     call one_force_call(real_argument(2, 0.0_c_double))
   case ("bench")
     call bench(int(real_argument(2, 20.0_c_double)), int(real_argument(3, 50.0_c_double)))
   case default
-    write (*, '(a)') "usage: host_fortran patch [support kernel] | bar | forces DT | bench CELLS CALLS"
+    write (*, '(a)') "usage: host_fortran patch [support kernel [host-law]] | bar [host-law] | forces DT | "// &
+      "bench CELLS CALLS"
     error stop 2
   end select
 
@@ -57,12 +61,22 @@ contains
     end if
   end function real_argument
 
+  !> Whether argument `position` asks for the host's own law ("host-law") instead of the
+  !> library's elastic law.
+  logical function host_law_argument(position)
+    integer, intent(in) :: position
+    character(len=32) :: argument
+    call get_command_argument(position, argument)
+    host_law_argument = trim(argument) == "host-law"
+  end function host_law_argument
+
   !> v = A X on every node at the start and on the block's surface throughout: the exact motion
   !> keeps v = A X everywhere (uniform stress, interior forces vanish). tr A > 0, so no bulk
   !> viscosity acts and both sides see the same uniform stress.
-  subroutine patch_test(support, kernel)
+  subroutine patch_test(support, kernel, host_law)
     real(c_double), intent(in) :: support
     integer(c_int), intent(in) :: kernel
+    logical, intent(in) :: host_law
     real(c_double), parameter :: gradient(3, 3) = reshape([0.010_c_double, 0.003_c_double, -0.001_c_double, &
                                                            0.004_c_double, -0.006_c_double, 0.002_c_double, &
                                                            -0.002_c_double, 0.005_c_double, 0.008_c_double], [3, 3])
@@ -89,7 +103,7 @@ contains
         end do
       end do
     end do
-    call set_up_model(mesh, meshfree, driven, density, young, 0.3_c_double, support, kernel, model)
+    call set_up_model(mesh, meshfree, driven, density, young, 0.3_c_double, support, kernel, host_law, model)
     ! the part's mass against density times its cells' volume (the host integrates them)
     call set_up_solids(mesh%coordinates, mesh%hexahedra(:, pack([(e, e=1, size(meshfree))], meshfree)), density, &
                        young, 0.3_c_double, meshfree_cells)
@@ -132,7 +146,8 @@ contains
   !> velocity pulse of 0.004 ms (about 20 mm, 20 cells long). Probes: the host node at x = 20
   !> (incident pulse, then whatever the interface reflects) and the interior particle at x = 75
   !> (transmitted pulse, physical velocity).
-  subroutine coupled_bar()
+  subroutine coupled_bar(host_law)
+    logical, intent(in) :: host_law
     real(c_double), parameter :: duration = 0.004_c_double, end_time = 0.023_c_double
     real(c_double), parameter :: pi = 3.14159265358979323846_c_double
     type(host_mesh_t) :: mesh
@@ -158,7 +173,8 @@ contains
       end do
     end do
     ! the supported nodes are the part's: marked as boundary nodes (nodal values)
-    call set_up_model(mesh, meshfree, supported, density, young, 0.0_c_double, 1.5_c_double, 0_c_int, model)
+    call set_up_model(mesh, meshfree, supported, density, young, 0.0_c_double, 1.5_c_double, 0_c_int, host_law, &
+                      model)
     incident_probe = node_index(mesh, 20, 0, 0)
     transmitted_probe = node_index(mesh, 75, 1, 1)
     write (*, '(a, 4(1x, i0))') "counts", model%counts
@@ -208,7 +224,7 @@ contains
     allocate (meshfree(size(mesh%hexahedra, 2)), marked(size(mesh%coordinates, 2)))
     meshfree = .true.
     marked = .false.
-    call set_up_model(mesh, meshfree, marked, density, young, 0.3_c_double, 1.5_c_double, 0_c_int, model)
+    call set_up_model(mesh, meshfree, marked, density, young, 0.3_c_double, 1.5_c_double, 0_c_int, .false., model)
     do k = 0, mesh%cells(3)
       do j = 0, mesh%cells(2)
         do i = 0, mesh%cells(1)
@@ -266,7 +282,7 @@ contains
     allocate (meshfree(size(mesh%hexahedra, 2)), marked(size(mesh%coordinates, 2)), seconds(calls))
     meshfree = .true.
     marked = .false.
-    call set_up_model(mesh, meshfree, marked, density, young, 0.3_c_double, 1.2_c_double, 0_c_int, model)
+    call set_up_model(mesh, meshfree, marked, density, young, 0.3_c_double, 1.2_c_double, 0_c_int, .false., model)
     model%part_displacement = 1.0e-3_c_double*sin(mesh%coordinates)
     model%part_velocity = 1.0e-1_c_double*cos(mesh%coordinates)
     ! the first call builds the part's run-time state (blocks, their colours, stresses): untimed,

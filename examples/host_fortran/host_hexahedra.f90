@@ -6,11 +6,18 @@
 !> This is the same update the meshfree part applies at its points, so a uniform deformation
 !> gives the same stress on both sides of the interface (the explicit patch test).
 module host_hexahedra
-  use, intrinsic :: iso_c_binding, only: c_double
+  use, intrinsic :: iso_c_binding, only: c_double, c_int, c_ptr, c_f_pointer
   implicit none
   private
 
   public :: host_solids_t, set_up_solids, add_solid_masses, add_solid_forces
+  public :: host_elastic_t, host_elastic_law
+
+  !> The constants of the host's elastic law, handed to the meshfree part as the context of its
+  !> material callback (bind(C): the C host passes the same layout).
+  type, bind(c) :: host_elastic_t
+    real(c_double) :: lame = 0.0_c_double, shear = 0.0_c_double
+  end type host_elastic_t
 
   integer, parameter :: points = 8
 
@@ -146,6 +153,27 @@ contains
       stable_dt = min(stable_dt, length/(viscous + sqrt(viscous**2 + sound_speed**2)))
     end do
   end subroutine add_solid_forces
+
+  !> The host's own elastic law as the meshfree part's material callback (cf_efg_material_law):
+  !> on a block of n points, the stress (already rotated by the library) plus the elastic
+  !> increment of the strain increment, Voigt order xx yy zz xy yz zx with tensor shear
+  !> components; `context` points to a host_elastic_t. The same law as the host's elements. An
+  !> elastic law keeps no history and needs no spin (the library has rotated the stress).
+  subroutine host_elastic_law(n, strain_increment, spin, stress, history, context) bind(c)
+    integer(c_int), value, intent(in) :: n
+    real(c_double), intent(in) :: strain_increment(n, 6), spin(n, 3)
+    real(c_double), intent(inout) :: stress(n, 6), history(n, *)
+    type(c_ptr), value, intent(in) :: context
+    type(host_elastic_t), pointer :: law
+    real(c_double) :: trace
+    integer :: i
+    call c_f_pointer(context, law)
+    do i = 1, n
+      trace = strain_increment(i, 1) + strain_increment(i, 2) + strain_increment(i, 3)
+      stress(i, 1:3) = stress(i, 1:3) + law%lame*trace + 2.0_c_double*law%shear*strain_increment(i, 1:3)
+      stress(i, 4:6) = stress(i, 4:6) + 2.0_c_double*law%shear*strain_increment(i, 4:6)
+    end do
+  end subroutine host_elastic_law
 
   !> Largest face area of an element with current corner positions `corners` (each face as
   !> half the cross product of its diagonals).

@@ -10,6 +10,8 @@ with pkg-config only. Their runs must show:
   part's row-sum masses add up to density times its volume (1e-12);
 - the host's coupled bar: a smooth pulse crosses the host-element / meshfree interface with a
   reflection below 1% of the incident amplitude;
+- the part with the host's own elastic law (cf_efg_set_material_callback) passes the patch test
+  and carries the same waves as with the library's law;
 - the same part as a keyword deck: the solver's accelerations after its first cycle equal the
   host's -f/m from one cf_efg_internal_force call to round-off, and its step is 0.9 times the
   part's stable step;
@@ -80,9 +82,12 @@ def test_library_needs_no_hdf5_or_metis(hosts):
 
 
 @pytest.mark.parametrize("host", HOSTS)
-@pytest.mark.parametrize("support, kernel", [(1.5, 0), (1.01, 0), (1.2, 2)], ids=["box-1.5", "box-1.01", "sphere-1.2"])
-def test_explicit_patch_test_of_the_host(hosts, host, support, kernel):
-    result = rows(run_host(hosts, host, "patch", support, kernel))
+@pytest.mark.parametrize("support, kernel, law", [(1.5, 0, "library"), (1.01, 0, "library"), (1.2, 2, "library"),
+                                                  (1.5, 0, "host-law")],
+                         ids=["box-1.5", "box-1.01", "sphere-1.2", "box-1.5-host-law"])
+def test_explicit_patch_test_of_the_host(hosts, host, support, kernel, law):
+    # host-law: the part computes its stresses with the host's own law, through the callback
+    result = rows(run_host(hosts, host, "patch", support, kernel, law))
     nodes, particles, boundary, points = map(int, result["counts"][0])
     assert particles == 32 and nodes == 144 and points == 8 * 75
     mass_error = float(result["mass_error"][0][0])
@@ -106,11 +111,17 @@ def bar_figures(output):
 
 @pytest.mark.parametrize("host", HOSTS)
 def test_wave_crosses_the_host_interface_without_reflection(hosts, host):
-    incident, reflected, transmitted, time = bar_figures(run_host(hosts, host, "bar"))
+    output = run_host(hosts, host, "bar")
+    incident, reflected, transmitted, time = bar_figures(output)
     assert time.max() > 0.022
     assert incident > 0.9, f"incident amplitude {incident:.3f} (driven with 1)"
     assert reflected < 0.01 * incident, f"reflection {100 * reflected / incident:.2f}% of the incident pulse"
     assert transmitted > 0.9 * incident, f"transmitted {transmitted:.3f} against incident {incident:.3f}"
+    # the host's own elastic law through the material callback: the same waves to round-off
+    library = np.array(rows(output)["sample"], float)
+    host_law = np.array(rows(run_host(hosts, host, "bar", "host-law"))["sample"], float)
+    assert library.shape == host_law.shape
+    assert np.abs(library - host_law).max() < 1e-12
 
 
 def forces_deck(path, output):
