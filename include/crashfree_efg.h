@@ -13,8 +13,8 @@
  *   -> cf_efg_counts, cf_efg_lumped_mass (declares the density), one law (cf_efg_set_elastic,
  *      cf_efg_set_plastic_kinematic or cf_efg_set_material_callback)
  *   -> cf_efg_internal_force every cycle -> cf_efg_destroy.
- * The law and the density may be given any time before the first cf_efg_internal_force and are
- * fixed after it.
+ * The law, the density and the bulk viscosity (cf_efg_set_bulk_viscosity, optional) may be given
+ * any time before the first cf_efg_internal_force and are fixed after it.
  *
  * Arrays of one call must not overlap (the library reads its inputs while it writes its outputs).
  *
@@ -129,6 +129,11 @@ int cf_efg_set_plastic_kinematic(cf_efg_part *part, double young, double poisson
    wave_modulus > 0, the law's largest constrained modulus K + 4/3 G (for the stable step). */
 int cf_efg_set_material_callback(cf_efg_part *part, cf_efg_material_law callback, void *context,
                                  int history_count, double wave_modulus);
+
+/* The bulk viscosity of the part, as *CONTROL_BULK_VISCOSITY: quadratic Q1 and linear Q2, both
+   >= 0 (LS-DYNA's defaults 1.5 and 0.06 hold until this is called); it acts in compression only.
+   Before the first internal force. */
+int cf_efg_set_bulk_viscosity(cf_efg_part *part, double quadratic, double linear);
 
 /* ADD the part's internal forces into force[3*n] (the host's sign: a = (f_ext - force) / m) for
    displacement[3*n] at the end of the step and velocity[3*n] at its middle (d^{n+1},

@@ -13,9 +13,10 @@
 !> Order of calls: cf_efg_create -> cf_efg_mark_boundary (any number of times) -> cf_efg_set_up
 !> -> cf_efg_counts, cf_efg_lumped_mass (declares the density), a law (cf_efg_set_elastic,
 !> cf_efg_set_plastic_kinematic or cf_efg_set_material_callback) -> cf_efg_internal_force every
-!> cycle -> cf_efg_destroy. The law and the density can be given any time before the first
-!> internal force and are fixed after it. cf_efg_to_physical, cf_efg_internal_energy and
-!> cf_efg_last_error can be called any time after set-up (last_error always).
+!> cycle -> cf_efg_destroy. The law, the density and the bulk viscosity (cf_efg_set_bulk_viscosity,
+!> optional) can be given any time before the first internal force and are fixed after it.
+!> cf_efg_to_physical and cf_efg_internal_energy can be called any time after set-up,
+!> cf_efg_last_error always.
 !>
 !> Arrays are column-major, node by node: coordinates(3, n) holds x, y, z of node 1, then of
 !> node 2 ...; hexahedra(8, m) 1-based node indices in LS-DYNA's order (nodes 1-4 one face,
@@ -50,6 +51,7 @@ module crashfree_efg
   public :: cf_efg_part, cf_efg_material_law
   public :: cf_efg_create, cf_efg_mark_boundary, cf_efg_set_up, cf_efg_counts, cf_efg_lumped_mass
   public :: cf_efg_set_elastic, cf_efg_set_plastic_kinematic, cf_efg_set_material_callback
+  public :: cf_efg_set_bulk_viscosity
   public :: cf_efg_internal_force, cf_efg_to_physical, cf_efg_internal_energy, cf_efg_destroy
   public :: cf_efg_last_error, cf_efg_is_null, cf_efg_node_count, cf_efg_set_error
 
@@ -99,6 +101,8 @@ module crashfree_efg
     type(material_t) :: material                     !< the built-in law
     type(host_law_t) :: host_law                     !< the host's law
     real(wp) :: density = 0.0_wp                     !< from cf_efg_lumped_mass (0: not given)
+    !> bulk viscosity coefficients Q1 (quadratic) and Q2 (linear): LS-DYNA's defaults
+    real(wp) :: bulk_quadratic = 1.5_wp, bulk_linear = 0.06_wp
   end type part_object_t
 
   !> A meshfree part: an opaque handle, null until cf_efg_create, null again after
@@ -443,6 +447,33 @@ contains
     status = cf_efg_ok
   end subroutine cf_efg_set_material_callback
 
+  !> The bulk viscosity of the part's points, as *CONTROL_BULK_VISCOSITY: `quadratic` Q1 and
+  !> `linear` Q2 (both >= 0; LS-DYNA's defaults 1.5 and 0.06 hold until this is called). It acts
+  !> in compression only. Before the first internal force.
+  subroutine cf_efg_set_bulk_viscosity(part, quadratic, linear, status)
+    type(cf_efg_part), intent(inout) :: part
+    real(c_double), intent(in) :: quadratic, linear
+    integer(c_int), intent(out) :: status
+    character(len=*), parameter :: name = "cf_efg_set_bulk_viscosity"
+    if (.not. live(part, status)) return
+    associate (object => part%object)
+      if (.not. law_may_change(object, name, status)) return
+      if (.not. (quadratic >= 0.0_wp .and. ieee_is_finite(quadratic))) then
+        call fail(object, cf_efg_error_argument, name//": quadratic = "//scientific_text(quadratic, 3)// &
+                  " must be a finite number, 0 or more (Q1)", status)
+        return
+      end if
+      if (.not. (linear >= 0.0_wp .and. ieee_is_finite(linear))) then
+        call fail(object, cf_efg_error_argument, name//": linear = "//scientific_text(linear, 3)// &
+                  " must be a finite number, 0 or more (Q2)", status)
+        return
+      end if
+      object%bulk_quadratic = quadratic
+      object%bulk_linear = linear
+    end associate
+    status = cf_efg_ok
+  end subroutine cf_efg_set_bulk_viscosity
+
   !> Add the part's internal forces into `force(3, n)` (the host's sign: a = (f_ext - force) / m,
   !> as LS-DYNA's internal force) for `displacement(3, n)` at the end of the step and
   !> `velocity(3, n)` at its middle (central differences: d^{n+1}, v^{n+1/2}), generalized values
@@ -483,10 +514,9 @@ contains
                     status)
           return
         end if
-        ! LS-DYNA's default bulk viscosity (Q1 1.5, Q2 0.06), as the solver's parts
         call set_up_efg_state(object%geometry, object%coordinates, object%hexahedra, object%material, &
-                              object%density, 1.5_wp, 0.06_wp, object%host_law, size(object%coordinates, 2), &
-                              object%state)
+                              object%density, object%bulk_quadratic, object%bulk_linear, object%host_law, &
+                              size(object%coordinates, 2), object%state)
         object%stage = stage_running
       end if
       call compute_efg_forces(object%material, object%state, displacement, velocity, dt, force)
@@ -661,7 +691,7 @@ contains
                                      "cf_efg_set_up first (the part is "//stage_text(object%stage)//")", status)
   end function set_up_done
 
-  !> A law may be set after create and before the first internal force.
+  !> A law (and the bulk viscosity) may be set after create and before the first internal force.
   logical function law_may_change(object, name, status)
     type(part_object_t), intent(inout) :: object
     character(len=*), intent(in) :: name
@@ -669,7 +699,8 @@ contains
     law_may_change = object%stage == stage_created .or. object%stage == stage_set_up
     status = cf_efg_ok
     if (.not. law_may_change) call fail(object, cf_efg_error_order, name//": wrong order of calls: the "// &
-                                        "material law is fixed once internal forces were computed", status)
+                                        "material law and the bulk viscosity are fixed once internal forces "// &
+                                        "were computed", status)
   end function law_may_change
 
   logical function elastic_constants_valid(object, name, young, poisson, status)

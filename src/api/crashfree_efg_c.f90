@@ -12,7 +12,8 @@ module crashfree_efg_c
                                          c_associated, c_f_pointer, c_f_procpointer, c_loc
   use crashfree_efg, only: cf_efg_part, cf_efg_material_law, cf_efg_create, cf_efg_mark_boundary, cf_efg_set_up, &
                            cf_efg_counts, cf_efg_lumped_mass, cf_efg_set_elastic, cf_efg_set_plastic_kinematic, &
-                           cf_efg_set_material_callback, cf_efg_internal_force, cf_efg_to_physical, &
+                           cf_efg_set_material_callback, cf_efg_set_bulk_viscosity, cf_efg_internal_force, &
+                           cf_efg_to_physical, &
                            cf_efg_internal_energy, cf_efg_destroy, cf_efg_last_error, cf_efg_node_count, &
                            cf_efg_set_error, cf_efg_error_argument, cf_efg_error_handle, cf_efg_ok
   implicit none
@@ -20,6 +21,7 @@ module crashfree_efg_c
 
   public :: cf_efg_create_c, cf_efg_mark_boundary_c, cf_efg_set_up_c, cf_efg_counts_c, cf_efg_lumped_mass_c
   public :: cf_efg_set_elastic_c, cf_efg_set_plastic_kinematic_c, cf_efg_set_material_callback_c
+  public :: cf_efg_set_bulk_viscosity_c
   public :: cf_efg_internal_force_c, cf_efg_to_physical_c, cf_efg_internal_energy_c, cf_efg_destroy_c
   public :: cf_efg_last_error_c
 
@@ -49,7 +51,8 @@ contains
     coordinate_values => no_reals
     hexahedron_values => no_integers
     support_values => no_support
-    if (c_associated(coordinates) .and. node_count > 0) call c_f_pointer(coordinates, coordinate_values, [3, node_count])
+    if (c_associated(coordinates) .and. node_count > 0) &
+      call c_f_pointer(coordinates, coordinate_values, [3, node_count])
     if (c_associated(hexahedra) .and. hexahedron_count > 0) &
       call c_f_pointer(hexahedra, hexahedron_values, [8, hexahedron_count])
     if (c_associated(support)) call c_f_pointer(support, support_values, [3])
@@ -151,6 +154,15 @@ contains
     call cf_efg_set_material_callback(handle, law, context, history_count, wave_modulus, &
                                       cf_efg_set_material_callback_c)
   end function cf_efg_set_material_callback_c
+
+  !> int cf_efg_set_bulk_viscosity(cf_efg_part *part, double quadratic, double linear)
+  integer(c_int) function cf_efg_set_bulk_viscosity_c(part, quadratic, linear) bind(c, name="cf_efg_set_bulk_viscosity")
+    type(c_ptr), value, intent(in) :: part
+    real(c_double), value, intent(in) :: quadratic, linear
+    type(cf_efg_part), pointer :: handle
+    if (.not. handle_of(part, handle, cf_efg_set_bulk_viscosity_c)) return
+    call cf_efg_set_bulk_viscosity(handle, quadratic, linear, cf_efg_set_bulk_viscosity_c)
+  end function cf_efg_set_bulk_viscosity_c
 
   !> int cf_efg_internal_force(cf_efg_part *part, const double *displacement,
   !>                           const double *velocity, double dt, double *force, double *stable_dt)

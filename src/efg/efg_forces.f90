@@ -19,6 +19,8 @@
 !> than twice the thread count are computed first, all in parallel, and only add their forces
 !> in the colour loop (the order at each node is the same, so are the results). `d` is the
 !> solver's nodal displacement: physical at Gamma nodes, generalized at interior particles.
+!> A part may have a host code's law instead (efg_host_law, given through the library
+!> crashfree_efg): it takes the place of the material routines, after the same rotation.
 !>
 !> Internal energy is the work of the point forces, integrated as central differences
 !> integrate the kinetic energy 1/2 m v(n-1/2) . v(n+1/2) (the finite elements do the same, see
@@ -225,9 +227,9 @@ contains
           !$omp do schedule(dynamic, 1)
           do k = colours%offsets(colour), colours%offsets(colour + 1) - 1
             b = colours%corners(k)
-            call compute_efg_block(material, solver%host_law, solver%geometry, solver%point_cell_volume, solver%density, &
-                                   solver%bulk_quadratic, solver%bulk_linear, solver%blocks(b), displacement, &
-                                   velocity, dt, solver%point_stress, solver%block_time_step(b), &
+            call compute_efg_block(material, solver%host_law, solver%geometry, solver%point_cell_volume, &
+                                   solver%density, solver%bulk_quadratic, solver%bulk_linear, solver%blocks(b), &
+                                   displacement, velocity, dt, solver%point_stress, solver%block_time_step(b), &
                                    solver%block_critical_point(b), solver%block_inverted_point(b))
           end do
           !$omp end do nowait
@@ -240,9 +242,9 @@ contains
         do k = colours%offsets(colour), colours%offsets(colour + 1) - 1
           b = colours%corners(k)
           if (fused) then
-            call compute_efg_block(material, solver%host_law, solver%geometry, solver%point_cell_volume, solver%density, &
-                                   solver%bulk_quadratic, solver%bulk_linear, solver%blocks(b), displacement, &
-                                   velocity, dt, solver%point_stress, solver%block_time_step(b), &
+            call compute_efg_block(material, solver%host_law, solver%geometry, solver%point_cell_volume, &
+                                   solver%density, solver%bulk_quadratic, solver%bulk_linear, solver%blocks(b), &
+                                   displacement, velocity, dt, solver%point_stress, solver%block_time_step(b), &
                                    solver%block_critical_point(b), solver%block_inverted_point(b))
           end if
           call add_block_forces(solver%geometry, solver%blocks(b), solver%point_stress, internal_force)

@@ -90,8 +90,9 @@ static void host_elastic_law(int n, const double *strain_increment, const double
                              double *history, void *context)
 {
     const struct elastic_constants *constants = context;
-    double lame = constants->young * constants->poisson / ((1.0 + constants->poisson) * (1.0 - 2.0 * constants->poisson));
-    double shear = 0.5 * constants->young / (1.0 + constants->poisson);
+    double nu = constants->poisson;
+    double lame = constants->young * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+    double shear = 0.5 * constants->young / (1.0 + nu);
     (void)spin;
     for (int i = 0; i < n; i++) {
         double trace = strain_increment[i] + strain_increment[i + n] + strain_increment[i + 2 * n];
@@ -143,7 +144,8 @@ int main(void)
         bad[8 + a + 4] = hexahedra[8 + a];
     }
     status = cf_efg_create(&part, NODES, coordinates, HEXAHEDRA, bad, support, 0, 1);
-    expect("create with an inside-out hexahedron", part, status, CF_EFG_ERROR_GEOMETRY, "hexahedra(:, 2) is inside out");
+    expect("create with an inside-out hexahedron", part, status, CF_EFG_ERROR_GEOMETRY,
+           "hexahedra(:, 2) is inside out");
     cf_efg_destroy(&part);
     check("destroy sets the handle to NULL", part == NULL, part);
 
@@ -188,7 +190,9 @@ int main(void)
     check("patch: traction resultant on x = 1", fabs(right - expected) <= 1e-10 * expected, part);
     check("energy", cf_efg_internal_energy(part, &energy) == CF_EFG_OK && energy > 0.0, part);
     expect("law changed while running", part, cf_efg_set_elastic(part, young, poisson), CF_EFG_ERROR_ORDER,
-           "law is fixed");
+           "are fixed once");
+    expect("bulk viscosity changed while running", part, cf_efg_set_bulk_viscosity(part, 1.5, 0.06), CF_EFG_ERROR_ORDER,
+           "are fixed once");
 
     /* the host's law as a C function pointer */
     struct elastic_constants constants = {young, poisson};
