@@ -505,7 +505,7 @@ static void patch_test(double support, int kernel, int host_law)
         if (fabs(exact[k]) > largest) largest = fabs(exact[k]);
     }
     printf("velocity_error %.16e\n", error / largest);
-    cf_efg_destroy(&model.part);
+    check(&model, cf_efg_destroy(&model.part), "cf_efg_destroy");
 }
 
 static void coupled_bar(int host_law)
@@ -549,7 +549,7 @@ static void coupled_bar(int host_law)
         physical_field(&model, model.velocity, physical);
         printf("sample %.16e %.16e %.16e\n", time - 0.5 * dt, physical[3 * incident_probe], physical[3 * transmitted_probe]);
     }
-    cf_efg_destroy(&model.part);
+    check(&model, cf_efg_destroy(&model.part), "cf_efg_destroy");
 }
 
 static void one_force_call(double step)
@@ -594,7 +594,7 @@ static void one_force_call(double step)
         printf("node %d %.16e %.16e %.16e %.16e %.16e %.16e %.16e %.16e %.16e %.16e %.16e %.16e %.16e\n", node + 1, x[0], x[1],
                x[2], v[0], v[1], v[2], model.mass[node], f[0], f[1], f[2], a[0], a[1], a[2]);
     }
-    cf_efg_destroy(&model.part);
+    check(&model, cf_efg_destroy(&model.part), "cf_efg_destroy");
 }
 
 static int compare_doubles(const void *a, const void *b)
@@ -638,7 +638,7 @@ static void bench(int cells_per_side, int calls)
     printf("integration_points %d\n", model.counts[3]);
     printf("ns_per_point_call %12.3f\n", 1.0e9 * seconds[(calls + 1) / 2 - 1] / model.counts[3]);
     printf("ns_per_point_call_mean %12.3f\n", 1.0e9 * total / calls / model.counts[3]);
-    cf_efg_destroy(&model.part);
+    check(&model, cf_efg_destroy(&model.part), "cf_efg_destroy");
 }
 
 /* one misuse: its status and the library's message on one line */

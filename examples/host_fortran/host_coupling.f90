@@ -11,14 +11,14 @@ module host_coupling
   use, intrinsic :: iso_c_binding, only: c_double, c_int, c_loc
   use crashfree_efg, only: cf_efg_part, cf_efg_create, cf_efg_mark_boundary, cf_efg_set_up, cf_efg_counts, &
                            cf_efg_lumped_mass, cf_efg_set_elastic, cf_efg_set_material_callback, &
-                           cf_efg_internal_force, cf_efg_to_physical, cf_efg_last_error
+                           cf_efg_internal_force, cf_efg_to_physical, cf_efg_last_error, cf_efg_destroy
   use host_mesh, only: host_mesh_t
   use host_hexahedra, only: host_solids_t, set_up_solids, add_solid_masses, add_solid_forces, host_elastic_t, &
                             host_elastic_law
   implicit none
   private
 
-  public :: host_model_t, set_up_model, compute_forces, physical_field, check
+  public :: host_model_t, set_up_model, compute_forces, physical_field, check, destroy_model
 
   !> The host's model: mesh, its elements, the meshfree part and the nodal arrays.
   type :: host_model_t
@@ -159,6 +159,15 @@ contains
     model%force(:, model%part_node) = model%force(:, model%part_node) + model%part_force
     stable_dt = min(stable_dt, part_dt)
   end subroutine compute_forces
+
+  !> Frees the part, then the law constants its callback used.
+  subroutine destroy_model(model)
+    type(host_model_t), intent(inout) :: model
+    integer(c_int) :: status
+    call cf_efg_destroy(model%part, status)
+    call check(model, status, "cf_efg_destroy")
+    if (associated(model%law)) deallocate (model%law)
+  end subroutine destroy_model
 
   !> A nodal field with physical values at the part's interior particles (eq. 16 of the
   !> formulation), for output, probes and contact.

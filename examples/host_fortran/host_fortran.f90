@@ -18,10 +18,10 @@
 !>                                         CELLS^3 meshfree cells: ns per integration point per call
 program host_fortran
   use, intrinsic :: iso_c_binding, only: c_double, c_int, c_int64_t
-  use crashfree_efg, only: cf_efg_internal_force, cf_efg_destroy
+  use crashfree_efg, only: cf_efg_internal_force
   use host_mesh, only: host_mesh_t, block_mesh, node_index, on_block_boundary
   use host_hexahedra, only: host_solids_t, set_up_solids
-  use host_coupling, only: host_model_t, set_up_model, compute_forces, physical_field, check
+  use host_coupling, only: host_model_t, set_up_model, compute_forces, physical_field, check, destroy_model
   implicit none
 
   real(c_double), parameter :: density = 7.85e-6_c_double, young = 210.0_c_double
@@ -82,12 +82,11 @@ contains
                                                            -0.002_c_double, 0.005_c_double, 0.008_c_double], [3, 3])
     type(host_mesh_t) :: mesh
     type(host_model_t) :: model
-    integer(c_int) :: status
     type(host_solids_t) :: meshfree_cells
     logical, allocatable :: meshfree(:), driven(:)
     real(c_double), allocatable :: exact(:, :), physical(:, :)
     real(c_double) :: stable_dt, dt, previous_dt, part_volume
-    integer :: i, j, k, cycle, e
+    integer :: i, j, k, cycle_number, e
 
     call block_mesh([6, 5, 5], 0.25_c_double, 0.25_c_double, 11, mesh)
     allocate (meshfree(size(mesh%hexahedra, 2)), driven(size(mesh%coordinates, 2)))
@@ -116,7 +115,7 @@ contains
     model%velocity = exact
     call compute_forces(model, 0.0_c_double, stable_dt)
     previous_dt = 0.0_c_double
-    do cycle = 1, 100
+    do cycle_number = 1, 100
       dt = 0.9_c_double*stable_dt
       call advance(model, 0.5_c_double*(previous_dt + dt))
       where (spread(driven, 1, 3)) model%velocity = exact
@@ -127,8 +126,7 @@ contains
     allocate (physical(3, size(exact, 2)))
     call physical_field(model, model%velocity, physical)
     write (*, '(a, es25.16e3)') "velocity_error", maxval(abs(physical - exact))/maxval(abs(exact))
-    call cf_efg_destroy(model%part, status)
-    call check(model, status, "cf_efg_destroy")
+    call destroy_model(model)
   end subroutine patch_test
 
   !> v += step a with a = -f / m (no external forces here).
@@ -152,7 +150,6 @@ contains
     real(c_double), parameter :: pi = 3.14159265358979323846_c_double
     type(host_mesh_t) :: mesh
     type(host_model_t) :: model
-    integer(c_int) :: status
     logical, allocatable :: meshfree(:), supported(:), driven(:)
     real(c_double), allocatable :: physical(:, :)
     real(c_double) :: stable_dt, dt, previous_dt, time, pulse
@@ -202,8 +199,7 @@ contains
       write (*, '(a, 3(1x, es25.16e3))') "sample", time - 0.5_c_double*dt, physical(1, incident_probe), &
         physical(1, transmitted_probe)
     end do
-    call cf_efg_destroy(model%part, status)
-    call check(model, status, "cf_efg_destroy")
+    call destroy_model(model)
   end subroutine coupled_bar
 
   !> An all-meshfree block of 5 x 4 x 4 perturbed 1 mm cells (box kernel, DX 1.5) at rest, a
@@ -214,7 +210,6 @@ contains
     real(c_double), intent(in) :: step
     type(host_mesh_t) :: mesh
     type(host_model_t) :: model
-    integer(c_int) :: status
     logical, allocatable :: meshfree(:), marked(:)
     real(c_double), allocatable :: acceleration(:, :), physical(:, :)
     real(c_double) :: stable_dt, x, y, z
@@ -259,8 +254,7 @@ contains
       write (*, '(a, 1x, i0, 13(1x, es25.16e3))') "node", node, mesh%coordinates(:, node), model%velocity(:, node), &
         model%mass(node), model%force(:, node), physical(:, node)
     end do
-    call cf_efg_destroy(model%part, status)
-    call check(model, status, "cf_efg_destroy")
+    call destroy_model(model)
   end subroutine one_force_call
 
   !> ns per integration point per call of cf_efg_internal_force on a block of cells^3 meshfree
@@ -303,8 +297,7 @@ contains
     write (*, '(a, 1x, i0)') "integration_points", model%counts(4)
     write (*, '(a, f12.3)') "ns_per_point_call", 1.0e9_c_double*seconds((calls + 1)/2)/model%counts(4)
     write (*, '(a, f12.3)') "ns_per_point_call_mean", 1.0e9_c_double*sum(seconds)/calls/model%counts(4)
-    call cf_efg_destroy(model%part, status)
-    call check(model, status, "cf_efg_destroy")
+    call destroy_model(model)
   end subroutine bench
 
   !> Insertion sort (a few hundred values).
