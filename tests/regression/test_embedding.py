@@ -217,3 +217,13 @@ def test_c_calls_in_error_give_a_status_and_a_message(request, build):
     for case, (status, word) in MISUSE.items():
         assert found[case][0] == status, f"{case}: status {found[case][0]} ({found[case][1]})"
         assert word in found[case][1], f"{case}: the message does not name {word!r}: {found[case][1]}"
+
+
+@pytest.mark.parametrize("host", HOSTS)
+def test_the_checked_library_runs_the_hosts(debug_hosts, host):
+    # -fcheck=all and -ffpe-trap in the library, two threads: no bound or floating-point fault
+    # in a patch test with the host's law and the bar
+    result = rows(run_host(debug_hosts, host, "patch", 1.2, 2, "host-law", threads=2))
+    assert float(result["velocity_error"][0][0]) < 1e-10
+    incident, reflected, _, _ = bar_figures(run_host(debug_hosts, host, "bar", threads=2))
+    assert reflected < 0.01 * incident
