@@ -16,7 +16,8 @@
 #   make install    the embedding library (lib/libcrashfree_efg.a), its header, Fortran module and
 #                   pkg-config file crashfree-efg.pc under PREFIX (default /usr/local); docs/embedding.md
 #   make examples   install into build/release/install, then build the host codes of examples/
-#                   against it with pkg-config only (build/release/examples)
+#                   against it with pkg-config only (build/release/examples; MODE=debug: against
+#                   the checked library, in build/debug)
 MODE ?= release
 FC := gfortran
 PYTHON ?= python3
