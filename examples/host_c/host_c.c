@@ -261,8 +261,9 @@ static double add_solid_forces(host_solids *solids, const double *displacement, 
                 viscosity = solids->density / jacobian * length *
                             (solids->bulk_quadratic * solids->bulk_quadratic * length * volumetric_rate * volumetric_rate -
                              solids->bulk_linear * sound_speed * volumetric_rate);
-                if (volumetric_rate / 8 < compression) compression = volumetric_rate / 8;
             }
+            /* the element's mean rate of compression, for its stable step */
+            if (volumetric_rate < 0) compression += volumetric_rate / 8;
             /* P = J (sigma - q I) F^-T: P_ij = J sum_k (sigma - q I)_ik (F^-1)_jk */
             double first_piola[3][3];
             for (int i = 0; i < 3; i++)

@@ -140,8 +140,9 @@ contains
           length = (element_volume*jacobian)**(1.0_c_double/3.0_c_double)
           viscosity = solids%density/jacobian*length*(solids%bulk_quadratic**2*length*volumetric_rate**2 &
                                                        - solids%bulk_linear*sound_speed*volumetric_rate)
-          compression = min(compression, volumetric_rate/points)
         end if
+        ! the element's mean rate of compression, for its stable step
+        compression = compression + min(volumetric_rate, 0.0_c_double)/points
         first_piola = jacobian*matmul(sigma - viscosity*identity, transpose(inverse))
         force(:, solids%nodes(:, e)) = force(:, solids%nodes(:, e)) &
                                        + solids%weight(g, e)*matmul(first_piola, solids%gradient(:, :, g, e))
