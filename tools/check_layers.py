@@ -23,6 +23,12 @@ Every `use` of every src/**/*.f90 is checked (intrinsic and library modules such
 not the project's and are skipped). Uses listed in ALLOWED_FOR_NOW are reported but do not fail
 the check; an entry that no longer occurs fails it, so that the list only shrinks. Prints every
 violation and exits with status 1 when there is one. Usage: check_layers.py [SRC_DIR]
+
+The embedding library (src/api and every module it uses, directly or not) never prints, never
+stops the process, never opens or writes files; and only the program (src/app) sets the OpenMP
+thread count. Both are checked on the code (comments left out): a `stop`, `error stop`, `print`,
+`write` to the terminal, `open` or C `fopen` in a module of the library's closure, or a call of
+`omp_set_num_threads` outside src/app, is a violation.
 """
 import re
 import sys
@@ -47,6 +53,13 @@ LAYERS = {
 # Known violations, allowed until the files that hold them are rewritten (none now).
 ALLOWED_FOR_NOW = set()
 
+# What the library may not do (on the code of a line, its comment cut off).
+LIBRARY_FOLDER = "api"
+FORBIDDEN_IN_LIBRARY = re.compile(
+    r"^\s*(error\s+)?stop\b|\bprint\s*[*'\"(]|\bwrite\s*\(\s*(\*|output_unit|error_unit)|\bopen\s*\(|c_fopen",
+    re.IGNORECASE)
+THREAD_COUNT = re.compile(r"\bomp_set_num_threads\b", re.IGNORECASE)
+
 MODULE = re.compile(r"^\s*module\s+(?!procedure\b)(\w+)", re.IGNORECASE)
 USE = re.compile(r"^\s*use\s*(?:,\s*(?:non_)?intrinsic\s*::)?\s*(\w+)", re.IGNORECASE)
 
@@ -66,6 +79,47 @@ def scan(src: Path):
             if found:
                 uses.append((relative, number, found.group(1).lower()))
     return defined, uses
+
+
+def fortran_sources(src: Path):
+    """Every Fortran source of src/ (free form, preprocessed or not)."""
+    return sorted([*src.rglob("*.f90"), *src.rglob("*.F90")])
+
+
+def library_problems(src: Path):
+    """Lines of the library's module closure that print, stop or open files; thread counts set
+    outside src/app."""
+    uses_of = {}
+    for path in fortran_sources(src):
+        for line in path.read_text(errors="replace").splitlines():
+            found = USE.match(line.split("!")[0])
+            if found:
+                uses_of.setdefault(path, set()).add(found.group(1).lower())
+    module_file = {}
+    for path in fortran_sources(src):
+        for line in path.read_text(errors="replace").splitlines():
+            found = MODULE.match(line.split("!")[0])
+            if found:
+                module_file[found.group(1).lower()] = path
+    closure = set()
+    pending = [path for path in fortran_sources(src) if path.parent == src / LIBRARY_FOLDER]
+    while pending:
+        path = pending.pop()
+        if path in closure:
+            continue
+        closure.add(path)
+        pending.extend(module_file[module] for module in uses_of.get(path, ()) if module in module_file)
+    problems = []
+    for path in fortran_sources(src):
+        relative = path.relative_to(src).as_posix()
+        for number, line in enumerate(path.read_text(errors="replace").splitlines(), start=1):
+            code = line.split("!")[0]
+            if path in closure and FORBIDDEN_IN_LIBRARY.search(code):
+                problems.append(f"src/{relative}:{number}: the embedding library (src/{LIBRARY_FOLDER}/ and the "
+                                f"modules it uses) may not print, stop or open files: {code.strip()}")
+            if relative.split("/")[0] != "app" and THREAD_COUNT.search(code):
+                problems.append(f"src/{relative}:{number}: only the program (src/app/) sets the OpenMP thread count")
+    return problems, len(closure)
 
 
 def main() -> int:
@@ -95,6 +149,8 @@ def main() -> int:
     for relative, module in sorted(ALLOWED_FOR_NOW - allowed_seen):
         problems.append(f"src/{relative}: allowed use of {module} no longer occurs: remove it from "
                         "ALLOWED_FOR_NOW in tools/check_layers.py")
+    library, closure_size = library_problems(src)
+    problems.extend(library)
     for problem in problems:
         print(problem)
     order = " <- ".join(
@@ -105,6 +161,7 @@ def main() -> int:
     )
     print(f"layers: {order}")
     print(f"layers: {len(uses)} use statements checked, {len(allowed_seen)} allowed for now, "
+          f"{closure_size} files of the embedding library checked for output, stops and thread counts, "
           f"{len(problems)} violations")
     return 1 if problems else 0
 
