@@ -22,7 +22,6 @@ with pkg-config only. Their runs must show:
 """
 import os
 import subprocess
-from pathlib import Path
 
 import numpy as np
 import pytest
