@@ -10,7 +10,7 @@ REPEAT times; the figures are nanoseconds per integration point per call:
   - host: the mean (and the median) of CALLS timed calls of cf_efg_internal_force, after a first
     untimed call that builds the part's run-time state (the solver builds it during its set-up).
     bench_api.py --host build/release/examples/host_fortran --solver bin/crashfree
-                 --directory build/bench/api [--cells 16] [--calls 100] [--repeat 3]
+                 --directory build/bench/api [--cells 16] [--calls 200] [--repeat 5]
 """
 import argparse
 import os
@@ -74,8 +74,8 @@ def main():
     parser.add_argument("--solver", default="bin/crashfree")
     parser.add_argument("--directory", default="build/bench/api")
     parser.add_argument("--cells", type=int, default=16)
-    parser.add_argument("--calls", type=int, default=100)
-    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--calls", type=int, default=200)
+    parser.add_argument("--repeat", type=int, default=5)
     options = parser.parse_args()
     directory = Path(options.directory)
     directory.mkdir(parents=True, exist_ok=True)
