@@ -60,7 +60,8 @@ extern "C" {
 /* The shape functions cannot be built (singular moment matrix, non-positive row-sum masses):
    the supports do not suit the part. */
 #define CF_EFG_ERROR_SINGULAR 5
-/* The material gave a non-finite or non-positive stable time step. */
+/* The material gave a non-finite or non-positive stable time step, or the host's law a stress
+   that is not a finite number. */
 #define CF_EFG_ERROR_MATERIAL 6
 
 /* kernel of cf_efg_create (LS-DYNA's ISPLINE) */

@@ -70,8 +70,8 @@ module crashfree_efg
   !> The shape functions cannot be built: the moment matrix is singular or the row-sum masses are
   !> not positive (supports too small or too large for the part).
   integer(c_int), parameter, public :: cf_efg_error_singular = 5
-  !> The material gave a non-finite stable time step (a host law returned NaN or a negative
-  !> modulus).
+  !> The material gave a non-finite stable time step, or a host's law a stress that is not a
+  !> finite number.
   integer(c_int), parameter, public :: cf_efg_error_material = 6
 
   !> Kernel (ISPLINE) and integration (IDIM) choices of cf_efg_create.
@@ -520,6 +520,17 @@ contains
         object%stage = stage_running
       end if
       call compute_efg_forces(object%material, object%state, displacement, velocity, dt, force)
+      ! a host's law is not known to the library: its stresses are checked (the built-in laws'
+      ! are finite for finite input)
+      if (object%law == law_host) then
+        do point = 1, size(object%state%point_stress, 2)
+          if (all(ieee_is_finite(object%state%point_stress(:, point)))) cycle
+          call fail(object, cf_efg_error_material, name//": the host's material law returned a stress that is "// &
+                    "not a finite number at integration point "//integer_text(point)//" of hexahedron "// &
+                    integer_text(object%geometry%point_cell(point)), status)
+          return
+        end do
+      end if
       do b = 1, size(object%state%blocks)
         if (object%state%block_inverted_point(b) /= 0) then
           point = object%state%block_inverted_point(b)

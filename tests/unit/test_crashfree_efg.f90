@@ -21,7 +21,7 @@ program test_crashfree_efg
                            cf_efg_to_physical, &
                            cf_efg_internal_energy, cf_efg_destroy, cf_efg_last_error, cf_efg_is_null, cf_efg_ok, &
                            cf_efg_error_argument, cf_efg_error_order, cf_efg_error_handle, cf_efg_error_geometry, &
-                           cf_efg_error_singular, &
+                           cf_efg_error_singular, cf_efg_error_material, &
                            cf_efg_material_law
   !$ use omp_lib, only: omp_get_max_threads, omp_set_num_threads
   implicit none
@@ -30,7 +30,7 @@ program test_crashfree_efg
   integer, parameter :: node_count = side_nodes**3, cell_count = cells_per_side**3
   real(wp), parameter :: young = 210.0_wp, poisson = 0.3_wp, density = 7.85e-3_wp
   type(test_suite_t) :: suite
-  procedure(cf_efg_material_law) :: host_elastic_law
+  procedure(cf_efg_material_law) :: host_elastic_law, host_failing_law
   real(wp), target :: coordinates(3, node_count)
   integer :: hexahedra(8, cell_count)
 
@@ -300,6 +300,15 @@ contains
     call check_close(suite, "callback: stable step equals the built-in law's", stable(2), stable(1), rel=1.0e-12_wp)
     call cf_efg_destroy(built_in, status)
     call cf_efg_destroy(hosted, status)
+    ! a host law that fails (a stress that is not a number) gives a status, not NaN forces
+    call new_part(hosted, 0, 1)
+    call cf_efg_lumped_mass(hosted, density, mass, status)
+    call cf_efg_set_material_callback(hosted, host_failing_law, c_loc(constants), 0, young, status)
+    force = 0.0_wp
+    call cf_efg_internal_force(hosted, displacement, velocity, dt, force(:, :, 2), stable(2), status)
+    call expect("a host law returning NaN", hosted, status, cf_efg_error_material, &
+                "the host's material law returned a stress that is not a finite number")
+    call cf_efg_destroy(hosted, status)
   end subroutine test_callback
 
   !> The built-in plastic law: a stretch beyond yield stores less energy than the elastic law.
@@ -540,3 +549,17 @@ subroutine host_elastic_law(n, strain_increment, spin, stress, history, context)
     history(i, 1) = history(i, 1) + 1.0_wp + 0.0_wp*spin(i, 1)
   end do
 end subroutine host_elastic_law
+
+!> A host's law that fails: the stress of its first point is not a number.
+subroutine host_failing_law(n, strain_increment, spin, stress, history, context) bind(c)
+  use, intrinsic :: iso_c_binding, only: c_int, c_double, c_ptr, c_associated
+  use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+  implicit none
+  integer(c_int), value, intent(in) :: n
+  real(c_double), intent(in) :: strain_increment(n, 6), spin(n, 3)
+  real(c_double), intent(inout) :: stress(n, 6), history(n, *)
+  type(c_ptr), value, intent(in) :: context
+  ! it reads its arguments as a law would, then fails
+  if (c_associated(context)) history(1, 1) = history(1, 1) + 0.0_c_double*(strain_increment(1, 1) + spin(1, 1))
+  stress(1, 1) = ieee_value(stress(1, 1), ieee_quiet_nan)
+end subroutine host_failing_law
