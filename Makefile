@@ -10,11 +10,17 @@
 #   make test       install what is missing, build, layer check, unit tests (debug build) and
 #                   regression tests
 #   make layers     check that each folder of src/ uses only the folders below it
-#   make bench      performance figures (ns per element per cycle; MPI scaling: tools/bench_mpi.sh)
+#   make bench      performance figures (ns per element per cycle; MPI scaling: tools/bench_mpi.sh;
+#                   the embedding API: tools/bench_api.sh)
 #   make verify     verification studies (patch test, cantilever): docs/verification.md (NCPU=n)
 #   make MODE=debug checked build in build/debug
 #   make MPI=no     the one-rank build without MPI (in build/MODE-serial); by default MPI is used when
 #                   Open MPI's mpifort is installed (docs/parallel.md: mpirun -np N bin/crashfree ...)
+#   make install    the embedding library (lib/libcrashfree_efg.a), its header, Fortran module and
+#                   pkg-config file crashfree-efg.pc under PREFIX (default /usr/local); docs/embedding.md
+#   make examples   install into build/release/install, then build the host codes of examples/
+#                   against it with pkg-config only (build/release/examples; MODE=debug: against
+#                   the checked library, in build/debug)
 MODE ?= release
 MPI ?= $(if $(shell command -v mpifort 2>/dev/null),yes,no)
 # With MPI everything is compiled by the mpifort wrapper (the same gfortran underneath) and the
@@ -44,6 +50,10 @@ else
             -Wno-maybe-uninitialized
 endif
 LIBRARY := $(BUILD)/lib/libcrashfree.a
+# The embedding library (docs/embedding.md): the API modules of src/api and the project modules
+# they use (tools/library_objects.py writes EFG_LIBRARY_OBJECTS), nothing that needs HDF5 or METIS.
+EFG_LIBRARY := $(BUILD)/lib/libcrashfree_efg.a
+EFG_API_SOURCES := $(sort $(wildcard src/api/crashfree_efg*.f90))
 PROGRAM := $(BUILD)/bin/crashfree
 FFLAGS += -J$(MOD) -I$(MOD) -I$(HDF5_INCLUDE)
 
@@ -61,17 +71,19 @@ vpath %.f90 $(sort $(dir $(ALL_SOURCES)))
 vpath %.F90 $(sort $(dir $(ALL_SOURCES)))
 
 .PHONY: all deps run taylor test unit regression bench clean debug verify fuzz layers
-# The release build is also published as bin/crashfree and lib/ (library and .mod files). (Checked
-# at every make, not by date: after `make MPI=no` the MPI build's older program is published again.)
+# The release build is also published as bin/crashfree and lib/ (libraries and .mod files).
+# (Checked at every make, not by date: after `make MPI=no` the MPI build's older program is
+# published again.)
 ifeq ($(MODE),release)
 all: bin/crashfree
 .PHONY: bin/crashfree
-bin/crashfree: $(PROGRAM)
+bin/crashfree: $(PROGRAM) $(EFG_LIBRARY)
 	@mkdir -p bin lib
 	@cmp -s $(PROGRAM) bin/crashfree || (cp $(PROGRAM) bin/crashfree.new && mv -f bin/crashfree.new bin/crashfree)
-	@cmp -s $(LIBRARY) lib/libcrashfree.a || cp $(LIBRARY) $(MOD)/*.mod lib/
+	@cmp -s $(LIBRARY) lib/libcrashfree.a && cmp -s $(EFG_LIBRARY) lib/libcrashfree_efg.a || \
+	  cp $(LIBRARY) $(EFG_LIBRARY) $(MOD)/*.mod lib/
 else
-all: $(PROGRAM)
+all: $(PROGRAM) $(EFG_LIBRARY)
 endif
 
 $(OBJ)/%.o: %.f90 | $(OBJ) $(MOD)
@@ -112,9 +124,47 @@ $(BUILD)/deps.mk: $(ALL_SOURCES) tools/fortran_deps.py
 	@mkdir -p $(BUILD)
 	@$(PYTHON) tools/fortran_deps.py $(OBJ) $(ALL_SOURCES) > $@
 
+$(BUILD)/efg_library.mk: $(LIBRARY_SOURCES) tools/library_objects.py
+	@mkdir -p $(BUILD)
+	@$(PYTHON) tools/library_objects.py EFG_LIBRARY_OBJECTS $(OBJ) $(EFG_API_SOURCES) -- $(LIBRARY_SOURCES) > $@
+
 ifeq ($(filter deps clean,$(MAKECMDGOALS)),)
 include $(BUILD)/deps.mk
+include $(BUILD)/efg_library.mk
 endif
+
+$(EFG_LIBRARY): $(EFG_LIBRARY_OBJECTS) | $(dir $(EFG_LIBRARY))
+	@rm -f $@
+	ar rcs $@ $^
+
+# make install PREFIX=DIR: the embedding library, its C header, its Fortran module (gfortran's
+# .mod files are compiler-specific: include/crashfree/, apart from the header) and the
+# pkg-config file, whose Libs name the static library's own dependencies (tools/crashfree-efg.pc.in).
+# Only the API's own .mod is installed: a host needs no other, and the internal module names
+# (kinds, model, ...) would collide with a host's own.
+PREFIX ?= /usr/local
+CRASHFREE_VERSION := $(shell sed -n 's/.*crashfree_version *= *"\([^"]*\)".*/\1/p' src/core/version.f90)
+INSTALL_PREFIX = $(abspath $(PREFIX))
+.PHONY: install examples
+install: $(EFG_LIBRARY)
+	@mkdir -p $(DESTDIR)$(INSTALL_PREFIX)/lib/pkgconfig $(DESTDIR)$(INSTALL_PREFIX)/include/crashfree
+	cp $(EFG_LIBRARY) $(DESTDIR)$(INSTALL_PREFIX)/lib/
+	cp include/crashfree_efg.h $(DESTDIR)$(INSTALL_PREFIX)/include/
+	cp $(MOD)/crashfree_efg.mod $(DESTDIR)$(INSTALL_PREFIX)/include/crashfree/
+	sed -e 's|@PREFIX@|$(INSTALL_PREFIX)|g' -e 's|@VERSION@|$(CRASHFREE_VERSION)|g' \
+	    tools/crashfree-efg.pc.in > $(DESTDIR)$(INSTALL_PREFIX)/lib/pkgconfig/crashfree-efg.pc
+
+# make examples: install into EXAMPLES_PREFIX, then build the two host codes of examples/ with
+# their own Makefiles, which know the library only through pkg-config.
+EXAMPLES_PREFIX ?= $(BUILD)/install
+EXAMPLES_OUT ?= $(BUILD)/examples
+examples:
+	@$(MAKE) --no-print-directory install PREFIX=$(EXAMPLES_PREFIX)
+	@mkdir -p $(EXAMPLES_OUT)
+	PKG_CONFIG_PATH=$(abspath $(EXAMPLES_PREFIX))/lib/pkgconfig $(MAKE) --no-print-directory -C examples/host_fortran \
+	    OUT=$(abspath $(EXAMPLES_OUT))
+	PKG_CONFIG_PATH=$(abspath $(EXAMPLES_PREFIX))/lib/pkgconfig $(MAKE) --no-print-directory -C examples/host_c \
+	    OUT=$(abspath $(EXAMPLES_OUT))
 
 deps:
 	@bash tools/install_dependencies.sh
@@ -167,6 +217,7 @@ bench: deps
 	@bash tools/bench.sh
 	@bash tools/bench_contact.sh
 	@bash tools/bench_mpi.sh
+	@bash tools/bench_api.sh
 
 # Verification studies: write the decks, run every case (NCPU threads each, default 1), then
 # write docs/verification.md and its plots (also when a case failed; the exit status says so).

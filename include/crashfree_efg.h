@@ -36,7 +36,7 @@
  * never sets the thread count); results are bit-identical for any thread count.
  *
  * Link: the Fortran library and its run-time, e.g. through pkg-config crashfree-efg; by hand
- * libcrashfree.a -lgfortran -lgomp -llapack -lblas -lm (or link with gfortran -fopenmp).
+ * libcrashfree_efg.a -lgfortran -lgomp -llapack -lblas -lm (or link with gfortran -fopenmp).
  */
 #ifndef CRASHFREE_EFG_H
 #define CRASHFREE_EFG_H

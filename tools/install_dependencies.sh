@@ -11,6 +11,8 @@ set -euo pipefail
 
 debian_packages=(gfortran make libhdf5-dev libmetis-dev liblapack-dev libopenblas-dev python3 python3-pip
                  libegl1 libegl-mesa0 libgl1-mesa-dri libopenmpi-dev openmpi-bin)
+# the embedding examples and their test (docs/embedding.md): a C compiler, pkg-config, nm
+debian_packages+=(gcc pkg-config binutils)
 missing=()
 for package in "${debian_packages[@]}"; do
   dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")
