@@ -414,6 +414,7 @@ contains
     part_ids = part_ids(1:count)
     steps = steps(1:count)
   end subroutine list_time_steps
+
   integer function block_count(self)
     class(efg_group_t), intent(in) :: self
     integer :: p

@@ -510,6 +510,7 @@ contains
       end associate
     end do
   end subroutine list_time_steps
+
   integer function block_count(self)
     class(efg_shell_group_t), intent(in) :: self
     integer :: p

@@ -408,6 +408,7 @@ contains
       end associate
     end do
   end subroutine list_time_steps
+
   !> Its blocks are shared out among the ranks of a distributed run (docs/parallel.md).
   logical function distributes_blocks(self)
     class(beam_group_t), intent(in) :: self

@@ -436,6 +436,7 @@ contains
     kind = ""
     allocate (element_ids(0), part_ids(0), steps(0))
   end subroutine list_time_steps
+
   !> The distinct entries of `list`, ascending (block_nodes of every kind; set-up only).
   pure function distinct_nodes(list) result(nodes)
     integer, intent(in) :: list(:)

@@ -481,6 +481,7 @@ contains
     part_ids = part_ids(1:count)
     steps = steps(1:count)
   end subroutine list_time_steps
+
   !> Its blocks are shared out among the ranks of a distributed run (docs/parallel.md).
   logical function distributes_blocks(self)
     class(shell_group_t), intent(in) :: self
