@@ -193,15 +193,21 @@ def test_meshfree_model_is_identical_on_one_two_and_three_ranks(tmp_path):
         print(f"{ranks} ranks: meshfree point blocks computed per rank {[int(count) for count in shared['meshfree']]}")
 
 
+def side_impact_deck(directory, cycles):
+    """inputs/side_impact's coupled model as its generator writes it (3 ms, 3 states) into
+    `directory`, ending after `cycles` cycles."""
+    subprocess.run([sys.executable, str(SIDE_IMPACT_GENERATOR), "--end-time", "3.0", "--states", "3",
+                    "-o", str(directory)], check=True, capture_output=True, text=True)
+    return shortened(directory / "coupled.k", cycles)
+
+
 def test_side_impact_meshfree_solids_and_shells_are_identical_on_one_two_and_three_ranks(tmp_path):
     """inputs/side_impact's coupled model (three meshfree rib foams, the meshfree shell jacket,
     FE rib bands, a rigid door and spine, two contacts), 250 cycles: the door reaches the jacket
     (2 mm at 8 mm/ms, 0.25 ms). Every rank count gives the file of the run alone; each rank
     computes part of the blocks of both meshfree kinds; the energy stays balanced (ratio within
     1e-3 of 1) and the meshfree parts have taken up strain energy."""
-    subprocess.run([sys.executable, str(SIDE_IMPACT_GENERATOR), "--end-time", "3.0", "--states", "3",
-                    "-o", str(tmp_path)], check=True, capture_output=True, text=True)
-    deck = shortened(tmp_path / "coupled.k", 250)
+    deck = side_impact_deck(tmp_path, 250)
     reference = assert_same_on_every_rank_count(deck, tmp_path)
     with h5py.File(reference, "r") as results:
         ratio = results["history/glstat/energy_ratio"][...]
@@ -221,9 +227,7 @@ def test_side_impact_meshfree_solids_and_shells_are_identical_on_one_two_and_thr
 def test_side_impact_with_two_threads_per_rank(tmp_path):
     """The side-impact model on two ranks of two threads: the same file as one rank of two
     threads (the meshfree colours split between threads and ranks at once)."""
-    subprocess.run([sys.executable, str(SIDE_IMPACT_GENERATOR), "--end-time", "3.0", "--states", "3",
-                    "-o", str(tmp_path)], check=True, capture_output=True, text=True)
-    deck = shortened(tmp_path / "coupled.k", 120)
+    deck = side_impact_deck(tmp_path, 120)
     assert_same_on_every_rank_count(deck, tmp_path, counts=(2,), threads=2)
 
 
@@ -263,6 +267,24 @@ def test_restart_on_another_number_of_ranks(tmp_path):
         process = solver(ranks, [f"r={target / dump}"])
         assert process.returncode == 0, process.stdout + process.stderr
         assert process.stdout.count(f"continuing from restart dump {target / dump}") == 1, process.stdout
+        difference = results_difference(reference, target / "results.h5")
+        assert not difference, f"{dump} continued on {ranks or 1} rank(s): {difference}"
+
+
+def test_side_impact_restart_on_another_number_of_ranks(tmp_path):
+    """The side-impact model dumped every 100 cycles on 2 ranks: the meshfree blocks' state comes
+    together in the dump; the first dump continued on 3 ranks and the second alone give the
+    uninterrupted run's file."""
+    deck = side_impact_deck(tmp_path, 250)
+    deck.write_text(deck.read_text().replace("*PART\n", "*DATABASE_BINARY_D3DUMP\n" + fields(100) + "\n*PART\n", 1))
+    reference = run(deck, tmp_path / "alone", None)
+    dumped = run(deck, tmp_path / "two", 2)
+    assert not results_difference(reference, dumped)
+    for dump, ranks in (("d3dump01", 3), ("d3dump02", None)):
+        target = tmp_path / f"continued_{dump}_{ranks}"
+        shutil.copytree(tmp_path / "two", target)
+        process = solver(ranks, [f"r={target / dump}"])
+        assert process.returncode == 0, process.stdout + process.stderr
         difference = results_difference(reference, target / "results.h5")
         assert not difference, f"{dump} continued on {ranks or 1} rank(s): {difference}"
 
