@@ -209,12 +209,15 @@ contains
   !> Stresses (W P) and stable steps of every point of one part, and their forces added into
   !> internal_force. `dt` is the step just taken (0 at the start); displacement and velocity
   !> are the solver's d^{n+1} and v^{n+1/2}.
-  subroutine compute_efg_forces(material, solver, displacement, velocity, dt, internal_force)
+  subroutine compute_efg_forces(material, solver, displacement, velocity, dt, internal_force, computed)
     type(material_t), intent(in) :: material
     type(efg_solver_t), intent(inout) :: solver
     real(wp), intent(in), contiguous :: displacement(:, :), velocity(:, :)
     real(wp), intent(in) :: dt
     real(wp), intent(inout), contiguous :: internal_force(:, :)
+    !> A distributed run (docs/parallel.md): the part's blocks this rank computes; the others are
+    !> left alone (their state stays as it was). Absent: all.
+    logical, intent(in), optional :: computed(:)
     integer :: colour, k, b, threads
     logical :: fused
     threads = 1
@@ -229,6 +232,9 @@ contains
           !$omp do schedule(dynamic, 1)
           do k = colours%offsets(colour), colours%offsets(colour + 1) - 1
             b = colours%corners(k)
+            if (present(computed)) then
+              if (.not. computed(b)) cycle
+            end if
             call compute_efg_block(material, solver%host_law, solver%geometry, solver%point_cell_volume, &
                                    solver%density, solver%bulk_quadratic, solver%bulk_linear, solver%blocks(b), &
                                    displacement, velocity, dt, solver%point_stress, solver%block_time_step(b), &
@@ -243,6 +249,9 @@ contains
         !$omp parallel do schedule(dynamic, 1) default(shared) private(k, b)
         do k = colours%offsets(colour), colours%offsets(colour + 1) - 1
           b = colours%corners(k)
+          if (present(computed)) then
+            if (.not. computed(b)) cycle
+          end if
           if (fused) then
             call compute_efg_block(material, solver%host_law, solver%geometry, solver%point_cell_volume, &
                                    solver%density, solver%bulk_quadratic, solver%bulk_linear, solver%blocks(b), &

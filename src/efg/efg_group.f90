@@ -25,7 +25,6 @@ module efg_group
 
   type, extends(element_group_t) :: efg_group_t
     type(efg_solver_t), allocatable :: parts(:)
-    integer :: failed_part = 0                     !< the part of failed_element (model part index)
   contains
     procedure :: element_count
     procedure :: block_count
@@ -46,6 +45,9 @@ module efg_group
     procedure :: forces_to_generalized
     procedure :: add_particle_rows
     procedure :: list_time_steps
+    procedure :: distributes_blocks
+    procedure :: exchange_block_state
+    procedure :: exchange_block_energies
   end type efg_group_t
 
 contains
@@ -151,34 +153,49 @@ contains
   end subroutine lump_masses
 
   !> Part after part (a Gamma node shared with an FE part receives the finite elements' forces
-  !> first, then these, always in this order).
+  !> first, then these, always in this order). A distributed run (docs/parallel.md) computes
+  !> the blocks of `computed` only, and the header covers them (the solver makes it global);
+  !> the group's blocks are numbered part after part (block_count).
   subroutine add_internal_forces(self, model, nodes, step)
     class(efg_group_t), intent(inout) :: self
     type(model_t), intent(in) :: model
     type(nodal_state_t), intent(inout) :: nodes
     real(wp), intent(in) :: step
-    integer :: k, b
+    integer :: k, b, before
     self%stable_time_step = huge(1.0_wp)
     self%critical_element = 0
+    self%critical_block = 0
     self%failed_element = 0
-    self%failed_part = 0
+    self%failed_block = 0
     self%step_not_finite = .false.
+    ! the group's blocks of the parts before this one
+    before = 0
     do k = 1, size(self%parts)
       associate (efg => self%parts(k))
-        call compute_efg_forces(model%materials(efg%geometry%material), efg, nodes%displacement, nodes%velocity, &
-                                step, nodes%internal_force)
-        ! meshfree integration points follow the FE rule of their background cell
+        if (allocated(self%computed)) then
+          call compute_efg_forces(model%materials(efg%geometry%material), efg, nodes%displacement, nodes%velocity, &
+                                  step, nodes%internal_force, self%computed(before + 1:before + size(efg%blocks)))
+        else
+          call compute_efg_forces(model%materials(efg%geometry%material), efg, nodes%displacement, nodes%velocity, &
+                                  step, nodes%internal_force)
+        end if
+        ! meshfree integration points follow the FE rule of their background cell; the first
+        ! block on a tie (the same for any thread or rank count)
         do b = 1, size(efg%blocks)
+          ! (a block another rank computes holds an old step)
+          if (.not. self%computes(before + b)) cycle
           if (efg%block_time_step(b) < self%stable_time_step) then
             self%stable_time_step = efg%block_time_step(b)
             self%critical_element = efg%geometry%point_cell(efg%block_critical_point(b))
+            self%critical_block = before + b
           end if
           if (self%failed_element == 0 .and. efg%block_inverted_point(b) /= 0) then
             self%failed_element = efg%geometry%point_cell(efg%block_inverted_point(b))
-            self%failed_part = efg%geometry%part
+            self%failed_block = before + b
           end if
+          if (efg%block_time_step(b) /= efg%block_time_step(b)) self%step_not_finite = .true.
         end do
-        if (any(efg%block_time_step /= efg%block_time_step)) self%step_not_finite = .true.
+        before = before + size(efg%blocks)
       end associate
     end do
   end subroutine add_internal_forces
@@ -260,12 +277,16 @@ contains
            integer_text(model%parts(model%solid_part(element))%id)//")"
   end function describe
 
+  !> The part from the failed block (the header a distributed run made global names the block,
+  !> which another rank may have computed).
   function failure_text(self, model) result(text)
     class(efg_group_t), intent(in) :: self
     type(model_t), intent(in) :: model
     character(len=:), allocatable :: text
+    integer :: p, local
+    call find_block(self, self%failed_block, p, local)
     text = "negative volume at an integration point of meshfree part "// &
-           integer_text(model%parts(self%failed_part)%id)//" (background cell "// &
+           integer_text(model%parts(self%parts(p)%geometry%part)%id)//" (background cell "// &
            integer_text(model%solid_ids(self%failed_element))//")"
   end function failure_text
 
@@ -414,6 +435,50 @@ contains
     part_ids = part_ids(1:count)
     steps = steps(1:count)
   end subroutine list_time_steps
+
+  !> Its point blocks are shared out among the ranks of a distributed run (docs/parallel.md).
+  logical function distributes_blocks(self)
+    class(efg_group_t), intent(in) :: self
+    distributes_blocks = .true.
+  end function distributes_blocks
+
+  !> One point block's state (a store in memory: the ranks of a distributed run bring their
+  !> blocks together): its entries of the part's per-block step arrays, its stresses, history,
+  !> energies, powers and last step, and its points' W P (the next force call's old power).
+  subroutine exchange_block_state(self, store, block, error)
+    class(efg_group_t), intent(inout) :: self
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: block
+    type(error_t), allocatable, intent(inout) :: error
+    integer :: p, local
+    call find_block(self, block, p, local)
+    associate (solver => self%parts(p))
+      associate (cells => solver%blocks(local))
+        call exchange_restart(store, "time_step", solver%block_time_step(local), error)
+        call exchange_restart(store, "critical_point", solver%block_critical_point(local), error)
+        call exchange_restart(store, "inverted_point", solver%block_inverted_point(local), error)
+        call exchange_restart(store, "point_stress", &
+                              solver%point_stress(:, cells%first_point:cells%first_point + cells%point_count - 1), error)
+        call exchange_restart(store, "stress", cells%stress, error)
+        call exchange_restart(store, "history", cells%history, error)
+        call exchange_restart(store, "internal_energy", cells%internal_energy, error)
+        call exchange_restart(store, "force_power", cells%force_power, error)
+        call exchange_restart(store, "previous_time_step", cells%previous_time_step, error)
+      end associate
+    end associate
+  end subroutine exchange_block_state
+
+  !> One point block's energies and powers (what add_energies and add_part_energies read).
+  subroutine exchange_block_energies(self, store, block, error)
+    class(efg_group_t), intent(inout) :: self
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: block
+    type(error_t), allocatable, intent(inout) :: error
+    integer :: p, local
+    call find_block(self, block, p, local)
+    call exchange_restart(store, "internal_energy", self%parts(p)%blocks(local)%internal_energy, error)
+    call exchange_restart(store, "force_power", self%parts(p)%blocks(local)%force_power, error)
+  end subroutine exchange_block_energies
 
   integer function block_count(self)
     class(efg_group_t), intent(in) :: self

@@ -394,18 +394,24 @@ contains
   !> taken (0 at the start); coordinates, velocity and angular_velocity are the solver's
   !> (generalized at interior particles).
   subroutine compute_efg_shell_forces(material, solver, coordinates, velocity, angular_velocity, dt, &
-                                      internal_force, internal_moment, normal_sum, area_sum)
+                                      internal_force, internal_moment, normal_sum, area_sum, computed)
     type(material_t), intent(in) :: material
     type(efg_shell_solver_t), intent(inout) :: solver
     real(wp), intent(in), contiguous :: coordinates(:, :), velocity(:, :), angular_velocity(:, :)
     real(wp), intent(in) :: dt
     real(wp), intent(inout), contiguous :: internal_force(:, :), internal_moment(:, :), normal_sum(:, :), area_sum(:)
+    !> A distributed run (docs/parallel.md): the part's blocks this rank computes; the others are
+    !> left alone (their state stays as it was). Absent: all.
+    logical, intent(in), optional :: computed(:)
     integer :: colour, k, b
     associate (colours => solver%block_colours)
       do colour = 1, size(colours%offsets) - 1
         !$omp parallel do schedule(dynamic, 1) default(shared) private(k, b)
         do k = colours%offsets(colour), colours%offsets(colour + 1) - 1
           b = colours%corners(k)
+          if (present(computed)) then
+            if (.not. computed(b)) cycle
+          end if
           call compute_shell_block(material, solver%geometry, solver%cell_nodes, solver%density, &
                                    solver%shear_factor, solver%thickness_points, solver%point_height, &
                                    solver%point_weight, solver%blocks(b), coordinates, velocity, angular_velocity, &
@@ -1060,14 +1066,20 @@ contains
 
   !> The largest effective plastic strain over the points of each cell, raised into its corner
   !> nodes that `wanted` flags (the nodes of spot welds that fail by EP / EPSF), as the FE shells.
-  subroutine raise_corner_plastic_strain(material, solver, wanted, strain)
+  subroutine raise_corner_plastic_strain(material, solver, wanted, strain, computed)
     type(material_t), intent(in) :: material
     type(efg_shell_solver_t), intent(in) :: solver
     logical, intent(in) :: wanted(:)
     real(wp), intent(inout) :: strain(:)
+    !> A distributed run: the part's blocks this rank computes (the others' state is old here;
+    !> the solver takes the largest over the ranks). Absent: all.
+    logical, intent(in), optional :: computed(:)
     real(wp) :: point_strain(block_size), largest(block_size)
     integer :: b, point, i, c, corner, node
     do b = 1, size(solver%blocks)
+      if (present(computed)) then
+        if (.not. computed(b)) cycle
+      end if
       associate (block => solver%blocks(b))
         if (size(block%history, 2) == 0) cycle
         largest = 0.0_wp

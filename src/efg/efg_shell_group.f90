@@ -44,7 +44,6 @@ module efg_shell_group
   type, extends(element_group_t) :: efg_shell_group_t
     type(efg_shell_solver_t), allocatable :: parts(:)
     type(part_masses_t), allocatable :: masses(:)
-    integer :: failed_part = 0                     !< the part of failed_element (model part index)
   contains
     procedure :: element_count
     procedure :: block_count
@@ -67,6 +66,9 @@ module efg_shell_group
     procedure :: thinnest
     procedure :: raise_nodal_plastic_strain
     procedure :: list_time_steps
+    procedure :: distributes_blocks
+    procedure :: exchange_block_state
+    procedure :: exchange_block_energies
   end type efg_shell_group_t
 
 contains
@@ -227,34 +229,51 @@ contains
     end do
   end subroutine lump_masses
 
-  !> Part after part; the cell with the smallest step and the first failed cell.
+  !> Part after part; the cell with the smallest step (the first block on a tie: the same for
+  !> any thread or rank count) and the first failed cell. A distributed run (docs/parallel.md)
+  !> computes the blocks of `computed` only, and the header covers them (the solver makes it
+  !> global); the group's blocks are numbered part after part (block_count).
   subroutine add_internal_forces(self, model, nodes, step)
     class(efg_shell_group_t), intent(inout) :: self
     type(model_t), intent(in) :: model
     type(nodal_state_t), intent(inout) :: nodes
     real(wp), intent(in) :: step
-    integer :: k, b
+    integer :: k, b, before
     self%stable_time_step = huge(1.0_wp)
     self%critical_element = 0
+    self%critical_block = 0
     self%failed_element = 0
-    self%failed_part = 0
+    self%failed_block = 0
     self%step_not_finite = .false.
+    ! the group's blocks of the parts before this one
+    before = 0
     do k = 1, size(self%parts)
       associate (efg => self%parts(k))
-        call compute_efg_shell_forces(model%materials(efg%geometry%material), efg, nodes%coordinates, nodes%velocity, &
-                                      nodes%angular_velocity, step, nodes%internal_force, nodes%internal_moment, &
-                                      nodes%shell_normal_sum, nodes%shell_area_sum)
+        if (allocated(self%computed)) then
+          call compute_efg_shell_forces(model%materials(efg%geometry%material), efg, nodes%coordinates, &
+                                        nodes%velocity, nodes%angular_velocity, step, nodes%internal_force, &
+                                        nodes%internal_moment, nodes%shell_normal_sum, nodes%shell_area_sum, &
+                                        self%computed(before + 1:before + size(efg%blocks)))
+        else
+          call compute_efg_shell_forces(model%materials(efg%geometry%material), efg, nodes%coordinates, &
+                                        nodes%velocity, nodes%angular_velocity, step, nodes%internal_force, &
+                                        nodes%internal_moment, nodes%shell_normal_sum, nodes%shell_area_sum)
+        end if
         do b = 1, size(efg%blocks)
+          ! (a block another rank computes holds an old step)
+          if (.not. self%computes(before + b)) cycle
           if (efg%block_time_step(b) < self%stable_time_step) then
             self%stable_time_step = efg%block_time_step(b)
             self%critical_element = efg%geometry%cells(efg%block_critical_cell(b))
+            self%critical_block = before + b
           end if
           if (self%failed_element == 0 .and. efg%block_failed_cell(b) /= 0) then
             self%failed_element = efg%geometry%cells(efg%block_failed_cell(b))
-            self%failed_part = efg%geometry%part
+            self%failed_block = before + b
           end if
+          if (efg%block_time_step(b) /= efg%block_time_step(b)) self%step_not_finite = .true.
         end do
-        if (any(efg%block_time_step /= efg%block_time_step)) self%step_not_finite = .true.
+        before = before + size(efg%blocks)
       end associate
     end do
   end subroutine add_internal_forces
@@ -400,9 +419,19 @@ contains
     type(model_t), intent(in) :: model
     logical, intent(in) :: wanted(:)
     real(wp), intent(inout) :: strain(:)
-    integer :: k
+    integer :: k, before
+    ! (a distributed run takes the largest over the ranks: each has its computed blocks current)
+    before = 0
     do k = 1, size(self%parts)
-      call raise_corner_plastic_strain(model%materials(self%parts(k)%geometry%material), self%parts(k), wanted, strain)
+      associate (efg => self%parts(k))
+        if (allocated(self%computed)) then
+          call raise_corner_plastic_strain(model%materials(efg%geometry%material), efg, wanted, strain, &
+                                           self%computed(before + 1:before + size(efg%blocks)))
+        else
+          call raise_corner_plastic_strain(model%materials(efg%geometry%material), efg, wanted, strain)
+        end if
+        before = before + size(efg%blocks)
+      end associate
     end do
   end subroutine raise_nodal_plastic_strain
 
@@ -510,6 +539,68 @@ contains
       end associate
     end do
   end subroutine list_time_steps
+
+  !> Its cell blocks are shared out among the ranks of a distributed run (docs/parallel.md).
+  logical function distributes_blocks(self)
+    class(efg_shell_group_t), intent(in) :: self
+    distributes_blocks = .true.
+  end function distributes_blocks
+
+  !> One cell block's state (a store in memory: the ranks of a distributed run bring their
+  !> blocks together): its entries of the part's per-block step arrays, its stresses, history,
+  !> energies, powers and last step, and what its force call keeps per cell, point and station
+  !> (frames, areas, resultants, the point and station forces: the next call and the output
+  !> read them).
+  subroutine exchange_block_state(self, store, block, error)
+    class(efg_shell_group_t), intent(inout) :: self
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: block
+    type(error_t), allocatable, intent(inout) :: error
+    integer :: p, local, first_cell, last_cell, first_point, last_point
+    call find_block(self, block, p, local)
+    associate (solver => self%parts(p))
+      associate (cells => solver%blocks(local))
+        first_cell = cells%first_cell
+        last_cell = cells%first_cell + cells%cell_count - 1
+        first_point = cells%first_point
+        last_point = cells%first_point + cells%point_count - 1
+        call exchange_restart(store, "time_step", solver%block_time_step(local), error)
+        call exchange_restart(store, "critical_cell", solver%block_critical_cell(local), error)
+        call exchange_restart(store, "failed_cell", solver%block_failed_cell(local), error)
+        call exchange_restart(store, "cell_frame", solver%cell_frame(:, :, first_cell:last_cell), error)
+        call exchange_restart(store, "cell_area", solver%cell_area(first_cell:last_cell), error)
+        call exchange_restart(store, "point_membrane", solver%point_membrane(:, first_point:last_point), error)
+        call exchange_restart(store, "point_moment", solver%point_moment(:, first_point:last_point), error)
+        call exchange_restart(store, "point_force", solver%point_force(:, :, first_point:last_point), error)
+        call exchange_restart(store, "point_couple", solver%point_couple(:, :, first_point:last_point), error)
+        call exchange_restart(store, "station_force", solver%station_force(:, :, first_cell:last_cell), error)
+        call exchange_restart(store, "stress", cells%stress, error)
+        call exchange_restart(store, "history", cells%history, error)
+        call exchange_restart(store, "shear_stress", cells%shear_stress, error)
+        call exchange_restart(store, "internal_energy", cells%internal_energy, error)
+        call exchange_restart(store, "force_power", cells%force_power, error)
+        call exchange_restart(store, "shear_energy", cells%shear_energy, error)
+        call exchange_restart(store, "shear_power", cells%shear_power, error)
+        call exchange_restart(store, "previous_time_step", cells%previous_time_step, error)
+      end associate
+    end associate
+  end subroutine exchange_block_state
+
+  !> One cell block's energies and powers (what add_energies and add_part_energies read).
+  subroutine exchange_block_energies(self, store, block, error)
+    class(efg_shell_group_t), intent(inout) :: self
+    type(restart_store_t), intent(inout) :: store
+    integer, intent(in) :: block
+    type(error_t), allocatable, intent(inout) :: error
+    integer :: p, local
+    call find_block(self, block, p, local)
+    associate (cells => self%parts(p)%blocks(local))
+      call exchange_restart(store, "internal_energy", cells%internal_energy, error)
+      call exchange_restart(store, "force_power", cells%force_power, error)
+      call exchange_restart(store, "shear_energy", cells%shear_energy, error)
+      call exchange_restart(store, "shear_power", cells%shear_power, error)
+    end associate
+  end subroutine exchange_block_energies
 
   integer function block_count(self)
     class(efg_shell_group_t), intent(in) :: self

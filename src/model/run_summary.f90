@@ -24,6 +24,10 @@ module run_summary
     integer, allocatable :: rank_elements(:, :)  !< (kinds, ranks) elements owned (meshfree: cells)
     integer, allocatable :: rank_blocks(:)       !< blocks owned
     integer, allocatable :: rank_ghost_blocks(:) !< blocks computed but owned by another rank
+    !> (kinds, ranks) blocks computed: owned and ghost blocks of a kind that shares its blocks
+    !> out (element_group's distributes_blocks), every block of one computed whole on every rank
+    integer, allocatable :: rank_computed_blocks(:, :)
+    integer, allocatable :: kind_blocks(:)       !< (kinds) the blocks of each kind, all ranks together
     integer, allocatable :: rank_owned_nodes(:)  !< nodes owned (their forces sent each cycle)
     !> nodes on the domain's interface: touched by a block it owns and by a block another rank
     !> owns (a neighbour exchange would send or receive these each cycle)

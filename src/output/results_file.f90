@@ -1461,7 +1461,8 @@ contains
 
   !> `/run/partition` (MPI runs and partition=N; nothing for one rank): per rank (rows, rank 0
   !> first) its elements by kind (`rank_elements`, columns in `kind_names`' order), blocks,
-  !> ghost blocks, owned and interface nodes, estimated cost (ns per cycle, owned blocks and with
+  !> ghost blocks, blocks computed by kind (`rank_computed_blocks`; `kind_blocks`: all ranks'
+  !> blocks of each kind), owned and interface nodes, estimated cost (ns per cycle, owned blocks and with
   !> the ghost blocks); per solid, shell and beam (the mesh's order) the rank computing it, -1
   !> for none (rigid parts: every rank); per node the rank owning it. Attributes: rank_count, method, imbalance (max / mean
   !> cost), computed_imbalance. A continued run replaces the earlier run's.
@@ -1494,6 +1495,8 @@ contains
       call write_integer_dataset_2d(group_id, path, "rank_elements", partition%rank_elements, error)
       call write_integer_dataset_1d(group_id, path, "rank_blocks", partition%rank_blocks, error)
       call write_integer_dataset_1d(group_id, path, "rank_ghost_blocks", partition%rank_ghost_blocks, error)
+      call write_integer_dataset_2d(group_id, path, "rank_computed_blocks", partition%rank_computed_blocks, error)
+      call write_integer_dataset_1d(group_id, path, "kind_blocks", partition%kind_blocks, error)
       call write_integer_dataset_1d(group_id, path, "rank_owned_nodes", partition%rank_owned_nodes, error)
       call write_integer_dataset_1d(group_id, path, "rank_interface_nodes", partition%rank_interface_nodes, error)
       call write_real_dataset_1d(group_id, path, "rank_cost", partition%rank_cost, error)

@@ -652,7 +652,8 @@ contains
     report%rank_count = rank_count
     allocate (report%kind_names(size(groups)), report%rank_elements(size(groups), rank_count), &
               report%rank_blocks(rank_count), report%rank_ghost_blocks(rank_count), report%rank_owned_nodes(rank_count), &
-              report%rank_interface_nodes(rank_count), report%rank_cost(rank_count), report%rank_computed_cost(rank_count))
+              report%rank_interface_nodes(rank_count), report%rank_cost(rank_count), report%rank_computed_cost(rank_count), &
+              report%rank_computed_blocks(size(groups), rank_count), report%kind_blocks(size(groups)))
     allocate (report%solid_rank(size(model%solid_ids)), report%shell_rank(size(model%shell_ids)), &
               report%beam_rank(size(model%beam_ids)))
     report%solid_rank = -1
@@ -661,6 +662,8 @@ contains
     report%rank_elements = 0
     report%rank_blocks = 0
     report%rank_ghost_blocks = 0
+    report%rank_computed_blocks = 0
+    report%kind_blocks = 0
     report%rank_cost = 0.0_wp
     report%rank_computed_cost = 0.0_wp
     do g = 1, size(groups)
@@ -673,6 +676,12 @@ contains
       family = groups(g)%group%element_family
       r = block_owner(k) + 1
       report%rank_blocks(r) = report%rank_blocks(r) + 1
+      report%kind_blocks(g) = report%kind_blocks(g) + 1
+      if (groups(g)%group%distributes_blocks()) then
+        report%rank_computed_blocks(g, r) = report%rank_computed_blocks(g, r) + 1
+      else
+        report%rank_computed_blocks(g, :) = report%rank_computed_blocks(g, :) + 1
+      end if
       report%rank_cost(r) = report%rank_cost(r) + blocks%block_cost(k)
       report%rank_computed_cost(r) = report%rank_computed_cost(r) + blocks%block_cost(k)
       do lane = blocks%lane_offsets(k), blocks%lane_offsets(k + 1) - 1
@@ -701,6 +710,8 @@ contains
         if (r == block_owner(k) + 1 .or. seen_by(r) == k) cycle
         seen_by(r) = k
         report%rank_ghost_blocks(r) = report%rank_ghost_blocks(r) + 1
+        if (groups(blocks%block_group(k))%group%distributes_blocks()) &
+          report%rank_computed_blocks(blocks%block_group(k), r) = report%rank_computed_blocks(blocks%block_group(k), r) + 1
         report%rank_computed_cost(r) = report%rank_computed_cost(r) + blocks%block_cost(k)
       end do
     end do

@@ -1,7 +1,9 @@
 """Distributed runs (MPI, docs/parallel.md): `mpirun -np N bin/crashfree` gives the results file
 of the one-rank run bit for bit, for N = 1, 2, 3 ranks and with 2 threads per rank, on a contact
-model, a coupled meshfree / finite element model, a shell model with elements that erode and a
-rigid-body model; a run continued from a restart dump on another number of ranks gives the
+model, a coupled meshfree / finite element model, the side-impact dummy (meshfree solids and
+meshfree shells coupled to FE shells, contact, rigid bodies), a shell model with elements that
+erode and a rigid-body model; the meshfree blocks are shared out among the ranks as the finite
+elements' (the partition report's computed blocks); a run continued from a restart dump on another number of ranks gives the
 uninterrupted run's file, also after SIGTERM to mpirun (every rank stops after the same cycle). Every dataset and attribute is compared (test_threads'
 comparison) but /timing, the /run attributes that may differ between runs (threads, run_id)
 and /run/partition, the partition report, which says how the ranks shared the model out.
@@ -17,6 +19,7 @@ import os
 import shutil
 import signal
 import subprocess
+import sys
 from pathlib import Path
 
 import h5py
@@ -34,6 +37,7 @@ CYCLES = 100
 # what may differ between runs on different numbers of ranks (besides /timing)
 RUN_ATTRIBUTES_ALLOWED_TO_DIFFER = {"threads", "run_id"}
 RANK_REPORT = "run/partition"
+SIDE_IMPACT_GENERATOR = Path(__file__).resolve().parents[2] / "inputs" / "side_impact" / "generate_side_impact.py"
 
 
 def mpi_missing_reason():
@@ -156,14 +160,75 @@ def test_contact_model_with_two_threads_per_rank(tmp_path):
     assert_same_on_every_rank_count(deck, tmp_path, counts=(2,), threads=2)
 
 
+def assert_shared_out(results_path, kinds):
+    """The partition report of a run on several ranks: every rank computes some but not all of
+    the blocks of each of `kinds`, and together they compute all (owned and ghost blocks).
+    Returns {kind: computed blocks per rank}."""
+    with h5py.File(results_path, "r") as results:
+        partition = results[RANK_REPORT]
+        names = [name.decode() for name in partition["kind_names"][...]]
+        computed = partition["rank_computed_blocks"][...]      # (ranks, kinds)
+        total = partition["kind_blocks"][...]
+    shared = {}
+    for kind in kinds:
+        column = names.index(kind)
+        blocks = computed[:, column]
+        assert np.all(blocks > 0) and np.all(blocks < total[column]), (kind, blocks, total[column])
+        assert blocks.sum() >= total[column], (kind, blocks, total[column])
+        shared[kind] = blocks
+    return shared
+
+
 def test_meshfree_model_is_identical_on_one_two_and_three_ranks(tmp_path):
-    """test_threads' coupled EFG / FE bar against a rigid wall (the meshfree part is computed
-    on every rank, the finite elements are shared out)."""
+    """test_threads' coupled EFG / FE bar against a rigid wall: the meshfree part's point blocks
+    are shared out among the ranks with the finite elements; the wall force and the meshfree
+    part's energy of every rank count are those of the run alone."""
     deck = shortened(meshfree_deck(tmp_path / "meshfree.k"), 60)
     reference = assert_same_on_every_rank_count(deck, tmp_path)
     with h5py.File(reference, "r") as results:
         assert results["history/matsum/1/internal_energy"][-1] > 0.0
         assert np.abs(results["history/rwforc/5/force"][...][:, 0]).max() > 0.0
+    for ranks in (2, 3):
+        shared = assert_shared_out(tmp_path / f"np{ranks}_ncpu1" / "results.h5", ["meshfree"])
+        print(f"{ranks} ranks: meshfree point blocks computed per rank {[int(count) for count in shared['meshfree']]}")
+
+
+def side_impact_deck(directory, cycles):
+    """inputs/side_impact's coupled model as its generator writes it (3 ms, 3 states) into
+    `directory`, ending after `cycles` cycles."""
+    subprocess.run([sys.executable, str(SIDE_IMPACT_GENERATOR), "--end-time", "3.0", "--states", "3",
+                    "-o", str(directory)], check=True, capture_output=True, text=True)
+    return shortened(directory / "coupled.k", cycles)
+
+
+def test_side_impact_meshfree_solids_and_shells_are_identical_on_one_two_and_three_ranks(tmp_path):
+    """inputs/side_impact's coupled model (three meshfree rib foams, the meshfree shell jacket,
+    FE rib bands, a rigid door and spine, two contacts), 250 cycles: the door reaches the jacket
+    (2 mm at 8 mm/ms, 0.25 ms). Every rank count gives the file of the run alone; each rank
+    computes part of the blocks of both meshfree kinds; the energy stays balanced (ratio within
+    1e-3 of 1) and the meshfree parts have taken up strain energy."""
+    deck = side_impact_deck(tmp_path, 250)
+    reference = assert_same_on_every_rank_count(deck, tmp_path)
+    with h5py.File(reference, "r") as results:
+        ratio = results["history/glstat/energy_ratio"][...]
+        door_force = np.abs(results["history/rcforc/1/force"][...]).max()
+        jacket, foams = (results["history/matsum/3/internal_energy"][-1],
+                         [results[f"history/matsum/{part}/internal_energy"][-1] for part in (21, 22, 23)])
+    print(f"door contact force up to {door_force:.3f} kN; strain energy: jacket {jacket:.4f} J, "
+          f"foams {', '.join(f'{energy:.4f}' for energy in foams)} J")
+    assert np.all(np.abs(ratio - 1.0) < 1e-3), ratio
+    assert door_force > 0.0 and jacket > 0.0 and min(foams) > 0.0
+    for ranks in (2, 3):
+        shared = assert_shared_out(tmp_path / f"np{ranks}_ncpu1" / "results.h5", ["meshfree", "meshfree shell"])
+        counts = {kind: [int(count) for count in blocks] for kind, blocks in shared.items()}
+        print(f"{ranks} ranks: blocks computed per rank {counts}")
+
+
+def test_side_impact_with_two_threads_per_rank(tmp_path):
+    """The side-impact model on two ranks of two threads: the same file as one rank of two
+    threads (the meshfree colours split between threads and ranks at once)."""
+    deck = side_impact_deck(tmp_path, 120)
+    assert_same_on_every_rank_count(deck, tmp_path, counts=(2,), threads=2)
 
 
 def test_eroding_shells_are_identical_on_one_two_and_three_ranks(tmp_path):
@@ -202,6 +267,24 @@ def test_restart_on_another_number_of_ranks(tmp_path):
         process = solver(ranks, [f"r={target / dump}"])
         assert process.returncode == 0, process.stdout + process.stderr
         assert process.stdout.count(f"continuing from restart dump {target / dump}") == 1, process.stdout
+        difference = results_difference(reference, target / "results.h5")
+        assert not difference, f"{dump} continued on {ranks or 1} rank(s): {difference}"
+
+
+def test_side_impact_restart_on_another_number_of_ranks(tmp_path):
+    """The side-impact model dumped every 100 cycles on 2 ranks: the meshfree blocks' state comes
+    together in the dump; the first dump continued on 3 ranks and the second alone give the
+    uninterrupted run's file."""
+    deck = side_impact_deck(tmp_path, 250)
+    deck.write_text(deck.read_text().replace("*PART\n", "*DATABASE_BINARY_D3DUMP\n" + fields(100) + "\n*PART\n", 1))
+    reference = run(deck, tmp_path / "alone", None)
+    dumped = run(deck, tmp_path / "two", 2)
+    assert not results_difference(reference, dumped)
+    for dump, ranks in (("d3dump01", 3), ("d3dump02", None)):
+        target = tmp_path / f"continued_{dump}_{ranks}"
+        shutil.copytree(tmp_path / "two", target)
+        process = solver(ranks, [f"r={target / dump}"])
+        assert process.returncode == 0, process.stdout + process.stderr
         difference = results_difference(reference, target / "results.h5")
         assert not difference, f"{dump} continued on {ranks or 1} rank(s): {difference}"
 
