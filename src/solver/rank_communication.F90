@@ -9,14 +9,14 @@
 !> Everything here is collective over all ranks unless said otherwise: every rank must make the
 !> same calls in the same order. The exchanges only move values, they add nothing: the sums that
 !> reach results happen on one rank in the one-rank order (the determinism argument of
-!> docs/parallel.md), and the reductions offered are exact ones (integer sums, logical or, max).
+!> docs/parallel.md), and the reductions offered are exact ones (logical or, max).
 module rank_communication
   use kinds, only: wp
 #ifdef CRASHFREE_MPI
   use mpi_f08, only: MPI_Init_thread, MPI_Initialized, MPI_Finalized, MPI_Finalize, MPI_Comm_rank, &
-                     MPI_Comm_size, MPI_Barrier, MPI_Allgatherv, MPI_Allgather, MPI_Allreduce, MPI_Bcast, &
-                     MPI_Abort, MPI_COMM_WORLD, MPI_THREAD_FUNNELED, MPI_DOUBLE_PRECISION, MPI_INTEGER, &
-                     MPI_LOGICAL, MPI_CHARACTER, MPI_MAX, MPI_SUM, MPI_LOR, MPI_IN_PLACE
+                     MPI_Comm_size, MPI_Barrier, MPI_Allgatherv, MPI_Allgather, MPI_Allreduce, &
+                     MPI_Abort, MPI_COMM_WORLD, MPI_THREAD_FUNNELED, MPI_DOUBLE_PRECISION, MPI_LOGICAL, &
+                     MPI_MAX, MPI_LOR, MPI_IN_PLACE
 #endif
   use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
   implicit none
@@ -24,7 +24,7 @@ module rank_communication
 
   public :: start_ranks, finish_ranks, rank_index, rank_total, mpi_built, barrier_ranks
   public :: gather_reals, gather_fixed_reals, largest_over_ranks, any_rank
-  public :: broadcast_text, abort_ranks
+  public :: abort_ranks
 
   !> Whether this binary was built with MPI (mpirun -np N runs N ranks) or is one rank only.
 #ifdef CRASHFREE_MPI
@@ -153,29 +153,6 @@ contains
     if (mpi_running()) call MPI_Allreduce(flag, any_rank, 1, MPI_LOGICAL, MPI_LOR, MPI_COMM_WORLD)
 #endif
   end function any_rank
-
-  !> Rank `root`'s `text` on every rank (`text` is reallocated to its length).
-  subroutine broadcast_text(text, root)
-    character(len=:), allocatable, intent(inout) :: text
-    integer, intent(in) :: root
-#ifdef CRASHFREE_MPI
-    integer :: length(1)
-    if (.not. mpi_running()) then
-      if (root /= 0 .or. .not. allocated(text)) text = ""
-      return
-    end if
-    length = 0
-    if (rank_index() == root .and. allocated(text)) length = len(text)
-    call MPI_Bcast(length, 1, MPI_INTEGER, root, MPI_COMM_WORLD)
-    if (rank_index() /= root) then
-      if (allocated(text)) deallocate (text)
-      allocate (character(len=length(1)) :: text)
-    end if
-    if (length(1) > 0) call MPI_Bcast(text, length(1), MPI_CHARACTER, root, MPI_COMM_WORLD)
-#else
-    if (root /= 0 .or. .not. allocated(text)) text = ""
-#endif
-  end subroutine broadcast_text
 
   !> Stop every rank at once: `message` on standard error (with the rank when there are several),
   !> then the exit status `status` (1 run-time error, 2 input rejected). For an error that only
