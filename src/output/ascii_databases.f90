@@ -260,7 +260,7 @@ contains
         write (cycle_text, '(i8)') nint(value_of(series, "cycle", row))
         call add_line(out, "")
         call add_line(out, "")
-        call add_line(out, " dt of cycle"//trim(cycle_text))
+        call add_line(out, " dt of cycle"//trim(cycle_text)//controller_text(series, row))
         call add_line(out, "")
         call glstat_line(out, "time", value_of(series, "time", row))
         call glstat_line(out, "time step", value_of(series, "time_step", row))
@@ -289,6 +289,23 @@ contains
     end associate
     call finish_database(out, path, error)
   end subroutine write_glstat
+
+  !> The end of glstat's "dt of cycle" line: " is controlled by solid   <id> of part   <id>", as
+  !> LS-DYNA writes it; nothing when no element set the step (a rigid body's step).
+  function controller_text(series, row) result(text)
+    type(history_series_t), intent(in) :: series
+    integer, intent(in) :: row
+    character(len=:), allocatable :: text
+    character(len=10), parameter :: families(3) = [character(len=10) :: "solid", "shell", "beam"]
+    character(len=64) :: buffer
+    integer :: family
+    text = ""
+    family = nint(value_of(series, "controlling_element_family", row))
+    if (family < 1 .or. family > size(families)) return
+    write (buffer, '(a,a10,i10,a,i10)') " is controlled by ", families(family), &
+      nint(value_of(series, "controlling_element", row)), " of part", nint(value_of(series, "controlling_part", row))
+    text = trim(buffer)
+  end function controller_text
 
   !> The legend of part, wall or contact titles LS-DYNA writes after the header.
   subroutine write_legend(out, ids, titles)

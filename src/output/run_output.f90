@@ -5,6 +5,7 @@ module run_output
   use kinds, only: wp
   use error_handling, only: error_t
   use model, only: model_t, wall_planar
+  use element_group, only: family_solid, family_shell, family_beam
   use explicit_state, only: explicit_state_t, energy_totals_t
   use output_plan, only: output_plan_t, clock_due
   use history_buffer, only: history_set_t, append_history_row
@@ -56,7 +57,7 @@ contains
         state%added_mass, energy%momentum, energy%eroded_internal, energy%eroded_hourglass, &
         energy%eroded_kinetic, real(state%eroded_count, wp), 0.0_wp, 0.0_wp, energy_ratio_without_eroded(energy), &
         100.0_wp*state%added_mass/max(state%physical_mass, tiny(1.0_wp)), energy%momentum/total_mass, &
-        real(state%cycle, wp), state%physical_mass])
+        real(state%cycle, wp), state%physical_mass, controlling_element_row(model, state)])
       if (plan%weld_series > 0) call append_history_row(histories%series(plan%weld_series), &
                                                         [state%time, real(failed_weld_count(state%welds), wp)])
     end if
@@ -249,4 +250,29 @@ contains
       end if
     end associate
   end subroutine write_current_state
+  !> glstat's controlling element: the family of the element that set the stable step (1 solid,
+  !> 2 shell, 3 beam; 0 when a rigid body's step or nothing set it), its deck id and its part id.
+  function controlling_element_row(model, state) result(row)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(in) :: state
+    real(wp) :: row(3)
+    integer :: element
+    row = 0.0_wp
+    if (state%controlling_group <= 0 .or. state%controlling_element <= 0) return
+    element = state%controlling_element
+    associate (family => state%groups(state%controlling_group)%group%element_family)
+      row(1) = real(family, wp)
+      select case (family)
+      case (family_solid)
+        row(2:3) = [real(model%solid_ids(element), wp), real(model%parts(model%solid_part(element))%id, wp)]
+      case (family_shell)
+        row(2:3) = [real(model%shell_ids(element), wp), real(model%parts(model%shell_part(element))%id, wp)]
+      case (family_beam)
+        row(2:3) = [real(model%beam_ids(element), wp), real(model%parts(model%beam_part(element))%id, wp)]
+      case default
+        row = 0.0_wp
+      end select
+    end associate
+  end function controlling_element_row
+
 end module run_output

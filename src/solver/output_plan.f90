@@ -53,14 +53,18 @@ module output_plan
   end type output_plan_t
 
   ! the columns after eroded_elements came with LS-DYNA's glstat lines (appended, so that the
-  ! earlier ones keep their place)
-  character(len=32), parameter :: glstat_columns(23) = [character(len=32) :: "time", "time_step", &
+  ! earlier ones keep their place); the element that set the step (glstat's "dt of cycle ... is
+  ! controlled by"): its family (1 solid, 2 shell, 3 beam; 0: a rigid body's step or none), deck id
+  ! and part id
+  character(len=32), parameter :: glstat_columns(26) = [character(len=32) :: "time", "time_step", &
     "kinetic_energy", "internal_energy", "hourglass_energy", "contact_energy", "external_work", &
     "total_energy", "rigid_wall_energy", "energy_ratio", "added_mass", "momentum", &
     "eroded_internal_energy", "eroded_hourglass_energy", "eroded_kinetic_energy", "eroded_elements", &
     "spring_damper_energy", "system_damping_energy", "energy_ratio_without_eroded", "percent_mass_increase", &
-    "global_velocity", "cycle", "physical_mass"]
-  integer, parameter :: glstat_widths(23) = [1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 3, 1, 1, 1, 1, 1, 1, 1, 1, 3, 1, 1]
+    "global_velocity", "cycle", "physical_mass", "controlling_element_family", "controlling_element", &
+    "controlling_part"]
+  integer, parameter :: glstat_widths(26) = [1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 3, 1, 1, 1, 1, 1, 1, 1, 1, 3, 1, 1, &
+                                             1, 1, 1]
 
 
 contains

@@ -407,6 +407,16 @@ def test_d3hsp_lists_the_smallest_element_time_steps(tmp_path, run_deck):
     with run.open() as results:
         first_step = results["history/glstat/time_step"][0]
     assert abs(rows[0][3] * TIME_STEP_SCALE - first_step) <= 1e-6 * first_step
+    # glstat names the element that set the step: one of the smallest rows (a tie among the
+    # shells of equal size), in results.h5 and on glstat's "dt of cycle" line
+    smallest = {row[:3] for row in rows if abs(row[3] - rows[0][3]) <= 1e-12 * rows[0][3]}
+    with run.open() as results:
+        family = results["history/glstat/controlling_element_family"][0]
+        element = int(results["history/glstat/controlling_element"][0])
+        part = int(results["history/glstat/controlling_part"][0])
+    assert family == 2 and ("shell", element, part) in smallest, (family, element, part, smallest)
+    glstat = (run.results.parent / "glstat").read_text()
+    assert f" dt of cycle       0 is controlled by shell     {element:10d} of part{part:10d}\n" in glstat
 
 
 # ------------------------------------------------------------------ rbdout
