@@ -41,7 +41,7 @@ module penalty_contact
   private
 
   public :: contact_state_t, contact_pass_t, set_up_contacts, set_up_contact, compute_contact_forces, &
-            report_initial_penetrations
+            report_initial_penetrations, mass_in_contact
 
   !> Parametric tolerance of the projection (LS-DYNA's MAXPAR default 1.025).
   real(wp), parameter :: parametric_limit = 1.025_wp
@@ -1013,4 +1013,38 @@ contains
     real(wp) :: c(3)
     c = [a(2)*b(3) - a(3)*b(2), a(3)*b(1) - a(1)*b(3), a(1)*b(2) - a(2)*b(1)]
   end function cross
+
+  !> rcforc's masses: the nodal mass in contact on each side, (SURFA, SURFB), after the last
+  !> force call: the secondary nodes of a pass that penetrated and the nodes of the segments they
+  !> met, each node once per side (summed in node order). A node the contact excludes (interior
+  !> meshfree particle) is never in contact.
+  function mass_in_contact(contact, node_mass) result(mass)
+    type(contact_state_t), intent(in) :: contact
+    real(wp), intent(in) :: node_mass(:)
+    real(wp) :: mass(2)
+    logical, allocatable :: touching(:, :)
+    integer :: pass, k, corner, secondary_side, node
+    allocate (touching(size(node_mass), 2))
+    touching = .false.
+    do pass = 1, contact%pass_count
+      associate (this => contact%passes(pass))
+        secondary_side = merge(1, 2, this%side_sign > 0.0_wp)
+        if (.not. allocated(this%pair_depth)) cycle
+        do k = 1, size(this%nodes)
+          if (this%pair_depth(k) <= 0.0_wp .or. this%pair_segment(k) <= 0) cycle
+          touching(this%nodes(k), secondary_side) = .true.
+          do corner = 1, 4
+            node = this%segments(corner, this%pair_segment(k))
+            if (node > 0) touching(node, 3 - secondary_side) = .true.
+          end do
+        end do
+      end associate
+    end do
+    mass = 0.0_wp
+    do node = 1, size(node_mass)
+      if (touching(node, 1)) mass(1) = mass(1) + node_mass(node)
+      if (touching(node, 2)) mass(2) = mass(2) + node_mass(node)
+    end do
+  end function mass_in_contact
+
 end module penalty_contact

@@ -469,8 +469,7 @@ contains
   end subroutine write_rwforc
 
   !> rcforc: per sample and contact a "slave" line (the force on SURFA) and a "master" line
-  !> (on SURFB): time, x, y, z force and mass (0: the mass of the nodes in contact is not
-  !> measured).
+  !> (on SURFB): time, x, y, z force and the side's nodal mass in contact.
   subroutine write_rcforc(model, histories, path, error)
     type(model_t), intent(in) :: model
     type(history_set_t), intent(in) :: histories
@@ -497,12 +496,12 @@ contains
             "  x "//c_exponential(value_of(series, "force", row, 1), 12, 5)// &
             "  y "//c_exponential(value_of(series, "force", row, 2), 12, 5)// &
             "  z "//c_exponential(value_of(series, "force", row, 3), 12, 5)// &
-            " mass "//c_exponential(0.0_wp, 12, 5))
+            " mass "//c_exponential(value_of(series, "mass", row), 12, 5))
           call add_line(out, "  master"//contact_text//" time"//c_exponential(series%rows(1, row), 12, 5)// &
             "  x "//c_exponential(value_of(series, "surfb_force", row, 1), 12, 5)// &
             "  y "//c_exponential(value_of(series, "surfb_force", row, 2), 12, 5)// &
             "  z "//c_exponential(value_of(series, "surfb_force", row, 3), 12, 5)// &
-            " mass "//c_exponential(0.0_wp, 12, 5))
+            " mass "//c_exponential(value_of(series, "surfb_mass", row), 12, 5))
         end associate
       end do
     end do

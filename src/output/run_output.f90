@@ -15,6 +15,7 @@ module run_output
   use results_file, only: results_file_t, write_state
   use rigid_bodies, only: rigid_body_history_row
   use spot_weld_constraints, only: failed_weld_count
+  use penalty_contact, only: mass_in_contact
   use ascii_databases, only: c_exponential
   use binout_file, only: binout_requested, binout_name, write_binout
   use ascii_run_summary, only: initial_time_step_tables
@@ -166,6 +167,7 @@ contains
 
   !> Contact force on the SURFA side averaged over the sampling interval (impulse / interval),
   !> as rwforc, and on the SURFB side (the opposite: LS-DYNA's master line); at t = 0 both are 0.
+  !> Then each side's nodal mass in contact at the sample (LS-DYNA's rcforc mass).
   subroutine record_contact_forces(state, plan, histories)
     type(explicit_state_t), intent(in) :: state
     type(output_plan_t), intent(inout) :: plan
@@ -176,7 +178,8 @@ contains
     do k = 1, size(plan%rcforc_series)
       force = 0.0_wp
       if (interval > 0.0_wp) force = (state%contacts(k)%impulse - plan%contact_impulse(:, k))/interval
-      call append_history_row(histories%series(plan%rcforc_series(k)), [state%time, force, 0.0_wp - force])
+      call append_history_row(histories%series(plan%rcforc_series(k)), [state%time, force, 0.0_wp - force, &
+                              mass_in_contact(state%contacts(k), state%nodes%mass)])
       plan%contact_impulse(:, k) = state%contacts(k)%impulse
     end do
     plan%last_rcforc_time = state%time

@@ -137,7 +137,8 @@ contains
         do k = 1, size(model%contacts)
           write (label, '(i0)') model%contacts(k)%id
           call add_history_series(histories, "rcforc/"//trim(label), [character(len=32) :: "time", "force", &
-                                  "surfb_force"], [1, 3, 3], capacity, plan%rcforc_series(k))
+                                  "surfb_force", "mass", "surfb_mass"], [1, 3, 3, 1, 1], capacity, &
+                                  plan%rcforc_series(k))
         end do
       end if
     end if

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from deck_writer import block_mesh, fields, nodes_card, shells_card, solids_card, write_deck
-from test_contact import head_on_deck
+from test_contact import LENGTH, head_on_deck, nodal_masses
 
 DENSITY = 7.85e-6        # kg/mm^3
 SPEED = 50.0             # mm/ms
@@ -275,7 +275,7 @@ def test_ascii_files_equal_results_and_physics(tmp_path, run_deck):
 
 
 def test_contact_forces_both_sides(tmp_path, run_deck):
-    deck, *_ = head_on_deck(tmp_path / "head_on.k")
+    deck, a_nodes, a_elements, _ = head_on_deck(tmp_path / "head_on.k")
     run = run_deck(deck)
     assert run.status == 0, run.stdout + run.stderr
     with run.open() as results:
@@ -291,6 +291,13 @@ def test_contact_forces_both_sides(tmp_path, run_deck):
             assert close(m[3 + axis], history["surfb_force"][k][axis], 5)
     assert np.array_equal(history["surfb_force"], -history["force"])
     assert np.abs(history["force"][:, 0]).max() > 0.0
+    # the mass in contact (LS-DYNA's rcforc mass): none before the blocks meet; pressed together
+    # (identical meshes, face against face), each side's whole front face
+    face_mass = nodal_masses(a_nodes, a_elements)[np.isclose(a_nodes[:, 0], LENGTH)].sum()
+    for side, key in ((slave, "mass"), (master, "surfb_mass")):
+        assert history[key][0] == 0.0
+        assert abs(history[key].max() - face_mass) <= 1e-9 * face_mass, (key, history[key].max(), face_mass)
+        assert all(close(row[6], history[key][k], 5) for k, row in enumerate(side))
 
 
 def test_binary_two_writes_no_ascii_file_and_jobid_prefixes(tmp_path, run_deck):
