@@ -21,8 +21,9 @@
 !> - kept: the candidate whose largest computed cost (owned and ghost blocks) is smaller, (a) on
 !>   a tie (choose_owners). A graph without edges, or one METIS refuses, is split contiguously in
 !>   block order by cost instead;
-!> - a node belongs to the lowest rank among the owners of the blocks touching it (nodes no
-!>   block touches: rank 0);
+!> - a node belongs to one of the ranks owning a block touching it (nodes no block touches:
+!>   rank 0): the interface nodes are dealt out so that the ranks' computed costs stay even
+!>   (own_nodes);
 !> - a rank computes the blocks it owns and the blocks touching a node it owns.
 !> One rank owns everything and calls no METIS. More ranks than blocks is refused.
 !>
@@ -623,15 +624,15 @@ contains
 
   !> Each node to one of the ranks owning a block touching it (rank 0 when none). A node touched
   !> by one rank's blocks goes to that rank. An interface node (touched by several ranks) makes
-  !> its owner compute every block on it (ghost blocks): giving them all to the lowest rank, as
-  !> before, left the low ranks with most ghost blocks (computed imbalance 3.0 at 1,024 ranks on
-  !> the scaling deck). So the interface nodes are dealt out greedily, in node order: each to the
-  !> touching rank whose computed cost (owned blocks plus the ghost blocks taken so far, each
-  !> counted once per rank) would be smallest after taking it, the lowest rank on a tie. A rank
-  !> that already computes the node's blocks gains nothing, so the nodes along one interface
-  !> mostly follow one another and ghost blocks are rarely computed twice. Serial and in a fixed
-  !> order: the same on every rank. Any touching rank is correct (its owner computes every block
-  !> on it); only the cost depends on the choice.
+  !> its owner compute every block on it (ghost blocks): giving each to the lowest touching rank
+  !> leaves the low ranks with most ghost blocks (computed imbalance 3.0 at 1,024 ranks on the
+  !> scaling deck, 1.35 with this rule). So the interface nodes are dealt out greedily, in node
+  !> order: each to the touching rank whose computed cost (owned blocks plus the ghost blocks
+  !> taken so far, each counted once per rank) would be smallest after taking it, the lowest rank
+  !> on a tie. A rank that already computes the node's blocks gains nothing, so the nodes along
+  !> one interface mostly follow one another and a block is rarely computed by more ranks than
+  !> needed. Serial and in a fixed order: the same on every rank. Any touching rank is correct
+  !> (its owner computes every block on it); only the cost depends on the choice.
   subroutine own_nodes(node_count, blocks, block_owner, rank_count, node_owner)
     integer, intent(in) :: node_count
     type(block_list_t), intent(in) :: blocks
