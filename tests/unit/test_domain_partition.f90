@@ -2,8 +2,11 @@
 !> of 1 mm: x < 6 finite elements, the rest a meshfree part sharing their nodes; shells under the
 !> finite elements): 2 solid blocks, 4 meshfree blocks (256 points), 1 shell block.
 !> - one rank: everything owned by rank 0 and computed there, no METIS;
-!> - N = 2, 3, 4, seen from every rank: the same owners on every rank; each node belongs to the
-!>   lowest rank among the owners of the blocks touching it (rank 0 when none); a rank computes
+!> - N = 2, 3, 4, seen from every rank: the same owners on every rank; each node belongs to one
+!>   of the ranks owning a block touching it (rank 0 when none), to that rank when only one rank's
+!>   blocks touch it; the busiest rank's computed cost (owned and ghost blocks, recounted here from
+!>   the node owners and equal to the report's) is at most what giving every node to the lowest
+!>   touching rank (the former rule) would make it; a rank computes
 !>   exactly the blocks it owns and those touching a node it owns, so every block touching a
 !>   node is computed on the node's owner (the meshfree blocks' nodes reach beyond their cells);
 !>   every element is on one rank and the counts per rank add up;
@@ -20,7 +23,7 @@ program test_domain_partition
   use deck_reader, only: read_deck
   use run_state, only: run_state_t
   use explicit_setup, only: set_up_run_state
-  use domain_partition, only: domain_partition_t, partition_domains
+  use domain_partition, only: domain_partition_t, partition_domains, lane_cost
   use command_line, only: check_launch
   use rank_communication, only: start_ranks, finish_ranks
   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
@@ -85,10 +88,12 @@ contains
     integer, intent(in) :: rank_count
     type(domain_partition_t) :: first, partition
     type(error_t), allocatable :: error
-    integer, allocatable :: nodes(:), lowest(:)
-    logical :: same, lowest_rule, computed_rule, owner_computes, counted
+    integer, allocatable :: nodes(:), elements(:), lowest(:), highest(:)
+    real(wp), allocatable :: computed_cost(:), lowest_rule_cost(:)
+    real(wp) :: block_cost
+    logical :: same, lowest_rule, computed_rule, owner_computes, counted, touching, found
     character(len=:), allocatable :: label
-    integer :: rank, g, b
+    integer :: rank, g, b, node
 
     label = integer_text(rank_count)//" ranks: "
     call partition_domains(model, run%state%groups, rank_count, 0, first, error)
@@ -96,17 +101,61 @@ contains
     if (allocated(error)) return
     call check(suite, label//"METIS", first%report%by_metis)
 
-    ! node owner: the lowest owner among the blocks touching it
-    allocate (lowest(size(model%node_ids)))
+    ! node owner: one of the owners of the blocks touching it; the lowest and the highest of
+    ! them bound it, and where they agree (one rank's blocks) it is that rank
+    allocate (lowest(size(model%node_ids)), highest(size(model%node_ids)))
     lowest = huge(1)
+    highest = -1
+    touching = .true.
     do g = 1, size(first%groups)
       do b = 1, size(first%groups(g)%owner)
         call run%state%groups(g)%group%block_nodes(b, nodes)
         lowest(nodes) = min(lowest(nodes), first%groups(g)%owner(b))
+        highest(nodes) = max(highest(nodes), first%groups(g)%owner(b))
       end do
     end do
     where (lowest == huge(1)) lowest = 0
-    call check(suite, label//"each node to the lowest rank of its blocks", all(first%node_owner == lowest))
+    where (highest < 0) highest = 0
+    ! the owner is a touching rank: some block on the node is owned by it
+    do node = 1, size(model%node_ids)
+      if (lowest(node) == highest(node)) cycle
+      found = .false.
+      do g = 1, size(first%groups)
+        do b = 1, size(first%groups(g)%owner)
+          if (first%groups(g)%owner(b) /= first%node_owner(node)) cycle
+          call run%state%groups(g)%group%block_nodes(b, nodes)
+          found = found .or. any(nodes == node)
+        end do
+      end do
+      touching = touching .and. found
+    end do
+    call check(suite, label//"a node of one rank's blocks belongs to that rank (rank 0: no block)", &
+               all(pack(first%node_owner, lowest == highest) == pack(lowest, lowest == highest)))
+    call check(suite, label//"an interface node belongs to a rank owning a block on it", touching)
+
+    ! computed cost per rank: owned blocks and blocks touching an owned node, with these owners
+    ! and with every node to the lowest touching rank
+    allocate (computed_cost(0:rank_count - 1), lowest_rule_cost(0:rank_count - 1))
+    computed_cost = 0.0_wp
+    lowest_rule_cost = 0.0_wp
+    do g = 1, size(first%groups)
+      do b = 1, size(first%groups(g)%owner)
+        call run%state%groups(g)%group%block_nodes(b, nodes)
+        call run%state%groups(g)%group%block_elements(b, elements)
+        block_cost = size(elements)*lane_cost(run%state%groups(g)%group%name)
+        do rank = 0, rank_count - 1
+          if (first%groups(g)%owner(b) == rank .or. any(first%node_owner(nodes) == rank)) &
+            computed_cost(rank) = computed_cost(rank) + block_cost
+          if (first%groups(g)%owner(b) == rank .or. any(lowest(nodes) == rank)) &
+            lowest_rule_cost(rank) = lowest_rule_cost(rank) + block_cost
+        end do
+      end do
+    end do
+    call check(suite, label//"computed cost per rank as reported", &
+               all(abs(computed_cost - first%report%rank_computed_cost) <= 1.0e-9_wp*maxval(computed_cost)))
+    call check(suite, label//"busiest rank no busier than with the lowest-rank rule (" // &
+               integer_text(nint(maxval(computed_cost)))//" ns against "//integer_text(nint(maxval(lowest_rule_cost)))// &
+               ")", maxval(computed_cost) <= maxval(lowest_rule_cost)*(1.0_wp + 1.0e-12_wp))
 
     same = .true.
     computed_rule = .true.
