@@ -32,8 +32,9 @@
 !> nodes but no face (a row of hexahedra joined at edges) are ordered on the graph of shared
 !> nodes instead. SIGTERM is held back while METIS runs, which would catch it (signal_hold).
 module element_ordering
-  use, intrinsic :: iso_c_binding, only: c_int, c_int32_t, c_float, c_ptr, c_null_ptr, c_associated, &
-                                         c_f_pointer
+  use, intrinsic :: iso_c_binding, only: c_int, c_ptr, c_null_ptr, c_associated, c_f_pointer
+  use metis_library, only: idx_t, real_t, metis_ok, metis_option_count, metis_option_seed, metis_option_numbering, &
+                           metis_set_default_options, metis_mesh_to_dual, metis_part_graph_recursive, metis_free
   use kinds, only: block_size
   use signal_hold, only: signal_mask_t, hold_termination_signal, release_held_signals
   implicit none
@@ -41,13 +42,6 @@ module element_ordering
 
   public :: spatial_element_order
 
-  !> METIS's idx_t and real_t: 32 bits in Debian's libmetis-dev 5.1.0 (IDXTYPEWIDTH and
-  !> REALTYPEWIDTH 32 in metis.h).
-  integer, parameter :: idx_t = c_int32_t, real_t = c_float
-  integer(c_int), parameter :: metis_ok = 1
-  integer, parameter :: metis_option_count = 40          !< METIS_NOPTIONS
-  integer, parameter :: metis_option_seed = 8            !< METIS_OPTION_SEED (0-based index)
-  integer, parameter :: metis_option_numbering = 17      !< METIS_OPTION_NUMBERING (0-based index)
   !> Any fixed seed makes METIS's randomized matching repeatable; this one is arbitrary.
   integer(idx_t), parameter :: metis_seed = 20240611_idx_t
 
@@ -57,47 +51,6 @@ module element_ordering
     integer(idx_t), allocatable :: offsets(:)
     integer(idx_t), allocatable :: neighbours(:)
   end type graph_t
-
-  interface
-    function metis_set_default_options(options) bind(c, name="METIS_SetDefaultOptions") result(status)
-      import :: c_int, idx_t
-      integer(idx_t), intent(out) :: options(*)
-      integer(c_int) :: status
-    end function metis_set_default_options
-
-    !> The dual graph of a mesh: elements adjacent when they share at least `shared_nodes`
-    !> nodes (or all but one of either element's nodes). METIS allocates the two arrays.
-    function metis_mesh_to_dual(element_count, node_count, element_offsets, element_nodes, shared_nodes, &
-                                numbering, graph_offsets, graph_neighbours) bind(c, name="METIS_MeshToDual") &
-      result(status)
-      import :: c_int, c_ptr, idx_t
-      integer(idx_t), intent(in) :: element_count, node_count, shared_nodes, numbering
-      integer(idx_t), intent(in) :: element_offsets(*), element_nodes(*)
-      type(c_ptr), intent(out) :: graph_offsets, graph_neighbours
-      integer(c_int) :: status
-    end function metis_mesh_to_dual
-
-    function metis_part_graph_recursive(vertex_count, constraint_count, graph_offsets, graph_neighbours, &
-                                        vertex_weights, vertex_sizes, edge_weights, piece_count, target_weights, &
-                                        imbalance, options, edge_cut, piece) &
-      bind(c, name="METIS_PartGraphRecursive") result(status)
-      import :: c_int, c_ptr, idx_t, real_t
-      integer(idx_t), intent(in) :: vertex_count, constraint_count, piece_count
-      integer(idx_t), intent(in) :: graph_offsets(*), graph_neighbours(*)
-      type(c_ptr), value :: vertex_weights, vertex_sizes, edge_weights, imbalance
-      real(real_t), intent(in) :: target_weights(*)
-      integer(idx_t), intent(in) :: options(*)
-      integer(idx_t), intent(out) :: edge_cut
-      integer(idx_t), intent(out) :: piece(*)
-      integer(c_int) :: status
-    end function metis_part_graph_recursive
-
-    function metis_free(memory) bind(c, name="METIS_Free") result(status)
-      import :: c_int, c_ptr
-      type(c_ptr), value :: memory
-      integer(c_int) :: status
-    end function metis_free
-  end interface
 
 contains
 

@@ -29,8 +29,9 @@
 !>
 !> Elements in no block (rigid parts: the rigid bodies are replicated) get rank -1 in the report.
 module domain_partition
-  use, intrinsic :: iso_c_binding, only: c_int, c_int32_t, c_float, c_ptr, c_null_ptr, c_associated, c_f_pointer, &
-                                         c_loc
+  use, intrinsic :: iso_c_binding, only: c_int, c_ptr, c_null_ptr, c_associated, c_f_pointer, c_loc
+  use metis_library, only: idx_t, metis_ok, metis_option_count, metis_option_seed, metis_option_numbering, &
+                           metis_set_default_options, metis_mesh_to_dual, metis_part_graph_kway, metis_free
   use kinds, only: wp
   use model, only: model_t
   use error_handling, only: error_t, make_error
@@ -59,13 +60,6 @@ module domain_partition
     type(partition_summary_t) :: report
   end type domain_partition_t
 
-  !> METIS's idx_t and real_t: 32 bits in Debian's libmetis-dev 5.1.0 (IDXTYPEWIDTH and
-  !> REALTYPEWIDTH 32 in /usr/include/metis.h).
-  integer, parameter :: idx_t = c_int32_t, real_t = c_float
-  integer(c_int), parameter :: metis_ok = 1
-  integer, parameter :: metis_option_count = 40          !< METIS_NOPTIONS
-  integer, parameter :: metis_option_seed = 8            !< METIS_OPTION_SEED (0-based index)
-  integer, parameter :: metis_option_numbering = 17      !< METIS_OPTION_NUMBERING (0-based index)
   !> Any fixed seed makes METIS's randomized matching repeatable; this one is arbitrary.
   integer(idx_t), parameter :: metis_seed = 20261126_idx_t
 
@@ -78,47 +72,6 @@ module domain_partition
     integer, allocatable :: node_offsets(:), node_list(:)
     real(wp), allocatable :: block_cost(:)
   end type block_list_t
-
-  interface
-    function metis_set_default_options(options) bind(c, name="METIS_SetDefaultOptions") result(status)
-      import :: c_int, idx_t
-      integer(idx_t), intent(out) :: options(*)
-      integer(c_int) :: status
-    end function metis_set_default_options
-
-    !> The dual graph of a mesh: elements adjacent when they share at least `shared_nodes`
-    !> nodes. METIS allocates the two arrays.
-    function metis_mesh_to_dual(element_count, node_count, element_offsets, element_nodes, shared_nodes, &
-                                numbering, graph_offsets, graph_neighbours) bind(c, name="METIS_MeshToDual") &
-      result(status)
-      import :: c_int, c_ptr, idx_t
-      integer(idx_t), intent(in) :: element_count, node_count, shared_nodes, numbering
-      integer(idx_t), intent(in) :: element_offsets(*), element_nodes(*)
-      type(c_ptr), intent(out) :: graph_offsets, graph_neighbours
-      integer(c_int) :: status
-    end function metis_mesh_to_dual
-
-    function metis_part_graph_kway(vertex_count, constraint_count, graph_offsets, graph_neighbours, &
-                                   vertex_weights, vertex_sizes, edge_weights, piece_count, target_weights, &
-                                   imbalance, options, edge_cut, piece) bind(c, name="METIS_PartGraphKway") &
-      result(status)
-      import :: c_int, c_ptr, idx_t
-      integer(idx_t), intent(in) :: vertex_count, constraint_count, piece_count
-      type(c_ptr), value :: graph_offsets, graph_neighbours
-      integer(idx_t), intent(in) :: vertex_weights(*)
-      type(c_ptr), value :: vertex_sizes, edge_weights, target_weights, imbalance
-      integer(idx_t), intent(in) :: options(*)
-      integer(idx_t), intent(out) :: edge_cut
-      integer(idx_t), intent(out) :: piece(*)
-      integer(c_int) :: status
-    end function metis_part_graph_kway
-
-    function metis_free(memory) bind(c, name="METIS_Free") result(status)
-      import :: c_int, c_ptr
-      type(c_ptr), value :: memory
-      integer(c_int) :: status
-    end function metis_free
-  end interface
 
 contains
 
