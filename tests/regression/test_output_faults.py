@@ -56,10 +56,10 @@ def test_output_cost_per_state_does_not_grow_with_the_number_of_states(tmp_path,
     assert per_state[800][0] < 1.3 * per_state[100][0], per_state
     for states, (_, timing) in per_state.items():
         # Values: one state (27 nodes x 6 + 8 solids x 7, and the solids' 32-bit eroded flags),
-        # one glstat row (27 values, the eroded energies and count and LS-DYNA's remaining glstat
-        # lines included) and one matsum row (11 values: energies, momentum, rigid-body velocity,
-        # mass).
-        assert timing["output_bytes"] == (states + 1) * (8 * (27 * 6 + 8 * 7 + 27 + 11) + 4 * 8)
+        # one glstat row (30 values, the eroded energies and count, LS-DYNA's remaining glstat
+        # lines and the element that set the step included) and one matsum row (11 values:
+        # energies, momentum, rigid-body velocity, mass).
+        assert timing["output_bytes"] == (states + 1) * (8 * (27 * 6 + 8 * 7 + 30 + 11) + 4 * 8)
         # The XDMF file at states 1, 2, 4, ... and the end; else at most every 2 s of the run.
         assert timing["xdmf_writes"] <= math.ceil(math.log2(states + 1)) + 2 + timing["wall_s"] / 2.0
 
