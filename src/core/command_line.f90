@@ -163,14 +163,8 @@ contains
     character(len=*), intent(in) :: value
     type(run_options_t), intent(inout) :: options
     type(error_t), allocatable, intent(out) :: error
-    integer :: status
-    status = 1
-    if (verify(value, "0123456789") == 0 .and. len(value) >= 1 .and. len(value) <= 6) &
-      read (value, *, iostat=status) options%binary_file_scale
-    if (status /= 0 .or. options%binary_file_scale < 1) then
-      call make_error(error, "command line: x='"//value//"' is not a positive whole number (the d3plot file "// &
-                      "size in multiples of 512^2 words)")
-    end if
+    call read_positive_whole_number("x", value, "the d3plot file size in multiples of 512^2 words", &
+                                    options%binary_file_scale, error)
   end subroutine read_file_scale
 
   !> partition=N: a positive whole number of ranks.
@@ -178,15 +172,29 @@ contains
     character(len=*), intent(in) :: value
     type(run_options_t), intent(inout) :: options
     type(error_t), allocatable, intent(out) :: error
-    integer :: status
+    call read_positive_whole_number("partition", value, "the number of MPI ranks to partition the model for", &
+                                    options%partition_ranks, error)
+  end subroutine read_partition_ranks
+
+  !> name=value as a positive whole number of at most 6 digits into `number` (left as it was, and
+  !> an error naming the argument and its `meaning`, otherwise).
+  subroutine read_positive_whole_number(name, value, meaning, number, error)
+    character(len=*), intent(in) :: name, value, meaning
+    integer, intent(inout) :: number
+    type(error_t), allocatable, intent(out) :: error
+    integer :: status, read_number
     status = 1
     if (verify(value, "0123456789") == 0 .and. len(value) >= 1 .and. len(value) <= 6) &
-      read (value, *, iostat=status) options%partition_ranks
-    if (status /= 0 .or. options%partition_ranks < 1) then
-      call make_error(error, "command line: partition='"//value//"' is not a positive whole number (the number "// &
-                      "of MPI ranks to partition the model for)")
+      read (value, *, iostat=status) read_number
+    if (status == 0) then
+      if (read_number >= 1) then
+        number = read_number
+        return
+      end if
     end if
-  end subroutine read_partition_ranks
+    call make_error(error, "command line: "//name//"='"//value//"' is not a positive whole number ("// &
+                    meaning//")")
+  end subroutine read_positive_whole_number
 
   !> The number of processes an MPI launcher (mpirun, mpiexec, srun) started this one among,
   !> read from the environment it sets: Open MPI's OMPI_COMM_WORLD_SIZE, else PMI_SIZE (MPICH,

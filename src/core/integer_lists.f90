@@ -5,7 +5,8 @@ module integer_lists
   implicit none
   private
 
-  public :: reserve_integers, reserve_integer_columns, append_integer, sorted_position, sort_short_list
+  public :: reserve_integers, reserve_integer_columns, append_integer, sorted_position, sort_short_list, &
+            sort_integers
 
 contains
 
@@ -97,4 +98,42 @@ contains
       values(j + 1) = held
     end do
   end subroutine sort_short_list
+
+  !> Ascending heap sort in place: n log n whatever the input (a particle's neighbours, a meshfree
+  !> block's thousands of pair nodes).
+  pure subroutine sort_integers(values)
+    integer, intent(inout) :: values(:)
+    integer :: n, last, held
+
+    n = size(values)
+    do last = n/2, 1, -1
+      call sift_down(values, last, n)
+    end do
+    do last = n, 2, -1
+      held = values(1)
+      values(1) = values(last)
+      values(last) = held
+      call sift_down(values, 1, last - 1)
+    end do
+  end subroutine sort_integers
+
+  pure subroutine sift_down(values, start, last)
+    integer, intent(inout) :: values(:)
+    integer, intent(in) :: start, last
+    integer :: root, child, held
+
+    root = start
+    held = values(root)
+    do
+      child = 2*root
+      if (child > last) exit
+      if (child < last) then
+        if (values(child + 1) > values(child)) child = child + 1
+      end if
+      if (values(child) <= held) exit
+      values(root) = values(child)
+      root = child
+    end do
+    values(root) = held
+  end subroutine sift_down
 end module integer_lists

@@ -11,7 +11,7 @@
 !> everything built from them is deterministic.
 module efg_neighbour_search
   use kinds, only: wp
-  use integer_lists, only: append_integer
+  use integer_lists, only: append_integer, sort_integers
   use efg_kernel, only: kernel_weight
   implicit none
   private
@@ -166,41 +166,4 @@ contains
     integer, intent(in) :: bin(3)
     bin_number = bin(1) + grid%bins(1)*((bin(2) - 1) + grid%bins(2)*(bin(3) - 1))
   end function bin_number
-
-  !> Ascending heap sort (the lists are short but may reach a few thousand entries).
-  pure subroutine sort_integers(values)
-    integer, intent(inout) :: values(:)
-    integer :: n, last, held
-
-    n = size(values)
-    do last = n/2, 1, -1
-      call sift_down(values, last, n)
-    end do
-    do last = n, 2, -1
-      held = values(1)
-      values(1) = values(last)
-      values(last) = held
-      call sift_down(values, 1, last - 1)
-    end do
-  end subroutine sort_integers
-
-  pure subroutine sift_down(values, start, last)
-    integer, intent(inout) :: values(:)
-    integer, intent(in) :: start, last
-    integer :: root, child, held
-
-    root = start
-    held = values(root)
-    do
-      child = 2*root
-      if (child > last) exit
-      if (child < last) then
-        if (values(child + 1) > values(child)) child = child + 1
-      end if
-      if (values(child) <= held) exit
-      values(root) = values(child)
-      root = child
-    end do
-    values(root) = held
-  end subroutine sift_down
 end module efg_neighbour_search

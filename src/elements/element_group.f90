@@ -17,6 +17,7 @@
 !> message.
 module element_group
   use kinds, only: wp
+  use integer_lists, only: sort_integers
   use model, only: model_t
   use nodal_state, only: nodal_state_t
   use wall_clock, only: phase_timer_t
@@ -445,7 +446,7 @@ contains
     integer :: k, count
     allocate (sorted(size(list)))
     sorted(:) = list
-    call heap_sort(sorted)
+    call sort_integers(sorted)
     allocate (nodes(size(sorted)))
     count = 0
     do k = 1, size(sorted)
@@ -457,40 +458,6 @@ contains
     end do
     nodes = nodes(1:count)
   end function distinct_nodes
-
-  !> Ascending, in place (n log n whatever the input: a meshfree block lists thousands of pairs).
-  pure subroutine heap_sort(values)
-    integer, intent(inout) :: values(:)
-    integer :: last, first, held
-    do first = size(values)/2, 1, -1
-      call sift_down(values, first, size(values))
-    end do
-    do last = size(values), 2, -1
-      held = values(1)
-      values(1) = values(last)
-      values(last) = held
-      call sift_down(values, 1, last - 1)
-    end do
-  end subroutine heap_sort
-
-  pure subroutine sift_down(values, first, last)
-    integer, intent(inout) :: values(:)
-    integer, intent(in) :: first, last
-    integer :: parent, child, held
-    parent = first
-    held = values(parent)
-    do
-      child = 2*parent
-      if (child > last) exit
-      if (child < last) then
-        if (values(child + 1) > values(child)) child = child + 1
-      end if
-      if (values(child) <= held) exit
-      values(parent) = values(child)
-      parent = child
-    end do
-    values(parent) = held
-  end subroutine sift_down
 
   !> Layers written per shell to the d3plot (its MAXINT): LS-DYNA's default 3 (mid, inner and
   !> outer surface) when no shell section has more than 3 points (NIP), else the largest NIP
