@@ -29,6 +29,7 @@ module job
   use restart_control, only: restart_control_t, prepare_restart, check_restart_deck, set_up_restart_control, &
                              continue_restart_results, count_earlier_run
   use rank_communication, only: rank_index, rank_total, any_rank
+  use text_format, only: integer_text
   use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
   !$ use omp_lib, only: omp_set_num_threads, omp_get_max_threads
   implicit none
@@ -381,7 +382,9 @@ contains
     type(run_state_t), intent(in) :: run
     integer, intent(in) :: cycles
     character(len=240) :: line
+    character(len=:), allocatable :: counts
     real(wp) :: per_cycle
+    integer :: r
     per_cycle = 1.0e3_wp/real(max(1, cycles), wp)
     write (line, '(a,i0,a,f0.3,a,f0.1,a,f0.3,a)') "  MPI: ", run%exchange%rank_count, &
       " ranks; force exchange ", per_cycle*run%exchange%timer%seconds, " ms per cycle (", &
@@ -393,6 +396,16 @@ contains
       " times (energy checks, histories): ", run%exchange%gather_timer%seconds, " s, ", &
       8.0e-6_wp*run%exchange%gathered_values, " MB received"
     write (*, '(a)') trim(line)
+    if (size(run%state%contacts) == 0) return
+    write (line, '(a,f0.3,a,f0.1,a)') "  MPI: contact pair exchange ", per_cycle*run%exchange%contact_timer%seconds, &
+      " ms per cycle (", 8.0e-3_wp*run%exchange%pair_values/real(max(1, cycles), wp), " kB to each rank per cycle)"
+    write (*, '(a)') trim(line)
+    ! how evenly the ranks shared the pairs that touched (a pair found in one cycle counts once)
+    counts = "  MPI: contact pairs found per rank over the run:"
+    do r = 1, size(run%exchange%rank_pair_records)
+      counts = counts//" "//integer_text(nint(run%exchange%rank_pair_records(r)))
+    end do
+    write (*, '(a)') counts
   end subroutine print_exchange_summary
 
   function count_text(value) result(text)

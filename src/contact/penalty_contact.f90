@@ -28,7 +28,15 @@
 !> Determinism: the secondary nodes are processed in parallel, each writing only its own pair
 !> result (segment, weights, force); the forces are then added to the nodes in one serial loop
 !> in pair order. Results are bit-identical for any thread count; no atomics.
+!>
+!> A distributed run (docs/parallel.md) shares the pairs out: `find_contact_pairs` computes the
+!> pairs of the secondary nodes this rank owns (the costly part: the projections), the ranks
+!> hand each other their pair records (`pack_pair_records`, `unpack_pair_records`; the exchange
+!> itself is the solver's), and `apply_contact_pairs` adds every pair's forces on every rank in
+!> the one-rank pair order. A pair depends only on its node, the candidate lists and the last
+!> cycle's pair of that node, so it is the same whichever rank computes it.
 module penalty_contact
+  use, intrinsic :: iso_fortran_env, only: int64
   use kinds, only: wp
   use message_log, only: message_log_t, log_message
   use error_handling, only: error_t, make_error
@@ -42,6 +50,12 @@ module penalty_contact
 
   public :: contact_state_t, contact_pass_t, set_up_contacts, set_up_contact, compute_contact_forces, &
             report_initial_penetrations, mass_in_contact
+  public :: find_contact_pairs, apply_contact_pairs, pair_record_count, pack_pair_records, unpack_pair_records
+  public :: pair_record_size
+
+  !> Values of one pair record of the exchange: contact, pass, secondary node (pass index),
+  !> segment, side, depth, initial depth, weights (4), force (3), friction spring (3).
+  integer, parameter :: pair_record_size = 17
 
   !> Parametric tolerance of the projection (LS-DYNA's MAXPAR default 1.025).
   real(wp), parameter :: parametric_limit = 1.025_wp
@@ -91,6 +105,13 @@ module penalty_contact
     real(wp), allocatable :: pair_depth(:)         !< penetration of the node's pair in the last cycle (0: none)
     real(wp), allocatable :: pair_weights(:, :), pair_force(:, :), tangential(:, :)
     real(wp) :: side_sign = 1.0_wp                !< +1: secondary is SURFA; -1: the B -> A pass
+    ! a distributed run: the secondary nodes whose pairs this rank computes (pass indices,
+    ! ascending; listed at the first search after set-up, erosion or a restart), and those of
+    ! other ranks whose records it took in the last exchange (cleared before the next one)
+    integer, allocatable :: handled(:)
+    logical, allocatable :: is_handled(:)
+    integer, allocatable :: received(:)
+    integer :: received_count = 0
   end type contact_pass_t
 
   !> One contact during the run.
@@ -412,7 +433,7 @@ contains
   !> `contact_force`, which is zeroed first) and the contact energy increment: minus the work
   !> of the contact forces over the step, by the trapezoidal rule
   !> `-dt/2 (f^n + f^{n+1}) . v^{n+1/2}`. For a linear spring this is exactly the change of
-  !> its stored energy; friction adds its (positive) dissipation.
+  !> its stored energy; friction adds its (positive) dissipation. One rank: every pair here.
   subroutine compute_contact_forces(model, contacts, time, step, coordinates, velocity, mass, &
                                     contact_force, energy_increment)
     type(model_t), intent(in) :: model
@@ -421,26 +442,34 @@ contains
     real(wp), intent(in) :: coordinates(:, :), velocity(:, :), mass(:)
     real(wp), intent(inout) :: contact_force(:, :)
     real(wp), intent(out) :: energy_increment
-    integer :: k, p, i, j, node
-    real(wp) :: work_before, work_after, total(3)
-    logical :: active
+    real(wp) :: work_before
+    call find_contact_pairs(model, contacts, time, step, coordinates, velocity, mass, work_before)
+    call apply_contact_pairs(contacts, step, velocity, contact_force, work_before, energy_increment)
+  end subroutine compute_contact_forces
 
+  !> The first half of the contact forces: the power of the last cycle's pairs (`work_before`,
+  !> every pair: the pairs are complete on every rank after an exchange), the searches, and the
+  !> pairs of the secondary nodes this rank handles (`node_handled`, per model node; absent:
+  !> all). A contact outside its birth and death times has no pairs.
+  subroutine find_contact_pairs(model, contacts, time, step, coordinates, velocity, mass, work_before, rank, &
+                                rank_count)
+    type(model_t), intent(in) :: model
+    type(contact_state_t), intent(inout) :: contacts(:)
+    real(wp), intent(in) :: time, step
+    real(wp), intent(in) :: coordinates(:, :), velocity(:, :), mass(:)
+    real(wp), intent(out) :: work_before
+    integer, intent(in), optional :: rank, rank_count   !< this rank (0-based) of rank_count (absent: 0 of 1)
+    integer :: k, p
+    logical :: active, rebuilt
     work_before = 0.0_wp
     do k = 1, size(contacts)
       do p = 1, contacts(k)%pass_count
         work_before = work_before + pass_work(contacts(k)%passes(p), velocity)
       end do
     end do
-    !$omp parallel do schedule(static) default(shared) private(node)
-    do node = 1, size(contact_force, 2)
-      contact_force(:, node) = 0.0_wp
-    end do
-    !$omp end parallel do
-    work_after = 0.0_wp
     do k = 1, size(contacts)
       associate (contact => model%contacts(k), state => contacts(k))
         active = time >= contact%birth .and. time <= contact%death
-        state%force = 0.0_wp
         do p = 1, state%pass_count
           associate (pass => state%passes(p))
             if (.not. active) then
@@ -452,9 +481,44 @@ contains
             end if
             ! BSORT of the contact, else NSBCS of *CONTROL_CONTACT, else only when nodes moved
             call update_search(pass, coordinates, merge(contact%bucket_interval, model%contact_sort_interval, &
-                                                        contact%bucket_interval > 0))
+                                                        contact%bucket_interval > 0), rebuilt)
+            if (rebuilt .or. .not. allocated(pass%handled)) then
+              if (present(rank)) then
+                call share_out_pairs(pass, rank, rank_count)
+              else
+                call share_out_pairs(pass, 0, 1)
+              end if
+            end if
             call pair_forces(contact, pass, step, coordinates, velocity, mass)
-            ! serial, in pair order: the same sums for any thread count
+          end associate
+        end do
+      end associate
+    end do
+  end subroutine find_contact_pairs
+
+  !> The second half, once every rank holds every pair: the first evaluation's initial
+  !> penetrations summed up, the pair forces added to the nodes (serial, in pair order: the same
+  !> sums for any thread and rank count), the contacts' forces and impulses, and the energy
+  !> increment with the power of the new pairs.
+  subroutine apply_contact_pairs(contacts, step, velocity, contact_force, work_before, energy_increment)
+    type(contact_state_t), intent(inout) :: contacts(:)
+    real(wp), intent(in) :: step, velocity(:, :), work_before
+    real(wp), intent(inout) :: contact_force(:, :)
+    real(wp), intent(out) :: energy_increment
+    integer :: k, p, i, j, node
+    real(wp) :: work_after, total(3)
+    !$omp parallel do schedule(static) default(shared) private(node)
+    do node = 1, size(contact_force, 2)
+      contact_force(:, node) = 0.0_wp
+    end do
+    !$omp end parallel do
+    work_after = 0.0_wp
+    do k = 1, size(contacts)
+      associate (state => contacts(k))
+        state%force = 0.0_wp
+        do p = 1, state%pass_count
+          associate (pass => state%passes(p))
+            if (.not. pass%initial_checked .and. allocated(pass%handled)) call sum_up_initial_penetrations(pass)
             total = 0.0_wp
             do i = 1, pass%node_count
               if (pass%pair_segment(i) == 0) cycle
@@ -477,7 +541,181 @@ contains
       end associate
     end do
     energy_increment = -0.5_wp*step*(work_before + work_after)
-  end subroutine compute_contact_forces
+  end subroutine apply_contact_pairs
+
+  !> The secondary nodes of `pass` whose pairs this rank computes, chosen again at every search
+  !> (the same on every rank: the candidate lists are): contiguous ranges of the pass's nodes
+  !> with about equal work, a node weighing 1 plus its candidates (a node far from any segment
+  !> costs a test; one near the surfaces, a projection per candidate). Any rank may compute any
+  !> pair, all see the whole model; the ranges keep a rank's nodes together in memory. A node
+  !> that leaves this rank with a pair is listed as received, so that the next exchange clears
+  !> it unless its new rank sends it again.
+  subroutine share_out_pairs(pass, rank, rank_count)
+    type(contact_pass_t), intent(inout) :: pass
+    integer, intent(in) :: rank, rank_count
+    integer(int64) :: total, before, first_weight, last_weight
+    integer :: i, first, last
+    logical, allocatable :: was_handled(:)
+    if (allocated(pass%is_handled)) then
+      call move_alloc(pass%is_handled, was_handled)
+    else
+      allocate (was_handled(pass%node_count))
+      was_handled = .true.
+    end if
+    if (.not. allocated(pass%received)) allocate (pass%received(16))
+    total = int(pass%node_count, int64) + int(pass%candidate_first(pass%node_count + 1) - 1, int64)
+    first_weight = (total*rank)/rank_count
+    last_weight = (total*(rank + 1))/rank_count
+    ! this rank: the nodes whose weights end in (first_weight, last_weight]
+    first = pass%node_count + 1
+    last = 0
+    before = 0
+    do i = 1, pass%node_count
+      before = before + 1 + (pass%candidate_first(i + 1) - pass%candidate_first(i))
+      if (before > first_weight .and. before <= last_weight) then
+        first = min(first, i)
+        last = i
+      end if
+    end do
+    allocate (pass%is_handled(pass%node_count))
+    pass%is_handled = .false.
+    if (last >= first) pass%is_handled(first:last) = .true.
+    pass%handled = [(i, i=first, last)]
+    do i = 1, pass%node_count
+      if (was_handled(i) .and. .not. pass%is_handled(i) .and. carries_record(pass, i)) call note_received(pass, i)
+    end do
+  end subroutine share_out_pairs
+
+  !> Secondary node `i` of `pass` is another rank's: its pair values are cleared at the next
+  !> exchange, unless that rank sends them.
+  subroutine note_received(pass, i)
+    type(contact_pass_t), intent(inout) :: pass
+    integer, intent(in) :: i
+    integer, allocatable :: grown(:)
+    if (pass%received_count == size(pass%received)) then
+      allocate (grown(max(16, 2*size(pass%received))))
+      grown(1:pass%received_count) = pass%received(1:pass%received_count)
+      call move_alloc(grown, pass%received)
+    end if
+    pass%received_count = pass%received_count + 1
+    pass%received(pass%received_count) = i
+  end subroutine note_received
+
+  !> After the first evaluation: how many nodes penetrated from the start, the deepest and where
+  !> (report_initial_penetrations); from then on the pairs take the initial depths off.
+  subroutine sum_up_initial_penetrations(pass)
+    type(contact_pass_t), intent(inout) :: pass
+    integer :: i
+    pass%initial_checked = .true.
+    pass%initial_count = count(pass%initial_depth > 0.0_wp)
+    if (pass%initial_count > 0) then
+      i = maxloc(pass%initial_depth, dim=1)
+      pass%initial_deepest = pass%initial_depth(i)
+      pass%initial_node = pass%nodes(i)
+    end if
+  end subroutine sum_up_initial_penetrations
+
+  !> Records this rank's pairs would send: its handled secondary nodes with a pair, a depth or an
+  !> initial depth (the others are all zero, which the receivers assume).
+  integer function pair_record_count(contacts)
+    type(contact_state_t), intent(in) :: contacts(:)
+    integer :: k, p, h
+    pair_record_count = 0
+    do k = 1, size(contacts)
+      do p = 1, contacts(k)%pass_count
+        associate (pass => contacts(k)%passes(p))
+          if (.not. allocated(pass%handled)) cycle
+          do h = 1, size(pass%handled)
+            if (carries_record(pass, pass%handled(h))) pair_record_count = pair_record_count + 1
+          end do
+        end associate
+      end do
+    end do
+  end function pair_record_count
+
+  !> This rank's pair records into `buffer` (pair_record_size values each, contacts, passes and
+  !> nodes in order).
+  subroutine pack_pair_records(contacts, buffer)
+    type(contact_state_t), intent(in) :: contacts(:)
+    real(wp), intent(inout) :: buffer(:)
+    integer :: k, p, h, i, at
+    at = 0
+    do k = 1, size(contacts)
+      do p = 1, contacts(k)%pass_count
+        associate (pass => contacts(k)%passes(p))
+          if (.not. allocated(pass%handled)) cycle
+          do h = 1, size(pass%handled)
+            i = pass%handled(h)
+            if (.not. carries_record(pass, i)) cycle
+            buffer(at + 1:at + pair_record_size) = [real(k, wp), real(p, wp), real(i, wp), &
+              real(pass%pair_segment(i), wp), pass%pair_side(i), pass%pair_depth(i), pass%initial_depth(i), &
+              pass%pair_weights(:, i), pass%pair_force(:, i), pass%tangential(:, i)]
+            at = at + pair_record_size
+          end do
+        end associate
+      end do
+    end do
+  end subroutine pack_pair_records
+
+  !> Every rank's records (`records` of them in `buffer`): the pairs of the nodes other ranks
+  !> handle replace those of the last exchange, which are cleared first; this rank's own are
+  !> already in place.
+  subroutine unpack_pair_records(contacts, buffer, records)
+    type(contact_state_t), intent(inout) :: contacts(:)
+    real(wp), intent(in) :: buffer(:)
+    integer, intent(in) :: records
+    integer :: k, p, i, n, at
+    do k = 1, size(contacts)
+      do p = 1, contacts(k)%pass_count
+        associate (pass => contacts(k)%passes(p))
+          if (.not. allocated(pass%received)) cycle
+          ! (a node that became this rank's at a search holds this cycle's own pair)
+          do n = 1, pass%received_count
+            if (.not. pass%is_handled(pass%received(n))) call clear_pair(pass, pass%received(n))
+          end do
+          pass%received_count = 0
+        end associate
+      end do
+    end do
+    do n = 1, records
+      at = (n - 1)*pair_record_size
+      k = nint(buffer(at + 1))
+      p = nint(buffer(at + 2))
+      i = nint(buffer(at + 3))
+      associate (pass => contacts(k)%passes(p))
+        if (pass%is_handled(i)) cycle
+        call note_received(pass, i)
+        pass%pair_segment(i) = nint(buffer(at + 4))
+        pass%pair_side(i) = buffer(at + 5)
+        pass%pair_depth(i) = buffer(at + 6)
+        pass%initial_depth(i) = buffer(at + 7)
+        pass%pair_weights(:, i) = buffer(at + 8:at + 11)
+        pass%pair_force(:, i) = buffer(at + 12:at + 14)
+        pass%tangential(:, i) = buffer(at + 15:at + 17)
+      end associate
+    end do
+  end subroutine unpack_pair_records
+
+  !> Whether secondary node `i` of `pass` has anything for the other ranks.
+  logical function carries_record(pass, i)
+    type(contact_pass_t), intent(in) :: pass
+    integer, intent(in) :: i
+    carries_record = pass%pair_segment(i) /= 0 .or. pass%pair_depth(i) /= 0.0_wp .or. &
+                     pass%initial_depth(i) /= 0.0_wp .or. any(pass%tangential(:, i) /= 0.0_wp)
+  end function carries_record
+
+  !> Secondary node `i` of `pass` without a pair.
+  subroutine clear_pair(pass, i)
+    type(contact_pass_t), intent(inout) :: pass
+    integer, intent(in) :: i
+    pass%pair_segment(i) = 0
+    pass%pair_side(i) = 1.0_wp
+    pass%pair_depth(i) = 0.0_wp
+    pass%initial_depth(i) = 0.0_wp
+    pass%pair_weights(:, i) = 0.0_wp
+    pass%pair_force(:, i) = 0.0_wp
+    pass%tangential(:, i) = 0.0_wp
+  end subroutine clear_pair
 
   !> One warning line per contact whose first evaluation found penetrating nodes (then never
   !> again): how many (over its passes), the deepest and where. Their initial penetration is
@@ -534,12 +772,14 @@ contains
 
   !> Rebuild the candidate lists when a node of the pass has moved half the margin since the
   !> last build (two surfaces then approached by at most the margin), or after BSORT cycles.
-  subroutine update_search(pass, coordinates, bucket_interval)
+  subroutine update_search(pass, coordinates, bucket_interval, rebuilt)
     type(contact_pass_t), intent(inout) :: pass
     real(wp), intent(in) :: coordinates(:, :)
     integer, intent(in) :: bucket_interval
+    logical, intent(out) :: rebuilt
     real(wp) :: moved, low(3), high(3), common(3)
     integer :: n
+    rebuilt = .false.
     pass%cycles_since_build = pass%cycles_since_build + 1
     moved = 0.0_wp
     if (pass%built .and. size(pass%tracked) > 0) then
@@ -565,6 +805,7 @@ contains
     if (pass%built .and. moved < 0.5_wp*pass%margin .and. &
         (bucket_interval <= 0 .or. pass%cycles_since_build < bucket_interval)) return
     call build_candidates(pass, coordinates)
+    rebuilt = .true.
   end subroutine update_search
 
   !> Bucket sort: segment boxes (grown by the margin, the contact depth and the parametric
@@ -731,7 +972,7 @@ contains
     type(contact_t), intent(in) :: contact
     type(contact_pass_t), intent(inout) :: pass
     real(wp), intent(in) :: step, coordinates(:, :), velocity(:, :), mass(:)
-    integer :: i, c, seg, best, j
+    integer :: i, c, seg, best, j, h
     real(wp) :: x(3), corners(3, 4), weights(4), normal(3), gap, best_depth, best_weights(4), best_normal(3)
     real(wp) :: relative(3), stiffness, node_mass, segment_mass, reduced_mass, normal_force, damping
     real(wp) :: tangential(3), sliding(3), friction, limit, size_t, penetration, side, best_side
@@ -740,8 +981,9 @@ contains
     !$omp parallel do schedule(static) default(shared) private(i, c, seg, best, j, x, corners, weights, &
     !$omp& normal, gap, best_depth, best_weights, best_normal, relative, stiffness, node_mass, segment_mass, &
     !$omp& reduced_mass, normal_force, damping, tangential, sliding, friction, limit, size_t, inside, penetration, &
-    !$omp& side, best_side, reach, low, high, reachable)
-    do i = 1, pass%node_count
+    !$omp& side, best_side, reach, low, high, reachable, h)
+    do h = 1, size(pass%handled)
+      i = pass%handled(h)
       x = coordinates(:, pass%nodes(i))
       best = 0
       best_depth = huge(1.0_wp)
@@ -829,7 +1071,11 @@ contains
         if (best_depth <= 0.0_wp) best = 0
       end if
       if (best == 0) then
+        ! (side and weights too: a node without a pair holds the values of set-up, the same
+        ! whichever rank computed it, so that restart dumps do not depend on the rank count)
         pass%pair_segment(i) = 0
+        pass%pair_side(i) = 1.0_wp
+        pass%pair_weights(:, i) = 0.0_wp
         pass%pair_force(:, i) = 0.0_wp
         pass%tangential(:, i) = 0.0_wp
         cycle
@@ -880,15 +1126,6 @@ contains
       pass%pair_force(:, i) = normal_force*best_normal + tangential
     end do
     !$omp end parallel do
-    if (.not. pass%initial_checked) then
-      pass%initial_checked = .true.
-      pass%initial_count = count(pass%initial_depth > 0.0_wp)
-      if (pass%initial_count > 0) then
-        i = maxloc(pass%initial_depth, dim=1)
-        pass%initial_deepest = pass%initial_depth(i)
-        pass%initial_node = pass%nodes(i)
-      end if
-    end if
   end subroutine pair_forces
 
   !> Closest point of a segment to `x`: weights of the corners (bilinear shape functions at

@@ -11,6 +11,10 @@
 !> eroded elements) are made global with the one-rank tie rules, and the block state that the
 !> output, the checks and the dumps read is brought together from the owners first
 !> (gather_block_state), only when it is read.
+!>
+!> Contact is shared out by secondary node: each rank computes the pairs of its share of every
+!> contact's secondary nodes (penalty_contact's share_out_pairs), and the ranks hand each other the pair records (exchange_contact_pairs) before every
+!> rank adds the pairs' forces in the one-rank pair order (penalty_contact).
 module domain_exchange
   use kinds, only: wp
   use error_handling, only: error_t
@@ -20,13 +24,15 @@ module domain_exchange
   use restart_file, only: restart_store_t, start_memory_store
   use wall_clock, only: phase_timer_t, start_phase, stop_phase
   use domain_partition, only: domain_partition_t, partition_domains
+  use penalty_contact, only: contact_state_t, pair_record_size, pair_record_count, pack_pair_records, &
+                             unpack_pair_records
   use rank_communication, only: rank_index, rank_total, gather_reals, gather_fixed_reals, barrier_ranks, abort_ranks
   use text_format, only: integer_text
   implicit none
   private
 
   public :: domain_exchange_t, set_up_domains, exchange_internal_forces, combine_group_headers, gather_block_state
-  public :: gather_block_energies
+  public :: gather_block_energies, exchange_contact_pairs
 
   !> Values per group in the header exchange: step, critical block, critical element, failed
   !> block, failed element, step not finite, newly eroded (owned blocks).
@@ -53,6 +59,12 @@ module domain_exchange
     !> of bringing the blocks together
     type(phase_timer_t) :: timer, wait_timer, gather_timer
     real(wp) :: gathered_values = 0.0_wp        !< values received by the block gathers, in all
+    !> the contact pair exchange: counts of records per rank, buffers (grown, never shrunk)
+    real(wp), allocatable :: pair_send(:), pair_receive(:), record_counts(:, :)
+    integer, allocatable :: pair_value_counts(:), pair_value_offsets(:)
+    type(phase_timer_t) :: contact_timer        !< wall-clock time of the pair exchange
+    real(wp) :: pair_values = 0.0_wp            !< values received by the pair exchanges, in all
+    real(wp), allocatable :: rank_pair_records(:)   !< per rank, the pair records it sent, in all
   end type domain_exchange_t
 
 contains
@@ -103,7 +115,51 @@ contains
               exchange%receive(exchange%values_per_node*size(exchange%rank_nodes)))
     allocate (exchange%header_send(header_values*size(groups)), &
               exchange%header_receive(header_values*size(groups), exchange%rank_count))
+    allocate (exchange%pair_send(pair_record_size), exchange%pair_receive(pair_record_size), &
+              exchange%record_counts(1, exchange%rank_count), exchange%pair_value_counts(exchange%rank_count), &
+              exchange%pair_value_offsets(exchange%rank_count), exchange%rank_pair_records(exchange%rank_count))
+    exchange%rank_pair_records = 0.0_wp
   end subroutine set_up_domains
+
+  !> After each rank computed the contact pairs of its share of the secondary nodes: every rank's
+  !> pair records (a secondary node with a pair, a depth or an initial depth) to every rank
+  !> (MPI_Allgatherv; the buffers grow with the number of pairs and are kept), so that every
+  !> rank holds every pair, as one rank computes them.
+  subroutine exchange_contact_pairs(contacts, exchange)
+    type(contact_state_t), intent(inout) :: contacts(:)
+    type(domain_exchange_t), intent(inout) :: exchange
+    real(wp) :: records(1)
+    integer :: r, total
+    if (exchange%rank_count == 1 .or. size(contacts) == 0) return
+    ! (the wait for the rank with the most pairs apart from the exchange, as for the forces)
+    call start_phase(exchange%wait_timer)
+    call barrier_ranks()
+    call stop_phase(exchange%wait_timer)
+    call start_phase(exchange%contact_timer)
+    records(1) = real(pair_record_count(contacts), wp)
+    if (size(exchange%pair_send) < pair_record_size*nint(records(1))) then
+      deallocate (exchange%pair_send)
+      allocate (exchange%pair_send(2*pair_record_size*nint(records(1))))
+    end if
+    call pack_pair_records(contacts, exchange%pair_send)
+    call gather_fixed_reals(records, exchange%record_counts)
+    exchange%pair_value_counts = pair_record_size*nint(exchange%record_counts(1, :))
+    exchange%rank_pair_records = exchange%rank_pair_records + exchange%record_counts(1, :)
+    exchange%pair_value_offsets(1) = 0
+    do r = 2, exchange%rank_count
+      exchange%pair_value_offsets(r) = exchange%pair_value_offsets(r - 1) + exchange%pair_value_counts(r - 1)
+    end do
+    total = sum(exchange%pair_value_counts)
+    if (size(exchange%pair_receive) < total) then
+      deallocate (exchange%pair_receive)
+      allocate (exchange%pair_receive(2*total))
+    end if
+    call gather_reals(exchange%pair_send, exchange%pair_value_counts, exchange%pair_value_offsets, &
+                      exchange%pair_receive)
+    call unpack_pair_records(contacts, exchange%pair_receive, total/pair_record_size)
+    exchange%pair_values = exchange%pair_values + real(total, wp)
+    call stop_phase(exchange%contact_timer)
+  end subroutine exchange_contact_pairs
 
   !> After the groups added their forces: every rank sends the nodal arrays the groups fill
   !> (forces; with rotations also moments and the shells' normal and area sums) at the nodes it

@@ -39,7 +39,7 @@ module explicit_solver
   use rigid_bodies, only: advance_rigid_bodies
   use spot_weld_constraints, only: advance_spot_welds
   use tied_contact, only: distribute_tied_nodes, follow_segments
-  use penalty_contact, only: compute_contact_forces, report_initial_penetrations
+  use penalty_contact, only: find_contact_pairs, apply_contact_pairs, report_initial_penetrations
   use energy_balance, only: measured_energies, total_energy
   use run_checks, only: set_up_run_checks, check_runaway_motion, check_elements, check_time_step, check_energy, &
                         energy_check_interval
@@ -47,7 +47,8 @@ module explicit_solver
   use run_summary, only: run_summary_t
   use text_format, only: integer_text
   use wall_clock, only: start_phase, stop_phase
-  use domain_exchange, only: exchange_internal_forces, combine_group_headers, gather_block_energies
+  use domain_exchange, only: domain_exchange_t, exchange_internal_forces, combine_group_headers, &
+                             gather_block_energies, exchange_contact_pairs
   use rank_communication, only: largest_over_ranks
   implicit none
   private
@@ -137,7 +138,7 @@ contains
     call erode_elements(model, run%state)
     call stop_phase(run%timers(phase_erosion))
     call start_phase(run%timers(phase_contact))
-    call contact_forces(model, run%state, step)
+    call contact_forces(model, run%state, run%exchange, step)
     call stop_phase(run%timers(phase_contact))
     call start_phase(run%timers(phase_external_forces))
     call external_forces(model, run%state, step)
@@ -368,21 +369,29 @@ contains
   !> A v, and their forces f on those come back to the generalized unknowns as A^T f (the
   !> groups' to_physical and forces_to_generalized; consistent, and momentum is kept because the
   !> rows of A sum to one). Contact energy is the work on the physical motion, which A^T makes
-  !> the same as on the generalized one.
-  subroutine contact_forces(model, state, step)
+  !> the same as on the generalized one. A distributed run computes the pairs of the nodes each
+  !> rank owns and exchanges them before the forces are added (domain_exchange).
+  subroutine contact_forces(model, state, exchange, step)
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(inout) :: state
+    type(domain_exchange_t), intent(inout) :: exchange
     real(wp), intent(in) :: step
-    real(wp) :: work
+    real(wp) :: work, work_before
     integer :: k
     if (size(state%contacts) == 0) return
     if (.not. any(state%nodes%is_particle)) then
-      call compute_contact_forces(model, state%contacts, state%time, step, state%nodes%coordinates, &
-                                  state%nodes%velocity, state%nodes%mass, state%nodes%contact_force, work)
+      call find_contact_pairs(model, state%contacts, state%time, step, state%nodes%coordinates, &
+                              state%nodes%velocity, state%nodes%mass, work_before, exchange%rank, exchange%rank_count)
+      call exchange_contact_pairs(state%contacts, exchange)
+      call apply_contact_pairs(state%contacts, step, state%nodes%velocity, state%nodes%contact_force, &
+                               work_before, work)
     else
       call physical_contact_values(state)
-      call compute_contact_forces(model, state%contacts, state%time, step, state%contact_coordinates, &
-                                  state%contact_velocity, state%nodes%mass, state%nodes%contact_force, work)
+      call find_contact_pairs(model, state%contacts, state%time, step, state%contact_coordinates, &
+                              state%contact_velocity, state%nodes%mass, work_before, exchange%rank, exchange%rank_count)
+      call exchange_contact_pairs(state%contacts, exchange)
+      call apply_contact_pairs(state%contacts, step, state%contact_velocity, state%nodes%contact_force, &
+                               work_before, work)
       state%contact_physical_force = state%nodes%contact_force
       do k = 1, size(state%groups)
         call state%groups(k)%group%forces_to_generalized(state%contact_physical_force, state%nodes%contact_force)

@@ -75,9 +75,19 @@ def solver(ranks, arguments, threads=1, timeout=300.0):
 
 
 def run(deck, output, ranks, threads=1):
+    """The results file of the run; its standard output is kept beside it (stdout.txt)."""
     process = solver(ranks, [f"i={deck}", f"outdir={output}"], threads)
     assert process.returncode == 0, f"-np {ranks} ncpu={threads}:\n" + process.stdout + process.stderr
+    (output / "stdout.txt").write_text(process.stdout)
     return output / "results.h5"
+
+
+def contact_pairs_per_rank(output):
+    """The first rank's count of the contact pairs each rank found over the run (its last print)."""
+    marker = "contact pairs found per rank over the run:"
+    lines = [line for line in (output / "stdout.txt").read_text().splitlines() if marker in line]
+    assert lines, f"no '{marker}' in {output / 'stdout.txt'}"
+    return [int(value) for value in lines[-1].split(marker)[1].split()]
 
 
 def results_difference(reference_path, other_path):
@@ -147,6 +157,10 @@ def test_contact_model_is_identical_on_one_two_and_three_ranks(tmp_path):
     bounced."""
     deck = shortened(contact_deck(tmp_path / "contact.k"))
     reference = assert_same_on_every_rank_count(deck, tmp_path)
+    # the ranks shared the contact pairs out (each computed some), yet the forces are the same
+    for ranks in [count for count in RANK_COUNTS if count > 1]:
+        pairs = contact_pairs_per_rank(tmp_path / f"np{ranks}_ncpu1")
+        assert len(pairs) == ranks and min(pairs) > 0, pairs
     with h5py.File(reference, "r") as results:
         assert np.abs(results["history/rcforc/12/force"][...][:, 2]).max() > 0.0
         assert results["history/glstat/contact_energy"][...].max() > 0.0
