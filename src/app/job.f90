@@ -11,7 +11,7 @@ module job
   use model, only: model_t, formulation_efg
   use deck_reader, only: read_deck
   use explicit_state, only: explicit_state_t
-  use run_state, only: run_state_t
+  use run_state, only: run_state_t, phase_internal_forces, phase_contact
   use explicit_setup, only: set_up_run_state, set_up_warnings
   use explicit_run, only: run_explicit
   use domain_partition, only: domain_partition_t, partition_domains, partition_text
@@ -196,7 +196,7 @@ contains
     call close_results(results, summary, close_error)
     if (allocated(close_error)) exit_status = 1
     call print_summary(summary, settings, model%implicit_static)
-    if (run%exchange%rank_count > 1) call print_exchange_summary(run, summary%cycles)
+    if (run%exchange%rank_count > 1) call print_exchange_summary(run, summary)
     flush (output_unit)
     if (allocated(error)) call report("crashfree: error termination: "//error%message, messages)
     ! last: what the results file holds after a failed write
@@ -378,13 +378,14 @@ contains
 
   !> A distributed run: the seconds of the exchanges among the ranks (the first rank's), per
   !> cycle, and the forces' volume.
-  subroutine print_exchange_summary(run, cycles)
+  subroutine print_exchange_summary(run, summary)
     type(run_state_t), intent(in) :: run
-    integer, intent(in) :: cycles
+    type(run_summary_t), intent(in) :: summary
     character(len=240) :: line
     character(len=:), allocatable :: counts
     real(wp) :: per_cycle
-    integer :: r
+    integer :: r, cycles
+    cycles = summary%cycles
     per_cycle = 1.0e3_wp/real(max(1, cycles), wp)
     write (line, '(a,i0,a,f0.3,a,f0.1,a,f0.3,a)') "  MPI: ", run%exchange%rank_count, &
       " ranks; force exchange ", per_cycle*run%exchange%timer%seconds, " ms per cycle (", &
@@ -396,6 +397,17 @@ contains
       " times (energy checks, histories): ", run%exchange%gather_timer%seconds, " s, ", &
       8.0e-6_wp*run%exchange%gathered_values, " MB received"
     write (*, '(a)') trim(line)
+    ! every rank's seconds: where the balance is lost
+    if (allocated(summary%rank_seconds)) then
+      write (*, '(a)') "  MPI: seconds per rank   internal forces    contact   force exchange    waiting   all phases"
+      associate (seconds => summary%rank_seconds)
+        do r = 1, size(seconds, 2)
+          write (line, '(i22,5f11.3)') r - 1, seconds(phase_internal_forces, r), seconds(phase_contact, r), &
+            seconds(size(seconds, 1) - 1, r), seconds(size(seconds, 1), r), sum(seconds(:, r))
+          write (*, '(a)') trim(line)
+        end do
+      end associate
+    end if
     if (size(run%state%contacts) == 0) return
     write (line, '(a,f0.3,a,f0.1,a)') "  MPI: contact pair exchange ", per_cycle*run%exchange%contact_timer%seconds, &
       " ms per cycle (", 8.0e-3_wp*run%exchange%pair_values/real(max(1, cycles), wp), " kB to each rank per cycle)"

@@ -71,6 +71,11 @@ module run_summary
     !> seconds of each phase of the explicit cycle (/timing phase_<name>_s; none for a static run)
     character(len=16), allocatable :: phase_names(:)
     real(wp), allocatable :: phase_seconds(:)
+    !> a distributed run: every rank's seconds (rank_column_names' columns, ranks): the phases,
+    !> then the force exchange and the wait for the slowest rank before it (outside the phases;
+    !> the contact phase holds its pair exchange and the wait before it)
+    character(len=24), allocatable :: rank_column_names(:)
+    real(wp), allocatable :: rank_seconds(:, :)
     type(partition_summary_t) :: partition       !< MPI domains (one rank: rank_count 1, nothing else)
   end type run_summary_t
 end module run_summary

@@ -1606,6 +1606,11 @@ contains
                                   summary%phase_seconds(entry), error)
       end do
     end if
+    ! a distributed run: each rank's (row = rank), to see the balance
+    if (allocated(summary%rank_seconds)) then
+      call write_real_dataset_2d(group_id, "/timing", "rank_seconds", summary%rank_seconds, error)
+      call write_string_dataset(group_id, "rank_column_names", summary%rank_column_names, error)
+    end if
     call write_long_attribute(group_id, "/timing", "output_bytes", results%output_bytes, error)
     call write_integer_attribute(group_id, "/timing", "xdmf_writes", results%xdmf_writes, error)
     call h5gclose_f(group_id, status)

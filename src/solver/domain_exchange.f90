@@ -63,6 +63,7 @@ module domain_exchange
     real(wp), allocatable :: pair_send(:), pair_receive(:), record_counts(:, :)
     integer, allocatable :: pair_value_counts(:), pair_value_offsets(:)
     type(phase_timer_t) :: contact_timer        !< wall-clock time of the pair exchange
+    type(phase_timer_t) :: contact_wait_timer   !< of the wait for the slowest rank before it
     real(wp) :: pair_values = 0.0_wp            !< values received by the pair exchanges, in all
     real(wp), allocatable :: rank_pair_records(:)   !< per rank, the pair records it sent, in all
   end type domain_exchange_t
@@ -132,9 +133,9 @@ contains
     integer :: r, total
     if (exchange%rank_count == 1 .or. size(contacts) == 0) return
     ! (the wait for the rank with the most pairs apart from the exchange, as for the forces)
-    call start_phase(exchange%wait_timer)
+    call start_phase(exchange%contact_wait_timer)
     call barrier_ranks()
-    call stop_phase(exchange%wait_timer)
+    call stop_phase(exchange%contact_wait_timer)
     call start_phase(exchange%contact_timer)
     records(1) = real(pair_record_count(contacts), wp)
     if (size(exchange%pair_send) < pair_record_size*nint(records(1))) then

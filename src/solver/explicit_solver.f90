@@ -27,7 +27,7 @@ module explicit_solver
   use error_handling, only: error_t
   use model, only: model_t
   use explicit_state, only: explicit_state_t
-  use run_state, only: run_state_t, phase_velocities, phase_constraints, phase_walls, phase_rigid_bodies, &
+  use run_state, only: run_state_t, phase_count, phase_velocities, phase_constraints, phase_walls, phase_rigid_bodies, &
                        phase_positions, phase_internal_forces, phase_contact, phase_external_forces, &
                        phase_accelerations, phase_time_step, phase_checks, phase_output, phase_erosion, phase_names
   use element_groups, only: compute_internal_forces, smallest_group_step, eroded_element_masks
@@ -49,7 +49,7 @@ module explicit_solver
   use wall_clock, only: start_phase, stop_phase
   use domain_exchange, only: domain_exchange_t, exchange_internal_forces, combine_group_headers, &
                              gather_block_energies, exchange_contact_pairs
-  use rank_communication, only: largest_over_ranks
+  use rank_communication, only: largest_over_ranks, gather_fixed_reals
   implicit none
   private
 
@@ -547,9 +547,10 @@ contains
     call stop_phase(run%timers(phase_checks))
   end subroutine check_distortion
 
-  !> The run summary's times (per element kind, contact with the walls, output) and the
-  !> distortion record. (The groups' counts went in before the run, describe_model of job; their
-  !> times are added here.)
+  !> The run summary's times (per element kind, contact with the walls, output; with several
+  !> ranks every rank's phases, brought to all: every rank must call this) and the distortion
+  !> record. (The groups' counts went in before the run, describe_model of job; their times are
+  !> added here.)
   subroutine summarise(model, run, summary)
     type(model_t), intent(in) :: model
     type(run_state_t), intent(in) :: run
@@ -564,6 +565,13 @@ contains
     summary%output_s = run%timers(phase_output)%seconds
     summary%phase_names = phase_names
     summary%phase_seconds = run%timers%seconds
+    ! a distributed run: every rank's seconds, for the balance (the first rank prints and writes)
+    if (run%exchange%rank_count > 1) then
+      allocate (summary%rank_seconds(phase_count + 2, run%exchange%rank_count))
+      call gather_fixed_reals([run%timers%seconds, run%exchange%timer%seconds, run%exchange%wait_timer%seconds], &
+                              summary%rank_seconds)
+      summary%rank_column_names = [character(len=24) :: phase_names, "force_exchange", "force_exchange_wait"]
+    end if
     summary%tangled_solids = run%distortion%tangled
     summary%worst_corner_jacobian_ratio = run%distortion%worst_ratio
     if (run%distortion%worst_element > 0) &

@@ -161,6 +161,11 @@ def test_contact_model_is_identical_on_one_two_and_three_ranks(tmp_path):
     for ranks in [count for count in RANK_COUNTS if count > 1]:
         pairs = contact_pairs_per_rank(tmp_path / f"np{ranks}_ncpu1")
         assert len(pairs) == ranks and min(pairs) > 0, pairs
+        # every rank's phase seconds, a row per rank, for the balance
+        with h5py.File(tmp_path / f"np{ranks}_ncpu1" / "results.h5", "r") as results:
+            names = [name.decode() for name in results["timing/rank_column_names"][...]]
+            assert results["timing/rank_seconds"].shape == (ranks, len(names))
+            assert {"internal_forces", "contact", "force_exchange", "force_exchange_wait"} <= set(names)
     with h5py.File(reference, "r") as results:
         assert np.abs(results["history/rcforc/12/force"][...][:, 2]).max() > 0.0
         assert results["history/glstat/contact_energy"][...].max() > 0.0
