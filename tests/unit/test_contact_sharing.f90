@@ -1,0 +1,230 @@
+!> Contact pairs shared out over ranks (penalty_contact: find_contact_pairs, share_out_pairs,
+!> pack_pair_records, unpack_pair_records, apply_contact_pairs), with the ranks played in one
+!> process: three copies of the contact state, each computing its share, their pair records
+!> concatenated in rank order as MPI_Allgatherv would, every copy unpacking them and adding the
+!> forces. A block of 3 x 3 hexahedra is pushed into a block of 4 x 4, slid across it with
+!> friction and lifted off at once; the bucket search is redone every other cycle (NSBCS 2) and
+!> as the blocks move, so that the ranks' shares move and pairs change hands (also in the cycle
+!> that ends them). At every cycle each copy must hold exactly the one-rank pairs
+!> (segment, side, depth, initial depth, weights, force, friction spring), contact forces,
+!> contact force sums and energy, bit for bit, and the shares must cover the secondary nodes
+!> once.
+program test_contact_sharing
+  use kinds, only: wp
+  use testing, only: test_suite_t, check, finish_suite
+  use fixtures, only: make_scratch_directory
+  use error_handling, only: error_t, error_list_t
+  use model, only: model_t
+  use deck_reader, only: read_deck
+  use penalty_contact, only: contact_state_t, set_up_contacts, find_contact_pairs, apply_contact_pairs, &
+                             pair_record_count, pack_pair_records, unpack_pair_records, pair_record_size
+  implicit none
+
+  integer, parameter :: rank_count = 3, cycles = 60
+  real(wp), parameter :: step = 0.02_wp
+  type(test_suite_t) :: suite
+  character(len=:), allocatable :: directory
+
+  suite%name = "contact_sharing"
+  directory = make_scratch_directory("crashfree_test_contact_sharing")
+  call test_ranks_hold_the_one_rank_pairs()
+  call finish_suite(suite)
+
+contains
+
+  subroutine test_ranks_hold_the_one_rank_pairs()
+    type(model_t) :: model
+    type(contact_state_t), allocatable :: alone(:), ranks(:, :)
+    real(wp), allocatable :: x(:, :), v(:, :), mass(:), force(:, :), rank_force(:, :, :), buffer(:)
+    real(wp) :: work_before, energy, rank_energy(rank_count), rank_work_before(rank_count), moved(3), velocity(3)
+    integer :: cycle, r, records, at, node, upper_first, handled_total, pairs_seen
+    integer :: changed_hands, previous_first(rank_count)
+    logical :: same, covered, all_same, all_covered, ranks_busy(rank_count)
+    type(error_t), allocatable :: error
+    logical, allocatable :: is_particle(:)
+
+    if (.not. read_model("blocks.k", blocks_deck(upper_first), model)) return
+    allocate (is_particle(size(model%node_ids)))
+    is_particle = .false.
+    call set_up_contacts(model, is_particle, alone, error)
+    call check(suite, "the single surface contact is set up", .not. allocated(error))
+    if (allocated(error)) return
+    allocate (ranks(size(alone), rank_count))
+    do r = 1, rank_count
+      ranks(:, r) = alone
+    end do
+    x = model%coordinates
+    allocate (v(3, size(x, 2)), mass(size(x, 2)), force(3, size(x, 2)), rank_force(3, size(x, 2), rank_count))
+    v = 0.0_wp
+    mass = [(1.0_wp + 0.01_wp*mod(node, 7), node=1, size(x, 2))]
+    allocate (buffer(pair_record_size))
+    all_same = .true.
+    all_covered = .true.
+    ranks_busy = .false.
+    pairs_seen = 0
+    changed_hands = 0
+    previous_first = 0
+    do cycle = 1, cycles
+      ! the upper block comes down 0.005 a cycle from 0.05 above, then slides along x, each of
+      ! its nodes a little differently (no symmetry to hide a wrong pair)
+      velocity = [merge(2.0_wp, 0.0_wp, cycle > 20), 0.1_wp, merge(-0.25_wp, 0.0_wp, cycle <= 30)]
+      do node = upper_first, size(x, 2)
+        moved = step*velocity*(1.0_wp + 0.01_wp*sin(real(node, wp)))
+        x(:, node) = x(:, node) + moved
+        v(:, node) = moved/step
+        ! at cycle 50 it is lifted off at once: every pair goes in the same cycle as the searches
+        ! hand the nodes to other ranks (a rank must not keep a pair it no longer computes)
+        if (cycle == 50) x(3, node) = x(3, node) + 3.0_wp
+      end do
+      call find_contact_pairs(model, alone, 0.0_wp, step, x, v, mass, work_before)
+      call apply_contact_pairs(alone, step, v, force, work_before, energy)
+      ! the ranks: their shares, the records gathered in rank order, every rank unpacking all
+      records = 0
+      do r = 1, rank_count
+        call find_contact_pairs(model, ranks(:, r), 0.0_wp, step, x, v, mass, rank_work_before(r), r - 1, rank_count)
+        records = records + pair_record_count(ranks(:, r))
+      end do
+      if (size(buffer) < pair_record_size*records) then
+        deallocate (buffer)
+        allocate (buffer(pair_record_size*records))
+      end if
+      at = 0
+      do r = 1, rank_count
+        associate (sent => pair_record_count(ranks(:, r)))
+          if (sent > 0) ranks_busy(r) = .true.
+          call pack_pair_records(ranks(:, r), buffer(at + 1:))
+          at = at + pair_record_size*sent
+        end associate
+      end do
+      do r = 1, rank_count
+        call unpack_pair_records(ranks(:, r), buffer, records)
+        call apply_contact_pairs(ranks(:, r), step, v, rank_force(:, :, r), rank_work_before(r), rank_energy(r))
+      end do
+      pairs_seen = max(pairs_seen, count(alone(1)%passes(1)%pair_segment > 0))
+      associate (alone_pass => alone(1)%passes(1))
+        handled_total = 0
+        covered = .true.
+        do r = 1, rank_count
+          associate (pass => ranks(1, r)%passes(1))
+            same = all(pass%pair_segment == alone_pass%pair_segment) .and. &
+                   all(pass%pair_side == alone_pass%pair_side) .and. &
+                   all(pass%pair_depth == alone_pass%pair_depth) .and. &
+                   all(pass%initial_depth == alone_pass%initial_depth) .and. &
+                   all(pass%pair_weights == alone_pass%pair_weights) .and. &
+                   all(pass%pair_force == alone_pass%pair_force) .and. &
+                   all(pass%tangential == alone_pass%tangential) .and. &
+                   all(rank_force(:, :, r) == force) .and. rank_energy(r) == energy .and. &
+                   all(ranks(1, r)%force == alone(1)%force) .and. all(ranks(1, r)%impulse == alone(1)%impulse)
+            all_same = all_same .and. same
+            if (.not. same) call check(suite, "rank "//achar(47 + r)//" differs from one rank at cycle "// &
+                                       cycle_text(cycle), .false.)
+            handled_total = handled_total + size(pass%handled)
+            if (size(pass%handled) > 0) then
+              if (previous_first(r) /= 0 .and. pass%handled(1) /= previous_first(r)) changed_hands = changed_hands + 1
+              previous_first(r) = pass%handled(1)
+            end if
+          end associate
+        end do
+        covered = handled_total == alone_pass%node_count
+        all_covered = all_covered .and. covered
+      end associate
+      if (.not. all_same) exit
+    end do
+    call check(suite, "three ranks hold the one-rank pairs, contact forces and energy at every cycle, bit for bit", &
+               all_same)
+    call check(suite, "the ranks' shares cover the secondary nodes once at every cycle", all_covered)
+    call check(suite, "the blocks were in contact (more than 9 pairs at once), and apart at the end", &
+               pairs_seen > 9 .and. all(alone(1)%passes(1)%pair_segment == 0))
+    call check(suite, "every rank found pairs", all(ranks_busy))
+    call check(suite, "the shares moved between ranks as the searches were redone", changed_hands > 0)
+  end subroutine test_ranks_hold_the_one_rank_pairs
+
+  !> Two blocks of unit hexahedra (part 1: 4 x 4 x 1 from z = 0; part 2: 3 x 3 x 1 from
+  !> z = 1.05, over the middle), one single surface contact with friction, NSBCS 2;
+  !> `upper_first`: the first node of the upper block.
+  function blocks_deck(upper_first) result(lines)
+    integer, intent(out) :: upper_first
+    character(len=80), allocatable :: lines(:)
+    integer :: i, j, k, e, n
+    lines = [character(len=80) :: "*KEYWORD", "*CONTROL_TERMINATION", "1.0", "*CONTROL_CONTACT", "0.1", &
+             "0,0,2", "*PART", "lower", "1,1,1", "*PART", "upper", "2,1,1", "*SECTION_SOLID", "1,1", &
+             "*MAT_ELASTIC", "1,1.0e-6,1.0,0.3", "*CONTACT_AUTOMATIC_SINGLE_SURFACE", "0,0,5", "0.3,0.2", "", &
+             "*NODE"]
+    do k = 0, 1
+      do j = 0, 4
+        do i = 0, 4
+          lines = [character(len=80) :: lines, node_line(1 + i + 5*j + 25*k, real([i, j, k], wp))]
+        end do
+      end do
+    end do
+    upper_first = 51
+    do k = 0, 1
+      do j = 0, 3
+        do i = 0, 3
+          lines = [character(len=80) :: lines, node_line(upper_first + i + 4*j + 16*k, &
+                                                         [0.5_wp + i, 0.5_wp + j, 1.05_wp + k])]
+        end do
+      end do
+    end do
+    lines = [character(len=80) :: lines, "*ELEMENT_SOLID"]
+    e = 0
+    do j = 0, 3
+      do i = 0, 3
+        e = e + 1
+        n = 1 + i + 5*j
+        lines = [character(len=80) :: lines, element_line(e, 1, [n, n + 1, n + 6, n + 5, n + 25, n + 26, n + 31, &
+                                                                 n + 30])]
+      end do
+    end do
+    do j = 0, 2
+      do i = 0, 2
+        e = e + 1
+        n = upper_first + i + 4*j
+        lines = [character(len=80) :: lines, element_line(e, 2, [n, n + 1, n + 5, n + 4, n + 16, n + 17, n + 21, &
+                                                                 n + 20])]
+      end do
+    end do
+    lines = [character(len=80) :: lines, "*END"]
+  end function blocks_deck
+
+  logical function read_model(name, lines, model)
+    character(len=*), intent(in) :: name, lines(:)
+    type(model_t), intent(out) :: model
+    type(error_list_t) :: warnings
+    type(error_t), allocatable :: error
+    integer :: unit, k
+    open (newunit=unit, file=directory//"/"//name, status="replace", action="write")
+    do k = 1, size(lines)
+      write (unit, '(a)') trim(lines(k))
+    end do
+    close (unit)
+    call read_deck(directory//"/"//name, model, warnings, error, .false.)
+    read_model = .not. allocated(error)
+    if (allocated(error)) call check(suite, name//" is accepted", .false., error%message)
+  end function read_model
+
+  function cycle_text(value) result(text)
+    integer, intent(in) :: value
+    character(len=:), allocatable :: text
+    character(len=12) :: buffer
+    write (buffer, '(i0)') value
+    text = trim(buffer)
+  end function cycle_text
+
+  function node_line(id, position) result(line)
+    integer, intent(in) :: id
+    real(wp), intent(in) :: position(3)
+    character(len=80) :: line
+    write (line, '(i0,3(",",es16.8))') id, position
+  end function node_line
+
+  function element_line(id, part, nodes) result(line)
+    integer, intent(in) :: id, part, nodes(:)
+    character(len=80) :: line
+    integer :: k
+    write (line, '(i0,",",i0)') id, part
+    do k = 1, size(nodes)
+      write (line, '(a,",",i0)') trim(line), nodes(k)
+    end do
+  end function element_line
+end program test_contact_sharing
