@@ -18,11 +18,39 @@ STAGE_1_REALS = {False: 3, True: 10}
 
 
 def cycle_seconds(path):
-    """Seconds of the cycle's phases (output excluded), cycles, elements."""
+    """Seconds of the cycle's phases (output excluded), cycles, elements. With several ranks, the
+    slowest rank's phases and its force exchange with the wait before it (outside the phases)."""
     with h5py.File(path, "r") as results:
         timing = results["timing"].attrs
         phases = sum(float(timing[name]) for name in timing if name.startswith("phase_") and name != "phase_output_s")
+        if "rank_seconds" in results["timing"]:
+            names = [name.decode() for name in results["timing/rank_column_names"][...]]
+            rows = results["timing/rank_seconds"][...]
+            phases = max(sum(value for name, value in zip(names, row) if name != "output") for row in rows)
         return phases, int(timing["cycles"]), int(timing["fe_elements"])
+
+
+def print_phase_shares(path, cycles):
+    """Milliseconds per cycle of the force, contact and other phases; with several ranks, each
+    rank's (/timing/rank_seconds: what the first rank's clocks alone do not show)."""
+    with h5py.File(path, "r") as results:
+        timing = results["timing"]
+        if "rank_seconds" in timing:
+            names = [name.decode() for name in timing["rank_column_names"][...]]
+            rows = timing["rank_seconds"][...]
+        else:
+            names = [name[len("phase_"):-len("_s")] for name in timing.attrs if name.startswith("phase_")]
+            rows = np.array([[float(timing.attrs[f"phase_{name}_s"]) for name in names]])
+    column = {name: k for k, name in enumerate(names)}
+    exchange = [column[name] for name in ("force_exchange", "force_exchange_wait") if name in column]
+    others = [k for name, k in column.items() if name not in ("internal_forces", "contact", "output")
+              and k not in exchange]
+    print(f"{'':>8}{'rank':>6} {'internal forces':>16} {'contact':>9} {'force exchange + wait':>22} "
+          f"{'other phases':>13}   (ms per cycle)")
+    for rank, row in enumerate(rows):
+        scale = 1e3 / max(cycles, 1)
+        print(f"{'':>8}{rank:>6} {scale * row[column['internal_forces']]:>16.1f} {scale * row[column['contact']]:>9.1f} "
+              f"{scale * sum(row[k] for k in exchange):>22.1f} {scale * sum(row[k] for k in others):>13.1f}")
 
 
 def main():
@@ -41,6 +69,7 @@ def main():
             single = per_cycle
         efficiency = f"{single / (ranks * per_cycle):.2f}" if single else "-"
         print(f"{ranks:>6} {cycles:>7} {per_cycle:>12.4f} {1e9 * per_cycle / elements:>25.1f} {efficiency:>11}")
+        print_phase_shares(path, cycles)
         log = directory / f"ranks_{ranks}.log"
         if ranks > 1 and log.exists():
             for line in log.read_text().splitlines():
