@@ -12,9 +12,9 @@ import numpy as np
 
 # what a stage-2 neighbour exchange would send per interface node: its force and moment (6 reals)
 DOUBLES_PER_NODE = 6
-# what stage 1's allgatherv sends per owned node (domain_exchange): 3 force components, 10 with
-# shell nodes (moments, the normal and area sums)
-STAGE_1_REALS = {False: 3, True: 10}
+# what stage 1's allgatherv sends per owned node (domain_exchange): 3 force components, 10 at the
+# nodes of shells and beams (moments, the normal and area sums)
+FORCE_REALS, MOMENT_REALS = 3, 10
 
 
 def cycle_seconds(path):
@@ -73,7 +73,7 @@ def main():
         log = directory / f"ranks_{ranks}.log"
         if ranks > 1 and log.exists():
             for line in log.read_text().splitlines():
-                if line.strip().startswith("MPI:"):
+                if line.strip().startswith("MPI:") and "seconds per rank" not in line:
                     print("        " + line.strip())
 
     print()
@@ -91,9 +91,18 @@ def main():
             owned = partition["rank_owned_nodes"][()]
             interface = partition["rank_interface_nodes"][()]
             nodes = owned.sum()
-            shells = "mesh/shells" in results and len(results["mesh/shells/ids"]) > 0
-            # stage 1: each rank receives every other rank's owned nodes (allgatherv)
-            stage_1 = (nodes - owned.min()) * STAGE_1_REALS[shells] * 8 / 1024
+            owner = partition["node_rank"][()]
+            moment_nodes = np.zeros(len(owner), dtype=bool)
+            if "mesh/shells" in results:
+                ids = results["mesh/nodes/ids"][()]
+                order = np.argsort(ids)
+                shell_nodes = results["mesh/shells/connectivity"][()].ravel()
+                moment_nodes[order[np.searchsorted(ids[order], shell_nodes)]] = True
+            reals = np.where(moment_nodes, MOMENT_REALS, FORCE_REALS)
+            # stage 1: each rank receives every other rank's owned nodes (allgatherv); the rank
+            # owning the fewest values receives the most
+            owned_reals = np.bincount(owner, weights=reals, minlength=ranks)
+            stage_1 = (reals.sum() - owned_reals.min()) * 8 / 1024
             stage_2 = interface.max() * DOUBLES_PER_NODE * 8 / 1024
             print(f"{ranks:>6} {partition.attrs['imbalance']:>9.3f} {partition.attrs['computed_imbalance']:>11.3f} "
                   f"{blocks.mean():>11.1f} {ghosts.mean():>10.1f} {ghosts.max():>9d} {owned.mean():>11.0f} "

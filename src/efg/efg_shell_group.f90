@@ -66,7 +66,7 @@ module efg_shell_group
     procedure :: thinnest
     procedure :: raise_nodal_plastic_strain
     procedure :: list_time_steps
-    procedure :: distributes_blocks
+    procedure :: distributes_blocks, adds_moments
     procedure :: exchange_block_state
     procedure :: exchange_block_energies
   end type efg_shell_group_t
@@ -545,6 +545,11 @@ contains
     class(efg_shell_group_t), intent(in) :: self
     distributes_blocks = .true.
   end function distributes_blocks
+
+  logical function adds_moments(self)
+    class(efg_shell_group_t), intent(in) :: self
+    adds_moments = .true.
+  end function adds_moments
 
   !> One cell block's state (a store in memory: the ranks of a distributed run bring their
   !> blocks together): its entries of the part's per-block step arrays, its stresses, history,

@@ -181,6 +181,10 @@ module element_group
     !> Optional, with distributes_blocks: the same for what add_energies and add_part_energies
     !> read of one block (energies and powers), all that the energy checks and histories need.
     procedure :: exchange_block_energies
+    !> Optional: whether its force call adds moments, shell normals or areas at the nodes of its
+    !> blocks (shells, beams, meshfree shells; default: no). A distributed run exchanges those
+    !> only at such nodes (forces alone elsewhere).
+    procedure :: adds_moments
     !> Whether this rank computes, or owns, block `block` (always, when not distributed).
     procedure, non_overridable :: computes, owns
   end type element_group_t
@@ -336,6 +340,11 @@ contains
     class(element_group_t), intent(in) :: self
     distributes_blocks = .false.
   end function distributes_blocks
+
+  logical function adds_moments(self)
+    class(element_group_t), intent(in) :: self
+    adds_moments = .false.
+  end function adds_moments
 
   subroutine exchange_block_state(self, store, block, error)
     class(element_group_t), intent(inout) :: self

@@ -46,7 +46,7 @@ module shell_group
     procedure :: describe
     procedure :: add_to_summary
     procedure :: exchange_state
-    procedure :: distributes_blocks
+    procedure :: distributes_blocks, adds_moments
     procedure :: exchange_block_state
     procedure :: exchange_block_energies
     procedure :: failure_text
@@ -487,6 +487,11 @@ contains
     class(shell_group_t), intent(in) :: self
     distributes_blocks = .true.
   end function distributes_blocks
+
+  logical function adds_moments(self)
+    class(shell_group_t), intent(in) :: self
+    adds_moments = .true.
+  end function adds_moments
 
   !> One block's state and its entries of the per-block step arrays (a store in memory: the
   !> ranks of a distributed run bring their blocks together).

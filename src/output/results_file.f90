@@ -1573,9 +1573,11 @@ contains
     character(len=*), parameter :: count_names(13) = [character(len=19) :: "cycles", "threads", &
       "fe_elements", "efg_particles", "dofs_total", "dofs_efg", "fe_solids", "fe_shells", "fe_beams", "failed_beams", &
       "efg_shell_cells", "efg_shell_particles", "dofs_efg_shell"]
+    character(len=*), parameter :: rank_datasets(2) = [character(len=17) :: "rank_seconds", "rank_column_names"]
     real(wp) :: seconds(11)
     integer :: counts(13), entry, status
     integer(hid_t) :: group_id
+    logical :: exists
 
     call create_group_path(results%file_id, "/timing", error)
     if (allocated(error)) return
@@ -1606,7 +1608,12 @@ contains
                                   summary%phase_seconds(entry), error)
       end do
     end if
-    ! a distributed run: each rank's (row = rank), to see the balance
+    ! a distributed run: each rank's (row = rank), to see the balance; a run continued from a
+    ! dump replaces those of the run before (on any number of ranks)
+    do entry = 1, size(rank_datasets)
+      call h5lexists_f(group_id, trim(rank_datasets(entry)), exists, status)
+      if (status == 0 .and. exists) call h5ldelete_f(group_id, trim(rank_datasets(entry)), status)
+    end do
     if (allocated(summary%rank_seconds)) then
       call write_real_dataset_2d(group_id, "/timing", "rank_seconds", summary%rank_seconds, error)
       call write_string_dataset(group_id, "rank_column_names", summary%rank_column_names, error)

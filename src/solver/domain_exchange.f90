@@ -45,7 +45,11 @@ module domain_exchange
     !> every rank's owned nodes, ascending, rank after rank: rank r's are
     !> rank_nodes(node_offsets(r + 1):node_offsets(r + 2) - 1)
     integer, allocatable :: rank_nodes(:), node_offsets(:)
-    integer :: values_per_node = 3              !< force; with rotations + moment, normal sum, area sum
+    !> where rank_nodes(k)'s values start in the receive buffer (0-based), and whether they hold
+    !> the moment, normal sum and area sum after the force (10 values; 3 at nodes that no group
+    !> adding moments touches: adds_moments)
+    integer, allocatable :: value_start(:)
+    logical, allocatable :: with_moments(:)
     integer, allocatable :: value_counts(:), value_offsets(:)   !< per rank, for the force exchange
     real(wp), allocatable :: send(:), receive(:)
     real(wp), allocatable :: header_send(:), header_receive(:, :)
@@ -79,7 +83,9 @@ contains
     type(domain_partition_t), intent(out) :: partition
     type(domain_exchange_t), intent(out) :: exchange
     type(error_t), allocatable, intent(out) :: error
-    integer :: k, r, node, filled
+    integer :: k, r, b, node, filled
+    logical, allocatable :: moment_node(:)
+    integer, allocatable :: block_nodes(:)
     exchange%rank = rank_index()
     exchange%rank_count = rank_total()
     ! (one rank: no partition, every block computed as always)
@@ -106,14 +112,32 @@ contains
         filled = filled + 1
       end do
     end do
-    exchange%values_per_node = merge(10, 3, nodes%rotational)
-    allocate (exchange%value_counts(exchange%rank_count), exchange%value_offsets(exchange%rank_count))
+    ! 10 values at the nodes of blocks that add moments, 3 (the force) elsewhere: on a model of
+    ! solids with a shell plate most nodes need only their force
+    allocate (moment_node(nodes%count))
+    moment_node = .false.
+    if (nodes%rotational) then
+      do k = 1, size(groups)
+        if (.not. groups(k)%group%adds_moments()) cycle
+        do b = 1, groups(k)%group%block_count()
+          call groups(k)%group%block_nodes(b, block_nodes)
+          moment_node(block_nodes) = .true.
+        end do
+      end do
+    end if
+    allocate (exchange%value_counts(exchange%rank_count), exchange%value_offsets(exchange%rank_count), &
+              exchange%value_start(size(exchange%rank_nodes)), exchange%with_moments(size(exchange%rank_nodes)))
+    filled = 0
     do r = 1, exchange%rank_count
-      exchange%value_counts(r) = exchange%values_per_node*(exchange%node_offsets(r + 1) - exchange%node_offsets(r))
-      exchange%value_offsets(r) = exchange%values_per_node*(exchange%node_offsets(r) - 1)
+      exchange%value_offsets(r) = filled
+      do k = exchange%node_offsets(r), exchange%node_offsets(r + 1) - 1
+        exchange%value_start(k) = filled
+        exchange%with_moments(k) = moment_node(exchange%rank_nodes(k))
+        filled = filled + merge(10, 3, exchange%with_moments(k))
+      end do
+      exchange%value_counts(r) = filled - exchange%value_offsets(r)
     end do
-    allocate (exchange%send(max(1, exchange%value_counts(exchange%rank + 1))), &
-              exchange%receive(exchange%values_per_node*size(exchange%rank_nodes)))
+    allocate (exchange%send(max(1, exchange%value_counts(exchange%rank + 1))), exchange%receive(max(1, filled)))
     allocate (exchange%header_send(header_values*size(groups)), &
               exchange%header_receive(header_values*size(groups), exchange%rank_count))
     allocate (exchange%pair_send(pair_record_size), exchange%pair_receive(pair_record_size), &
@@ -163,8 +187,9 @@ contains
   end subroutine exchange_contact_pairs
 
   !> After the groups added their forces: every rank sends the nodal arrays the groups fill
-  !> (forces; with rotations also moments and the shells' normal and area sums) at the nodes it
-  !> owns, complete there, and takes the others' at theirs. Every rank then holds the one-rank
+  !> (forces; at the nodes of groups that add moments also the moments and the shells' normal
+  !> and area sums, which are zero elsewhere on every rank) at the nodes it owns, complete
+  !> there, and takes the others' at theirs. Every rank then holds the one-rank
   !> arrays, bit for bit.
   subroutine exchange_internal_forces(nodes, exchange)
     type(nodal_state_t), intent(inout) :: nodes
@@ -175,13 +200,13 @@ contains
     call barrier_ranks()
     call stop_phase(exchange%wait_timer)
     call start_phase(exchange%timer)
-    first = exchange%node_offsets(exchange%rank + 1)
+    first = exchange%value_offsets(exchange%rank + 1)
     !$omp parallel do schedule(static) default(shared) private(k, node, at)
-    do k = first, exchange%node_offsets(exchange%rank + 2) - 1
+    do k = exchange%node_offsets(exchange%rank + 1), exchange%node_offsets(exchange%rank + 2) - 1
       node = exchange%rank_nodes(k)
-      at = (k - first)*exchange%values_per_node
+      at = exchange%value_start(k) - first
       exchange%send(at + 1:at + 3) = nodes%internal_force(:, node)
-      if (exchange%values_per_node > 3) then
+      if (exchange%with_moments(k)) then
         exchange%send(at + 4:at + 6) = nodes%internal_moment(:, node)
         exchange%send(at + 7:at + 9) = nodes%shell_normal_sum(:, node)
         exchange%send(at + 10) = nodes%shell_area_sum(node)
@@ -193,9 +218,9 @@ contains
     !$omp parallel do schedule(static) default(shared) private(k, node, at)
     do k = 1, size(exchange%rank_nodes)
       node = exchange%rank_nodes(k)
-      at = (k - 1)*exchange%values_per_node
+      at = exchange%value_start(k)
       nodes%internal_force(:, node) = exchange%receive(at + 1:at + 3)
-      if (exchange%values_per_node > 3) then
+      if (exchange%with_moments(k)) then
         nodes%internal_moment(:, node) = exchange%receive(at + 4:at + 6)
         nodes%shell_normal_sum(:, node) = exchange%receive(at + 7:at + 9)
         nodes%shell_area_sum(node) = exchange%receive(at + 10)
