@@ -2,7 +2,8 @@
 of the one-rank run bit for bit, for N = 1, 2, 3 ranks and with 2 threads per rank, on a contact
 model, a coupled meshfree / finite element model, the side-impact dummy (meshfree solids and
 meshfree shells coupled to FE shells, contact, rigid bodies), a shell model with elements that
-erode and a rigid-body model; the meshfree blocks are shared out among the ranks as the finite
+erode, a rigid-body model and spot welds that fail by plastic strain on FE and on meshfree
+shells (the coupled model also on 4 ranks); the meshfree blocks are shared out among the ranks as the finite
 elements' (the partition report's computed blocks); a run continued from a restart dump on another number of ranks gives the
 uninterrupted run's file, also after SIGTERM to mpirun (every rank stops after the same cycle). Every dataset and attribute is compared (test_threads'
 comparison) but /timing, the /run attributes that may differ between runs (threads, run_id)
@@ -471,3 +472,13 @@ def test_welds_failing_by_plastic_strain_are_identical_on_one_two_and_three_rank
         on_interfaces.update({(ranks, weld): why for weld, why in found.items() if weld in failures})
     print("failing welds on domain interfaces:", {key: why for key, why in on_interfaces.items() if "shells" in why})
     assert any("shells on ranks" in why for why in on_interfaces.values()), on_interfaces
+
+
+def test_meshfree_model_is_identical_on_four_ranks(tmp_path):
+    """test_threads' coupled EFG / FE bar on 4 ranks (the cheapest model of this file in which
+    each of 4 ranks computes blocks of every kind it has: solids and meshfree points; the others
+    were run on 4 ranks by hand, docs/parallel.md): the file of the run alone."""
+    deck = shortened(meshfree_deck(tmp_path / "meshfree.k"), 60)
+    assert_same_on_every_rank_count(deck, tmp_path, counts=(4,))
+    shared = assert_shared_out(tmp_path / "np4_ncpu1" / "results.h5", ["solid", "meshfree"])
+    print(f"4 ranks: blocks computed per rank {({kind: [int(count) for count in blocks] for kind, blocks in shared.items()})}")
