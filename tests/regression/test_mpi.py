@@ -482,3 +482,19 @@ def test_meshfree_model_is_identical_on_four_ranks(tmp_path):
     assert_same_on_every_rank_count(deck, tmp_path, counts=(4,))
     shared = assert_shared_out(tmp_path / "np4_ncpu1" / "results.h5", ["solid", "meshfree"])
     print(f"4 ranks: blocks computed per rank {({kind: [int(count) for count in blocks] for kind, blocks in shared.items()})}")
+
+
+def test_models_with_fewer_than_two_element_blocks_are_refused_with_one_rank_advised(tmp_path):
+    """More ranks than element blocks is refused (exit status 2, test above); a model of one block
+    (one hexahedron with point masses and a weld, test_spot_welds) or of none (two rigid cubes
+    and point masses: rigid bodies are in no block) is told to run on one rank, not "at most 1
+    ranks" or "at most 0 ranks". Checked with partition=2 (the same set-up without mpirun)."""
+    from test_spot_welds import merged_bodies_deck, weld_deck
+    one_block = weld_deck(tmp_path / "one_block.k", "*CONSTRAINED_SPOTWELD\n" + fields(1, 2, 4.0, 0.0))
+    rigid_only, _ = merged_bodies_deck(tmp_path / "rigid_only.k")
+    for deck, expected in ((one_block, "2 ranks are more than the model's 1 element block (elements: 1;"),
+                           (rigid_only, "2 ranks, but the model has no deformable element to share out")):
+        process = solver(None, [f"i={deck}", f"outdir={tmp_path / deck.stem}", "partition=2"])
+        assert process.returncode == 2, process.stdout + process.stderr
+        assert expected in process.stderr and "run it on one rank (without mpirun)" in process.stderr, process.stderr
+        assert "use at most" not in process.stderr, process.stderr
