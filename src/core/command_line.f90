@@ -216,13 +216,13 @@ contains
   !> they all stop.)
   integer function launched_rank_index()
     character(len=32) :: setting
-    integer :: length, status, index
+    integer :: length, status, process_index
     launched_rank_index = 0
     call get_environment_variable("OMPI_COMM_WORLD_RANK", setting, length, status)
     if (status /= 0) call get_environment_variable("PMI_RANK", setting, length, status)
     if (status /= 0) return
-    read (setting, *, iostat=status) index
-    if (status == 0 .and. index > 0) launched_rank_index = index
+    read (setting, *, iostat=status) process_index
+    if (status == 0 .and. process_index > 0) launched_rank_index = process_index
   end function launched_rank_index
 
   !> A program built without MPI (`mpi_built` false) that an MPI launcher started as one of
