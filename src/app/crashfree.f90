@@ -2,7 +2,7 @@
 !> The program only reads the command line; everything else lives in libcrashfree.
 program crashfree
   use command_line, only: run_options_t, command_argument_t, get_command_arguments, &
-                          parse_command_line, usage_text, check_launch
+                          parse_command_line, usage_text, check_launch, launched_rank_index
   use error_handling, only: error_t
   use job, only: run_job
   use version, only: crashfree_version
@@ -35,7 +35,8 @@ program crashfree
   ! a build without MPI that a launcher started several times would run the whole job in each
   call check_launch(mpi_built=mpi_built, error=error)
   if (allocated(error)) then
-    if (rank_index() == 0) write (error_unit, '(a)') "crashfree: "//error%message
+    ! (MPI is not running: the launcher's numbering picks the one process that says it)
+    if (launched_rank_index() == 0) write (error_unit, '(a)') "crashfree: "//error%message
     call finish(2)
   end if
   if (options%show_help) then

@@ -10,7 +10,7 @@ module command_line
   private
 
   public :: run_options_t, command_argument_t, parse_command_line, usage_text
-  public :: get_command_arguments, launched_rank_count, check_launch
+  public :: get_command_arguments, launched_rank_count, launched_rank_index, check_launch
 
   !> One argument as the shell passed it, whatever its length.
   type :: command_argument_t
@@ -209,6 +209,21 @@ contains
     read (setting, *, iostat=status) count
     if (status == 0 .and. count > 1) launched_rank_count = count
   end function launched_rank_count
+
+  !> This process's place (0, 1, ...) among those an MPI launcher started, from the environment
+  !> it sets: OMPI_COMM_WORLD_RANK, else PMI_RANK; 0 when started without a launcher. (A build
+  !> without MPI has no other way to tell the processes apart: the first one alone says why
+  !> they all stop.)
+  integer function launched_rank_index()
+    character(len=32) :: setting
+    integer :: length, status, process_index
+    launched_rank_index = 0
+    call get_environment_variable("OMPI_COMM_WORLD_RANK", setting, length, status)
+    if (status /= 0) call get_environment_variable("PMI_RANK", setting, length, status)
+    if (status /= 0) return
+    read (setting, *, iostat=status) process_index
+    if (status == 0 .and. process_index > 0) launched_rank_index = process_index
+  end function launched_rank_index
 
   !> A program built without MPI (`mpi_built` false) that an MPI launcher started as one of
   !> several processes would run the whole job once per process, all writing the same files:

@@ -138,6 +138,19 @@ contains
       element_total = element_total + groups(g)%group%element_count()
     end do
     ! (one rank takes any model, also one whose elements are all rigid: no block)
+    if (rank_count > 1 .and. block_total == 0) then
+      ! rigid bodies, masses and welds are advanced by every rank alike: nothing to share out
+      call make_error(error, "domain partition: "//integer_text(rank_count)//" ranks, but the model has no "// &
+                      "deformable element to share out among them (its elements are all rigid: no element block); "// &
+                      "run it on one rank (without mpirun)")
+      return
+    end if
+    if (rank_count > 1 .and. rank_count > block_total .and. block_total == 1) then
+      call make_error(error, "domain partition: "//integer_text(rank_count)//" ranks are more than the model's "// &
+                      "1 element block (elements: "//integer_text(element_total)//"; at most 64 of one part per "// &
+                      "block); run it on one rank (without mpirun)")
+      return
+    end if
     if (rank_count > 1 .and. rank_count > block_total) then
       call make_error(error, "domain partition: "//integer_text(rank_count)//" ranks are more than the model's "// &
                       integer_text(block_total)//" element blocks ("//integer_text(element_total)// &

@@ -2,7 +2,8 @@
 of the one-rank run bit for bit, for N = 1, 2, 3 ranks and with 2 threads per rank, on a contact
 model, a coupled meshfree / finite element model, the side-impact dummy (meshfree solids and
 meshfree shells coupled to FE shells, contact, rigid bodies), a shell model with elements that
-erode and a rigid-body model; the meshfree blocks are shared out among the ranks as the finite
+erode, a rigid-body model and spot welds that fail by plastic strain on FE and on meshfree
+shells (the coupled model also on 4 ranks); the meshfree blocks are shared out among the ranks as the finite
 elements' (the partition report's computed blocks); a run continued from a restart dump on another number of ranks gives the
 uninterrupted run's file, also after SIGTERM to mpirun (every rank stops after the same cycle). Every dataset and attribute is compared (test_threads'
 comparison) but /timing, the /run attributes that may differ between runs (threads, run_id)
@@ -27,7 +28,7 @@ import numpy as np
 import pytest
 
 from conftest import BINARY
-from deck_writer import fields
+from deck_writer import fields, nodes_card, plate_mesh, shells_card, write_deck
 from test_rigid_wall import impact_deck
 from test_threads import (DENSITY, MODULUS, POISSON, TANGENT, YIELD, _first_difference, _objects, _position, _text,
                           contact_deck, meshfree_deck, rigid_deck)
@@ -345,3 +346,174 @@ def test_sigterm_to_mpirun_stops_every_rank_after_the_same_cycle(tmp_path):
     assert continued.returncode == 0, continued.stdout + continued.stderr
     difference = results_difference(reference, output / "results.h5")
     assert not difference, f"stopped on 2 ranks, continued on 3: {difference}"
+
+
+WELD_STRAIN = 0.02     # EP of the welds of welded_strips_deck
+
+
+def welded_strips_deck(path, meshfree, end_time=0.22, weld_strain=WELD_STRAIN, cell=2.0, length=64.0, width=16.0,
+                       pitch=4.0, thickness=1.0, speed=5.0):
+    """Two elastic-plastic steel strips (MAT_024, SIGY 0.2 GPa, ETAN 1 GPa) `length` x `width`,
+    one `thickness` above the other, joined along their centre line by a spot weld every `pitch`
+    (15 welds, *CONSTRAINED_SPOTWELD_ID 1 to 15 from x = 4 to x = 60) that fails by plastic
+    strain only (SN = SS = 0, EP `weld_strain`). The lower strip is clamped at x = 0; the upper
+    one's end x = `length` pulled along x at `speed` (ramped up over 0.1 ms): the welds carry the
+    pull in shear, the shells round the end welds yield first, and the joint unzips from both
+    ends towards the middle. FE shells (ELFORM 2) or meshfree shells (ELFORM 41, DX = DY =
+    1.5; the welds' nodes are Gamma nodes). States every 0.005 ms."""
+    counts = (round(length / cell), round(width / cell))
+    lower, shells = plate_mesh(counts, (length, width))
+    upper = lower + [0.0, 0.0, thickness]
+    nodes = np.vstack([lower, upper])
+    n = len(lower)
+    root = np.flatnonzero(np.isclose(lower[:, 0], 0.0))
+    end = n + np.flatnonzero(np.isclose(upper[:, 0], length))
+    welds = ["*CONSTRAINED_SPOTWELD_ID"]
+    for weld, x in enumerate(np.arange(pitch, length - pitch / 2, pitch)):
+        node = int(np.flatnonzero(np.isclose(lower[:, 0], x) & np.isclose(lower[:, 1], width / 2))[0])
+        welds += [fields(weld + 1), fields(node + 1, n + node + 1, 0.0, 0.0, 0.0, 0.0, 0.0, weld_strain)]
+    section = ("*SECTION_SHELL\n" + fields(1, 41 if meshfree else 2, 1.0, 3) + "\n" + fields(*[thickness] * 4) +
+               ("\n" + fields(1.5, 1.5) if meshfree else ""))
+    upper_shells = shells_card(shells, part_id=2, first_id=len(shells) + 1, first_node_id=n + 1)
+    return write_deck(
+        path,
+        "*CONTROL_TERMINATION\n" + fields(end_time),
+        "*DATABASE_GLSTAT\n" + fields(0.005),
+        "*DATABASE_BINARY_D3PLOT\n" + fields(0.005),
+        "*PART\nlower strip\n" + fields(1, 1, 1),
+        "*PART\nupper strip\n" + fields(2, 1, 1),
+        section,
+        "*MAT_PIECEWISE_LINEAR_PLASTICITY\n" + fields(1, DENSITY, MODULUS, POISSON, 0.2, 1.0) + "\n" + fields(0.0),
+        nodes_card(nodes),
+        shells_card(shells) + "\n" + "\n".join(upper_shells.splitlines()[1:]),
+        "*BOUNDARY_SPC_NODE\n" + "\n".join(fields(k + 1, 0, 1, 1, 1, 1, 1, 1) for k in root),
+        "*DEFINE_CURVE\n" + fields(1) + "\n" + f"{0.0:20.6e}{0.0:20.6e}\n{0.1:20.6e}{speed:20.6e}\n"
+        f"{100.0:20.6e}{speed:20.6e}",
+        "*BOUNDARY_PRESCRIBED_MOTION_NODE\n" + "\n".join(fields(k + 1, 1, 0, 1) for k in end),
+        "\n".join(welds),
+    )
+
+
+def weld_failures(stdout):
+    """{weld id: (its nodes' ids, failure time)} of the failure lines a run printed (EP only)."""
+    failures = {}
+    for line in stdout.splitlines():
+        if line.startswith("spot weld ") and " fails at t = " in line:
+            assert "reached the plastic strain" in line, line
+            weld = int(line.split()[2])
+            nodes = tuple(int(node) for node in line.split("(nodes ")[1].split(")")[0].split(","))
+            failures[weld] = (nodes, float(line.split("t =")[1].split(":")[0]))
+    return failures
+
+
+def deck_welds(deck):
+    """{weld id: (N1, N2)} of a *CONSTRAINED_SPOTWELD_ID written by welded_strips_deck."""
+    lines = deck.read_text().splitlines()
+    first = lines.index("*CONSTRAINED_SPOTWELD_ID") + 1
+    welds = {}
+    for k in range(first, len(lines) - 1, 2):
+        if lines[k].startswith("*"):
+            break
+        welds[int(lines[k])] = (int(lines[k + 1][0:10]), int(lines[k + 1][10:20]))
+    return welds
+
+
+def welds_on_interfaces(results_path, welds):
+    """The welds of a run on several ranks that a domain interface touches: {weld id: why} where
+    the shells round one of its nodes are computed by more than one rank (the ranks' largest
+    plastic strains there differ until they are brought together), or its two nodes have
+    different owners."""
+    with h5py.File(results_path, "r") as results:
+        node_rank = results[f"{RANK_REPORT}/node_rank"][...]
+        shell_rank = results[f"{RANK_REPORT}/shell_rank"][...]
+        connectivity = results["mesh/shells/connectivity_index"][...]
+        node_ids = results["mesh/nodes/ids"][...]
+    index = {int(node_id): k for k, node_id in enumerate(node_ids)}
+    found = {}
+    for weld, nodes in welds.items():
+        for node in nodes:
+            ranks = sorted(set(shell_rank[(connectivity == index[node]).any(axis=1)].tolist()))
+            if len(ranks) > 1:
+                found[weld] = f"node {node}: shells on ranks {ranks}"
+        owners = {int(node_rank[index[node]]) for node in nodes}
+        if weld not in found and len(owners) > 1:
+            found[weld] = f"nodes owned by ranks {sorted(owners)}"
+    return found
+
+
+@pytest.mark.parametrize("meshfree", [False, True], ids=["fe_shells", "meshfree_shells"])
+def test_welds_failing_by_plastic_strain_are_identical_on_one_two_and_three_ranks(tmp_path, meshfree):
+    """Spot welds that fail by EP (the shells' plastic strain at their nodes, raised by each rank
+    with the blocks it computes and brought together by a maximum over the ranks each cycle), on
+    FE shells and on meshfree shells: welded_strips_deck's joint unzips. Every rank count gives
+    the file of the run alone and prints the same failures. The physics, from the run alone: a
+    weld fails in the cycle after the force call in which a shell round one of its nodes first
+    reached EP, so at every state (every 0.005 ms) the largest plastic strain of the shells on
+    its nodes (`shell_plastic_strain_peak`) is below EP before the weld's failure time and at
+    least EP from it on; the welds that hold stay below EP; swforc counts the failures. Some
+    failing welds sit on a domain interface (the partition report)."""
+    deck = welded_strips_deck(tmp_path / "welded.k", meshfree)
+    reference = assert_same_on_every_rank_count(deck, tmp_path)
+    failures = weld_failures((tmp_path / "alone" / "messag").read_text())
+    for ranks in RANK_COUNTS:
+        printed = weld_failures((tmp_path / f"np{ranks}_ncpu1" / "messag").read_text())
+        assert printed == failures, f"-np {ranks}: {printed} != {failures}"
+    welds = deck_welds(deck)
+    print(f"{len(failures)} of {len(welds)} welds failed: " +
+          ", ".join(f"{weld} at {time:.5f} ms" for weld, (_, time) in sorted(failures.items(), key=lambda w: w[1][1])))
+    assert 3 <= len(failures) < len(welds), failures
+    assert all(failures[weld][0] == welds[weld] for weld in failures)
+    with h5py.File(reference, "r") as results:
+        connectivity = results["mesh/shells/connectivity_index"][...]
+        node_ids = results["mesh/nodes/ids"][...]
+        keys = sorted(results["states"].keys())
+        times = np.array([results["states"][key].attrs["time"] for key in keys])
+        peak = np.array([results["states"][key]["shell_plastic_strain_peak"][...] for key in keys])
+        count_time = results["history/swforc/time"][...]
+        failed_count = results["history/swforc/failed_welds"][...]
+    index = {int(node_id): k for k, node_id in enumerate(node_ids)}
+    for weld, nodes in welds.items():
+        around = (np.isin(connectivity, [index[node] for node in nodes])).any(axis=1)
+        strain = peak[:, around].max(axis=1)
+        # the printed time has 6 digits: a state within that rounding is the one at the failure
+        failed_at = failures[weld][1] * (1.0 - 1e-5) if weld in failures else np.inf
+        reached = strain >= WELD_STRAIN
+        # (the last state's force call is checked in no later cycle: only "failed -> reached" there)
+        assert np.array_equal(reached[:-1], (times >= failed_at)[:-1]), (weld, failed_at, times[reached][:1],
+                                                                          strain.max())
+        assert reached[-1] or times[-1] < failed_at, weld
+    # a sample at t is written before the welds' check of the cycle that starts at t
+    expected_count = [sum(time < sample * (1.0 - 1e-5) for _, time in failures.values()) for sample in count_time]
+    assert np.array_equal(failed_count, expected_count), (failed_count, expected_count)
+    on_interfaces = {}
+    for ranks in (2, 3):
+        found = welds_on_interfaces(tmp_path / f"np{ranks}_ncpu1" / "results.h5", welds)
+        on_interfaces.update({(ranks, weld): why for weld, why in found.items() if weld in failures})
+    print("failing welds on domain interfaces:", {key: why for key, why in on_interfaces.items() if "shells" in why})
+    assert any("shells on ranks" in why for why in on_interfaces.values()), on_interfaces
+
+
+def test_meshfree_model_is_identical_on_four_ranks(tmp_path):
+    """test_threads' coupled EFG / FE bar on 4 ranks (the cheapest model of this file in which
+    each of 4 ranks computes blocks of every kind it has: solids and meshfree points; the others
+    were run on 4 ranks by hand, docs/parallel.md): the file of the run alone."""
+    deck = shortened(meshfree_deck(tmp_path / "meshfree.k"), 60)
+    assert_same_on_every_rank_count(deck, tmp_path, counts=(4,))
+    shared = assert_shared_out(tmp_path / "np4_ncpu1" / "results.h5", ["solid", "meshfree"])
+    print(f"4 ranks: blocks computed per rank {({kind: [int(count) for count in blocks] for kind, blocks in shared.items()})}")
+
+
+def test_models_with_fewer_than_two_element_blocks_are_refused_with_one_rank_advised(tmp_path):
+    """More ranks than element blocks is refused (exit status 2, test above); a model of one block
+    (one hexahedron with point masses and a weld, test_spot_welds) or of none (two rigid cubes
+    and point masses: rigid bodies are in no block) is told to run on one rank, not "at most 1
+    ranks" or "at most 0 ranks". Checked with partition=2 (the same set-up without mpirun)."""
+    from test_spot_welds import merged_bodies_deck, weld_deck
+    one_block = weld_deck(tmp_path / "one_block.k", "*CONSTRAINED_SPOTWELD\n" + fields(1, 2, 4.0, 0.0))
+    rigid_only, _ = merged_bodies_deck(tmp_path / "rigid_only.k")
+    for deck, expected in ((one_block, "2 ranks are more than the model's 1 element block (elements: 1;"),
+                           (rigid_only, "2 ranks, but the model has no deformable element to share out")):
+        process = solver(None, [f"i={deck}", f"outdir={tmp_path / deck.stem}", "partition=2"])
+        assert process.returncode == 2, process.stdout + process.stderr
+        assert expected in process.stderr and "run it on one rank (without mpirun)" in process.stderr, process.stderr
+        assert "use at most" not in process.stderr, process.stderr

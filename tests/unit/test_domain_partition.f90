@@ -12,7 +12,8 @@
 !>   every element is on one rank and the counts per rank add up;
 !> - more ranks than blocks: an error naming both numbers;
 !> - check_launch: a build without MPI that a launcher started as several processes
-!>   (OMPI_COMM_WORLD_SIZE or PMI_SIZE above 1) is refused; one process, or an MPI build, is not.
+!>   (OMPI_COMM_WORLD_SIZE or PMI_SIZE above 1) is refused; one process, or an MPI build, is not;
+!>   launched_rank_index reads which process this is (OMPI_COMM_WORLD_RANK, else PMI_RANK).
 program test_domain_partition
   use kinds, only: wp
   use testing, only: test_suite_t, check, finish_suite
@@ -24,7 +25,7 @@ program test_domain_partition
   use run_state, only: run_state_t
   use explicit_setup, only: set_up_run_state
   use domain_partition, only: domain_partition_t, partition_domains, lane_cost
-  use command_line, only: check_launch
+  use command_line, only: check_launch, launched_rank_index
   use rank_communication, only: start_ranks, finish_ranks
   use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
   implicit none
@@ -224,6 +225,16 @@ contains
     call check_launch(.false., error)
     call check(suite, "launch: PMI_SIZE 2 (MPICH, Slurm) without MPI: refused", allocated(error))
     status = c_unsetenv("PMI_SIZE"//c_null_char)
+    ! which of the launched processes this is: the first alone prints the refusal
+    status = c_unsetenv("OMPI_COMM_WORLD_RANK"//c_null_char)
+    status = c_unsetenv("PMI_RANK"//c_null_char)
+    call check(suite, "launch: started alone: process 0", launched_rank_index() == 0)
+    status = c_setenv("PMI_RANK"//c_null_char, "2"//c_null_char, 1_c_int)
+    call check(suite, "launch: PMI_RANK 2: process 2", launched_rank_index() == 2)
+    status = c_setenv("OMPI_COMM_WORLD_RANK"//c_null_char, "1"//c_null_char, 1_c_int)
+    call check(suite, "launch: OMPI_COMM_WORLD_RANK 1 (before PMI_RANK): process 1", launched_rank_index() == 1)
+    status = c_unsetenv("OMPI_COMM_WORLD_RANK"//c_null_char)
+    status = c_unsetenv("PMI_RANK"//c_null_char)
   end subroutine test_launch
 
   integer function block_total(partition)
