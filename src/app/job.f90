@@ -30,7 +30,7 @@ module job
                              continue_restart_results, count_earlier_run
   use rank_communication, only: rank_index, rank_total, any_rank
   use text_format, only: integer_text
-  use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
+  use, intrinsic :: iso_fortran_env, only: error_unit, output_unit, int64
   !$ use omp_lib, only: omp_set_num_threads, omp_get_max_threads
   implicit none
   private
@@ -409,13 +409,16 @@ contains
       end associate
     end if
     if (size(run%state%contacts) == 0) return
-    write (line, '(a,f0.3,a,f0.1,a)') "  MPI: contact pair exchange ", per_cycle*run%exchange%contact_timer%seconds, &
-      " ms per cycle (", 8.0e-3_wp*run%exchange%pair_values/real(max(1, cycles), wp), " kB to each rank per cycle)"
+    write (line, '(a,f0.3,a,f0.1,a,f0.3,a)') "  MPI: contact pair exchange ", &
+      per_cycle*run%exchange%contact_timer%seconds, " ms per cycle (", &
+      8.0e-3_wp*run%exchange%pair_values/real(max(1, cycles), wp), " kB to each rank per cycle), waiting for the "// &
+      "rank with the most pairs ", per_cycle*run%exchange%contact_wait_timer%seconds, " ms per cycle"
     write (*, '(a)') trim(line)
-    ! how evenly the ranks shared the pairs that touched (a pair found in one cycle counts once)
-    counts = "  MPI: contact pairs found per rank over the run:"
+    ! how evenly the ranks shared the pairs (a record: a node with a pair, a depth or an
+    ! ignored initial penetration, in one cycle)
+    counts = "  MPI: contact pair records sent per rank over the run:"
     do r = 1, size(run%exchange%rank_pair_records)
-      counts = counts//" "//integer_text(nint(run%exchange%rank_pair_records(r)))
+      counts = counts//" "//integer_text(nint(run%exchange%rank_pair_records(r), int64))
     end do
     write (*, '(a)') counts
   end subroutine print_exchange_summary

@@ -30,7 +30,8 @@
 !> in pair order. Results are bit-identical for any thread count; no atomics.
 !>
 !> A distributed run (docs/parallel.md) shares the pairs out: `find_contact_pairs` computes the
-!> pairs of the secondary nodes this rank owns (the costly part: the projections), the ranks
+!> pairs of this rank's share of the secondary nodes (`share_out_pairs`: contiguous ranges of
+!> about equal work, chosen again at every bucket search; the costly part: the projections), the ranks
 !> hand each other their pair records (`pack_pair_records`, `unpack_pair_records`; the exchange
 !> itself is the solver's), and `apply_contact_pairs` adds every pair's forces on every rank in
 !> the one-rank pair order. A pair depends only on its node, the candidate lists and the last
@@ -397,15 +398,18 @@ contains
       allocate (pass%tracked_at_build(3, size(pass%tracked)), pass%box(6, pass%segment_count), &
                 pass%candidate_first(pass%node_count + 1), pass%candidates(max(16, 4*pass%node_count)), &
                 pass%cell_first(1), pass%cell_segments(max(16, 8*pass%segment_count)))
+      ! (all of it defined: a restart dump holds these arrays whole, also before the first search
+      ! and beyond the lists in use, and must be the same file for any run of the deck)
+      pass%tracked_at_build = 0.0_wp
+      pass%box = 0.0_wp
+      pass%candidate_first = 1
+      pass%candidates = 0
+      pass%cell_first = 0
+      pass%cell_segments = 0
       allocate (pass%pair_segment(pass%node_count), pass%pair_weights(4, pass%node_count), &
-                pass%pair_force(3, pass%node_count), pass%tangential(3, pass%node_count))
-      pass%pair_segment = 0
-      allocate (pass%pair_side(pass%node_count), pass%pair_depth(pass%node_count))
-      pass%pair_side = 1.0_wp
-      pass%pair_depth = 0.0_wp
-      pass%pair_weights = 0.0_wp
-      pass%pair_force = 0.0_wp
-      pass%tangential = 0.0_wp
+                pass%pair_force(3, pass%node_count), pass%tangential(3, pass%node_count), &
+                pass%pair_side(pass%node_count), pass%pair_depth(pass%node_count))
+      call clear_pairs(pass)
     end subroutine build_pass
 
     !> Part of a segment owner (a solid index, or minus a shell index).
@@ -449,8 +453,8 @@ contains
 
   !> The first half of the contact forces: the power of the last cycle's pairs (`work_before`,
   !> every pair: the pairs are complete on every rank after an exchange), the searches, and the
-  !> pairs of the secondary nodes this rank handles (`node_handled`, per model node; absent:
-  !> all). A contact outside its birth and death times has no pairs.
+  !> pairs of this rank's share of the secondary nodes (`rank` of `rank_count`, share_out_pairs;
+  !> absent: all). A contact outside its birth and death times has no pairs.
   subroutine find_contact_pairs(model, contacts, time, step, coordinates, velocity, mass, work_before, rank, &
                                 rank_count)
     type(model_t), intent(in) :: model
@@ -473,10 +477,7 @@ contains
         do p = 1, state%pass_count
           associate (pass => state%passes(p))
             if (.not. active) then
-              pass%pair_segment = 0
-              pass%pair_depth = 0.0_wp
-              pass%pair_force = 0.0_wp
-              pass%tangential = 0.0_wp
+              call clear_pairs(pass)
               cycle
             end if
             ! BSORT of the contact, else NSBCS of *CONTROL_CONTACT, else only when nodes moved
@@ -704,7 +705,20 @@ contains
                      pass%initial_depth(i) /= 0.0_wp .or. any(pass%tangential(:, i) /= 0.0_wp)
   end function carries_record
 
-  !> Secondary node `i` of `pass` without a pair.
+  !> Every secondary node of `pass` without a pair (the initial penetrations still ignored are
+  !> kept): set-up, and a contact outside its birth and death times.
+  subroutine clear_pairs(pass)
+    type(contact_pass_t), intent(inout) :: pass
+    pass%pair_segment = 0
+    pass%pair_side = 1.0_wp
+    pass%pair_depth = 0.0_wp
+    pass%pair_weights = 0.0_wp
+    pass%pair_force = 0.0_wp
+    pass%tangential = 0.0_wp
+  end subroutine clear_pairs
+
+  !> Secondary node `i` of `pass` without a pair, nor an initial penetration: what a node holds
+  !> when its rank sends no record for it.
   subroutine clear_pair(pass, i)
     type(contact_pass_t), intent(inout) :: pass
     integer, intent(in) :: i
@@ -877,7 +891,7 @@ contains
     total = pass%cell_first(cell_count + 1) - 1
     if (size(pass%cell_segments) < total) then
       deallocate (pass%cell_segments)
-      allocate (pass%cell_segments(2*total))
+      allocate (pass%cell_segments(2*total), source=0)
     end if
     allocate (counts(cell_count))
     counts = pass%cell_first(1:cell_count)
@@ -906,7 +920,7 @@ contains
     total = pass%candidate_first(pass%node_count + 1) - 1
     if (size(pass%candidates) < total) then
       deallocate (pass%candidates)
-      allocate (pass%candidates(2*total))
+      allocate (pass%candidates(2*total), source=0)
     end if
     !$omp parallel do schedule(static) default(shared) private(i, own)
     do i = 1, pass%node_count

@@ -369,8 +369,9 @@ contains
   !> A v, and their forces f on those come back to the generalized unknowns as A^T f (the
   !> groups' to_physical and forces_to_generalized; consistent, and momentum is kept because the
   !> rows of A sum to one). Contact energy is the work on the physical motion, which A^T makes
-  !> the same as on the generalized one. A distributed run computes the pairs of the nodes each
-  !> rank owns and exchanges them before the forces are added (domain_exchange).
+  !> the same as on the generalized one. In a distributed run each rank computes the pairs of its
+  !> share of the secondary nodes, and the ranks exchange them before the forces are added
+  !> (penalty_contact, domain_exchange).
   subroutine contact_forces(model, state, exchange, step)
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(inout) :: state

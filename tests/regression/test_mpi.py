@@ -84,8 +84,9 @@ def run(deck, output, ranks, threads=1):
 
 
 def contact_pairs_per_rank(output):
-    """The first rank's count of the contact pairs each rank found over the run (its last print)."""
-    marker = "contact pairs found per rank over the run:"
+    """The first rank's count of the contact pair records each rank sent over the run (its last
+    print)."""
+    marker = "contact pair records sent per rank over the run:"
     lines = [line for line in (output / "stdout.txt").read_text().splitlines() if marker in line]
     assert lines, f"no '{marker}' in {output / 'stdout.txt'}"
     return [int(value) for value in lines[-1].split(marker)[1].split()]
@@ -517,3 +518,50 @@ def test_models_with_fewer_than_two_element_blocks_are_refused_with_one_rank_adv
         assert process.returncode == 2, process.stdout + process.stderr
         assert expected in process.stderr and "run it on one rank (without mpirun)" in process.stderr, process.stderr
         assert "use at most" not in process.stderr, process.stderr
+
+
+def dying_contact_deck(path):
+    """The contact model with a death time on its surface-to-surface contact (DT 0.009 s, while
+    it is pressed) and a restart dump at cycle 90, after the death."""
+    deck = shortened(contact_deck(path))
+    text = deck.read_text()
+    start = text.index("*CONTACT_AUTOMATIC_SURFACE_TO_SURFACE_ID")
+    card = fields(0.2, 0.2) + "\n"
+    at = text.index(card, start)
+    text = text[:at] + fields(0.2, 0.2, 0.0, 0.0, 0.0, 0, 0.0, 0.009) + "\n" + text[at + len(card):]
+    deck.write_text(text.replace("*PART\n", "*DATABASE_BINARY_D3DUMP\n" + fields(90) + "\n*PART\n", 1))
+    return deck
+
+
+def dump_difference(first_path, second_path):
+    """'' when two restart dumps hold the same datasets bit for bit (but the wall-clock seconds
+    and the run id, which differ between any two runs), else the differing names."""
+    with h5py.File(first_path, "r") as first, h5py.File(second_path, "r") as second:
+        a, b = {}, {}
+        first.visititems(lambda name, item: a.__setitem__(name, item) if isinstance(item, h5py.Dataset) else None)
+        second.visititems(lambda name, item: b.__setitem__(name, item) if isinstance(item, h5py.Dataset) else None)
+        if a.keys() != b.keys():
+            return f"datasets in one dump only: {sorted(a.keys() ^ b.keys())[:5]}"
+        different = [name for name in sorted(a) if not name.endswith("seconds") and name != "results/run_id"
+                     and _first_difference(a[name][...], b[name][...]) is not None]
+    return ", ".join(different[:8]) + (f" (and {len(different) - 8} more)" if len(different) > 8 else "")
+
+
+def test_restart_dump_is_the_same_file_on_one_two_and_three_ranks(tmp_path):
+    """A dump taken after a contact's death time (its pairs cleared, the other contact pressed):
+    every dataset of d3dump01 from 2 and 3 ranks equals the one of the run alone (contact pair
+    arrays, search lists and their buffers included; not the wall-clock seconds and the run id),
+    so that a dump does not depend on N."""
+    deck = dying_contact_deck(tmp_path / "dying.k")
+    run(deck, tmp_path / "alone", None)
+    for ranks in (2, 3):
+        run(deck, tmp_path / f"np{ranks}", ranks)
+        difference = dump_difference(tmp_path / "alone" / "d3dump01", tmp_path / f"np{ranks}" / "d3dump01")
+        assert not difference, f"d3dump01 on {ranks} ranks differs from the run alone: {difference}"
+    with h5py.File(tmp_path / "alone" / "results.h5", "r") as results:
+        force = results["history/rcforc/12/force"][...]
+        time = results["history/rcforc/12/time"][...]
+    # the contact took load before its death time and none in the sampling intervals after it
+    # (rcforc's force is the interval's impulse over its length)
+    assert np.abs(force[time < 0.009]).max() > 0.0
+    assert np.all(force[time > 0.0101] == 0.0)
