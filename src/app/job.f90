@@ -402,8 +402,9 @@ contains
       write (*, '(a)') "  MPI: seconds per rank   internal forces    contact   force exchange    waiting   all phases"
       associate (seconds => summary%rank_seconds)
         do r = 1, size(seconds, 2)
+          ! (the last two columns, the pair exchange and its wait, lie inside the contact phase)
           write (line, '(i22,5f11.3)') r - 1, seconds(phase_internal_forces, r), seconds(phase_contact, r), &
-            seconds(size(seconds, 1) - 1, r), seconds(size(seconds, 1), r), sum(seconds(:, r))
+            seconds(size(seconds, 1) - 3, r), seconds(size(seconds, 1) - 2, r), sum(seconds(1:size(seconds, 1) - 2, r))
           write (*, '(a)') trim(line)
         end do
       end associate

@@ -485,9 +485,9 @@ contains
                                                         contact%bucket_interval > 0), rebuilt)
             if (rebuilt .or. .not. allocated(pass%handled)) then
               if (present(rank)) then
-                call share_out_pairs(pass, rank, rank_count)
+                call share_out_pairs(pass, coordinates, rank, rank_count)
               else
-                call share_out_pairs(pass, 0, 1)
+                call share_out_pairs(pass, coordinates, 0, 1)
               end if
             end if
             call pair_forces(contact, pass, step, coordinates, velocity, mass)
@@ -545,17 +545,23 @@ contains
   end subroutine apply_contact_pairs
 
   !> The secondary nodes of `pass` whose pairs this rank computes, chosen again at every search
-  !> (the same on every rank: the candidate lists are): contiguous ranges of the pass's nodes
-  !> with about equal work, a node weighing 1 plus its candidates (a node far from any segment
-  !> costs a test; one near the surfaces, a projection per candidate). Any rank may compute any
-  !> pair, all see the whole model; the ranges keep a rank's nodes together in memory. A node
-  !> that leaves this rank with a pair is listed as received, so that the next exchange clears
-  !> it unless its new rank sends it again.
-  subroutine share_out_pairs(pass, rank, rank_count)
+  !> (the same on every rank: the candidate lists and positions are): contiguous ranges of the
+  !> pass's nodes with about equal work. A node costs a little, each of its candidates a box
+  !> test, each candidate within reach now a projection (the bulk: a shell plate's nodes all
+  !> project onto their neighbouring segments every cycle, a solid's side faces hardly ever);
+  !> the weights below are their measured ratios (about 10, 24 and 160 ns on the scaling deck of
+  !> tools/make_scaling_deck.py). Any rank may compute any pair, all see the whole model; the
+  !> ranges keep a rank's nodes together in memory. A node that leaves this rank with a pair is
+  !> listed as received, so that the next exchange clears it unless its new rank sends it again.
+  subroutine share_out_pairs(pass, coordinates, rank, rank_count)
     type(contact_pass_t), intent(inout) :: pass
+    real(wp), intent(in) :: coordinates(:, :)
     integer, intent(in) :: rank, rank_count
+    integer, parameter :: node_weight = 1, candidate_weight = 2, projection_weight = 16
     integer(int64) :: total, before, first_weight, last_weight
-    integer :: i, first, last
+    integer :: i, c, j, first, last
+    integer, allocatable :: weight(:)
+    real(wp) :: corners(3, 4)
     logical, allocatable :: was_handled(:)
     if (allocated(pass%is_handled)) then
       call move_alloc(pass%is_handled, was_handled)
@@ -564,7 +570,24 @@ contains
       was_handled = .true.
     end if
     if (.not. allocated(pass%received)) allocate (pass%received(16))
-    total = int(pass%node_count, int64) + int(pass%candidate_first(pass%node_count + 1) - 1, int64)
+    allocate (weight(pass%node_count))
+    ! (one rank takes every node: no weights to measure)
+    if (rank_count == 1) weight = node_weight
+    !$omp parallel do schedule(static) default(shared) private(i, c, j, corners) if (rank_count > 1)
+    do i = 1, pass%node_count
+      if (rank_count == 1) cycle
+      weight(i) = node_weight
+      do c = pass%candidate_first(i), pass%candidate_first(i + 1) - 1
+        weight(i) = weight(i) + candidate_weight
+        do j = 1, 4
+          corners(:, j) = coordinates(:, pass%segments(j, pass%candidates(c)))
+        end do
+        if (within_reach(pass, i, pass%candidates(c), corners, coordinates(:, pass%nodes(i)))) &
+          weight(i) = weight(i) + projection_weight
+      end do
+    end do
+    !$omp end parallel do
+    total = sum(int(weight, int64))
     first_weight = (total*rank)/rank_count
     last_weight = (total*(rank + 1))/rank_count
     ! this rank: the nodes whose weights end in (first_weight, last_weight]
@@ -572,7 +595,7 @@ contains
     last = 0
     before = 0
     do i = 1, pass%node_count
-      before = before + 1 + (pass%candidate_first(i + 1) - pass%candidate_first(i))
+      before = before + weight(i)
       if (before > first_weight .and. before <= last_weight) then
         first = min(first, i)
         last = i
@@ -990,12 +1013,12 @@ contains
     real(wp) :: x(3), corners(3, 4), weights(4), normal(3), gap, best_depth, best_weights(4), best_normal(3)
     real(wp) :: relative(3), stiffness, node_mass, segment_mass, reduced_mass, normal_force, damping
     real(wp) :: tangential(3), sliding(3), friction, limit, size_t, penetration, side, best_side
-    real(wp) :: reach, low(3), high(3), reachable
+    real(wp) :: reachable
     logical :: inside
     !$omp parallel do schedule(static) default(shared) private(i, c, seg, best, j, x, corners, weights, &
     !$omp& normal, gap, best_depth, best_weights, best_normal, relative, stiffness, node_mass, segment_mass, &
     !$omp& reduced_mass, normal_force, damping, tangential, sliding, friction, limit, size_t, inside, penetration, &
-    !$omp& side, best_side, reach, low, high, reachable, h)
+    !$omp& side, best_side, reachable, h)
     do h = 1, size(pass%handled)
       i = pass%handled(h)
       x = coordinates(:, pass%nodes(i))
@@ -1008,16 +1031,7 @@ contains
         do j = 1, 4
           corners(:, j) = coordinates(:, pass%segments(j, seg))
         end do
-        ! the candidate lists hold every segment within the search margin; most are out of
-        ! reach this cycle, which the segment's current box (grown by the deepest contact and
-        ! the parametric tolerance) shows without projecting
-        reach = pass%node_offset(i) + max(pass%segment_offset(seg), pass%depth(seg))
-        do j = 1, 3
-          low(j) = min(corners(j, 1), corners(j, 2), corners(j, 3), corners(j, 4))
-          high(j) = max(corners(j, 1), corners(j, 2), corners(j, 3), corners(j, 4))
-        end do
-        reach = reach + (parametric_limit - 1.0_wp)*max(high(1) - low(1), high(2) - low(2), high(3) - low(3))
-        if (any(x < low - reach) .or. any(x > high + reach)) cycle
+        if (.not. within_reach(pass, i, seg, corners, x)) cycle
         call project_on_segment(x, corners, pass%segments(3, seg) == pass%segments(4, seg), weights, normal, &
                                 gap, inside)
         if (.not. inside) cycle
@@ -1141,6 +1155,25 @@ contains
     end do
     !$omp end parallel do
   end subroutine pair_forces
+
+  !> Whether secondary node `i` at `x` may touch segment `seg` with the given corners: the
+  !> candidate lists hold every segment within the search margin, most out of reach this cycle,
+  !> which the segment's current box (grown by the deepest contact, the node's shell offset and
+  !> the parametric tolerance) shows without projecting.
+  pure logical function within_reach(pass, i, seg, corners, x)
+    type(contact_pass_t), intent(in) :: pass
+    integer, intent(in) :: i, seg
+    real(wp), intent(in) :: corners(3, 4), x(3)
+    real(wp) :: reach, low(3), high(3)
+    integer :: j
+    reach = pass%node_offset(i) + max(pass%segment_offset(seg), pass%depth(seg))
+    do j = 1, 3
+      low(j) = min(corners(j, 1), corners(j, 2), corners(j, 3), corners(j, 4))
+      high(j) = max(corners(j, 1), corners(j, 2), corners(j, 3), corners(j, 4))
+    end do
+    reach = reach + (parametric_limit - 1.0_wp)*max(high(1) - low(1), high(2) - low(2), high(3) - low(3))
+    within_reach = .not. (any(x < low - reach) .or. any(x > high + reach))
+  end function within_reach
 
   !> Closest point of a segment to `x`: weights of the corners (bilinear shape functions at
   !> the point; barycentric for a triangle), the unit outward normal there and the signed gap

@@ -568,10 +568,12 @@ contains
     summary%phase_seconds = run%timers%seconds
     ! a distributed run: every rank's seconds, for the balance (the first rank prints and writes)
     if (run%exchange%rank_count > 1) then
-      allocate (summary%rank_seconds(phase_count + 2, run%exchange%rank_count))
-      call gather_fixed_reals([run%timers%seconds, run%exchange%timer%seconds, run%exchange%wait_timer%seconds], &
+      allocate (summary%rank_seconds(phase_count + 4, run%exchange%rank_count))
+      call gather_fixed_reals([run%timers%seconds, run%exchange%timer%seconds, run%exchange%wait_timer%seconds, &
+                               run%exchange%contact_timer%seconds, run%exchange%contact_wait_timer%seconds], &
                               summary%rank_seconds)
-      summary%rank_column_names = [character(len=24) :: phase_names, "force_exchange", "force_exchange_wait"]
+      summary%rank_column_names = [character(len=24) :: phase_names, "force_exchange", "force_exchange_wait", &
+                                   "contact_pair_exchange", "contact_pair_wait"]
     end if
     summary%tangled_solids = run%distortion%tangled
     summary%worst_corner_jacobian_ratio = run%distortion%worst_ratio
