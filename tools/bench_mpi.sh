@@ -2,14 +2,15 @@
 # MPI scaling benchmark (not a test; docs/parallel_scaling.md): the 513,600-element deck of
 # tools/make_scaling_deck.py (hexahedra dropped on a shell plate, single-surface contact), CYCLES
 # cycles (default 300), ncpu=1 per rank:
-#  1. N = 1 (no mpirun) and N = 2 (mpirun -np 2): nanoseconds per element per cycle of the cycle's
-#     phases (output excluded), parallel efficiency T1 / (N TN);
+#  1. N = 1 (no mpirun) and N = 2 (mpirun -np 2), REPEATS pairs alternating (default 1):
+#     nanoseconds per element per cycle of the slowest rank's cycle (output excluded), parallel
+#     efficiency T1 / (N TN), each rank's phases; with several pairs the medians;
 #  2. the partition for N = 2 ... 1,024 ranks (partition=N: set-up only): imbalance, ghost blocks,
 #     owned and interface nodes per rank, the communication volume per cycle per rank (stage 1's
 #     allgatherv of the owned nodes' forces; a stage-2 neighbour exchange of the interface nodes:
 #     6 doubles per node).
 # A build without MPI refuses to run under mpirun (exit status 2): step 1 then reports N = 1 only.
-#   tools/bench_mpi.sh [DIRECTORY] [BINARY]
+#   [REPEATS=3] tools/bench_mpi.sh [DIRECTORY] [BINARY]
 set -euo pipefail
 python=${PYTHON:-python3}
 cycles=${CYCLES:-300}
@@ -21,15 +22,22 @@ deck=$directory/scaling.k
 # Open MPI refuses to start as root unless told (containers, this machine)
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_NUM_THREADS=1
 
-"$binary" i="$deck" outdir="$directory/ranks_1" ncpu=1 > "$directory/ranks_1.log" 2>&1
-status=0
-mpirun -np 2 --oversubscribe "$binary" i="$deck" outdir="$directory/ranks_2" ncpu=1 \
-  > "$directory/ranks_2.log" 2>&1 || status=$?
-if [ "$status" -ne 0 ]; then
-  echo "N = 2 did not run (exit status $status; see $directory/ranks_2.log):"
-  grep -m1 "crashfree:" "$directory/ranks_2.log" || true
-  rm -rf "$directory/ranks_2"
-fi
+# REPEATS pairs of runs, N = 1 then N = 2, alternating (the machine's load drifts: medians of
+# alternating runs compare the two under the same conditions)
+repeats=${REPEATS:-1}
+for pair in $(seq 1 "$repeats"); do
+  run=$directory/pair_$pair
+  mkdir -p "$run"
+  "$binary" i="$deck" outdir="$run/ranks_1" ncpu=1 > "$run/ranks_1.log" 2>&1
+  status=0
+  mpirun -np 2 --oversubscribe "$binary" i="$deck" outdir="$run/ranks_2" ncpu=1 \
+    > "$run/ranks_2.log" 2>&1 || status=$?
+  if [ "$status" -ne 0 ]; then
+    echo "N = 2 did not run (exit status $status; see $run/ranks_2.log):"
+    grep -m1 "crashfree:" "$run/ranks_2.log" || true
+    rm -rf "$run/ranks_2"
+  fi
+done
 for ranks in 2 4 8 16 32 64 128 256 512 1024; do
   "$binary" i="$deck" outdir="$directory/partition_$ranks" partition="$ranks" ncpu=1 \
     > "$directory/partition_$ranks.log" 2>&1

@@ -56,11 +56,11 @@ def print_phase_shares(path, cycles):
               f"{scale * sum(row[k] for k in others):>13.1f}")
 
 
-def main():
-    directory = Path(sys.argv[1])
-    print("Timed runs (ncpu=1 per rank):")
+def print_timed_runs(directory):
+    """One pair of runs (ranks_1, ranks_2 in `directory`); returns {ranks: seconds per cycle}."""
     print(f"{'ranks':>6} {'cycles':>7} {'s per cycle':>12} {'ns per element per cycle':>25} {'efficiency':>11}")
     single = None
+    found = {}
     for ranks in (1, 2):
         path = directory / f"ranks_{ranks}" / "results.h5"
         if not path.exists():
@@ -68,6 +68,7 @@ def main():
             continue
         seconds, cycles, elements = cycle_seconds(path)
         per_cycle = seconds / max(cycles, 1)
+        found[ranks] = (per_cycle, elements)
         if ranks == 1:
             single = per_cycle
         efficiency = f"{single / (ranks * per_cycle):.2f}" if single else "-"
@@ -78,6 +79,27 @@ def main():
             for line in log.read_text().splitlines():
                 if line.strip().startswith("MPI:") and "seconds per rank" not in line:
                     print("        " + line.strip())
+    return found
+
+
+def main():
+    directory = Path(sys.argv[1])
+    print("Timed runs (ncpu=1 per rank):")
+    pairs = sorted(directory.glob("pair_*"), key=lambda path: int(path.name.split("_")[1]))
+    if not pairs:
+        pairs = [directory]
+    timed = []
+    for pair in pairs:
+        if len(pairs) > 1:
+            print(f"  {pair.name}:")
+        timed.append(print_timed_runs(pair))
+    if len(timed) > 1 and all(1 in runs and 2 in runs for runs in timed):
+        one = np.median([runs[1][0] for runs in timed])
+        two = np.median([runs[2][0] for runs in timed])
+        elements = timed[0][1][1]
+        print(f"  medians of {len(timed)} alternating pairs: N = 1 {one:.4f} s per cycle "
+              f"({1e9 * one / elements:.1f} ns per element), N = 2 {two:.4f} s ({1e9 * two / elements:.1f} ns), "
+              f"speed-up {one / two:.2f}, efficiency {one / (2 * two):.2f}")
 
     print()
     print("Partitions (partition=N; costs estimated from the per-kind lane costs):")
