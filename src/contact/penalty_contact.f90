@@ -582,7 +582,8 @@ contains
         do j = 1, 4
           corners(:, j) = coordinates(:, pass%segments(j, pass%candidates(c)))
         end do
-        if (within_reach(pass, i, pass%candidates(c), corners, coordinates(:, pass%nodes(i)))) &
+        if (within_reach(pass%node_offset(i), pass%segment_offset(pass%candidates(c)), &
+                         pass%depth(pass%candidates(c)), corners, coordinates(:, pass%nodes(i)))) &
           weight(i) = weight(i) + projection_weight
       end do
     end do
@@ -1013,12 +1014,12 @@ contains
     real(wp) :: x(3), corners(3, 4), weights(4), normal(3), gap, best_depth, best_weights(4), best_normal(3)
     real(wp) :: relative(3), stiffness, node_mass, segment_mass, reduced_mass, normal_force, damping
     real(wp) :: tangential(3), sliding(3), friction, limit, size_t, penetration, side, best_side
-    real(wp) :: reachable
+    real(wp) :: reach, low(3), high(3), reachable
     logical :: inside
     !$omp parallel do schedule(static) default(shared) private(i, c, seg, best, j, x, corners, weights, &
     !$omp& normal, gap, best_depth, best_weights, best_normal, relative, stiffness, node_mass, segment_mass, &
     !$omp& reduced_mass, normal_force, damping, tangential, sliding, friction, limit, size_t, inside, penetration, &
-    !$omp& side, best_side, reachable, h)
+    !$omp& side, best_side, reach, low, high, reachable, h)
     do h = 1, size(pass%handled)
       i = pass%handled(h)
       x = coordinates(:, pass%nodes(i))
@@ -1031,7 +1032,17 @@ contains
         do j = 1, 4
           corners(:, j) = coordinates(:, pass%segments(j, seg))
         end do
-        if (.not. within_reach(pass, i, seg, corners, x)) cycle
+        ! the candidate lists hold every segment within the search margin; most are out of
+        ! reach this cycle, which the segment's current box (grown by the deepest contact and
+        ! the parametric tolerance) shows without projecting (within_reach's test, written out
+        ! here: the compiler does not inline the call into this, the hottest contact loop)
+        reach = pass%node_offset(i) + max(pass%segment_offset(seg), pass%depth(seg))
+        do j = 1, 3
+          low(j) = min(corners(j, 1), corners(j, 2), corners(j, 3), corners(j, 4))
+          high(j) = max(corners(j, 1), corners(j, 2), corners(j, 3), corners(j, 4))
+        end do
+        reach = reach + (parametric_limit - 1.0_wp)*max(high(1) - low(1), high(2) - low(2), high(3) - low(3))
+        if (any(x < low - reach) .or. any(x > high + reach)) cycle
         call project_on_segment(x, corners, pass%segments(3, seg) == pass%segments(4, seg), weights, normal, &
                                 gap, inside)
         if (.not. inside) cycle
@@ -1156,23 +1167,25 @@ contains
     !$omp end parallel do
   end subroutine pair_forces
 
-  !> Whether secondary node `i` at `x` may touch segment `seg` with the given corners: the
-  !> candidate lists hold every segment within the search margin, most out of reach this cycle,
-  !> which the segment's current box (grown by the deepest contact, the node's shell offset and
-  !> the parametric tolerance) shows without projecting.
-  pure logical function within_reach(pass, i, seg, corners, x)
-    type(contact_pass_t), intent(in) :: pass
-    integer, intent(in) :: i, seg
-    real(wp), intent(in) :: corners(3, 4), x(3)
+  !> Whether a secondary node at `x` (shell offset `node_offset`) may touch a segment with the
+  !> given corners (shell offset `segment_offset`, contact depth `depth`): the candidate lists
+  !> hold every segment within the search margin, most out of reach this cycle, which the
+  !> segment's current box (grown by the deepest contact, the node's shell offset and the
+  !> parametric tolerance) shows without projecting. (pair_forces writes the same test out.)
+  pure logical function within_reach(node_offset, segment_offset, depth, corners, x)
+    real(wp), intent(in) :: node_offset, segment_offset, depth, corners(3, 4), x(3)
     real(wp) :: reach, low(3), high(3)
     integer :: j
-    reach = pass%node_offset(i) + max(pass%segment_offset(seg), pass%depth(seg))
+    reach = node_offset + max(segment_offset, depth)
     do j = 1, 3
       low(j) = min(corners(j, 1), corners(j, 2), corners(j, 3), corners(j, 4))
       high(j) = max(corners(j, 1), corners(j, 2), corners(j, 3), corners(j, 4))
     end do
     reach = reach + (parametric_limit - 1.0_wp)*max(high(1) - low(1), high(2) - low(2), high(3) - low(3))
-    within_reach = .not. (any(x < low - reach) .or. any(x > high + reach))
+    within_reach = .true.
+    do j = 1, 3
+      if (x(j) < low(j) - reach .or. x(j) > high(j) + reach) within_reach = .false.
+    end do
   end function within_reach
 
   !> Closest point of a segment to `x`: weights of the corners (bilinear shape functions at
