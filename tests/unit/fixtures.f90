@@ -1,15 +1,19 @@
 !> Helpers shared by the unit tests: a reproducible random sequence, scratch directories, the
-!> test steel and curves of *MAT_024, the cross product, the text of an error.
+!> test steel and curves of *MAT_024, the cross product, the text of an error, keyword decks
+!> written from lines (comma-separated node and element cards) and read.
 module fixtures
   use kinds, only: wp, long_int
   use model, only: material_t
   use material_laws, only: law_piecewise_linear
   use curves, only: curve_t
-  use error_handling, only: error_t
+  use error_handling, only: error_t, error_list_t
+  use model, only: model_t
+  use deck_reader, only: read_deck
   implicit none
   private
 
   public :: random_uniform, make_scratch_directory, piecewise_steel, make_curve, cross, error_message
+  public :: node_card, element_card, read_deck_lines
 
   !> The test steel: E, nu, yield stress (N, mm, s, t).
   real(wp), parameter, public :: steel_youngs = 210000.0_wp, steel_poisson = 0.3_wp, steel_yield = 250.0_wp
@@ -86,4 +90,38 @@ contains
     if (present(none)) text = none
     if (allocated(error)) text = error%message
   end function error_message
+
+  !> A *NODE card, comma separated: id, x, y, z.
+  function node_card(id, position) result(line)
+    integer, intent(in) :: id
+    real(wp), intent(in) :: position(3)
+    character(len=80) :: line
+    write (line, '(i0,3(",",es16.8))') id, position
+  end function node_card
+
+  !> An element card, comma separated: id, part, nodes.
+  function element_card(id, part, nodes) result(line)
+    integer, intent(in) :: id, part, nodes(:)
+    character(len=80) :: line
+    integer :: k
+    write (line, '(i0,",",i0)') id, part
+    do k = 1, size(nodes)
+      write (line, '(a,",",i0)') trim(line), nodes(k)
+    end do
+  end function element_card
+
+  !> Write `lines` to the keyword file `path` and read it into `model` (`error` when rejected).
+  subroutine read_deck_lines(path, lines, model, error)
+    character(len=*), intent(in) :: path, lines(:)
+    type(model_t), intent(out) :: model
+    type(error_t), allocatable, intent(out) :: error
+    type(error_list_t) :: warnings
+    integer :: unit, k
+    open (newunit=unit, file=path, status="replace", action="write")
+    do k = 1, size(lines)
+      write (unit, '(a)') trim(lines(k))
+    end do
+    close (unit)
+    call read_deck(path, model, warnings, error, .false.)
+  end subroutine read_deck_lines
 end module fixtures

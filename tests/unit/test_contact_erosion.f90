@@ -13,10 +13,9 @@
 program test_contact_erosion
   use kinds, only: wp
   use testing, only: test_suite_t, check, check_close, finish_suite
-  use fixtures, only: make_scratch_directory
-  use error_handling, only: error_t, error_list_t
+  use fixtures, only: make_scratch_directory, node_card, element_card, read_deck_lines
+  use error_handling, only: error_t
   use model, only: model_t
-  use deck_reader, only: read_deck
   use penalty_contact, only: contact_state_t, set_up_contacts, compute_contact_forces
   use contact_erosion, only: remove_eroded_elements
   implicit none
@@ -53,7 +52,7 @@ contains
     do k = 0, 2
       do j = 0, 2
         do i = 0, 2
-          lines = [character(len=80) :: lines, node_line(1 + i + 3*j + 9*k, real([i, j, k], wp))]
+          lines = [character(len=80) :: lines, node_card(1 + i + 3*j + 9*k, real([i, j, k], wp))]
         end do
       end do
     end do
@@ -61,7 +60,7 @@ contains
     do k = 0, 1
       do j = 0, 1
         do i = 0, 1
-          lines = [character(len=80) :: lines, node_line(28 + i + 2*j + 4*k, [1.3_wp, 1.2_wp, 2.5_wp] + &
+          lines = [character(len=80) :: lines, node_card(28 + i + 2*j + 4*k, [1.3_wp, 1.2_wp, 2.5_wp] + &
                                                          real([i, j, k], wp))]
         end do
       end do
@@ -73,13 +72,13 @@ contains
         do i = 0, 1
           e = e + 1
           associate (n => 1 + i + 3*j + 9*k)
-            lines = [character(len=80) :: lines, element_line(e, 1, [n, n + 1, n + 4, n + 3, n + 9, n + 10, n + 13, &
+            lines = [character(len=80) :: lines, element_card(e, 1, [n, n + 1, n + 4, n + 3, n + 9, n + 10, n + 13, &
                                                                       n + 12])]
           end associate
         end do
       end do
     end do
-    lines = [character(len=80) :: lines, element_line(9, 2, [28, 29, 31, 30, 32, 33, 35, 34]), "*END"]
+    lines = [character(len=80) :: lines, element_card(9, 2, [28, 29, 31, 30, 32, 33, 35, 34]), "*END"]
     if (.not. read_model("block.k", lines, model)) return
     call set_up(model, contacts, x, v, mass, force)
     probe = 28
@@ -135,13 +134,13 @@ contains
                                   "*CONTACT_AUTOMATIC_NODES_TO_SURFACE", "2,2,4,3", "*NODE"]
     do j = 0, 2
       do i = 0, 2
-        lines = [character(len=80) :: lines, node_line(1 + i + 3*j, real([i, j, 0], wp))]
+        lines = [character(len=80) :: lines, node_card(1 + i + 3*j, real([i, j, 0], wp))]
       end do
     end do
     do k = 0, 1
       do j = 0, 1
         do i = 0, 1
-          lines = [character(len=80) :: lines, node_line(10 + i + 2*j + 4*k, [0.5_wp, 0.4_wp, 0.5_wp] + &
+          lines = [character(len=80) :: lines, node_card(10 + i + 2*j + 4*k, [0.5_wp, 0.4_wp, 0.5_wp] + &
                                                          real([i, j, k], wp))]
         end do
       end do
@@ -152,11 +151,11 @@ contains
       do i = 0, 1
         k = k + 1
         associate (n => 1 + i + 3*j)
-          lines = [character(len=80) :: lines, element_line(k, 1, [n, n + 1, n + 4, n + 3])]
+          lines = [character(len=80) :: lines, element_card(k, 1, [n, n + 1, n + 4, n + 3])]
         end associate
       end do
     end do
-    lines = [character(len=80) :: lines, "*ELEMENT_SOLID", element_line(5, 2, [10, 11, 13, 12, 14, 15, 17, 16]), &
+    lines = [character(len=80) :: lines, "*ELEMENT_SOLID", element_card(5, 2, [10, 11, 13, 12, 14, 15, 17, 16]), &
              "*END"]
     if (.not. read_model("plate.k", lines, model)) return
     call set_up(model, contacts, x, v, mass, force)
@@ -213,19 +212,10 @@ contains
   logical function read_model(name, lines, model)
     character(len=*), intent(in) :: name, lines(:)
     type(model_t), intent(out) :: model
-    type(error_list_t) :: warnings
     type(error_t), allocatable :: error
-    integer :: unit, k
-    open (newunit=unit, file=directory//"/"//name, status="replace", action="write")
-    do k = 1, size(lines)
-      write (unit, '(a)') trim(lines(k))
-    end do
-    close (unit)
-    call read_deck(directory//"/"//name, model, warnings, error, .false.)
+    call read_deck_lines(directory//"/"//name, lines, model, error)
     read_model = .not. allocated(error)
-    if (allocated(error)) then
-      call check(suite, name//" is accepted", .false., error%message)
-    end if
+    if (allocated(error)) call check(suite, name//" is accepted", .false., error%message)
   end function read_model
 
   subroutine set_up(model, contacts, x, v, mass, force)
@@ -253,21 +243,4 @@ contains
     real(wp) :: energy
     call compute_contact_forces(model, contacts, 0.0_wp, step, x, v, mass, force, energy)
   end subroutine evaluate
-
-  function node_line(id, position) result(line)
-    integer, intent(in) :: id
-    real(wp), intent(in) :: position(3)
-    character(len=80) :: line
-    write (line, '(i0,3(",",es16.8))') id, position
-  end function node_line
-
-  function element_line(id, part, nodes) result(line)
-    integer, intent(in) :: id, part, nodes(:)
-    character(len=80) :: line
-    integer :: k
-    write (line, '(i0,",",i0)') id, part
-    do k = 1, size(nodes)
-      write (line, '(a,",",i0)') trim(line), nodes(k)
-    end do
-  end function element_line
 end program test_contact_erosion

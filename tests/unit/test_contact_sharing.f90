@@ -14,10 +14,9 @@
 program test_contact_sharing
   use kinds, only: wp
   use testing, only: test_suite_t, check, finish_suite
-  use fixtures, only: make_scratch_directory
-  use error_handling, only: error_t, error_list_t
+  use fixtures, only: make_scratch_directory, node_card, element_card, read_deck_lines
+  use error_handling, only: error_t
   use model, only: model_t
-  use deck_reader, only: read_deck
   use contact_erosion, only: remove_eroded_elements
   use penalty_contact, only: contact_state_t, set_up_contacts, find_contact_pairs, apply_contact_pairs, &
                              pair_record_count, pack_pair_records, unpack_pair_records, pair_record_size
@@ -210,7 +209,7 @@ contains
     do k = 0, 1
       do j = 0, 4
         do i = 0, 4
-          lines = [character(len=80) :: lines, node_line(1 + i + 5*j + 25*k, real([i, j, k], wp))]
+          lines = [character(len=80) :: lines, node_card(1 + i + 5*j + 25*k, real([i, j, k], wp))]
         end do
       end do
     end do
@@ -218,7 +217,7 @@ contains
     do k = 0, 1
       do j = 0, 3
         do i = 0, 3
-          lines = [character(len=80) :: lines, node_line(upper_first + i + 4*j + 16*k, &
+          lines = [character(len=80) :: lines, node_card(upper_first + i + 4*j + 16*k, &
                                                          [0.5_wp + i, 0.5_wp + j, 1.05_wp + k])]
         end do
       end do
@@ -229,7 +228,7 @@ contains
       do i = 0, 3
         e = e + 1
         n = 1 + i + 5*j
-        lines = [character(len=80) :: lines, element_line(e, 1, [n, n + 1, n + 6, n + 5, n + 25, n + 26, n + 31, &
+        lines = [character(len=80) :: lines, element_card(e, 1, [n, n + 1, n + 6, n + 5, n + 25, n + 26, n + 31, &
                                                                  n + 30])]
       end do
     end do
@@ -237,7 +236,7 @@ contains
       do i = 0, 2
         e = e + 1
         n = upper_first + i + 4*j
-        lines = [character(len=80) :: lines, element_line(e, 2, [n, n + 1, n + 5, n + 4, n + 16, n + 17, n + 21, &
+        lines = [character(len=80) :: lines, element_card(e, 2, [n, n + 1, n + 5, n + 4, n + 16, n + 17, n + 21, &
                                                                  n + 20])]
       end do
     end do
@@ -247,15 +246,8 @@ contains
   logical function read_model(name, lines, model)
     character(len=*), intent(in) :: name, lines(:)
     type(model_t), intent(out) :: model
-    type(error_list_t) :: warnings
     type(error_t), allocatable :: error
-    integer :: unit, k
-    open (newunit=unit, file=directory//"/"//name, status="replace", action="write")
-    do k = 1, size(lines)
-      write (unit, '(a)') trim(lines(k))
-    end do
-    close (unit)
-    call read_deck(directory//"/"//name, model, warnings, error, .false.)
+    call read_deck_lines(directory//"/"//name, lines, model, error)
     read_model = .not. allocated(error)
     if (allocated(error)) call check(suite, name//" is accepted", .false., error%message)
   end function read_model
@@ -288,21 +280,4 @@ contains
     write (buffer, '(i0)') value
     text = trim(buffer)
   end function cycle_text
-
-  function node_line(id, position) result(line)
-    integer, intent(in) :: id
-    real(wp), intent(in) :: position(3)
-    character(len=80) :: line
-    write (line, '(i0,3(",",es16.8))') id, position
-  end function node_line
-
-  function element_line(id, part, nodes) result(line)
-    integer, intent(in) :: id, part, nodes(:)
-    character(len=80) :: line
-    integer :: k
-    write (line, '(i0,",",i0)') id, part
-    do k = 1, size(nodes)
-      write (line, '(a,",",i0)') trim(line), nodes(k)
-    end do
-  end function element_line
 end program test_contact_sharing
