@@ -200,14 +200,7 @@ contains
   !> read from the environment it sets: Open MPI's OMPI_COMM_WORLD_SIZE, else PMI_SIZE (MPICH,
   !> Intel MPI, Slurm); 1 when started without a launcher.
   integer function launched_rank_count()
-    character(len=32) :: setting
-    integer :: length, status, count
-    launched_rank_count = 1
-    call get_environment_variable("OMPI_COMM_WORLD_SIZE", setting, length, status)
-    if (status /= 0) call get_environment_variable("PMI_SIZE", setting, length, status)
-    if (status /= 0) return
-    read (setting, *, iostat=status) count
-    if (status == 0 .and. count > 1) launched_rank_count = count
+    launched_rank_count = max(1, launcher_setting("OMPI_COMM_WORLD_SIZE", "PMI_SIZE", 1))
   end function launched_rank_count
 
   !> This process's place (0, 1, ...) among those an MPI launcher started, from the environment
@@ -215,15 +208,23 @@ contains
   !> without MPI has no other way to tell the processes apart: the first one alone says why
   !> they all stop.)
   integer function launched_rank_index()
-    character(len=32) :: setting
-    integer :: length, status, process_index
-    launched_rank_index = 0
-    call get_environment_variable("OMPI_COMM_WORLD_RANK", setting, length, status)
-    if (status /= 0) call get_environment_variable("PMI_RANK", setting, length, status)
-    if (status /= 0) return
-    read (setting, *, iostat=status) process_index
-    if (status == 0 .and. process_index > 0) launched_rank_index = process_index
+    launched_rank_index = max(0, launcher_setting("OMPI_COMM_WORLD_RANK", "PMI_RANK", 0))
   end function launched_rank_index
+
+  !> The whole number in the environment variable `open_mpi_name`, else in `pmi_name`; `absent`
+  !> when neither is set to a number.
+  integer function launcher_setting(open_mpi_name, pmi_name, absent)
+    character(len=*), intent(in) :: open_mpi_name, pmi_name
+    integer, intent(in) :: absent
+    character(len=32) :: setting
+    integer :: length, status, value
+    launcher_setting = absent
+    call get_environment_variable(open_mpi_name, setting, length, status)
+    if (status /= 0) call get_environment_variable(pmi_name, setting, length, status)
+    if (status /= 0) return
+    read (setting, *, iostat=status) value
+    if (status == 0) launcher_setting = value
+  end function launcher_setting
 
   !> A program built without MPI (`mpi_built` false) that an MPI launcher started as one of
   !> several processes would run the whole job once per process, all writing the same files:
