@@ -640,8 +640,9 @@ contains
     end if
   end subroutine sum_up_initial_penetrations
 
-  !> Records this rank's pairs would send: its handled secondary nodes with a pair, a depth or an
-  !> initial depth (the others are all zero, which the receivers assume).
+  !> Records this rank's pairs would send: its handled secondary nodes with a pair, a depth, an
+  !> initial depth or a friction spring (carries_record; the others hold no pair, which the
+  !> receivers assume).
   integer function pair_record_count(contacts)
     type(contact_state_t), intent(in) :: contacts(:)
     integer :: k, p, h
