@@ -12,14 +12,14 @@ import numpy as np
 
 # what a stage-2 neighbour exchange would send per interface node: its force and moment (6 reals)
 DOUBLES_PER_NODE = 6
-# what stage 1's allgatherv sends per owned node (domain_exchange): 3 force components, 10 at the
-# nodes of shells and beams (moments, the normal and area sums)
+# what stage 1's allgatherv sends per owned node (domain_exchange): 3 acceleration components, 10
+# at the nodes of shells and beams (angular accelerations, the normal and area sums)
 FORCE_REALS, MOMENT_REALS = 3, 10
 
 
 def cycle_seconds(path):
     """Seconds of the cycle's phases (output excluded), cycles, elements. With several ranks, the
-    slowest rank's phases and its force exchange with the wait before it (outside the phases)."""
+    slowest rank's phases and its nodal exchange with the wait before it (outside the phases)."""
     with h5py.File(path, "r") as results:
         timing = results["timing"].attrs
         phases = sum(float(timing[name]) for name in timing if name.startswith("phase_") and name != "phase_output_s")
@@ -43,12 +43,12 @@ def print_phase_shares(path, cycles):
             names = [name[len("phase_"):-len("_s")] for name in timing.attrs if name.startswith("phase_")]
             rows = np.array([[float(timing.attrs[f"phase_{name}_s"]) for name in names]])
     column = {name: k for k, name in enumerate(names)}
-    exchange = [column[name] for name in ("force_exchange", "force_exchange_wait") if name in column]
+    exchange = [column[name] for name in ("nodal_exchange", "nodal_exchange_wait") if name in column]
     pairs = [column[name] for name in ("contact_pair_exchange", "contact_pair_wait") if name in column]
     others = [k for name, k in column.items() if name not in ("internal_forces", "contact", "output")
               and k not in exchange and k not in pairs]
     print(f"{'':>8}{'rank':>6} {'internal forces':>16} {'contact':>9} {'(pair exchange + wait)':>23} "
-          f"{'force exchange + wait':>22} {'other phases':>13}   (ms per cycle)")
+          f"{'nodal exchange + wait':>22} {'other phases':>13}   (ms per cycle)")
     for rank, row in enumerate(rows):
         scale = 1e3 / max(cycles, 1)
         print(f"{'':>8}{rank:>6} {scale * row[column['internal_forces']]:>16.1f} {scale * row[column['contact']]:>9.1f} "

@@ -388,7 +388,7 @@ contains
     cycles = summary%cycles
     per_cycle = 1.0e3_wp/real(max(1, cycles), wp)
     write (line, '(a,i0,a,f0.3,a,f0.1,a,f0.3,a)') "  MPI: ", run%exchange%rank_count, &
-      " ranks; force exchange ", per_cycle*run%exchange%timer%seconds, " ms per cycle (", &
+      " ranks; nodal exchange (accelerations) ", per_cycle*run%exchange%timer%seconds, " ms per cycle (", &
       8.0e-3_wp*real(size(run%exchange%receive), wp), " kB to each rank), waiting for the slowest rank ", &
       per_cycle*run%exchange%wait_timer%seconds, " ms per cycle"
     write (*, '(a)') trim(line)
@@ -399,7 +399,7 @@ contains
     write (*, '(a)') trim(line)
     ! every rank's seconds: where the balance is lost
     if (allocated(summary%rank_seconds)) then
-      write (*, '(a)') "  MPI: seconds per rank   internal forces    contact   force exchange    waiting   all phases"
+      write (*, '(a)') "  MPI: seconds per rank   internal forces    contact   nodal exchange    waiting   all phases"
       associate (seconds => summary%rank_seconds)
         do r = 1, size(seconds, 2)
           ! (the last two columns, the pair exchange and its wait, lie inside the contact phase)

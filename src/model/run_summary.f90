@@ -72,7 +72,7 @@ module run_summary
     character(len=16), allocatable :: phase_names(:)
     real(wp), allocatable :: phase_seconds(:)
     !> a distributed run: every rank's seconds (rank_column_names' columns, ranks): the phases,
-    !> then the force exchange and the wait for the slowest rank before it (outside the phases),
+    !> then the nodal exchange (accelerations) and the wait for the slowest rank before it (outside the phases),
     !> the contact pair exchange and the wait before it (inside the contact phase)
     character(len=24), allocatable :: rank_column_names(:)
     real(wp), allocatable :: rank_seconds(:, :)

@@ -16,9 +16,9 @@
 !> ```
 !> clock/        time, cycle, time_step, next_time_step, stable_time_step, controlling_group,
 !>               controlling_element
-!> nodes/        coordinates, displacement, velocity, acceleration, internal_force, external_force,
+!> nodes/        coordinates, displacement, velocity, acceleration, external_force,
 !>               contact_force, free_acceleration, angular_velocity, angular_acceleration,
-!>               internal_moment, shell_normal_sum, shell_area_sum
+!>               shell_normal_sum, shell_area_sum
 !> groups/<name>/  each element group's own state (element_group's exchange_state: solid and
 !>               shell blocks, meshfree parts)
 !> rigid/k/      a rigid body's motion        walls/k/   a rigid wall's motion and forces
@@ -128,7 +128,8 @@ contains
   end subroutine exchange_clock
 
   !> Nodal arrays that change during the run (the reference coordinates, masses and
-  !> constraints come from the deck).
+  !> constraints come from the deck; the internal forces and moments are computed again before
+  !> anything reads them, and a distributed run holds them whole only at each rank's own nodes).
   subroutine exchange_nodes(store, path, state, error)
     type(restart_store_t), intent(inout) :: store
     character(len=*), intent(in) :: path
@@ -139,12 +140,10 @@ contains
       call exchange_restart(store, path//"/displacement", nodes%displacement, error)
       call exchange_restart(store, path//"/velocity", nodes%velocity, error)
       call exchange_restart(store, path//"/acceleration", nodes%acceleration, error)
-      call exchange_restart(store, path//"/internal_force", nodes%internal_force, error)
       call exchange_restart(store, path//"/external_force", nodes%external_force, error)
       call exchange_restart(store, path//"/contact_force", nodes%contact_force, error)
       call exchange_restart(store, path//"/angular_velocity", nodes%angular_velocity, error)
       call exchange_restart(store, path//"/angular_acceleration", nodes%angular_acceleration, error)
-      call exchange_restart(store, path//"/internal_moment", nodes%internal_moment, error)
       call exchange_restart(store, path//"/shell_normal_sum", nodes%shell_normal_sum, error)
       call exchange_restart(store, path//"/shell_area_sum", nodes%shell_area_sum, error)
     end associate

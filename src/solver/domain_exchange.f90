@@ -1,13 +1,14 @@
 !> The exchanges of a distributed run (stage 1 of docs/parallel.md): every rank holds the whole
 !> model and run state; the ranks share out the element blocks of the kinds that distribute them
-!> (FE solids, shells, beams), each computing its own blocks and those on a node it owns. After
-!> the force phase the ranks hand each other the forces of the nodes they own, and the rest of
-!> the cycle runs on every rank alike.
+!> (FE solids, shells, beams, meshfree solids and shells), each computing its own blocks and
+!> those on a node it owns. Each rank computes the accelerations of the nodes it owns, and the
+!> ranks hand them to each other (exchange_accelerations); the rest of the cycle runs on every
+!> rank alike.
 !>
 !> Why the results do not depend on the number of ranks: a node receives its element forces
 !> group by group, within a group colour by colour (element_groups), an order the global blocks
 !> fix. The rank that owns a node computes every block on it, so it adds the node's force in
-!> exactly that order; the exchange only copies it. The headers (stable step, failed element,
+!> exactly that order, and its acceleration from it; the exchange only copies that. The headers (stable step, failed element,
 !> eroded elements) are made global with the one-rank tie rules, and the block state that the
 !> output, the checks and the dumps read is brought together from the owners first
 !> (gather_block_state), only when it is read.
@@ -31,14 +32,14 @@ module domain_exchange
   implicit none
   private
 
-  public :: domain_exchange_t, set_up_domains, exchange_internal_forces, combine_group_headers, gather_block_state
+  public :: domain_exchange_t, set_up_domains, exchange_accelerations, combine_group_headers, gather_block_state
   public :: gather_block_energies, exchange_contact_pairs
 
   !> Values per group in the header exchange: step, critical block, critical element, failed
   !> block, failed element, step not finite, newly eroded (owned blocks).
   integer, parameter :: header_values = 7
 
-  !> What the exchanges need, set up once (the force exchange allocates nothing per cycle).
+  !> What the exchanges need, set up once (the nodal exchange allocates nothing per cycle).
   type :: domain_exchange_t
     integer :: rank = 0                         !< this rank, 0-based
     integer :: rank_count = 1                   !< ranks of the run (1: no exchange at all)
@@ -46,11 +47,11 @@ module domain_exchange
     !> rank_nodes(node_offsets(r + 1):node_offsets(r + 2) - 1)
     integer, allocatable :: rank_nodes(:), node_offsets(:)
     !> where rank_nodes(k)'s values start in the receive buffer (0-based), and whether they hold
-    !> the moment, normal sum and area sum after the force (10 values; 3 at nodes that no group
-    !> adding moments touches: adds_moments)
+    !> the angular acceleration, normal sum and area sum after the acceleration (10 values; 3 at
+    !> nodes that no group adding moments touches: adds_moments)
     integer, allocatable :: value_start(:)
     logical, allocatable :: with_moments(:)
-    integer, allocatable :: value_counts(:), value_offsets(:)   !< per rank, for the force exchange
+    integer, allocatable :: value_counts(:), value_offsets(:)   !< per rank, for the nodal exchange
     real(wp), allocatable :: send(:), receive(:)
     real(wp), allocatable :: header_send(:), header_receive(:, :)
     integer :: gathered_cycle = -1              !< the cycle whose block state was last brought together
@@ -58,7 +59,7 @@ module domain_exchange
     integer :: block_gathers = 0                !< how often the whole state was brought together
     integer :: energy_gathers = 0               !< how often only the energies were
     type(restart_store_t) :: store              !< this rank's blocks, packed for a gather
-    !> wall-clock time of the force and header exchanges; of the wait for the slowest rank before
+    !> wall-clock time of the nodal (accelerations) and header exchanges; of the wait for the slowest rank before
     !> them (a barrier: what the ranks' unequal work costs, kept apart from the communication);
     !> of bringing the blocks together
     type(phase_timer_t) :: timer, wait_timer, gather_timer
@@ -97,7 +98,7 @@ contains
       groups(k)%group%computed = partition%groups(k)%computed
       groups(k)%group%owned = partition%groups(k)%owner == exchange%rank
     end do
-    ! (every node has an owner; a node without one would only get no force from the others)
+    ! (every node has an owner; a node without one would get no acceleration from the others)
     allocate (exchange%node_offsets(exchange%rank_count + 1), &
               exchange%rank_nodes(count(partition%node_owner >= 0 .and. partition%node_owner < exchange%rank_count)))
     exchange%node_offsets(1) = 1
@@ -112,8 +113,8 @@ contains
         filled = filled + 1
       end do
     end do
-    ! 10 values at the nodes of blocks that add moments, 3 (the force) elsewhere: on a model of
-    ! solids with a shell plate most nodes need only their force
+    ! 10 values at the nodes of blocks that add moments, 3 (the acceleration) elsewhere: on a
+    ! model of solids with a shell plate most nodes need only their acceleration
     allocate (moment_node(nodes%count))
     moment_node = .false.
     if (nodes%rotational) then
@@ -156,7 +157,7 @@ contains
     real(wp) :: records(1)
     integer :: r, total
     if (exchange%rank_count == 1 .or. size(contacts) == 0) return
-    ! (the wait for the rank with the most pairs apart from the exchange, as for the forces)
+    ! (the wait for the rank with the most pairs apart from the exchange, as for the accelerations)
     call start_phase(exchange%contact_wait_timer)
     call barrier_ranks()
     call stop_phase(exchange%contact_wait_timer)
@@ -186,12 +187,14 @@ contains
     call stop_phase(exchange%contact_timer)
   end subroutine exchange_contact_pairs
 
-  !> After the groups added their forces: every rank sends the nodal arrays the groups fill
-  !> (forces; at the nodes of groups that add moments also the moments and the shells' normal
-  !> and area sums, which are zero elsewhere on every rank) at the nodes it owns, complete
-  !> there, and takes the others' at theirs. Every rank then holds the one-rank
-  !> arrays, bit for bit.
-  subroutine exchange_internal_forces(nodes, exchange)
+  !> After the accelerations of the nodes each rank owns (where its internal forces are
+  !> complete: it computes every block on them): every rank sends those accelerations (at the
+  !> nodes of groups that add moments also the angular accelerations and the shells' normal and
+  !> area sums, which the drilling constraint of the next cycle reads; zero elsewhere on every
+  !> rank) and takes the others'. Every rank then holds the one-rank arrays, bit for bit. (The
+  !> internal forces themselves stay partial at the nodes a rank does not own: nothing after the
+  !> accelerations reads them.)
+  subroutine exchange_accelerations(nodes, exchange)
     type(nodal_state_t), intent(inout) :: nodes
     type(domain_exchange_t), intent(inout) :: exchange
     integer :: k, node, first, at
@@ -205,9 +208,9 @@ contains
     do k = exchange%node_offsets(exchange%rank + 1), exchange%node_offsets(exchange%rank + 2) - 1
       node = exchange%rank_nodes(k)
       at = exchange%value_start(k) - first
-      exchange%send(at + 1:at + 3) = nodes%internal_force(:, node)
+      exchange%send(at + 1:at + 3) = nodes%acceleration(:, node)
       if (exchange%with_moments(k)) then
-        exchange%send(at + 4:at + 6) = nodes%internal_moment(:, node)
+        exchange%send(at + 4:at + 6) = nodes%angular_acceleration(:, node)
         exchange%send(at + 7:at + 9) = nodes%shell_normal_sum(:, node)
         exchange%send(at + 10) = nodes%shell_area_sum(node)
       end if
@@ -219,16 +222,16 @@ contains
     do k = 1, size(exchange%rank_nodes)
       node = exchange%rank_nodes(k)
       at = exchange%value_start(k)
-      nodes%internal_force(:, node) = exchange%receive(at + 1:at + 3)
+      nodes%acceleration(:, node) = exchange%receive(at + 1:at + 3)
       if (exchange%with_moments(k)) then
-        nodes%internal_moment(:, node) = exchange%receive(at + 4:at + 6)
+        nodes%angular_acceleration(:, node) = exchange%receive(at + 4:at + 6)
         nodes%shell_normal_sum(:, node) = exchange%receive(at + 7:at + 9)
         nodes%shell_area_sum(node) = exchange%receive(at + 10)
       end if
     end do
     !$omp end parallel do
     call stop_phase(exchange%timer)
-  end subroutine exchange_internal_forces
+  end subroutine exchange_accelerations
 
   !> The headers of the distributed groups from all ranks, made global with the one-rank rules:
   !> the smallest step, on a tie the first block (the group's own order: the same element as one

@@ -10,7 +10,8 @@
 !>   erode_elements           the elements that failed in that call: masks, messages, counts
 !>   contact_forces           penalty contacts
 !>   external_forces          nodal loads at t^{n+1}
-!>   accelerations            a = (f_ext - f_int + f_contact) / m, prescribed motions held, tied
+!>   accelerations            a = (f_ext - f_int + f_contact) / m (a distributed run: at the nodes
+!>                            each rank owns, then exchanged), prescribed motions held, tied
 !>                            contacts (tied nodes move with their segments)
 !>   next_time_step           TSSFAC times the smallest stable step, cut at ENDTIM
 !>   state checks             runaway motion, failed elements, time step, energy (run_checks)
@@ -26,6 +27,7 @@ module explicit_solver
   use fixed_order_sum, only: sum_chunk_size, sum_in_order
   use error_handling, only: error_t
   use model, only: model_t
+  use nodal_state, only: nodal_state_t
   use explicit_state, only: explicit_state_t
   use run_state, only: run_state_t, phase_count, phase_velocities, phase_constraints, phase_walls, phase_rigid_bodies, &
                        phase_positions, phase_internal_forces, phase_contact, phase_external_forces, &
@@ -47,7 +49,7 @@ module explicit_solver
   use run_summary, only: run_summary_t
   use text_format, only: integer_text
   use wall_clock, only: start_phase, stop_phase
-  use domain_exchange, only: domain_exchange_t, exchange_internal_forces, combine_group_headers, &
+  use domain_exchange, only: domain_exchange_t, exchange_accelerations, combine_group_headers, &
                              gather_block_energies, exchange_contact_pairs
   use rank_communication, only: largest_over_ranks, gather_fixed_reals
   implicit none
@@ -131,8 +133,8 @@ contains
     call start_phase(run%timers(phase_internal_forces))
     call compute_internal_forces(model, run%state%groups, run%state%nodes, step)
     call stop_phase(run%timers(phase_internal_forces))
-    ! a distributed run: the owned nodes' forces to every rank, the groups' headers made global
-    call exchange_internal_forces(run%state%nodes, run%exchange)
+    ! a distributed run: the groups' headers made global (each rank's forces are complete at the
+    ! nodes it owns; the accelerations of those go to every rank below)
     call combine_group_headers(run%state%groups, run%partition, run%exchange, run%state%cycle)
     call start_phase(run%timers(phase_erosion))
     call erode_elements(model, run%state)
@@ -144,7 +146,12 @@ contains
     call external_forces(model, run%state, step)
     call stop_phase(run%timers(phase_external_forces))
     call start_phase(run%timers(phase_accelerations))
-    call compute_accelerations(model, run%state)
+    call nodal_accelerations(run%state%nodes, run%exchange)
+    call stop_phase(run%timers(phase_accelerations))
+    ! a distributed run: the owned nodes' accelerations (and the shells' normal sums) to every rank
+    call exchange_accelerations(run%state%nodes, run%exchange)
+    call start_phase(run%timers(phase_accelerations))
+    call constrain_accelerations(model, run%state)
     call stop_phase(run%timers(phase_accelerations))
     call start_phase(run%timers(phase_time_step))
     call next_time_step(model, run%state)
@@ -436,38 +443,58 @@ contains
   end subroutine external_forces
 
   !> a = (f_ext - f_int + f_contact) / m, and for the rotations of shell nodes alpha = -m_int / I;
-  !> constrained dofs do not accelerate; prescribed motions hold theirs.
-  subroutine compute_accelerations(model, state)
-    type(model_t), intent(in) :: model
-    type(explicit_state_t), intent(inout) :: state
-    integer :: node
-    associate (nodes => state%nodes)
+  !> constrained dofs do not accelerate. A distributed run: at the nodes this rank owns, where
+  !> its internal forces are complete (the exchange then brings the others').
+  subroutine nodal_accelerations(nodes, exchange)
+    type(nodal_state_t), intent(inout) :: nodes
+    type(domain_exchange_t), intent(in) :: exchange
+    integer :: node, k
+    if (exchange%rank_count == 1) then
       !$omp parallel do schedule(static) default(shared) private(node)
       do node = 1, nodes%count
-        if (nodes%mass(node) > 0.0_wp) then
-          nodes%acceleration(:, node) = (nodes%external_force(:, node) - nodes%internal_force(:, node) + &
-                                         nodes%contact_force(:, node))/nodes%mass(node)
-        else
-          nodes%acceleration(:, node) = 0.0_wp
-        end if
-        where (nodes%fixed(:, node)) nodes%acceleration(:, node) = 0.0_wp
-        if (nodes%rotary_inertia(node) > 0.0_wp) then
-          nodes%angular_acceleration(:, node) = -nodes%internal_moment(:, node)/nodes%rotary_inertia(node)
-        else
-          nodes%angular_acceleration(:, node) = 0.0_wp
-        end if
-        where (nodes%fixed_rotation(:, node)) nodes%angular_acceleration(:, node) = 0.0_wp
+        call accelerate(node)
       end do
       !$omp end parallel do
-      ! tied contacts: the tied nodes' masses and forces to their segments; after the prescribed
-      ! motions are held, the tied nodes move with their points of the segments
+    else
+      !$omp parallel do schedule(static) default(shared) private(k)
+      do k = exchange%node_offsets(exchange%rank + 1), exchange%node_offsets(exchange%rank + 2) - 1
+        call accelerate(exchange%rank_nodes(k))
+      end do
+      !$omp end parallel do
+    end if
+  contains
+    subroutine accelerate(node)
+      integer, intent(in) :: node
+      if (nodes%mass(node) > 0.0_wp) then
+        nodes%acceleration(:, node) = (nodes%external_force(:, node) - nodes%internal_force(:, node) + &
+                                       nodes%contact_force(:, node))/nodes%mass(node)
+      else
+        nodes%acceleration(:, node) = 0.0_wp
+      end if
+      where (nodes%fixed(:, node)) nodes%acceleration(:, node) = 0.0_wp
+      if (nodes%rotary_inertia(node) > 0.0_wp) then
+        nodes%angular_acceleration(:, node) = -nodes%internal_moment(:, node)/nodes%rotary_inertia(node)
+      else
+        nodes%angular_acceleration(:, node) = 0.0_wp
+      end if
+      where (nodes%fixed_rotation(:, node)) nodes%angular_acceleration(:, node) = 0.0_wp
+    end subroutine accelerate
+  end subroutine nodal_accelerations
+
+  !> Tied contacts: the tied nodes' masses and forces to their segments; after the prescribed
+  !> motions are held, the tied nodes move with their points of the segments (every rank alike,
+  !> on every node's acceleration).
+  subroutine constrain_accelerations(model, state)
+    type(model_t), intent(in) :: model
+    type(explicit_state_t), intent(inout) :: state
+    associate (nodes => state%nodes)
       call distribute_tied_nodes(model, state%ties, nodes%mass, nodes%rotary_inertia, nodes%fixed, &
                                  nodes%fixed_rotation, nodes%acceleration, nodes%angular_acceleration)
       call hold_prescribed_accelerations(model, state%time, nodes%acceleration, state%free_acceleration)
       call follow_segments(model, nodes%rotary_inertia, nodes%acceleration, nodes%angular_acceleration, &
                            nodes%velocity, nodes%angular_velocity)
     end associate
-  end subroutine compute_accelerations
+  end subroutine constrain_accelerations
 
   !> Next step: TSSFAC times the smallest stable step of the element groups and the rigid
   !> bodies, cut so that the last step ends at ENDTIM; DTINIT caps the first step.
@@ -572,7 +599,7 @@ contains
       call gather_fixed_reals([run%timers%seconds, run%exchange%timer%seconds, run%exchange%wait_timer%seconds, &
                                run%exchange%contact_timer%seconds, run%exchange%contact_wait_timer%seconds], &
                               summary%rank_seconds)
-      summary%rank_column_names = [character(len=24) :: phase_names, "force_exchange", "force_exchange_wait", &
+      summary%rank_column_names = [character(len=24) :: phase_names, "nodal_exchange", "nodal_exchange_wait", &
                                    "contact_pair_exchange", "contact_pair_wait"]
     end if
     summary%tangled_solids = run%distortion%tangled

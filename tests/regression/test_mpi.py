@@ -167,7 +167,7 @@ def test_contact_model_is_identical_on_one_two_and_three_ranks(tmp_path):
         with h5py.File(tmp_path / f"np{ranks}_ncpu1" / "results.h5", "r") as results:
             names = [name.decode() for name in results["timing/rank_column_names"][...]]
             assert results["timing/rank_seconds"].shape == (ranks, len(names))
-            assert {"internal_forces", "contact", "force_exchange", "force_exchange_wait"} <= set(names)
+            assert {"internal_forces", "contact", "nodal_exchange", "nodal_exchange_wait"} <= set(names)
     with h5py.File(reference, "r") as results:
         assert np.abs(results["history/rcforc/12/force"][...][:, 2]).max() > 0.0
         assert results["history/glstat/contact_energy"][...].max() > 0.0
@@ -317,7 +317,7 @@ def test_first_rank_prints_and_too_many_ranks_are_refused(tmp_path):
     process = solver(2, [f"i={deck}", f"outdir={tmp_path / 'two'}"])
     assert process.returncode == 0, process.stdout + process.stderr
     assert process.stdout.count("normal termination") == 1, process.stdout
-    assert "on 2 MPI ranks of 1 thread(s)" in process.stdout and "  MPI: 2 ranks; force exchange" in process.stdout
+    assert "on 2 MPI ranks of 1 thread(s)" in process.stdout and "  MPI: 2 ranks; nodal exchange" in process.stdout
     tiny = impact_deck(tmp_path / "tiny.k")        # 125 hexahedra: 2 blocks
     process = solver(3, [f"i={tiny}", f"outdir={tmp_path / 'tiny'}"])
     assert process.returncode == 2, process.stdout + process.stderr
