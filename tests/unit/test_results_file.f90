@@ -128,21 +128,14 @@ contains
   !> Delete what the tests wrote, then the directory.
   subroutine remove_outputs(directory)
     character(len=*), intent(in) :: directory
-    call delete_file(directory//"/job.h5")
-    call delete_file(directory//"/job.xdmf")
-    call delete_file(directory//"/again.h5")
-    call delete_file(directory//"/again.xdmf")
-    call delete_file(directory//"/mixed.h5")
-    call delete_file(directory//"/mixed.xdmf")
-    call delete_file(directory//"/plates.h5")
-    call delete_file(directory//"/plates.xdmf")
-    call delete_file(directory//"/commits.h5")
-    call delete_file(directory//"/commits.xdmf")
-    call delete_file(directory//"/job.lock")
-    call delete_file(directory//"/again.lock")
-    call delete_file(directory//"/mixed.lock")
-    call delete_file(directory//"/plates.lock")
-    call delete_file(directory//"/commits.lock")
+    character(len=*), parameter :: jobs(5) = [character(len=7) :: "job", "again", "mixed", "plates", "commits"]
+    character(len=*), parameter :: endings(5) = [character(len=9) :: ".h5", ".xdmf", ".lock", ".d3plot", ".d3plot01"]
+    integer :: j, e
+    do j = 1, size(jobs)
+      do e = 1, size(endings)
+        call delete_file(directory//"/"//trim(jobs(j))//trim(endings(e)))
+      end do
+    end do
     call execute_command_line("rmdir '"//directory//"'")
   end subroutine remove_outputs
 
