@@ -51,7 +51,7 @@ module penalty_contact
 
   public :: contact_state_t, contact_pass_t, set_up_contacts, set_up_contact, compute_contact_forces, &
             report_initial_penetrations, mass_in_contact
-  public :: find_contact_pairs, apply_contact_pairs, pair_record_count, pack_pair_records, unpack_pair_records
+  public :: find_contact_pairs, apply_contact_pairs, pack_pair_records, unpack_pair_records
   public :: pair_record_size
 
   !> Values of one pair record of the exchange: contact, pass, secondary node (pass index),
@@ -640,31 +640,17 @@ contains
     end if
   end subroutine sum_up_initial_penetrations
 
-  !> Records this rank's pairs would send: its handled secondary nodes with a pair, a depth, an
-  !> initial depth or a friction spring (carries_record; the others hold no pair, which the
-  !> receivers assume).
-  integer function pair_record_count(contacts)
-    type(contact_state_t), intent(in) :: contacts(:)
-    integer :: k, p, h
-    pair_record_count = 0
-    do k = 1, size(contacts)
-      do p = 1, contacts(k)%pass_count
-        associate (pass => contacts(k)%passes(p))
-          if (.not. allocated(pass%handled)) cycle
-          do h = 1, size(pass%handled)
-            if (carries_record(pass, pass%handled(h))) pair_record_count = pair_record_count + 1
-          end do
-        end associate
-      end do
-    end do
-  end function pair_record_count
-
   !> This rank's pair records into `buffer` (pair_record_size values each, contacts, passes and
-  !> nodes in order).
-  subroutine pack_pair_records(contacts, buffer)
+  !> nodes in order; the buffer grows when they do not fit, and is kept), `records` of them: its
+  !> handled secondary nodes with a pair, a depth, an initial depth or a friction spring
+  !> (carries_record; the others hold no pair, which the receivers assume).
+  subroutine pack_pair_records(contacts, buffer, records)
     type(contact_state_t), intent(in) :: contacts(:)
-    real(wp), intent(inout) :: buffer(:)
+    real(wp), allocatable, intent(inout) :: buffer(:)
+    integer, intent(out) :: records
+    real(wp), allocatable :: grown(:)
     integer :: k, p, h, i, at
+    if (.not. allocated(buffer)) allocate (buffer(16*pair_record_size))
     at = 0
     do k = 1, size(contacts)
       do p = 1, contacts(k)%pass_count
@@ -673,6 +659,11 @@ contains
           do h = 1, size(pass%handled)
             i = pass%handled(h)
             if (.not. carries_record(pass, i)) cycle
+            if (at + pair_record_size > size(buffer)) then
+              allocate (grown(2*size(buffer) + pair_record_size))
+              grown(1:at) = buffer(1:at)
+              call move_alloc(grown, buffer)
+            end if
             buffer(at + 1:at + pair_record_size) = [real(k, wp), real(p, wp), real(i, wp), &
               real(pass%pair_segment(i), wp), pass%pair_side(i), pass%pair_depth(i), pass%initial_depth(i), &
               pass%pair_weights(:, i), pass%pair_force(:, i), pass%tangential(:, i)]
@@ -681,6 +672,7 @@ contains
         end associate
       end do
     end do
+    records = at/pair_record_size
   end subroutine pack_pair_records
 
   !> Every rank's records (`records` of them in `buffer`): the pairs of the nodes other ranks

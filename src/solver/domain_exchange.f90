@@ -25,8 +25,7 @@ module domain_exchange
   use restart_file, only: restart_store_t, start_memory_store
   use wall_clock, only: phase_timer_t, start_phase, stop_phase
   use domain_partition, only: domain_partition_t, partition_domains
-  use penalty_contact, only: contact_state_t, pair_record_size, pair_record_count, pack_pair_records, &
-                             unpack_pair_records
+  use penalty_contact, only: contact_state_t, pair_record_size, pack_pair_records, unpack_pair_records
   use rank_communication, only: rank_index, rank_total, gather_reals, gather_fixed_reals, barrier_ranks, abort_ranks
   use text_format, only: integer_text
   implicit none
@@ -155,19 +154,15 @@ contains
     type(contact_state_t), intent(inout) :: contacts(:)
     type(domain_exchange_t), intent(inout) :: exchange
     real(wp) :: records(1)
-    integer :: r, total
+    integer :: r, total, sent
     if (exchange%rank_count == 1 .or. size(contacts) == 0) return
     ! (the wait for the rank with the most pairs apart from the exchange, as for the accelerations)
     call start_phase(exchange%contact_wait_timer)
     call barrier_ranks()
     call stop_phase(exchange%contact_wait_timer)
     call start_phase(exchange%contact_timer)
-    records(1) = real(pair_record_count(contacts), wp)
-    if (size(exchange%pair_send) < pair_record_size*nint(records(1))) then
-      deallocate (exchange%pair_send)
-      allocate (exchange%pair_send(2*pair_record_size*nint(records(1))))
-    end if
-    call pack_pair_records(contacts, exchange%pair_send)
+    call pack_pair_records(contacts, exchange%pair_send, sent)
+    records(1) = real(sent, wp)
     call gather_fixed_reals(records, exchange%record_counts)
     exchange%pair_value_counts = pair_record_size*nint(exchange%record_counts(1, :))
     exchange%rank_pair_records = exchange%rank_pair_records + exchange%record_counts(1, :)

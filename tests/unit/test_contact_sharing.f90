@@ -19,7 +19,7 @@ program test_contact_sharing
   use model, only: model_t
   use contact_erosion, only: remove_eroded_elements
   use penalty_contact, only: contact_state_t, set_up_contacts, find_contact_pairs, apply_contact_pairs, &
-                             pair_record_count, pack_pair_records, unpack_pair_records, pair_record_size
+                             pack_pair_records, unpack_pair_records, pair_record_size
   implicit none
 
   integer, parameter :: rank_count = 3, cycles = 60
@@ -52,9 +52,9 @@ contains
     integer :: active_ranks, q, p
     real(wp) :: time
     type(contact_state_t), allocatable :: alone(:), ranks(:, :)
-    real(wp), allocatable :: x(:, :), v(:, :), mass(:), force(:, :), rank_force(:, :, :), buffer(:)
+    real(wp), allocatable :: x(:, :), v(:, :), mass(:), force(:, :), rank_force(:, :, :), buffer(:), rank_buffer(:)
     real(wp) :: work_before, energy, rank_energy(rank_count), rank_work_before(rank_count), moved(3), velocity(3)
-    integer :: cycle, r, records, at, node, upper_first, handled_total, pairs_seen
+    integer :: cycle, r, records, sent, at, node, upper_first, handled_total, pairs_seen
     integer :: changed_hands, previous_first(rank_count)
     logical :: same, covered, all_same, all_covered, ranks_busy(rank_count)
     type(error_t), allocatable :: error
@@ -75,7 +75,7 @@ contains
     allocate (v(3, size(x, 2)), mass(size(x, 2)), force(3, size(x, 2)), rank_force(3, size(x, 2), rank_count))
     v = 0.0_wp
     mass = [(1.0_wp + 0.01_wp*mod(node, 7), node=1, size(x, 2))]
-    allocate (buffer(pair_record_size))
+    allocate (buffer(0))
     all_same = .true.
     all_covered = .true.
     ranks_busy = .false.
@@ -125,22 +125,17 @@ contains
       call find_contact_pairs(model, alone, time, step, x, v, mass, work_before)
       call apply_contact_pairs(alone, step, v, force, work_before, energy)
       ! the ranks: their shares, the records gathered in rank order, every rank unpacking all
-      records = 0
       do r = 1, active_ranks
         call find_contact_pairs(model, ranks(:, r), time, step, x, v, mass, rank_work_before(r), r - 1, active_ranks)
-        records = records + pair_record_count(ranks(:, r))
       end do
-      if (size(buffer) < pair_record_size*records) then
-        deallocate (buffer)
-        allocate (buffer(pair_record_size*records))
-      end if
+      records = 0
       at = 0
       do r = 1, active_ranks
-        associate (sent => pair_record_count(ranks(:, r)))
-          if (sent > 0) ranks_busy(r) = .true.
-          call pack_pair_records(ranks(:, r), buffer(at + 1:))
-          at = at + pair_record_size*sent
-        end associate
+        call pack_pair_records(ranks(:, r), rank_buffer, sent)
+        if (sent > 0) ranks_busy(r) = .true.
+        buffer = [buffer(1:at), rank_buffer(1:pair_record_size*sent)]
+        at = at + pair_record_size*sent
+        records = records + sent
       end do
       do r = 1, active_ranks
         call unpack_pair_records(ranks(:, r), buffer, records)
