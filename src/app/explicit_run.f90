@@ -17,7 +17,7 @@ module explicit_run
   use progress_report, only: start_progress, report_progress
   use wall_clock, only: start_phase, stop_phase
   use output_plan, only: clock_is_due
-  use domain_exchange, only: gather_block_state, gather_block_energies
+  use domain_exchange, only: gather_block_state, share_block_energies
   use rank_communication, only: any_rank
   implicit none
   private
@@ -103,15 +103,14 @@ contains
     logical, intent(in) :: last
     type(error_t), allocatable, intent(out) :: error
     call start_phase(run%timers(phase_output))
-    ! a distributed run: the blocks' state from their owners when the output reads it (the
-    ! histories only their energies)
-    if (clock_is_due(run%plan%states, run%state%time, last)) then
+    ! the blocks' energy sums for the histories and the states' globals; a distributed run: the
+    ! blocks' state to the first rank, which writes the states (and all of it at the end: d3hsp,
+    ! the summary)
+    if (last .or. clock_is_due(run%plan%states, run%state%time, last) .or. &
+        clock_is_due(run%plan%glstat, run%state%time, last) .or. clock_is_due(run%plan%matsum, run%state%time, last)) &
+      call share_block_energies(run%state%groups, run%partition, run%exchange, run%state%cycle)
+    if (last .or. clock_is_due(run%plan%states, run%state%time, last)) &
       call gather_block_state(run%state%groups, run%partition, run%exchange, run%state%cycle)
-    else if (clock_is_due(run%plan%glstat, run%state%time, last) .or. clock_is_due(run%plan%matsum, run%state%time, last)) then
-      call gather_block_energies(run%state%groups, run%partition, run%exchange, run%state%cycle)
-    end if
-    ! (and all of it at the end: d3hsp, the summary)
-    if (last) call gather_block_state(run%state%groups, run%partition, run%exchange, run%state%cycle)
     call write_due_output(model, run%state, run%plan, run%histories, run%energy_scratch, results, last, error)
     call stop_phase(run%timers(phase_output))
   end subroutine output

@@ -392,10 +392,10 @@ contains
       8.0e-3_wp*real(size(run%exchange%receive), wp), " kB to each rank), waiting for the slowest rank ", &
       per_cycle*run%exchange%wait_timer%seconds, " ms per cycle"
     write (*, '(a)') trim(line)
-    write (line, '(a,i0,a,i0,a,f0.3,a,f0.1,a)') "  MPI: block state brought together ", run%exchange%block_gathers, &
-      " times (states, dumps, erosion), their energies alone ", run%exchange%energy_gathers, &
-      " times (energy checks, histories): ", run%exchange%gather_timer%seconds, " s, ", &
-      8.0e-6_wp*run%exchange%gathered_values, " MB received"
+    write (line, '(a,i0,a,i0,a,i0,a,f0.3,a,f0.1,a)') "  MPI: block state gathered to the first rank ", &
+      run%exchange%block_gathers, " times (states, dumps, the end), to every rank ", run%exchange%block_shares, &
+      " times (erosion); the blocks' energy sums shared ", run%exchange%energy_shares, " times: ", &
+      run%exchange%gather_timer%seconds, " s, ", 8.0e-6_wp*run%exchange%gathered_values, " MB received by the first rank"
     write (*, '(a)') trim(line)
     ! every rank's seconds: where the balance is lost
     if (allocated(summary%rank_seconds)) then

@@ -11,9 +11,9 @@ module efg_group
   use restart_file, only: restart_store_t, exchange_restart, exchange_restart_count
   use model, only: model_t, formulation_efg, boundary_full_transformation, integration_gauss_conventional
   use nodal_state, only: nodal_state_t
-  use element_group, only: element_group_t, element_results_t, distinct_nodes, family_solid
+  use element_group, only: element_group_t, element_results_t, distinct_nodes, family_solid, block_energy_values
   use particle_rows, only: particle_rows_t, append_particle_rows
-  use element_work, only: booked_energy, add_kinetic_energy
+  use element_work, only: booked_energy, lane_energy_sums, add_kinetic_energy
   use efg_part, only: efg_part_t
   use efg_setup, only: build_efg_part
   use efg_forces, only: efg_solver_t, set_up_efg_solver, compute_efg_forces, efg_point_results, &
@@ -33,6 +33,7 @@ module efg_group
     procedure :: scale_masses
     procedure :: lump_masses
     procedure :: add_internal_forces
+    procedure :: sum_block_energies
     procedure :: add_energies
     procedure :: add_part_energies
     procedure :: add_part_momenta
@@ -47,7 +48,6 @@ module efg_group
     procedure :: list_time_steps
     procedure :: distributes_blocks
     procedure :: exchange_block_state
-    procedure :: exchange_block_energies
   end type efg_group_t
 
 contains
@@ -108,6 +108,7 @@ contains
       if (allocated(error)) return
       call set_up_efg_solver(model, geometry, group%parts(count))
     end do
+    allocate (group%block_energy(block_energy_values, group%block_count()), source=0.0_wp)
   end subroutine build_group
 
   integer function element_count(self)
@@ -200,18 +201,31 @@ contains
     end do
   end subroutine add_internal_forces
 
+  !> Per point block (the group's numbers, part after part): its points' internal energy and
+  !> its power.
+  subroutine sum_block_energies(self)
+    class(efg_group_t), intent(inout) :: self
+    integer :: k, b, before
+    before = 0
+    do k = 1, size(self%parts)
+      do b = 1, size(self%parts(k)%blocks)
+        if (.not. self%computes(before + b)) cycle
+        associate (block => self%parts(k)%blocks(b))
+          self%block_energy(1:3, before + b) = lane_energy_sums(block%internal_energy, block%force_power, &
+                                                                block%point_count)
+        end associate
+      end do
+      before = before + size(self%parts(k)%blocks)
+    end do
+  end subroutine sum_block_energies
+
   subroutine add_energies(self, step_correction, internal, hourglass)
     class(efg_group_t), intent(in) :: self
     real(wp), intent(in) :: step_correction
     real(wp), intent(inout) :: internal, hourglass
-    integer :: k, b
-    do k = 1, size(self%parts)
-      do b = 1, size(self%parts(k)%blocks)
-        associate (block => self%parts(k)%blocks(b))
-          internal = internal + booked_energy(block%internal_energy, block%force_power, block%point_count, &
-                                              step_correction)
-        end associate
-      end do
+    integer :: b
+    do b = 1, size(self%block_energy, 2)
+      internal = internal + booked_energy(self%block_energy(1, b), self%block_energy(2, b), step_correction)
     end do
   end subroutine add_energies
 
@@ -220,13 +234,15 @@ contains
     type(nodal_state_t), intent(in) :: nodes
     real(wp), intent(in) :: average_step, step_correction
     real(wp), intent(inout) :: kinetic(:), internal(:), hourglass(:)
-    integer :: k, b, j, node
+    integer :: k, b, j, node, before
+    before = 0
     do k = 1, size(self%parts)
       associate (efg => self%parts(k), part => self%parts(k)%geometry%part)
-        do b = 1, size(efg%blocks)
-          internal(part) = internal(part) + booked_energy(efg%blocks(b)%internal_energy, efg%blocks(b)%force_power, &
-            efg%blocks(b)%point_count, step_correction)
+        do b = before + 1, before + size(efg%blocks)
+          internal(part) = internal(part) + booked_energy(self%block_energy(1, b), self%block_energy(2, b), &
+                                                          step_correction)
         end do
+        before = before + size(efg%blocks)
         do j = 1, size(efg%geometry%mass_node)
           node = efg%geometry%mass_node(j)
           call add_kinetic_energy(efg%density*efg%geometry%mass_volume(j), nodes%velocity(:, node), &
@@ -467,18 +483,6 @@ contains
       end associate
     end associate
   end subroutine exchange_block_state
-
-  !> One point block's energies and powers (what add_energies and add_part_energies read).
-  subroutine exchange_block_energies(self, store, block, error)
-    class(efg_group_t), intent(inout) :: self
-    type(restart_store_t), intent(inout) :: store
-    integer, intent(in) :: block
-    type(error_t), allocatable, intent(inout) :: error
-    integer :: p, local
-    call find_block(self, block, p, local)
-    call exchange_restart(store, "internal_energy", self%parts(p)%blocks(local)%internal_energy, error)
-    call exchange_restart(store, "force_power", self%parts(p)%blocks(local)%force_power, error)
-  end subroutine exchange_block_energies
 
   integer function block_count(self)
     class(efg_group_t), intent(in) :: self

@@ -22,9 +22,9 @@ module efg_shell_group
   use restart_file, only: restart_store_t, exchange_restart, exchange_restart_count
   use model, only: model_t, formulation_efg
   use nodal_state, only: nodal_state_t
-  use element_group, only: element_group_t, element_results_t, distinct_nodes, family_shell
+  use element_group, only: element_group_t, element_results_t, distinct_nodes, family_shell, block_energy_values
   use particle_rows, only: particle_rows_t, append_particle_rows
-  use element_work, only: booked_energy, add_kinetic_energy
+  use element_work, only: booked_energy, lane_energy_sums, add_kinetic_energy
   use efg_shell_part, only: efg_shell_part_t
   use efg_shell_setup, only: build_efg_shell_part
   use efg_shell_forces, only: efg_shell_solver_t, set_up_efg_shell_solver, compute_efg_shell_forces, &
@@ -52,6 +52,7 @@ module efg_shell_group
     procedure :: scale_masses
     procedure :: lump_masses
     procedure :: add_internal_forces
+    procedure :: sum_block_energies
     procedure :: add_energies
     procedure :: add_part_energies
     procedure :: add_part_momenta
@@ -68,7 +69,6 @@ module efg_shell_group
     procedure :: list_time_steps
     procedure :: distributes_blocks, adds_moments
     procedure :: exchange_block_state
-    procedure :: exchange_block_energies
   end type efg_shell_group_t
 
 contains
@@ -108,7 +108,10 @@ contains
       if (model%parts(part)%formulation == formulation_efg .and. used(part)) count = count + 1
     end do
     allocate (group%parts(count), group%masses(count))
-    if (count == 0) return
+    if (count == 0) then
+      allocate (group%block_energy(block_energy_values, 0))
+      return
+    end if
     count = 0
     do part = 1, size(model%parts)
       if (model%parts(part)%formulation /= formulation_efg .or. .not. used(part)) cycle
@@ -120,6 +123,7 @@ contains
       call efg_shell_nodal_masses(group%parts(count), size(model%coordinates, 2), group%masses(count)%mass, &
                                   group%masses(count)%inertia)
     end do
+    allocate (group%block_energy(block_energy_values, group%block_count()), source=0.0_wp)
   end subroutine build_group
 
   !> The nodes of `part` that must keep physical unknowns (module comment).
@@ -280,26 +284,49 @@ contains
 
   !> Internal energy: membrane, bending and transverse shear work (no hourglass energy: the
   !> sub-cell points leave no membrane or bending mode free).
+  !> Per cell block (the group's numbers, part after part): its points' internal energy and
+  !> its power, its cells' transverse shear energy and its power.
+  subroutine sum_block_energies(self)
+    class(efg_shell_group_t), intent(inout) :: self
+    real(wp) :: membrane(3), shear(3)
+    integer :: k, b, before
+    before = 0
+    do k = 1, size(self%parts)
+      do b = 1, size(self%parts(k)%blocks)
+        if (.not. self%computes(before + b)) cycle
+        associate (block => self%parts(k)%blocks(b))
+          membrane = lane_energy_sums(block%internal_energy, block%force_power, block%point_count)
+          shear = lane_energy_sums(block%shear_energy, block%shear_power, block%cell_count)
+        end associate
+        self%block_energy(1:4, before + b) = [membrane(1:2), shear(1:2)]
+      end do
+      before = before + size(self%parts(k)%blocks)
+    end do
+  end subroutine sum_block_energies
+
   subroutine add_energies(self, step_correction, internal, hourglass)
     class(efg_shell_group_t), intent(in) :: self
     real(wp), intent(in) :: step_correction
     real(wp), intent(inout) :: internal, hourglass
-    integer :: k
+    integer :: k, before
+    before = 0
     do k = 1, size(self%parts)
-      internal = internal + part_internal_energy(self%parts(k), step_correction)
+      internal = internal + part_internal_energy(self, before, size(self%parts(k)%blocks), step_correction)
+      before = before + size(self%parts(k)%blocks)
     end do
   end subroutine add_energies
 
-  real(wp) function part_internal_energy(solver, step_correction) result(energy)
-    type(efg_shell_solver_t), intent(in) :: solver
+  !> A part's internal energy from the sums of its blocks, the group's blocks before + 1 to
+  !> before + blocks.
+  real(wp) function part_internal_energy(group, before, blocks, step_correction) result(energy)
+    type(efg_shell_group_t), intent(in) :: group
+    integer, intent(in) :: before, blocks
     real(wp), intent(in) :: step_correction
     integer :: b
     energy = 0.0_wp
-    do b = 1, size(solver%blocks)
-      associate (block => solver%blocks(b))
-        energy = energy + booked_energy(block%internal_energy, block%force_power, block%point_count, step_correction) &
-                 + booked_energy(block%shear_energy, block%shear_power, block%cell_count, step_correction)
-      end associate
+    do b = before + 1, before + blocks
+      energy = energy + booked_energy(group%block_energy(1, b), group%block_energy(2, b), step_correction) &
+               + booked_energy(group%block_energy(3, b), group%block_energy(4, b), step_correction)
     end do
   end function part_internal_energy
 
@@ -308,10 +335,12 @@ contains
     type(nodal_state_t), intent(in) :: nodes
     real(wp), intent(in) :: average_step, step_correction
     real(wp), intent(inout) :: kinetic(:), internal(:), hourglass(:)
-    integer :: k, j, node
+    integer :: k, j, node, before
+    before = 0
     do k = 1, size(self%parts)
       associate (efg => self%parts(k), part => self%parts(k)%geometry%part)
-        internal(part) = internal(part) + part_internal_energy(efg, step_correction)
+        internal(part) = internal(part) + part_internal_energy(self, before, size(efg%blocks), step_correction)
+        before = before + size(efg%blocks)
         do j = 1, size(efg%geometry%mass_node)
           node = efg%geometry%mass_node(j)
           call add_kinetic_energy(self%masses(k)%mass(j), nodes%velocity(:, node), nodes%acceleration(:, node), &
@@ -590,22 +619,6 @@ contains
       end associate
     end associate
   end subroutine exchange_block_state
-
-  !> One cell block's energies and powers (what add_energies and add_part_energies read).
-  subroutine exchange_block_energies(self, store, block, error)
-    class(efg_shell_group_t), intent(inout) :: self
-    type(restart_store_t), intent(inout) :: store
-    integer, intent(in) :: block
-    type(error_t), allocatable, intent(inout) :: error
-    integer :: p, local
-    call find_block(self, block, p, local)
-    associate (cells => self%parts(p)%blocks(local))
-      call exchange_restart(store, "internal_energy", cells%internal_energy, error)
-      call exchange_restart(store, "force_power", cells%force_power, error)
-      call exchange_restart(store, "shear_energy", cells%shear_energy, error)
-      call exchange_restart(store, "shear_power", cells%shear_power, error)
-    end associate
-  end subroutine exchange_block_energies
 
   integer function block_count(self)
     class(efg_shell_group_t), intent(in) :: self

@@ -14,8 +14,9 @@ module beam_group
   use restart_file, only: restart_store_t, exchange_restart, exchange_restart_count
   use run_summary, only: run_summary_t
   use nodal_state, only: nodal_state_t
-  use element_group, only: element_group_t, element_results_t, distinct_nodes, family_beam
-  use element_work, only: append_marked_lanes, booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, &
+  use element_group, only: element_group_t, element_results_t, distinct_nodes, family_beam, block_energy_values
+  use element_work, only: append_marked_lanes, booked_energy, lane_energy_sums, add_kinetic_energy, &
+                          scale_block_density, &
                           raise_largest_scaling
   use beam_block, only: beam_block_t, build_beam_blocks, beam_block_masses, beam_block_time_steps, &
                         compute_beam_block
@@ -40,6 +41,7 @@ module beam_group
     procedure :: scale_masses
     procedure :: lump_masses
     procedure :: add_internal_forces
+    procedure :: sum_block_energies
     procedure :: add_energies
     procedure :: add_part_energies
     procedure :: add_part_momenta
@@ -49,7 +51,6 @@ module beam_group
     procedure :: exchange_state
     procedure :: distributes_blocks, adds_moments
     procedure :: exchange_block_state
-    procedure :: exchange_block_energies
     procedure :: failure_text
     procedure :: most_scaled
     procedure :: newly_eroded_elements
@@ -76,6 +77,7 @@ contains
                 group%block_degenerate_element(count))
       group%nodal_mass = 0.0_wp
       group%nodal_inertia = 0.0_wp
+      allocate (group%block_energy(block_energy_values, count), source=0.0_wp)
       group%block_time_step = huge(1.0_wp)
       group%block_critical_element = 0
       group%block_degenerate_element = 0
@@ -201,8 +203,7 @@ contains
     real(wp), intent(inout) :: internal, hourglass
     integer :: b
     do b = 1, size(self%blocks)
-      internal = internal + eroded_energy(self%blocks(b)%internal_energy, self%blocks(b)%element_count, &
-                                          self%blocks(b)%failed)
+      internal = internal + self%block_energy(3, b)
     end do
   end subroutine add_eroded_energies
 
@@ -220,16 +221,27 @@ contains
     end do
   end subroutine add_beam_forces
 
+  !> Per block: the live beams' internal energy and its power, the failed beams' internal
+  !> energy.
+  subroutine sum_block_energies(self)
+    class(beam_group_t), intent(inout) :: self
+    integer :: b
+    do b = 1, size(self%blocks)
+      if (.not. self%computes(b)) cycle
+      associate (beam => self%blocks(b))
+        self%block_energy(1:3, b) = lane_energy_sums(beam%internal_energy, beam%force_power, beam%element_count, &
+                                                     beam%failed)
+      end associate
+    end do
+  end subroutine sum_block_energies
+
   subroutine add_energies(self, step_correction, internal, hourglass)
     class(beam_group_t), intent(in) :: self
     real(wp), intent(in) :: step_correction
     real(wp), intent(inout) :: internal, hourglass
     integer :: b
     do b = 1, size(self%blocks)
-      associate (beam => self%blocks(b))
-        internal = internal + booked_energy(beam%internal_energy, beam%force_power, beam%element_count, &
-                                            step_correction, beam%failed)
-      end associate
+      internal = internal + booked_energy(self%block_energy(1, b), self%block_energy(2, b), step_correction)
     end do
   end subroutine add_energies
 
@@ -241,8 +253,8 @@ contains
     integer :: b, end, lane, node
     do b = 1, size(self%blocks)
       associate (beam => self%blocks(b))
-        internal(beam%part) = internal(beam%part) + booked_energy(beam%internal_energy, beam%force_power, &
-          beam%element_count, step_correction, beam%failed)
+        internal(beam%part) = internal(beam%part) + booked_energy(self%block_energy(1, b), self%block_energy(2, b), &
+                                                                  step_correction)
         do end = 1, 2
           do lane = 1, beam%element_count
             node = beam%nodes(lane, end)
@@ -432,16 +444,6 @@ contains
     call exchange_restart(store, "degenerate_element", self%block_degenerate_element(block), error)
     call exchange_beam_block(store, "block", self%blocks(block), error)
   end subroutine exchange_block_state
-
-  !> One block's energies and powers (what add_energies and add_part_energies read).
-  subroutine exchange_block_energies(self, store, block, error)
-    class(beam_group_t), intent(inout) :: self
-    type(restart_store_t), intent(inout) :: store
-    integer, intent(in) :: block
-    type(error_t), allocatable, intent(inout) :: error
-    call exchange_restart(store, "internal_energy", self%blocks(block)%internal_energy, error)
-    call exchange_restart(store, "force_power", self%blocks(block)%force_power, error)
-  end subroutine exchange_block_energies
 
   integer function block_count(self)
     class(beam_group_t), intent(in) :: self

@@ -36,6 +36,8 @@ module element_group
   !> the meshfree shells' background cells) or the beams. The domain partition counts and
   !> assigns elements by these lists.
   integer, parameter, public :: family_solid = 1, family_shell = 2, family_beam = 3
+  !> Values per block in block_energy (every kind uses at most these).
+  integer, parameter, public :: block_energy_values = 6
 
   !> Elements folded inside out at a corner while their volume stays positive (distortion_check),
   !> checked at every output state.
@@ -100,6 +102,13 @@ module element_group
     logical, allocatable :: computed(:), owned(:)
     integer :: critical_block = 0                  !< the block of critical_element (0: none, or not by block)
     integer :: failed_block = 0                    !< the block of failed_element (0: none, or not by block)
+    !> (block_energy_values, blocks): per block the sums of its lanes' energies that the energy
+    !> procedures read (add_energies, add_part_energies, add_eroded_energies; e.g. the live
+    !> lanes' internal energy and its power, the eroded lanes' energy: what each value means is
+    !> the kind's own). sum_block_energies fills the columns of the blocks this rank computes; a
+    !> distributed run then hands the owners' columns to every rank (domain_exchange's
+    !> share_block_energies), so that the energies need no block state from another rank.
+    real(wp), allocatable :: block_energy(:, :)
   contains
     !> Once before the first cycle: its element count (0: the group is dropped).
     procedure(count_interface), deferred :: element_count
@@ -110,7 +119,10 @@ module element_group
     !> Every cycle: add the internal forces (and moments) at the current configuration into
     !> `nodes`, which the engine has cleared; set the header's step, critical and failed element.
     procedure(forces_interface), deferred :: add_internal_forces
-    !> Internal and hourglass energies, summed block by block (energy_balance).
+    !> Before the energies are read (energy checks, glstat, matsum, states): the block_energy
+    !> columns of the blocks this rank computes, from their lanes.
+    procedure(block_energy_interface), deferred :: sum_block_energies
+    !> Internal and hourglass energies, summed block by block from block_energy (energy_balance).
     procedure(energy_interface), deferred :: add_energies
     !> Per part: internal, hourglass, and the kinetic energy of the nodal masses the group gave.
     procedure(part_energy_interface), deferred :: add_part_energies
@@ -178,9 +190,6 @@ module element_group
     !> Optional, with distributes_blocks: write or read the state of one block (as exchange_state
     !> does for all, into a store in memory), so that the ranks can bring their blocks together.
     procedure :: exchange_block_state
-    !> Optional, with distributes_blocks: the same for what add_energies and add_part_energies
-    !> read of one block (energies and powers), all that the energy checks and histories need.
-    procedure :: exchange_block_energies
     !> Optional: whether its force call adds moments, shell normals or areas at the nodes of its
     !> blocks (shells, beams, meshfree shells; default: no). A distributed run exchanges those
     !> only at such nodes (forces alone elsewhere).
@@ -223,6 +232,11 @@ module element_group
       type(nodal_state_t), intent(inout) :: nodes
       real(wp), intent(in) :: step          !< the step just taken (0 at the start)
     end subroutine forces_interface
+
+    subroutine block_energy_interface(self)
+      import :: element_group_t
+      class(element_group_t), intent(inout) :: self
+    end subroutine block_energy_interface
 
     subroutine energy_interface(self, step_correction, internal, hourglass)
       import :: element_group_t, wp
@@ -352,13 +366,6 @@ contains
     integer, intent(in) :: block
     type(error_t), allocatable, intent(inout) :: error
   end subroutine exchange_block_state
-
-  subroutine exchange_block_energies(self, store, block, error)
-    class(element_group_t), intent(inout) :: self
-    type(restart_store_t), intent(inout) :: store
-    integer, intent(in) :: block
-    type(error_t), allocatable, intent(inout) :: error
-  end subroutine exchange_block_energies
 
   pure logical function computes(self, block)
     class(element_group_t), intent(in) :: self

@@ -7,7 +7,7 @@ module element_work
   private
 
   public :: append_marked_lanes, mark_lanes
-  public :: add_force_work, smallest_time_step, booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, &
+  public :: add_force_work, smallest_time_step, booked_energy, lane_energy_sums, add_kinetic_energy, scale_block_density, &
             raise_largest_scaling
 
 contains
@@ -52,23 +52,35 @@ contains
     if (lane > 0) critical_element = elements(lane)
   end subroutine smallest_time_step
 
-  !> Energy of the first `count` lanes of a block as the solver reports it: the work booked by
-  !> the elements plus the step correction of their newest forces' power (see solid_block).
-  !> Eroded lanes (`eroded`) are left out: their energy is reported apart (eroded_energy).
-  pure real(wp) function booked_energy(energy, power, count, step_correction, eroded)
-    real(wp), intent(in) :: energy(:), power(:), step_correction
+  !> A block's energy as the solver reports it, from its lanes' sums (lane_energy_sums): the
+  !> work booked by the elements plus the step correction of their newest forces' power (see
+  !> solid_block).
+  pure real(wp) function booked_energy(energy_sum, power_sum, step_correction)
+    real(wp), intent(in) :: energy_sum, power_sum, step_correction
+    booked_energy = energy_sum + step_correction*power_sum
+  end function booked_energy
+
+  !> The sums over the first `count` lanes of a block that its energies need (element_group's
+  !> block_energy): the energy and the power of the live lanes (booked_energy adds them), and
+  !> the energy the eroded lanes (`eroded`) took along, reported apart (their powers are zero).
+  pure function lane_energy_sums(energy, power, count, eroded) result(sums)
+    real(wp), intent(in) :: energy(:), power(:)
     integer, intent(in) :: count
     logical, intent(in), optional :: eroded(:)
+    real(wp) :: sums(3)
     logical :: some_eroded
     some_eroded = .false.
     if (present(eroded)) some_eroded = any(eroded(1:count))
     if (some_eroded) then
-      booked_energy = sum(energy(1:count), mask=.not. eroded(1:count)) &
-                      + step_correction*sum(power(1:count), mask=.not. eroded(1:count))
+      sums(1) = sum(energy(1:count), mask=.not. eroded(1:count))
+      sums(2) = sum(power(1:count), mask=.not. eroded(1:count))
+      sums(3) = sum(energy(1:count), mask=eroded(1:count))
     else
-      booked_energy = sum(energy(1:count)) + step_correction*sum(power(1:count))
+      sums(1) = sum(energy(1:count))
+      sums(2) = sum(power(1:count))
+      sums(3) = 0.0_wp
     end if
-  end function booked_energy
+  end function lane_energy_sums
 
   !> Append to `elements` (`n` used) the elements (`lane_elements`) of the first `count` lanes
   !> of a block that `marked` flags, as long as there is room: the elements an element group
@@ -96,15 +108,6 @@ contains
       if (marked(lane)) mask(lane_elements(lane)) = .true.
     end do
   end subroutine mark_lanes
-
-  !> Energy the eroded lanes of a block took along (their powers are zero).
-  pure real(wp) function eroded_energy(energy, count, eroded)
-    real(wp), intent(in) :: energy(:)
-    integer, intent(in) :: count
-    logical, intent(in) :: eroded(:)
-    eroded_energy = 0.0_wp
-    if (any(eroded(1:count))) eroded_energy = sum(energy(1:count), mask=eroded(1:count))
-  end function eroded_energy
 
   !> Add a mass's share of the conserved kinetic energy 1/2 m v^{n-1/2} . v^{n+1/2}, split as
   !> explained at energy_balance: 1/2 m (v^n)^2 to `kinetic`, -1/8 m (dt a)^2 to `internal`.

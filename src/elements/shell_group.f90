@@ -13,8 +13,9 @@ module shell_group
   use restart_file, only: restart_store_t, exchange_restart, exchange_restart_count
   use run_summary, only: run_summary_t
   use nodal_state, only: nodal_state_t
-  use element_group, only: element_group_t, element_results_t, distinct_nodes, family_shell
-  use element_work, only: append_marked_lanes, mark_lanes, booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, &
+  use element_group, only: element_group_t, element_results_t, distinct_nodes, family_shell, block_energy_values
+  use element_work, only: append_marked_lanes, mark_lanes, booked_energy, lane_energy_sums, add_kinetic_energy, &
+                          scale_block_density, &
                           raise_largest_scaling
   use shell_block, only: shell_block_t, build_shell_blocks, shell_block_masses, shell_block_time_steps, &
                          compute_shell_block, shell_block_element_results
@@ -39,6 +40,7 @@ module shell_group
     procedure :: scale_masses
     procedure :: lump_masses
     procedure :: add_internal_forces
+    procedure :: sum_block_energies
     procedure :: add_energies
     procedure :: add_part_energies
     procedure :: add_part_momenta
@@ -48,7 +50,6 @@ module shell_group
     procedure :: exchange_state
     procedure :: distributes_blocks, adds_moments
     procedure :: exchange_block_state
-    procedure :: exchange_block_energies
     procedure :: failure_text
     procedure :: most_scaled
     procedure :: thinnest
@@ -85,6 +86,7 @@ contains
               group%block_degenerate_element(count))
     group%corner_mass = 0.0_wp
     group%corner_inertia = 0.0_wp
+    allocate (group%block_energy(block_energy_values, count), source=0.0_wp)
     group%block_time_step = huge(1.0_wp)
     group%block_critical_element = 0
     group%block_degenerate_element = 0
@@ -238,10 +240,8 @@ contains
     real(wp), intent(inout) :: internal, hourglass
     integer :: b
     do b = 1, size(self%blocks)
-      associate (shell => self%blocks(b))
-        internal = internal + eroded_energy(shell%internal_energy, shell%element_count, shell%eroded)
-        hourglass = hourglass + eroded_energy(shell%hourglass_energy, shell%element_count, shell%eroded)
-      end associate
+      internal = internal + self%block_energy(5, b)
+      hourglass = hourglass + self%block_energy(6, b)
     end do
   end subroutine add_eroded_energies
 
@@ -267,18 +267,30 @@ contains
     end do
   end subroutine add_shell_forces
 
+  !> Per block: the live lanes' internal energy and its power, their hourglass energy and its
+  !> power, the eroded lanes' internal and hourglass energy.
+  subroutine sum_block_energies(self)
+    class(shell_group_t), intent(inout) :: self
+    real(wp) :: internal(3), hourglass(3)
+    integer :: b
+    do b = 1, size(self%blocks)
+      if (.not. self%computes(b)) cycle
+      associate (shell => self%blocks(b))
+        internal = lane_energy_sums(shell%internal_energy, shell%force_power, shell%element_count, shell%eroded)
+        hourglass = lane_energy_sums(shell%hourglass_energy, shell%hourglass_power, shell%element_count, shell%eroded)
+      end associate
+      self%block_energy(:, b) = [internal(1:2), hourglass(1:2), internal(3), hourglass(3)]
+    end do
+  end subroutine sum_block_energies
+
   subroutine add_energies(self, step_correction, internal, hourglass)
     class(shell_group_t), intent(in) :: self
     real(wp), intent(in) :: step_correction
     real(wp), intent(inout) :: internal, hourglass
     integer :: b
     do b = 1, size(self%blocks)
-      associate (shell => self%blocks(b))
-        internal = internal + booked_energy(shell%internal_energy, shell%force_power, shell%element_count, &
-                                            step_correction, shell%eroded)
-        hourglass = hourglass + booked_energy(shell%hourglass_energy, shell%hourglass_power, shell%element_count, &
-                                              step_correction, shell%eroded)
-      end associate
+      internal = internal + booked_energy(self%block_energy(1, b), self%block_energy(2, b), step_correction)
+      hourglass = hourglass + booked_energy(self%block_energy(3, b), self%block_energy(4, b), step_correction)
     end do
   end subroutine add_energies
 
@@ -290,10 +302,10 @@ contains
     integer :: b, corner, lane, node
     do b = 1, size(self%blocks)
       associate (shell => self%blocks(b))
-        internal(shell%part) = internal(shell%part) + booked_energy(shell%internal_energy, shell%force_power, &
-          shell%element_count, step_correction, shell%eroded)
-        hourglass(shell%part) = hourglass(shell%part) + booked_energy(shell%hourglass_energy, shell%hourglass_power, &
-          shell%element_count, step_correction, shell%eroded)
+        internal(shell%part) = internal(shell%part) + booked_energy(self%block_energy(1, b), self%block_energy(2, b), &
+                                                                    step_correction)
+        hourglass(shell%part) = hourglass(shell%part) + booked_energy(self%block_energy(3, b), self%block_energy(4, b), &
+                                                                      step_correction)
         do corner = 1, 4
           do lane = 1, shell%element_count
             node = shell%nodes(lane, corner)
@@ -505,18 +517,6 @@ contains
     call exchange_restart(store, "degenerate_element", self%block_degenerate_element(block), error)
     call exchange_shell_block(store, "block", self%blocks(block), error)
   end subroutine exchange_block_state
-
-  !> One block's energies and powers (what add_energies and add_part_energies read).
-  subroutine exchange_block_energies(self, store, block, error)
-    class(shell_group_t), intent(inout) :: self
-    type(restart_store_t), intent(inout) :: store
-    integer, intent(in) :: block
-    type(error_t), allocatable, intent(inout) :: error
-    call exchange_restart(store, "internal_energy", self%blocks(block)%internal_energy, error)
-    call exchange_restart(store, "hourglass_energy", self%blocks(block)%hourglass_energy, error)
-    call exchange_restart(store, "force_power", self%blocks(block)%force_power, error)
-    call exchange_restart(store, "hourglass_power", self%blocks(block)%hourglass_power, error)
-  end subroutine exchange_block_energies
 
   integer function block_count(self)
     class(shell_group_t), intent(in) :: self

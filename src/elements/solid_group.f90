@@ -10,8 +10,10 @@ module solid_group
   use restart_file, only: restart_store_t, exchange_restart, exchange_restart_count
   use run_summary, only: run_summary_t
   use nodal_state, only: nodal_state_t
-  use element_group, only: element_group_t, element_results_t, distortion_t, distinct_nodes, family_solid
-  use element_work, only: append_marked_lanes, mark_lanes, booked_energy, eroded_energy, add_kinetic_energy, scale_block_density, &
+  use element_group, only: element_group_t, element_results_t, distortion_t, distinct_nodes, family_solid, &
+                           block_energy_values
+  use element_work, only: append_marked_lanes, mark_lanes, booked_energy, lane_energy_sums, add_kinetic_energy, &
+                          scale_block_density, &
                           raise_largest_scaling
   use solid_block, only: solid_block_t, build_solid_blocks, solid_block_corner_masses, solid_block_time_steps, &
                          compute_solid_block, solid_block_element_results
@@ -36,6 +38,7 @@ module solid_group
     procedure :: scale_masses
     procedure :: lump_masses
     procedure :: add_internal_forces
+    procedure :: sum_block_energies
     procedure :: add_energies
     procedure :: add_part_energies
     procedure :: add_part_momenta
@@ -45,7 +48,6 @@ module solid_group
     procedure :: exchange_state
     procedure :: distributes_blocks
     procedure :: exchange_block_state
-    procedure :: exchange_block_energies
     procedure :: failure_text
     procedure :: most_scaled
     procedure :: check_distortion
@@ -80,6 +82,7 @@ contains
     allocate (group%corner_mass(block_size, 8, count), group%block_time_step(count), &
               group%block_critical_element(count), group%block_inverted_element(count))
     group%corner_mass = 0.0_wp
+    allocate (group%block_energy(block_energy_values, count), source=0.0_wp)
     group%block_time_step = huge(1.0_wp)
     group%block_critical_element = 0
     group%block_inverted_element = 0
@@ -207,12 +210,26 @@ contains
     real(wp), intent(inout) :: internal, hourglass
     integer :: b
     do b = 1, size(self%blocks)
-      associate (block => self%blocks(b))
-        internal = internal + eroded_energy(block%internal_energy, block%element_count, block%eroded)
-        hourglass = hourglass + eroded_energy(block%hourglass_energy, block%element_count, block%eroded)
-      end associate
+      internal = internal + self%block_energy(5, b)
+      hourglass = hourglass + self%block_energy(6, b)
     end do
   end subroutine add_eroded_energies
+
+  !> Per block: the live lanes' internal energy and its power, their hourglass energy and its
+  !> power, the eroded lanes' internal and hourglass energy.
+  subroutine sum_block_energies(self)
+    class(solid_group_t), intent(inout) :: self
+    real(wp) :: internal(3), hourglass(3)
+    integer :: b
+    do b = 1, size(self%blocks)
+      if (.not. self%computes(b)) cycle
+      associate (block => self%blocks(b))
+        internal = lane_energy_sums(block%internal_energy, block%force_power, block%element_count, block%eroded)
+        hourglass = lane_energy_sums(block%hourglass_energy, block%hourglass_power, block%element_count, block%eroded)
+      end associate
+      self%block_energy(:, b) = [internal(1:2), hourglass(1:2), internal(3), hourglass(3)]
+    end do
+  end subroutine sum_block_energies
 
   subroutine add_energies(self, step_correction, internal, hourglass)
     class(solid_group_t), intent(in) :: self
@@ -220,12 +237,8 @@ contains
     real(wp), intent(inout) :: internal, hourglass
     integer :: b
     do b = 1, size(self%blocks)
-      associate (block => self%blocks(b))
-        internal = internal + booked_energy(block%internal_energy, block%force_power, block%element_count, &
-                                            step_correction, block%eroded)
-        hourglass = hourglass + booked_energy(block%hourglass_energy, block%hourglass_power, block%element_count, &
-                                              step_correction, block%eroded)
-      end associate
+      internal = internal + booked_energy(self%block_energy(1, b), self%block_energy(2, b), step_correction)
+      hourglass = hourglass + booked_energy(self%block_energy(3, b), self%block_energy(4, b), step_correction)
     end do
   end subroutine add_energies
 
@@ -238,10 +251,10 @@ contains
     integer :: b, corner, lane, node
     do b = 1, size(self%blocks)
       associate (block => self%blocks(b))
-        internal(block%part) = internal(block%part) + booked_energy(block%internal_energy, block%force_power, &
-          block%element_count, step_correction, block%eroded)
-        hourglass(block%part) = hourglass(block%part) + booked_energy(block%hourglass_energy, block%hourglass_power, &
-          block%element_count, step_correction, block%eroded)
+        internal(block%part) = internal(block%part) + booked_energy(self%block_energy(1, b), self%block_energy(2, b), &
+                                                                    step_correction)
+        hourglass(block%part) = hourglass(block%part) + booked_energy(self%block_energy(3, b), self%block_energy(4, b), &
+                                                                      step_correction)
         do corner = 1, 8
           do lane = 1, block%element_count
             node = block%nodes(lane, corner)
@@ -453,18 +466,6 @@ contains
     call exchange_restart(store, "inverted_element", self%block_inverted_element(block), error)
     call exchange_solid_block(store, "block", self%blocks(block), error)
   end subroutine exchange_block_state
-
-  !> One block's energies and powers (what add_energies and add_part_energies read).
-  subroutine exchange_block_energies(self, store, block, error)
-    class(solid_group_t), intent(inout) :: self
-    type(restart_store_t), intent(inout) :: store
-    integer, intent(in) :: block
-    type(error_t), allocatable, intent(inout) :: error
-    call exchange_restart(store, "internal_energy", self%blocks(block)%internal_energy, error)
-    call exchange_restart(store, "hourglass_energy", self%blocks(block)%hourglass_energy, error)
-    call exchange_restart(store, "force_power", self%blocks(block)%force_power, error)
-    call exchange_restart(store, "hourglass_power", self%blocks(block)%hourglass_power, error)
-  end subroutine exchange_block_energies
 
   integer function block_count(self)
     class(solid_group_t), intent(in) :: self

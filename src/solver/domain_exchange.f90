@@ -21,18 +21,19 @@ module domain_exchange
   use error_handling, only: error_t
   use model, only: model_t
   use nodal_state, only: nodal_state_t
-  use element_group, only: group_holder_t
+  use element_group, only: group_holder_t, block_energy_values
   use restart_file, only: restart_store_t, start_memory_store
   use wall_clock, only: phase_timer_t, start_phase, stop_phase
   use domain_partition, only: domain_partition_t, partition_domains
   use penalty_contact, only: contact_state_t, pair_record_size, pack_pair_records, unpack_pair_records
-  use rank_communication, only: rank_index, rank_total, gather_reals, gather_fixed_reals, barrier_ranks, abort_ranks
+  use rank_communication, only: rank_index, rank_total, gather_reals, gather_reals_to_first, gather_fixed_reals, &
+                                barrier_ranks, abort_ranks
   use text_format, only: integer_text
   implicit none
   private
 
   public :: domain_exchange_t, set_up_domains, exchange_accelerations, combine_group_headers, gather_block_state
-  public :: gather_block_energies, exchange_contact_pairs
+  public :: share_block_energies, exchange_contact_pairs
 
   !> Values per group in the header exchange: step, critical block, critical element, failed
   !> block, failed element, step not finite, newly eroded (owned blocks).
@@ -53,16 +54,18 @@ module domain_exchange
     integer, allocatable :: value_counts(:), value_offsets(:)   !< per rank, for the nodal exchange
     real(wp), allocatable :: send(:), receive(:)
     real(wp), allocatable :: header_send(:), header_receive(:, :)
-    integer :: gathered_cycle = -1              !< the cycle whose block state was last brought together
-    integer :: energies_cycle = -1              !< the cycle whose block energies were (or the whole state)
-    integer :: block_gathers = 0                !< how often the whole state was brought together
-    integer :: energy_gathers = 0               !< how often only the energies were
+    integer :: first_gathered_cycle = -1        !< the cycle whose block state the first rank last gathered
+    integer :: shared_cycle = -1                !< the cycle whose block state every rank last received
+    integer :: energies_cycle = -1              !< the cycle whose block energies were last summed and shared
+    integer :: block_gathers = 0                !< how often the first rank gathered the blocks' state
+    integer :: block_shares = 0                 !< how often every rank received it (elements eroded)
+    integer :: energy_shares = 0                !< how often the blocks' energy sums were shared
     type(restart_store_t) :: store              !< this rank's blocks, packed for a gather
     !> wall-clock time of the nodal (accelerations) and header exchanges; of the wait for the slowest rank before
     !> them (a barrier: what the ranks' unequal work costs, kept apart from the communication);
     !> of bringing the blocks together
     type(phase_timer_t) :: timer, wait_timer, gather_timer
-    real(wp) :: gathered_values = 0.0_wp        !< values received by the block gathers, in all
+    real(wp) :: gathered_values = 0.0_wp        !< values this rank received of block state and energies, in all
     !> the contact pair exchange: counts of records per rank, buffers (grown, never shrunk)
     real(wp), allocatable :: pair_send(:), pair_receive(:), record_counts(:, :)
     integer, allocatable :: pair_value_counts(:), pair_value_offsets(:)
@@ -233,7 +236,7 @@ contains
   !> rank picks); the failed element of the first block with one; a step that is not a number
   !> anywhere; the eroded elements of all ranks (then the blocks are brought together, so that
   !> every rank lists and marks the same elements). Groups computed whole on every rank already
-  !> hold the global header. `cycle` is the state's cycle (for gather_block_state).
+  !> hold the global header. `cycle` is the state's cycle (for share_block_state).
   subroutine combine_group_headers(groups, partition, exchange, cycle)
     type(group_holder_t), intent(inout) :: groups(:)
     type(domain_partition_t), intent(in) :: partition
@@ -287,48 +290,116 @@ contains
         if (newly_eroded > 0) eroded = .true.
       end associate
     end do
-    if (eroded) call gather_block_state(groups, partition, exchange, cycle)
+    if (eroded) call share_block_state(groups, partition, exchange, cycle)
   end subroutine combine_group_headers
 
-  !> Bring every block's state to every rank from its owner (each rank's others are old): before
-  !> anything outside the force call reads block state (output states, dumps, the eroded
-  !> elements, the end of the run). Once per cycle at most; nothing with one rank.
+  !> Bring every block's state to the first rank from its owner (each rank's others are old):
+  !> before the first rank writes what reads block state (output states, dumps, the end of the
+  !> run). Once per cycle at most; nothing with one rank.
   subroutine gather_block_state(groups, partition, exchange, cycle)
     type(group_holder_t), intent(inout) :: groups(:)
     type(domain_partition_t), intent(in) :: partition
     type(domain_exchange_t), intent(inout) :: exchange
     integer, intent(in) :: cycle
-    if (exchange%rank_count == 1 .or. exchange%gathered_cycle == cycle) return
+    if (exchange%rank_count == 1 .or. exchange%first_gathered_cycle == cycle) return
     call start_phase(exchange%gather_timer)
     call bring_blocks_together(groups, partition, exchange, .false.)
-    exchange%gathered_cycle = cycle
-    exchange%energies_cycle = cycle
+    exchange%first_gathered_cycle = cycle
     exchange%block_gathers = exchange%block_gathers + 1
     call stop_phase(exchange%gather_timer)
   end subroutine gather_block_state
 
-  !> The same for the blocks' energies and powers only (exchange_block_energies): what the energy
-  !> checks and the glstat and matsum histories read, a small part of a block's state.
-  subroutine gather_block_energies(groups, partition, exchange, cycle)
+  !> The same to every rank: in a cycle in which elements eroded, so that every rank lists and
+  !> marks the same elements (the contacts drop their segments everywhere alike).
+  subroutine share_block_state(groups, partition, exchange, cycle)
     type(group_holder_t), intent(inout) :: groups(:)
     type(domain_partition_t), intent(in) :: partition
     type(domain_exchange_t), intent(inout) :: exchange
     integer, intent(in) :: cycle
-    if (exchange%rank_count == 1 .or. exchange%energies_cycle == cycle) return
+    if (exchange%rank_count == 1 .or. exchange%shared_cycle == cycle) return
     call start_phase(exchange%gather_timer)
     call bring_blocks_together(groups, partition, exchange, .true.)
-    exchange%energies_cycle = cycle
-    exchange%energy_gathers = exchange%energy_gathers + 1
+    exchange%shared_cycle = cycle
+    exchange%first_gathered_cycle = cycle
+    exchange%block_shares = exchange%block_shares + 1
     call stop_phase(exchange%gather_timer)
-  end subroutine gather_block_energies
+  end subroutine share_block_state
 
-  !> The owners pack their blocks (whole, or their energies) into a store in memory, every rank
-  !> receives all stores (MPI_Allgatherv) and unpacks the blocks of the others, rank by rank.
-  subroutine bring_blocks_together(groups, partition, exchange, energies_only)
+  !> Before the energies are read (the energy checks, glstat, matsum, output states): every
+  !> group sums the energies of the blocks this rank computes into its block_energy columns,
+  !> and a distributed run hands each owner's columns to every rank (one MPI_Allgatherv of
+  !> block_energy_values reals per block). The energies are then the one-rank sums of the same
+  !> block sums, in the same order, on every rank. Once per cycle at most.
+  subroutine share_block_energies(groups, partition, exchange, cycle)
     type(group_holder_t), intent(inout) :: groups(:)
     type(domain_partition_t), intent(in) :: partition
     type(domain_exchange_t), intent(inout) :: exchange
-    logical, intent(in) :: energies_only
+    integer, intent(in) :: cycle
+    real(wp), allocatable :: send(:), received(:)
+    integer, allocatable :: counts(:), offsets(:)
+    integer :: k, b, r, at
+    if (exchange%energies_cycle == cycle) return
+    exchange%energies_cycle = cycle
+    do k = 1, size(groups)
+      call groups(k)%group%sum_block_energies()
+    end do
+    if (exchange%rank_count == 1) return
+    call start_phase(exchange%gather_timer)
+    allocate (counts(exchange%rank_count), offsets(exchange%rank_count))
+    counts = 0
+    do k = 1, size(groups)
+      if (.not. groups(k)%group%distributes_blocks()) cycle
+      do b = 1, size(partition%groups(k)%owner)
+        r = partition%groups(k)%owner(b)
+        counts(r + 1) = counts(r + 1) + block_energy_values
+      end do
+    end do
+    offsets(1) = 0
+    do r = 2, exchange%rank_count
+      offsets(r) = offsets(r - 1) + counts(r - 1)
+    end do
+    allocate (send(max(1, counts(exchange%rank + 1))), received(max(1, sum(counts))))
+    at = 0
+    call copy_energy_columns(exchange%rank, .true.)
+    call gather_reals(send, counts, offsets, received)
+    do r = 0, exchange%rank_count - 1
+      if (r == exchange%rank) cycle
+      at = offsets(r + 1)
+      call copy_energy_columns(r, .false.)
+    end do
+    exchange%energy_shares = exchange%energy_shares + 1
+    exchange%gathered_values = exchange%gathered_values + real(sum(counts) - counts(exchange%rank + 1), wp)
+    call stop_phase(exchange%gather_timer)
+  contains
+    !> The columns of rank `owner`'s blocks, group by group in block order: into `send`
+    !> (packing) or out of `received` from `at` on.
+    subroutine copy_energy_columns(owner, packing)
+      integer, intent(in) :: owner
+      logical, intent(in) :: packing
+      integer :: group_index, block
+      do group_index = 1, size(groups)
+        if (.not. groups(group_index)%group%distributes_blocks()) cycle
+        do block = 1, size(partition%groups(group_index)%owner)
+          if (partition%groups(group_index)%owner(block) /= owner) cycle
+          if (packing) then
+            send(at + 1:at + block_energy_values) = groups(group_index)%group%block_energy(:, block)
+          else
+            groups(group_index)%group%block_energy(:, block) = received(at + 1:at + block_energy_values)
+          end if
+          at = at + block_energy_values
+        end do
+      end do
+    end subroutine copy_energy_columns
+  end subroutine share_block_energies
+
+  !> The owners pack their blocks into a store in memory; the first rank (`everyone`: every
+  !> rank) receives all stores (MPI_Gatherv; MPI_Allgatherv) and unpacks the blocks of the
+  !> others, rank by rank.
+  subroutine bring_blocks_together(groups, partition, exchange, everyone)
+    type(group_holder_t), intent(inout) :: groups(:)
+    type(domain_partition_t), intent(in) :: partition
+    type(domain_exchange_t), intent(inout) :: exchange
+    logical, intent(in) :: everyone
     type(restart_store_t) :: reader
     type(error_t), allocatable :: error
     real(wp) :: length(1)
@@ -340,11 +411,7 @@ contains
       if (.not. groups(k)%group%distributes_blocks()) cycle
       do b = 1, size(partition%groups(k)%owner)
         if (partition%groups(k)%owner(b) /= exchange%rank) cycle
-        if (energies_only) then
-          call groups(k)%group%exchange_block_energies(exchange%store, b, error)
-        else
-          call groups(k)%group%exchange_block_state(exchange%store, b, error)
-        end if
+        call groups(k)%group%exchange_block_state(exchange%store, b, error)
       end do
     end do
     length(1) = real(exchange%store%position, wp)
@@ -355,8 +422,15 @@ contains
     do r = 2, exchange%rank_count
       offsets(r) = offsets(r - 1) + counts(r - 1)
     end do
-    allocate (received(max(1, sum(counts))))
-    call gather_reals(exchange%store%memory(1:max(1, exchange%store%position)), counts, offsets, received)
+    if (everyone) then
+      allocate (received(max(1, sum(counts))))
+      call gather_reals(exchange%store%memory(1:max(1, exchange%store%position)), counts, offsets, received)
+    else
+      ! (only the first rank receives: the others need no room)
+      allocate (received(merge(max(1, sum(counts)), 1, exchange%rank == 0)))
+      call gather_reals_to_first(exchange%store%memory(1:max(1, exchange%store%position)), counts, offsets, received)
+      if (exchange%rank /= 0) return
+    end if
     do r = 0, exchange%rank_count - 1
       if (r == exchange%rank) cycle
       reader%memory = received(offsets(r + 1) + 1:offsets(r + 1) + max(1, counts(r + 1)))
@@ -365,11 +439,7 @@ contains
         if (.not. groups(k)%group%distributes_blocks()) cycle
         do b = 1, size(partition%groups(k)%owner)
           if (partition%groups(k)%owner(b) /= r) cycle
-          if (energies_only) then
-            call groups(k)%group%exchange_block_energies(reader, b, error)
-          else
-            call groups(k)%group%exchange_block_state(reader, b, error)
-          end if
+          call groups(k)%group%exchange_block_state(reader, b, error)
         end do
       end do
       ! (ranks that disagree on the blocks' shapes run different builds or decks: no result can
@@ -378,6 +448,6 @@ contains
         call abort_ranks("block state from rank "//integer_text(r)//": "//integer_text(counts(r + 1))// &
                          " values received, "//integer_text(reader%position)//" expected", 1)
     end do
-    exchange%gathered_values = exchange%gathered_values + real(sum(counts), wp)
+    exchange%gathered_values = exchange%gathered_values + real(sum(counts) - counts(exchange%rank + 1), wp)
   end subroutine bring_blocks_together
 end module domain_exchange

@@ -50,7 +50,7 @@ module explicit_solver
   use text_format, only: integer_text
   use wall_clock, only: start_phase, stop_phase
   use domain_exchange, only: domain_exchange_t, exchange_accelerations, combine_group_headers, &
-                             gather_block_energies, exchange_contact_pairs
+                             share_block_energies, exchange_contact_pairs
   use rank_communication, only: largest_over_ranks, gather_fixed_reals
   implicit none
   private
@@ -69,7 +69,7 @@ contains
     if (.not. allocated(error)) call check_runaway_motion(model, run%state, 0.0_wp, error)
     if (allocated(error)) return
     call forces_and_next_step(model, run, 0.0_wp)
-    call gather_block_energies(run%state%groups, run%partition, run%exchange, run%state%cycle)
+    call share_block_energies(run%state%groups, run%partition, run%exchange, run%state%cycle)
     call measured_energies(model, run%state, run%energy_scratch, run%state%energy)
     run%state%energy%initial_total = total_energy(run%state%energy)
     call check_state(model, run, .true., error)
@@ -543,7 +543,7 @@ contains
     call check_elements(model, run%state, error)
     if (.not. allocated(error)) call check_time_step(model, run%state, run%state%stable_time_step, error)
     if (.not. allocated(error) .and. (last .or. mod(run%state%cycle, energy_check_interval) == 0)) then
-      call gather_block_energies(run%state%groups, run%partition, run%exchange, run%state%cycle)
+      call share_block_energies(run%state%groups, run%partition, run%exchange, run%state%cycle)
       call check_energy(model, run%state, run%energy_scratch, error)
       ! energies gone wrong in this cycle because a node ran away: name the node, as the next
       ! cycle's check would, rather than only the energies

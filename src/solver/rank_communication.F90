@@ -14,7 +14,7 @@ module rank_communication
   use kinds, only: wp
 #ifdef CRASHFREE_MPI
   use mpi_f08, only: MPI_Init_thread, MPI_Initialized, MPI_Finalized, MPI_Finalize, MPI_Comm_rank, &
-                     MPI_Comm_size, MPI_Barrier, MPI_Allgatherv, MPI_Allgather, MPI_Allreduce, &
+                     MPI_Comm_size, MPI_Barrier, MPI_Allgatherv, MPI_Gatherv, MPI_Allgather, MPI_Allreduce, &
                      MPI_Abort, MPI_COMM_WORLD, MPI_THREAD_FUNNELED, MPI_DOUBLE_PRECISION, MPI_LOGICAL, &
                      MPI_MAX, MPI_LOR, MPI_IN_PLACE
 #endif
@@ -23,7 +23,7 @@ module rank_communication
   private
 
   public :: start_ranks, finish_ranks, rank_index, rank_total, mpi_built, barrier_ranks
-  public :: gather_reals, gather_fixed_reals, largest_over_ranks, any_rank
+  public :: gather_reals, gather_reals_to_first, gather_fixed_reals, largest_over_ranks, any_rank
   public :: abort_ranks
 
   !> Whether this binary was built with MPI (mpirun -np N runs N ranks) or is one rank only.
@@ -120,6 +120,22 @@ contains
 #endif
     receive(offsets(1) + 1:offsets(1) + counts(1)) = send(1:counts(1))
   end subroutine gather_reals
+
+  !> Every rank's `send` (`counts(rank + 1)` values) into `receive(offsets(rank + 1) + 1:)` on
+  !> the first rank only (MPI_Gatherv; the others' `receive` is left as it is).
+  subroutine gather_reals_to_first(send, counts, offsets, receive)
+    real(wp), intent(in), contiguous :: send(:)
+    integer, intent(in), contiguous :: counts(:), offsets(:)
+    real(wp), intent(inout), contiguous :: receive(:)
+#ifdef CRASHFREE_MPI
+    if (mpi_running()) then
+      call MPI_Gatherv(send, counts(rank_index() + 1), MPI_DOUBLE_PRECISION, receive, counts, offsets, &
+                       MPI_DOUBLE_PRECISION, 0, MPI_COMM_WORLD)
+      return
+    end if
+#endif
+    receive(offsets(1) + 1:offsets(1) + counts(1)) = send(1:counts(1))
+  end subroutine gather_reals_to_first
 
   !> Every rank's `send` (the same size on all) into `receive(:, rank + 1)` on every rank.
   subroutine gather_fixed_reals(send, receive)
