@@ -18,6 +18,7 @@ program test_solid_elements
                          compute_solid_block, solid_block_element_results
   use testing, only: test_suite_t, check, check_close, finish_suite
   use fixtures, only: random_uniform, cross
+  use element_work, only: lane_energy_sums, booked_energy
   implicit none
 
   type(test_suite_t) :: suite
@@ -42,6 +43,7 @@ program test_solid_elements
   call test_hourglass_forces()
   call test_conservation()
   call test_energy_balance()
+  call test_block_energy_sums()
   call test_inverted_elements()
   call test_build_blocks()
   call test_exposed_elements()
@@ -906,6 +908,45 @@ contains
       call check(suite, trim(label)//": unused lanes have zero force", all(force(9:, :, :) == 0.0_wp))
     end do
   end subroutine test_conservation
+
+  !> A block's energy sums (what a distributed run hands between ranks instead of the lanes'
+  !> energies): the live lanes' energy and power, the eroded lanes' energy; booked as energy +
+  !> step correction x power. Checked against the lane-by-lane values of a block with eroded
+  !> lanes, and against a block without any.
+  subroutine test_block_energy_sums()
+    real(wp) :: energy(block_size), power(block_size), sums(3), live_energy, live_power, eroded_energy
+    logical :: eroded(block_size)
+    integer :: lane, count
+    count = 50
+    do lane = 1, block_size
+      energy(lane) = 5.0_wp*(1.0_wp + random_uniform(random_state))
+      power(lane) = 5.0_wp*random_uniform(random_state)
+    end do
+    eroded = .false.
+    eroded([3, 17, 40, 60]) = .true.      ! lane 60 lies beyond the block's 50 elements
+    live_energy = 0.0_wp
+    live_power = 0.0_wp
+    eroded_energy = 0.0_wp
+    do lane = 1, count
+      if (eroded(lane)) then
+        eroded_energy = eroded_energy + energy(lane)
+      else
+        live_energy = live_energy + energy(lane)
+        live_power = live_power + power(lane)
+      end if
+    end do
+    sums = lane_energy_sums(energy, power, count, eroded)
+    call check_close(suite, "block energy sums: live lanes' energy", sums(1), live_energy, rel=1e-14_wp)
+    call check_close(suite, "block energy sums: live lanes' power", sums(2), live_power, rel=1e-14_wp)
+    call check_close(suite, "block energy sums: eroded lanes' energy (lanes 3, 17, 40)", sums(3), &
+                     energy(3) + energy(17) + energy(40), rel=1e-14_wp)
+    call check_close(suite, "block energy sums: booked energy = energy + step correction x power", &
+                     booked_energy(sums(1), sums(2), 0.25_wp), live_energy + 0.25_wp*live_power, rel=1e-14_wp)
+    sums = lane_energy_sums(energy, power, count)
+    call check_close(suite, "block energy sums: no eroded lanes, all energy live", sums(1), sum(energy(1:count)), &
+                     rel=1e-14_wp)
+    call check(suite, "block energy sums: no eroded lanes, no eroded energy", sums(3) == 0.0_wp)
+  end subroutine test_block_energy_sums
 
   !> Central differences with a varying step on the irregular 8-element mesh (free, elastic,
   !> with bulk viscosity and hourglass control): kinetic energy 1/2 m v(n-1/2) . v(n+1/2) plus
