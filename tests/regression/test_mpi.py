@@ -28,7 +28,8 @@ import numpy as np
 import pytest
 
 from conftest import BINARY
-from deck_writer import fields, nodes_card, plate_mesh, shells_card, write_deck
+from deck_writer import block_mesh, fields, nodes_card, plate_mesh, shells_card, solids_card, write_deck
+from test_contact import head_on_deck as contact_head_on_deck
 from test_rigid_wall import impact_deck
 from test_threads import (DENSITY, MODULUS, POISSON, TANGENT, YIELD, _first_difference, _objects, _position, _text,
                           contact_deck, meshfree_deck, rigid_deck)
@@ -565,3 +566,67 @@ def test_restart_dump_is_the_same_file_on_one_two_and_three_ranks(tmp_path):
     # (rcforc's force is the interval's impulse over its length)
     assert np.abs(force[time < 0.009]).max() > 0.0
     assert np.all(force[time > 0.0101] == 0.0)
+
+
+def failing_run(deck, output, ranks):
+    """A run that must end in error termination: its message (the first rank's standard error,
+    one line) and results file."""
+    process = solver(ranks, [f"i={deck}", f"outdir={output}"])
+    assert process.returncode == 1, f"-np {ranks}:\n" + process.stdout + process.stderr
+    assert "Backtrace" not in process.stderr and "runtime error" not in process.stderr, process.stderr
+    messages = [line for line in process.stderr.splitlines() if "error termination" in line or "at time" in line]
+    assert messages, process.stderr
+    return messages, output / "results.h5"
+
+
+def test_error_terminations_are_the_same_on_one_two_and_three_ranks(tmp_path):
+    """Runs that must stop are stopped alike for any N, with the same message and the same file:
+    (a) the eight corner nodes of a 12 x 12 x 6 block (its other nodes held) pushed 1.5 element
+    sizes inwards in one step invert the eight corner hexahedra at once, on several ranks; the message names the element
+    one rank names (the first block with one: the tie rule across ranks); (b) two blocks meeting
+    head on with ENDENG 1e-6 percent: the energy check, from the blocks' energy sums shared among
+    the ranks, stops the run at the same cycle."""
+    nodes, elements = block_mesh((12, 12, 6), (12.0, 12.0, 6.0))
+    corners = [n + 1 for n, point in enumerate(nodes)
+               if all(abs(point[d]) < 1e-9 or abs(point[d] - (12.0, 12.0, 6.0)[d]) < 1e-9 for d in range(3))]
+    assert len(corners) == 8
+    centre = np.array([6.0, 6.0, 3.0])
+    motion = []
+    for node in corners:
+        inwards = centre - nodes[node - 1]
+        inwards = 1.5 * inwards / np.abs(inwards)      # 1.5 mm along each axis, towards the centre
+        motion += [fields(node, d + 1, 2, 1, inwards[d]) for d in range(3)]
+    crush = write_deck(
+        tmp_path / "crush.k",
+        "*CONTROL_TERMINATION\n" + fields(1.0),
+        "*DATABASE_BINARY_D3PLOT\n" + fields(0.5),
+        "*DATABASE_GLSTAT\n" + fields(0.001),
+        "*PART\nblock\n" + fields(42, 1, 1),
+        "*SECTION_SOLID\n" + fields(1, 1),
+        "*MAT_ELASTIC\n" + fields(1, 7.85e-6, 1.0, 0.3),
+        "*DEFINE_CURVE\n" + fields(1) + "\n" + "\n".join(
+            f"{t:20.6e}{u:20.6e}" for t, u in ((0.0, 0.0), (0.01, 0.0), (0.0101, 1.0), (10.0, 1.0))),
+        nodes_card(nodes),
+        solids_card(elements, part_id=42, first_id=1),
+        "*BOUNDARY_SPC_NODE\n" + "\n".join(fields(n, 0, 1, 1, 1, 0, 0, 0) for n in range(1, len(nodes) + 1)
+                                           if n not in corners),
+        "*BOUNDARY_PRESCRIBED_MOTION_NODE\n" + "\n".join(motion),
+    )
+    energy, *_ = contact_head_on_deck(tmp_path / "head_on.k", counts=(16, 4, 2))
+    energy.write_text(energy.read_text().replace("*CONTROL_TERMINATION\n" + fields(0.03),
+                                                 "*CONTROL_TERMINATION\n" + fields(0.03, None, None, 1e-6)))
+    for deck, pattern in ((crush, "negative volume in solid element"), (energy, "differs from 1 by more than ENDENG")):
+        reference_messages, reference = failing_run(deck, tmp_path / f"{deck.stem}_alone", None)
+        assert any(pattern in line for line in reference_messages), reference_messages
+        for ranks in (2, 3):
+            messages, other = failing_run(deck, tmp_path / f"{deck.stem}_np{ranks}", ranks)
+            assert messages == reference_messages, f"-np {ranks}"
+            difference = results_difference(reference, other)
+            assert not difference, f"{deck.stem}: mpirun -np {ranks} differs from the run alone: {difference}"
+        if deck is crush:
+            # the inverted corners lie on more than one rank (the test of the tie rule)
+            with h5py.File(tmp_path / "crush_np2" / "results.h5", "r") as results:
+                solid_rank = results["run/partition/solid_rank"][...]
+            corner_elements = [k for k, element in enumerate(elements) if any(n + 1 in corners for n in element)]
+            assert len(corner_elements) == 8
+            assert len(set(solid_rank[corner_elements])) > 1, solid_rank[corner_elements]
