@@ -582,8 +582,9 @@ def failing_run(deck, output, ranks):
 def test_error_terminations_are_the_same_on_one_two_and_three_ranks(tmp_path):
     """Runs that must stop are stopped alike for any N, with the same message and the same file:
     (a) the eight corner nodes of a 12 x 12 x 6 block (its other nodes held) pushed 1.5 element
-    sizes inwards in one step invert the eight corner hexahedra at once, on several ranks; the message names the element
-    one rank names (the first block with one: the tie rule across ranks); (b) two blocks meeting
+    sizes inwards in one step invert the eight corner hexahedra at once, on both ranks of 2; the
+    message names the element one rank names (the first block with one: the tie rule across
+    ranks); (b) two blocks meeting
     head on with ENDENG 1e-6 percent: the energy check, from the blocks' energy sums shared among
     the ranks, stops the run at the same cycle."""
     nodes, elements = block_mesh((12, 12, 6), (12.0, 12.0, 6.0))
