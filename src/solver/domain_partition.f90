@@ -534,20 +534,25 @@ contains
   !> owning a block that shares a node with it (so domains stay compact) when the owner's cost
   !> exceeds that rank's by more than the block's: each move lowers the sum of squared rank
   !> costs, so the sweeps end; at the end every two neighbouring ranks differ by at most one
-  !> block's cost. Serial and in a fixed order: the same on every rank.
+  !> block's cost. A rank METIS left without blocks neighbours none, so it also counts as a
+  !> neighbour of every block while it has none (with 4 blocks on 3 ranks METIS gave two ranks
+  !> two blocks each and the first rank none). Serial and in a fixed order: the same on every
+  !> rank.
   subroutine balance_owners(blocks, node_offsets, node_blocks, rank_count, block_owner)
     type(block_list_t), intent(in) :: blocks
     integer, intent(in) :: node_offsets(:), node_blocks(:), rank_count
     integer, intent(inout) :: block_owner(:)
-    integer, allocatable :: seen_by(:)
+    integer, allocatable :: seen_by(:), owned_blocks(:)
     real(wp), allocatable :: cost(:)
-    integer :: k, slot, node, other, target, source, best_target, sweep
+    integer :: k, slot, node, other, target, source, best_target, sweep, empty
     logical :: moved
 
-    allocate (cost(0:rank_count - 1), seen_by(0:rank_count - 1))
+    allocate (cost(0:rank_count - 1), seen_by(0:rank_count - 1), owned_blocks(0:rank_count - 1))
     cost = 0.0_wp
+    owned_blocks = 0
     do k = 1, size(blocks%block_group)
       cost(block_owner(k)) = cost(block_owner(k)) + blocks%block_cost(k)
+      owned_blocks(block_owner(k)) = owned_blocks(block_owner(k)) + 1
     end do
     seen_by = 0
     ! (a bound on the sweeps for safety; they end long before on any mesh tried)
@@ -577,10 +582,15 @@ contains
             seen_by(block_owner(node_blocks(other))) = 0
           end do
         end do
+        ! (the first rank without blocks, if any: no cost, so it beats every neighbour)
+        empty = findloc(owned_blocks == 0, .true., dim=1) - 1
+        if (empty >= 0) best_target = empty
         if (best_target < 0) cycle
         if (cost(source) - cost(best_target) <= blocks%block_cost(k)) cycle
         cost(source) = cost(source) - blocks%block_cost(k)
         cost(best_target) = cost(best_target) + blocks%block_cost(k)
+        owned_blocks(source) = owned_blocks(source) - 1
+        owned_blocks(best_target) = owned_blocks(best_target) + 1
         block_owner(k) = best_target
         moved = .true.
       end do

@@ -62,6 +62,7 @@ program test_domain_partition
     end do
     call test_too_many_ranks()
   end if
+  call test_no_rank_left_without_blocks()
   call test_launch()
   call finish_ranks()
   call finish_suite(suite)
@@ -201,6 +202,61 @@ contains
     call check(suite, "8 ranks for 7 blocks: the message names both", &
                index(error%message, "8 ranks") > 0 .and. index(error%message, "7 element blocks") > 0, error%message)
   end subroutine test_too_many_ranks
+
+  !> An 8 x 8 x 4 block of hexahedra makes 4 blocks (2 of exposed elements, 2 inside); on 3
+  !> ranks METIS gave two ranks two blocks each and the first none (an idle rank, imbalance 1.5
+  !> whatever the moves between neighbours): every rank now owns a block.
+  subroutine test_no_rank_left_without_blocks()
+    type(model_t) :: block_model
+    type(run_state_t) :: block_run
+    type(domain_partition_t) :: partition
+    type(error_list_t) :: warnings
+    type(error_t), allocatable :: error
+    integer, allocatable :: owned(:)
+    integer :: unit, i, j, k, element, rank
+    open (newunit=unit, file=directory//"/block.k", status="replace", action="write")
+    write (unit, '(a)') "*KEYWORD", "*CONTROL_TERMINATION", "1.0", "*PART", "block", "1,1,1", "*SECTION_SOLID", "1,1", &
+      "*MAT_ELASTIC", "1,7.85e-6,210.0,0.3", "*NODE"
+    do k = 0, 4
+      do j = 0, 8
+        do i = 0, 8
+          write (unit, '(i0,3(",",f0.1))') block_node(i, j, k), real(i, wp), real(j, wp), real(k, wp)
+        end do
+      end do
+    end do
+    write (unit, '(a)') "*ELEMENT_SOLID"
+    element = 0
+    do k = 0, 3
+      do j = 0, 7
+        do i = 0, 7
+          element = element + 1
+          write (unit, '(i0,",1",8(",",i0))') element, block_node(i, j, k), block_node(i + 1, j, k), &
+            block_node(i + 1, j + 1, k), block_node(i, j + 1, k), block_node(i, j, k + 1), block_node(i + 1, j, k + 1), &
+            block_node(i + 1, j + 1, k + 1), block_node(i, j + 1, k + 1)
+        end do
+      end do
+    end do
+    write (unit, '(a)') "*END"
+    close (unit)
+    call read_deck(directory//"/block.k", block_model, warnings, error, .false.)
+    if (.not. allocated(error)) call set_up_run_state(block_model, block_run, error)
+    if (.not. allocated(error)) call partition_domains(block_model, block_run%state%groups, 3, 0, partition, error)
+    call check(suite, "8 x 8 x 4 hexahedra on 3 ranks: set up and partitioned", .not. allocated(error))
+    if (allocated(error)) return
+    call check(suite, "8 x 8 x 4 hexahedra: 4 blocks", size(partition%groups(1)%owner) == 4)
+    allocate (owned(0:2))
+    do rank = 0, 2
+      owned(rank) = count(partition%groups(1)%owner == rank)
+    end do
+    call check(suite, "8 x 8 x 4 hexahedra on 3 ranks: every rank owns a block (2, 1, 1)", &
+               all(owned >= 1) .and. sum(owned) == 4, integer_text(owned(0))//" "//integer_text(owned(1))//" "// &
+               integer_text(owned(2)))
+  end subroutine test_no_rank_left_without_blocks
+
+  pure integer function block_node(i, j, k)
+    integer, intent(in) :: i, j, k
+    block_node = 1 + i + 9*j + 81*k
+  end function block_node
 
   subroutine test_launch()
     type(error_t), allocatable :: error
