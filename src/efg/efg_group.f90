@@ -34,7 +34,6 @@ module efg_group
     procedure :: lump_masses
     procedure :: add_internal_forces
     procedure :: sum_block_energies
-    procedure :: add_energies
     procedure :: add_part_energies
     procedure :: add_part_momenta
     procedure :: element_results
@@ -202,32 +201,23 @@ contains
   end subroutine add_internal_forces
 
   !> Per point block (the group's numbers, part after part): its points' internal energy and
-  !> its power.
+  !> its power (no hourglass energy, no erosion).
   subroutine sum_block_energies(self)
     class(efg_group_t), intent(inout) :: self
+    real(wp) :: internal(3)
     integer :: k, b, before
     before = 0
     do k = 1, size(self%parts)
       do b = 1, size(self%parts(k)%blocks)
         if (.not. self%computes(before + b)) cycle
         associate (block => self%parts(k)%blocks(b))
-          self%block_energy(1:3, before + b) = lane_energy_sums(block%internal_energy, block%force_power, &
-                                                                block%point_count)
+          internal = lane_energy_sums(block%internal_energy, block%force_power, block%point_count)
+          self%block_energy(:, before + b) = [internal(1:2), 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp]
         end associate
       end do
       before = before + size(self%parts(k)%blocks)
     end do
   end subroutine sum_block_energies
-
-  subroutine add_energies(self, step_correction, internal, hourglass)
-    class(efg_group_t), intent(in) :: self
-    real(wp), intent(in) :: step_correction
-    real(wp), intent(inout) :: internal, hourglass
-    integer :: b
-    do b = 1, size(self%block_energy, 2)
-      internal = internal + booked_energy(self%block_energy(1, b), self%block_energy(2, b), step_correction)
-    end do
-  end subroutine add_energies
 
   subroutine add_part_energies(self, nodes, average_step, step_correction, kinetic, internal, hourglass)
     class(efg_group_t), intent(in) :: self

@@ -285,7 +285,8 @@ contains
   !> Internal energy: membrane, bending and transverse shear work (no hourglass energy: the
   !> sub-cell points leave no membrane or bending mode free).
   !> Per cell block (the group's numbers, part after part): its points' internal energy and
-  !> its power, its cells' transverse shear energy and its power.
+  !> its power, its cells' transverse shear energy and its power in the rows of the hourglass
+  !> energy (add_energies counts it as internal energy: the kind has no hourglass modes).
   subroutine sum_block_energies(self)
     class(efg_shell_group_t), intent(inout) :: self
     real(wp) :: membrane(3), shear(3)
@@ -298,7 +299,7 @@ contains
           membrane = lane_energy_sums(block%internal_energy, block%force_power, block%point_count)
           shear = lane_energy_sums(block%shear_energy, block%shear_power, block%cell_count)
         end associate
-        self%block_energy(1:4, before + b) = [membrane(1:2), shear(1:2)]
+        self%block_energy(:, before + b) = [membrane(1:2), shear(1:2), 0.0_wp, 0.0_wp]
       end do
       before = before + size(self%parts(k)%blocks)
     end do

@@ -42,7 +42,6 @@ module beam_group
     procedure :: lump_masses
     procedure :: add_internal_forces
     procedure :: sum_block_energies
-    procedure :: add_energies
     procedure :: add_part_energies
     procedure :: add_part_momenta
     procedure :: element_results
@@ -54,7 +53,6 @@ module beam_group
     procedure :: failure_text
     procedure :: most_scaled
     procedure :: newly_eroded_elements
-    procedure :: add_eroded_energies
     procedure :: list_time_steps
   end type beam_group_t
 
@@ -197,16 +195,6 @@ contains
     end do
   end function newly_eroded_elements
 
-  !> The internal energy its failed beams took along (reported apart, as eroded energy).
-  subroutine add_eroded_energies(self, internal, hourglass)
-    class(beam_group_t), intent(in) :: self
-    real(wp), intent(inout) :: internal, hourglass
-    integer :: b
-    do b = 1, size(self%blocks)
-      internal = internal + self%block_energy(3, b)
-    end do
-  end subroutine add_eroded_energies
-
   subroutine add_beam_forces(block, beam_force, internal_force, internal_moment)
     type(beam_block_t), intent(in) :: block
     real(wp), intent(in) :: beam_force(block_size, 2, 6)
@@ -222,28 +210,19 @@ contains
   end subroutine add_beam_forces
 
   !> Per block: the live beams' internal energy and its power, the failed beams' internal
-  !> energy.
+  !> energy (reported apart, as eroded energy); beams have no hourglass energy.
   subroutine sum_block_energies(self)
     class(beam_group_t), intent(inout) :: self
+    real(wp) :: internal(3)
     integer :: b
     do b = 1, size(self%blocks)
       if (.not. self%computes(b)) cycle
       associate (beam => self%blocks(b))
-        self%block_energy(1:3, b) = lane_energy_sums(beam%internal_energy, beam%force_power, beam%element_count, &
-                                                     beam%failed)
+        internal = lane_energy_sums(beam%internal_energy, beam%force_power, beam%element_count, beam%failed)
+        self%block_energy(:, b) = [internal(1:2), 0.0_wp, 0.0_wp, internal(3), 0.0_wp]
       end associate
     end do
   end subroutine sum_block_energies
-
-  subroutine add_energies(self, step_correction, internal, hourglass)
-    class(beam_group_t), intent(in) :: self
-    real(wp), intent(in) :: step_correction
-    real(wp), intent(inout) :: internal, hourglass
-    integer :: b
-    do b = 1, size(self%blocks)
-      internal = internal + booked_energy(self%block_energy(1, b), self%block_energy(2, b), step_correction)
-    end do
-  end subroutine add_energies
 
   subroutine add_part_energies(self, nodes, average_step, step_correction, kinetic, internal, hourglass)
     class(beam_group_t), intent(in) :: self

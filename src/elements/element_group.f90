@@ -25,6 +25,7 @@ module element_group
   use error_handling, only: error_t
   use restart_file, only: restart_store_t
   use particle_rows, only: particle_rows_t
+  use element_work, only: booked_energy
   implicit none
   private
 
@@ -102,12 +103,14 @@ module element_group
     logical, allocatable :: computed(:), owned(:)
     integer :: critical_block = 0                  !< the block of critical_element (0: none, or not by block)
     integer :: failed_block = 0                    !< the block of failed_element (0: none, or not by block)
-    !> (block_energy_values, blocks): per block the sums of its lanes' energies that the energy
-    !> procedures read (add_energies, add_part_energies, add_eroded_energies; e.g. the live
-    !> lanes' internal energy and its power, the eroded lanes' energy: what each value means is
-    !> the kind's own). sum_block_energies fills the columns of the blocks this rank computes; a
-    !> distributed run then hands the owners' columns to every rank (domain_exchange's
-    !> share_block_energies), so that the energies need no block state from another rank.
+    !> (block_energy_values, blocks): per block the sums over its lanes that the energy
+    !> procedures read (add_energies, add_part_energies, add_eroded_energies): (1) the live
+    !> lanes' internal energy, (2) its power, (3) their hourglass energy, (4) its power, (5) the
+    !> eroded lanes' internal energy, (6) their hourglass energy (0 where a kind has none; a kind
+    !> with energies of its own kind overrides add_energies). sum_block_energies fills the
+    !> columns of the blocks this rank computes; a distributed run then hands the owners'
+    !> columns to every rank (domain_exchange's share_block_energies), so that the energies need
+    !> no block state from another rank.
     real(wp), allocatable :: block_energy(:, :)
   contains
     !> Once before the first cycle: its element count (0: the group is dropped).
@@ -123,7 +126,7 @@ module element_group
     !> columns of the blocks this rank computes, from their lanes.
     procedure(block_energy_interface), deferred :: sum_block_energies
     !> Internal and hourglass energies, summed block by block from block_energy (energy_balance).
-    procedure(energy_interface), deferred :: add_energies
+    procedure :: add_energies
     !> Per part: internal, hourglass, and the kinetic energy of the nodal masses the group gave.
     procedure(part_energy_interface), deferred :: add_part_energies
     !> Per part: the momentum and the mass of the nodal masses the group gave (matsum).
@@ -175,7 +178,7 @@ module element_group
     !> Optional (kinds that erode): set the entries of its eroded elements in the model-indexed
     !> masks (solids in `solid_eroded`, shells in `shell_eroded`); others are left alone.
     procedure :: mark_eroded
-    !> Optional (kinds that erode): internal and hourglass energy of its eroded elements.
+    !> Internal and hourglass energy of its eroded elements, from block_energy.
     procedure :: add_eroded_energies
     !> Optional (shells): raise `strain(node)`, at the nodes `wanted` flags, to the largest
     !> effective plastic strain of its elements on the node (spot welds failing by EP).
@@ -237,13 +240,6 @@ module element_group
       import :: element_group_t
       class(element_group_t), intent(inout) :: self
     end subroutine block_energy_interface
-
-    subroutine energy_interface(self, step_correction, internal, hourglass)
-      import :: element_group_t, wp
-      class(element_group_t), intent(in) :: self
-      real(wp), intent(in) :: step_correction
-      real(wp), intent(inout) :: internal, hourglass
-    end subroutine energy_interface
 
     subroutine part_energy_interface(self, nodes, average_step, step_correction, kinetic, internal, hourglass)
       import :: element_group_t, nodal_state_t, wp
@@ -424,9 +420,29 @@ contains
     logical, intent(inout) :: solid_eroded(:), shell_eroded(:)
   end subroutine mark_eroded
 
+  !> The blocks' booked internal and hourglass energies (block_energy's rows 1 to 4), block by
+  !> block: the work booked by the elements plus the step correction of their newest forces'
+  !> power (solid_block).
+  subroutine add_energies(self, step_correction, internal, hourglass)
+    class(element_group_t), intent(in) :: self
+    real(wp), intent(in) :: step_correction
+    real(wp), intent(inout) :: internal, hourglass
+    integer :: b
+    do b = 1, size(self%block_energy, 2)
+      internal = internal + booked_energy(self%block_energy(1, b), self%block_energy(2, b), step_correction)
+      hourglass = hourglass + booked_energy(self%block_energy(3, b), self%block_energy(4, b), step_correction)
+    end do
+  end subroutine add_energies
+
+  !> The energy its eroded elements took along (block_energy's rows 5 and 6), block by block.
   subroutine add_eroded_energies(self, internal, hourglass)
     class(element_group_t), intent(in) :: self
     real(wp), intent(inout) :: internal, hourglass
+    integer :: b
+    do b = 1, size(self%block_energy, 2)
+      internal = internal + self%block_energy(5, b)
+      hourglass = hourglass + self%block_energy(6, b)
+    end do
   end subroutine add_eroded_energies
 
   real(wp) function thinnest(self)

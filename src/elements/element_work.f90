@@ -7,8 +7,8 @@ module element_work
   private
 
   public :: append_marked_lanes, mark_lanes
-  public :: add_force_work, smallest_time_step, booked_energy, lane_energy_sums, add_kinetic_energy, scale_block_density, &
-            raise_largest_scaling
+  public :: add_force_work, smallest_time_step, booked_energy, lane_energy_sums, block_energy_column, add_kinetic_energy, &
+            scale_block_density, raise_largest_scaling
 
 contains
 
@@ -81,6 +81,21 @@ contains
       sums(3) = 0.0_wp
     end if
   end function lane_energy_sums
+
+  !> A block's column of element_group's block_energy from its lanes' internal and hourglass
+  !> energies and powers: live internal energy and power, live hourglass energy and power,
+  !> eroded internal and hourglass energy.
+  pure function block_energy_column(internal, internal_power, hourglass, hourglass_power, count, eroded) &
+    result(column)
+    real(wp), intent(in) :: internal(:), internal_power(:), hourglass(:), hourglass_power(:)
+    integer, intent(in) :: count
+    logical, intent(in) :: eroded(:)
+    real(wp) :: column(6)
+    real(wp) :: internal_sums(3), hourglass_sums(3)
+    internal_sums = lane_energy_sums(internal, internal_power, count, eroded)
+    hourglass_sums = lane_energy_sums(hourglass, hourglass_power, count, eroded)
+    column = [internal_sums(1:2), hourglass_sums(1:2), internal_sums(3), hourglass_sums(3)]
+  end function block_energy_column
 
   !> Append to `elements` (`n` used) the elements (`lane_elements`) of the first `count` lanes
   !> of a block that `marked` flags, as long as there is room: the elements an element group

@@ -14,7 +14,7 @@ module shell_group
   use run_summary, only: run_summary_t
   use nodal_state, only: nodal_state_t
   use element_group, only: element_group_t, element_results_t, distinct_nodes, family_shell, block_energy_values
-  use element_work, only: append_marked_lanes, mark_lanes, booked_energy, lane_energy_sums, add_kinetic_energy, &
+  use element_work, only: append_marked_lanes, mark_lanes, booked_energy, block_energy_column, add_kinetic_energy, &
                           scale_block_density, &
                           raise_largest_scaling
   use shell_block, only: shell_block_t, build_shell_blocks, shell_block_masses, shell_block_time_steps, &
@@ -41,7 +41,6 @@ module shell_group
     procedure :: lump_masses
     procedure :: add_internal_forces
     procedure :: sum_block_energies
-    procedure :: add_energies
     procedure :: add_part_energies
     procedure :: add_part_momenta
     procedure :: element_results
@@ -55,7 +54,6 @@ module shell_group
     procedure :: thinnest
     procedure :: newly_eroded_elements
     procedure :: mark_eroded
-    procedure :: add_eroded_energies
     procedure :: list_time_steps
     procedure :: raise_nodal_plastic_strain
   end type shell_group_t
@@ -235,16 +233,6 @@ contains
     end do
   end subroutine mark_eroded
 
-  subroutine add_eroded_energies(self, internal, hourglass)
-    class(shell_group_t), intent(in) :: self
-    real(wp), intent(inout) :: internal, hourglass
-    integer :: b
-    do b = 1, size(self%blocks)
-      internal = internal + self%block_energy(5, b)
-      hourglass = hourglass + self%block_energy(6, b)
-    end do
-  end subroutine add_eroded_energies
-
   !> internal_force and internal_moment of the block's nodes += the shells' nodal forces and
   !> moments, corner by corner, lane by lane; and each node's sums of area x normal and area of
   !> its shells (for the drilling projection of the time loop).
@@ -267,32 +255,18 @@ contains
     end do
   end subroutine add_shell_forces
 
-  !> Per block: the live lanes' internal energy and its power, their hourglass energy and its
-  !> power, the eroded lanes' internal and hourglass energy.
+  !> Each computed block's energy sums (element_group's block_energy).
   subroutine sum_block_energies(self)
     class(shell_group_t), intent(inout) :: self
-    real(wp) :: internal(3), hourglass(3)
     integer :: b
     do b = 1, size(self%blocks)
       if (.not. self%computes(b)) cycle
       associate (shell => self%blocks(b))
-        internal = lane_energy_sums(shell%internal_energy, shell%force_power, shell%element_count, shell%eroded)
-        hourglass = lane_energy_sums(shell%hourglass_energy, shell%hourglass_power, shell%element_count, shell%eroded)
+        self%block_energy(:, b) = block_energy_column(shell%internal_energy, shell%force_power, shell%hourglass_energy, &
+                                                      shell%hourglass_power, shell%element_count, shell%eroded)
       end associate
-      self%block_energy(:, b) = [internal(1:2), hourglass(1:2), internal(3), hourglass(3)]
     end do
   end subroutine sum_block_energies
-
-  subroutine add_energies(self, step_correction, internal, hourglass)
-    class(shell_group_t), intent(in) :: self
-    real(wp), intent(in) :: step_correction
-    real(wp), intent(inout) :: internal, hourglass
-    integer :: b
-    do b = 1, size(self%blocks)
-      internal = internal + booked_energy(self%block_energy(1, b), self%block_energy(2, b), step_correction)
-      hourglass = hourglass + booked_energy(self%block_energy(3, b), self%block_energy(4, b), step_correction)
-    end do
-  end subroutine add_energies
 
   subroutine add_part_energies(self, nodes, average_step, step_correction, kinetic, internal, hourglass)
     class(shell_group_t), intent(in) :: self

@@ -12,7 +12,7 @@ module solid_group
   use nodal_state, only: nodal_state_t
   use element_group, only: element_group_t, element_results_t, distortion_t, distinct_nodes, family_solid, &
                            block_energy_values
-  use element_work, only: append_marked_lanes, mark_lanes, booked_energy, lane_energy_sums, add_kinetic_energy, &
+  use element_work, only: append_marked_lanes, mark_lanes, booked_energy, block_energy_column, add_kinetic_energy, &
                           scale_block_density, &
                           raise_largest_scaling
   use solid_block, only: solid_block_t, build_solid_blocks, solid_block_corner_masses, solid_block_time_steps, &
@@ -39,7 +39,6 @@ module solid_group
     procedure :: lump_masses
     procedure :: add_internal_forces
     procedure :: sum_block_energies
-    procedure :: add_energies
     procedure :: add_part_energies
     procedure :: add_part_momenta
     procedure :: element_results
@@ -53,7 +52,6 @@ module solid_group
     procedure :: check_distortion
     procedure :: newly_eroded_elements
     procedure :: mark_eroded
-    procedure :: add_eroded_energies
     procedure :: list_time_steps
   end type solid_group_t
 
@@ -205,42 +203,18 @@ contains
     end do
   end subroutine mark_eroded
 
-  subroutine add_eroded_energies(self, internal, hourglass)
-    class(solid_group_t), intent(in) :: self
-    real(wp), intent(inout) :: internal, hourglass
-    integer :: b
-    do b = 1, size(self%blocks)
-      internal = internal + self%block_energy(5, b)
-      hourglass = hourglass + self%block_energy(6, b)
-    end do
-  end subroutine add_eroded_energies
-
-  !> Per block: the live lanes' internal energy and its power, their hourglass energy and its
-  !> power, the eroded lanes' internal and hourglass energy.
+  !> Each computed block's energy sums (element_group's block_energy).
   subroutine sum_block_energies(self)
     class(solid_group_t), intent(inout) :: self
-    real(wp) :: internal(3), hourglass(3)
     integer :: b
     do b = 1, size(self%blocks)
       if (.not. self%computes(b)) cycle
       associate (block => self%blocks(b))
-        internal = lane_energy_sums(block%internal_energy, block%force_power, block%element_count, block%eroded)
-        hourglass = lane_energy_sums(block%hourglass_energy, block%hourglass_power, block%element_count, block%eroded)
+        self%block_energy(:, b) = block_energy_column(block%internal_energy, block%force_power, block%hourglass_energy, &
+                                                      block%hourglass_power, block%element_count, block%eroded)
       end associate
-      self%block_energy(:, b) = [internal(1:2), hourglass(1:2), internal(3), hourglass(3)]
     end do
   end subroutine sum_block_energies
-
-  subroutine add_energies(self, step_correction, internal, hourglass)
-    class(solid_group_t), intent(in) :: self
-    real(wp), intent(in) :: step_correction
-    real(wp), intent(inout) :: internal, hourglass
-    integer :: b
-    do b = 1, size(self%blocks)
-      internal = internal + booked_energy(self%block_energy(1, b), self%block_energy(2, b), step_correction)
-      hourglass = hourglass + booked_energy(self%block_energy(3, b), self%block_energy(4, b), step_correction)
-    end do
-  end subroutine add_energies
 
   !> A node's kinetic energy is shared among parts in proportion to the corner masses.
   subroutine add_part_energies(self, nodes, average_step, step_correction, kinetic, internal, hourglass)
