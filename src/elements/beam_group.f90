@@ -16,8 +16,7 @@ module beam_group
   use nodal_state, only: nodal_state_t
   use element_group, only: element_group_t, element_results_t, distinct_nodes, family_beam, block_energy_values
   use element_work, only: append_marked_lanes, booked_energy, lane_energy_sums, add_kinetic_energy, &
-                          scale_block_density, &
-                          raise_largest_scaling
+                          scale_block_density, raise_largest_scaling
   use beam_block, only: beam_block_t, build_beam_blocks, beam_block_masses, beam_block_time_steps, &
                         compute_beam_block
   implicit none

@@ -15,8 +15,7 @@ module shell_group
   use nodal_state, only: nodal_state_t
   use element_group, only: element_group_t, element_results_t, distinct_nodes, family_shell, block_energy_values
   use element_work, only: append_marked_lanes, mark_lanes, booked_energy, block_energy_column, add_kinetic_energy, &
-                          scale_block_density, &
-                          raise_largest_scaling
+                          scale_block_density, raise_largest_scaling
   use shell_block, only: shell_block_t, build_shell_blocks, shell_block_masses, shell_block_time_steps, &
                          compute_shell_block, shell_block_element_results
   implicit none

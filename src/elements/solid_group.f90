@@ -13,8 +13,7 @@ module solid_group
   use element_group, only: element_group_t, element_results_t, distortion_t, distinct_nodes, family_solid, &
                            block_energy_values
   use element_work, only: append_marked_lanes, mark_lanes, booked_energy, block_energy_column, add_kinetic_energy, &
-                          scale_block_density, &
-                          raise_largest_scaling
+                          scale_block_density, raise_largest_scaling
   use solid_block, only: solid_block_t, build_solid_blocks, solid_block_corner_masses, solid_block_time_steps, &
                          compute_solid_block, solid_block_element_results
   use distortion_check, only: check_solid_distortion
