@@ -137,6 +137,7 @@ contains
         call add_line(out, " (cannot be read now)")
         cycle
       end if
+      bytes = 0
       inquire (unit=unit, size=bytes, iostat=status)
       done = 0
       last = new_line("a")
