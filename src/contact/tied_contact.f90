@@ -20,14 +20,16 @@ module tied_contact
 
   public :: set_up_tied_contacts, distribute_tied_nodes, follow_segments
 
-  !> Work arrays of the ties, allocated once: the shares the segments' nodes receive and the
-  !> list of those nodes.
+  !> Work arrays of the ties, allocated once and sized to the nodes of the segments that carry a
+  !> tied node (none without tied contacts): the list of those nodes, each one's slot in the
+  !> shares, and the shares they receive.
   type, public :: tied_state_t
-    integer, allocatable :: primary_nodes(:)        !< every node of a segment with a tied node
-    real(wp), allocatable :: extra_mass(:)          !< (nodes) tied masses received
-    real(wp), allocatable :: extra_force(:, :)      !< (3, nodes) tied forces received
-    real(wp), allocatable :: extra_inertia(:)       !< (nodes) tied rotary inertias received
-    real(wp), allocatable :: extra_moment(:, :)     !< (3, nodes) tied moments received (I alpha)
+    integer, allocatable :: primary_nodes(:)        !< (slots) every node of a segment with a tied node
+    integer, allocatable :: corner_slots(:)         !< (4 per tied node, ties in order) each corner's slot
+    real(wp), allocatable :: extra_mass(:)          !< (slots) tied masses received
+    real(wp), allocatable :: extra_force(:, :)      !< (3, slots) tied forces received
+    real(wp), allocatable :: extra_inertia(:)       !< (slots) tied rotary inertias received
+    real(wp), allocatable :: extra_moment(:, :)     !< (3, slots) tied moments received (I alpha)
   end type tied_state_t
 
 contains
@@ -42,61 +44,108 @@ contains
     real(wp), intent(in) :: mass(:), rotary_inertia(:)
     real(wp), intent(inout) :: velocity(:, :), angular_velocity(:, :)
     type(tied_state_t), intent(out) :: ties
-    logical, allocatable :: primary(:)
-    integer :: c, i, j, k, node, node_count
+    integer :: c, i, j, k, node, slot, corner
     real(wp) :: total
-    node_count = size(mass)
-    allocate (primary(node_count), ties%extra_mass(node_count), ties%extra_force(3, node_count), &
-              ties%extra_inertia(node_count), ties%extra_moment(3, node_count))
-    primary = .false.
+
+    call number_slots(model, size(mass), ties)
+    allocate (ties%extra_mass(size(ties%primary_nodes)), ties%extra_force(3, size(ties%primary_nodes)), &
+              ties%extra_inertia(size(ties%primary_nodes)), ties%extra_moment(3, size(ties%primary_nodes)))
     ties%extra_mass = 0.0_wp
     ties%extra_force = 0.0_wp
     ties%extra_inertia = 0.0_wp
     ties%extra_moment = 0.0_wp
-    if (allocated(model%tied_contacts)) then
-      do c = 1, size(model%tied_contacts)
-        associate (tie => model%tied_contacts(c))
-          do i = 1, size(tie%nodes)
-            primary(tie%segments(:, i)) = .true.
-            node = tie%nodes(i)
-            do j = 1, 4
-              ! extra_force holds momenta and extra_moment angular momenta here
-              ties%extra_mass(tie%segments(j, i)) = ties%extra_mass(tie%segments(j, i)) + tie%weights(j, i)*mass(node)
-              ties%extra_force(:, tie%segments(j, i)) = ties%extra_force(:, tie%segments(j, i)) + &
-                                                        tie%weights(j, i)*mass(node)*velocity(:, node)
-              if (.not. tie%rotations .or. rotary_inertia(node) <= 0.0_wp) cycle
-              if (.not. all(rotary_inertia(tie%segments(:, i)) > 0.0_wp)) cycle
-              ties%extra_inertia(tie%segments(j, i)) = ties%extra_inertia(tie%segments(j, i)) + &
-                                                       tie%weights(j, i)*rotary_inertia(node)
-              ties%extra_moment(:, tie%segments(j, i)) = ties%extra_moment(:, tie%segments(j, i)) + &
-                tie%weights(j, i)*rotary_inertia(node)*angular_velocity(:, node)
-            end do
+    if (size(ties%primary_nodes) == 0) return
+    corner = 0
+    do c = 1, size(model%tied_contacts)
+      associate (tie => model%tied_contacts(c))
+        do i = 1, size(tie%nodes)
+          node = tie%nodes(i)
+          do j = 1, 4
+            slot = ties%corner_slots(corner + j)
+            ! extra_force holds momenta and extra_moment angular momenta here
+            ties%extra_mass(slot) = ties%extra_mass(slot) + tie%weights(j, i)*mass(node)
+            ties%extra_force(:, slot) = ties%extra_force(:, slot) + tie%weights(j, i)*mass(node)*velocity(:, node)
+            if (.not. tie%rotations .or. rotary_inertia(node) <= 0.0_wp) cycle
+            if (.not. all(rotary_inertia(tie%segments(:, i)) > 0.0_wp)) cycle
+            ties%extra_inertia(slot) = ties%extra_inertia(slot) + tie%weights(j, i)*rotary_inertia(node)
+            ties%extra_moment(:, slot) = ties%extra_moment(:, slot) + &
+                                         tie%weights(j, i)*rotary_inertia(node)*angular_velocity(:, node)
           end do
-        end associate
-      end do
-    end if
-    ties%primary_nodes = pack([(node, node=1, node_count)], primary)
+          corner = corner + 4
+        end do
+      end associate
+    end do
     do k = 1, size(ties%primary_nodes)
       node = ties%primary_nodes(k)
-      total = mass(node) + ties%extra_mass(node)
-      if (total > 0.0_wp) velocity(:, node) = (mass(node)*velocity(:, node) + ties%extra_force(:, node))/total
-      total = rotary_inertia(node) + ties%extra_inertia(node)
-      if (ties%extra_inertia(node) > 0.0_wp) &
-        angular_velocity(:, node) = (rotary_inertia(node)*angular_velocity(:, node) + ties%extra_moment(:, node))/total
+      total = mass(node) + ties%extra_mass(k)
+      if (total > 0.0_wp) velocity(:, node) = (mass(node)*velocity(:, node) + ties%extra_force(:, k))/total
+      total = rotary_inertia(node) + ties%extra_inertia(k)
+      if (ties%extra_inertia(k) > 0.0_wp) &
+        angular_velocity(:, node) = (rotary_inertia(node)*angular_velocity(:, node) + ties%extra_moment(:, k))/total
     end do
+    do c = 1, size(model%tied_contacts)
+      associate (tie => model%tied_contacts(c))
+        do i = 1, size(tie%nodes)
+          velocity(:, tie%nodes(i)) = interpolated(velocity, tie%segments(:, i), tie%weights(:, i))
+          if (tie%rotations .and. rotary_inertia(tie%nodes(i)) > 0.0_wp .and. &
+              all(rotary_inertia(tie%segments(:, i)) > 0.0_wp)) &
+            angular_velocity(:, tie%nodes(i)) = interpolated(angular_velocity, tie%segments(:, i), tie%weights(:, i))
+        end do
+      end associate
+    end do
+  end subroutine set_up_tied_contacts
+
+  !> The slots: the distinct nodes of the segments that carry a tied node, in ascending node
+  !> order (primary_nodes), and for every corner of every tie its node's slot (corner_slots).
+  !> The map from nodes to slots is needed at set-up only.
+  subroutine number_slots(model, node_count, ties)
+    type(model_t), intent(in) :: model
+    integer, intent(in) :: node_count
+    type(tied_state_t), intent(inout) :: ties
+    integer, allocatable :: slot_of_node(:)
+    integer :: c, i, j, corners, node, slots
+    corners = 0
     if (allocated(model%tied_contacts)) then
       do c = 1, size(model%tied_contacts)
-        associate (tie => model%tied_contacts(c))
-          do i = 1, size(tie%nodes)
-            velocity(:, tie%nodes(i)) = interpolated(velocity, tie%segments(:, i), tie%weights(:, i))
-            if (tie%rotations .and. rotary_inertia(tie%nodes(i)) > 0.0_wp .and. &
-                all(rotary_inertia(tie%segments(:, i)) > 0.0_wp)) &
-              angular_velocity(:, tie%nodes(i)) = interpolated(angular_velocity, tie%segments(:, i), tie%weights(:, i))
-          end do
-        end associate
+        corners = corners + 4*size(model%tied_contacts(c)%nodes)
       end do
     end if
-  end subroutine set_up_tied_contacts
+    allocate (ties%corner_slots(corners))
+    if (corners == 0) then
+      allocate (ties%primary_nodes(0))
+      return
+    end if
+    allocate (slot_of_node(node_count))
+    slot_of_node = 0
+    do c = 1, size(model%tied_contacts)
+      associate (tie => model%tied_contacts(c))
+        do i = 1, size(tie%nodes)
+          slot_of_node(tie%segments(:, i)) = 1
+        end do
+      end associate
+    end do
+    slots = 0
+    do node = 1, node_count
+      if (slot_of_node(node) == 0) cycle
+      slots = slots + 1
+      slot_of_node(node) = slots
+    end do
+    allocate (ties%primary_nodes(slots))
+    do node = 1, node_count
+      if (slot_of_node(node) > 0) ties%primary_nodes(slot_of_node(node)) = node
+    end do
+    corners = 0
+    do c = 1, size(model%tied_contacts)
+      associate (tie => model%tied_contacts(c))
+        do i = 1, size(tie%nodes)
+          do j = 1, 4
+            ties%corner_slots(corners + j) = slot_of_node(tie%segments(j, i))
+          end do
+          corners = corners + 4
+        end do
+      end associate
+    end do
+  end subroutine number_slots
 
   !> The first half of the tie (see the module header): each tied node's mass and force go to
   !> its segment's nodes, whose accelerations are taken again from the sums (SPC'd dofs stay
@@ -108,20 +157,18 @@ contains
     real(wp), intent(in) :: mass(:), rotary_inertia(:)
     logical, intent(in) :: fixed(:, :), fixed_rotation(:, :)
     real(wp), intent(inout) :: acceleration(:, :), angular_acceleration(:, :)
-    integer :: c, i, j, k, node, primary
+    integer :: c, i, j, k, node, slot, corner
     real(wp) :: force(3), moment(3), total
     logical :: rotations
 
     if (.not. allocated(ties%primary_nodes)) return
     if (size(ties%primary_nodes) == 0) return
-    do k = 1, size(ties%primary_nodes)
-      node = ties%primary_nodes(k)
-      ties%extra_mass(node) = 0.0_wp
-      ties%extra_force(:, node) = 0.0_wp
-      ties%extra_inertia(node) = 0.0_wp
-      ties%extra_moment(:, node) = 0.0_wp
-    end do
+    ties%extra_mass = 0.0_wp
+    ties%extra_force = 0.0_wp
+    ties%extra_inertia = 0.0_wp
+    ties%extra_moment = 0.0_wp
     ! the tied nodes' masses and forces to their segments' nodes
+    corner = 0
     do c = 1, size(model%tied_contacts)
       associate (tie => model%tied_contacts(c))
         do i = 1, size(tie%nodes)
@@ -130,26 +177,27 @@ contains
           rotations = ties_rotations(tie%rotations, node, tie%segments(:, i), rotary_inertia)
           if (rotations) moment = rotary_inertia(node)*angular_acceleration(:, node)
           do j = 1, 4
-            primary = tie%segments(j, i)
-            ties%extra_mass(primary) = ties%extra_mass(primary) + tie%weights(j, i)*mass(node)
-            ties%extra_force(:, primary) = ties%extra_force(:, primary) + tie%weights(j, i)*force
+            slot = ties%corner_slots(corner + j)
+            ties%extra_mass(slot) = ties%extra_mass(slot) + tie%weights(j, i)*mass(node)
+            ties%extra_force(:, slot) = ties%extra_force(:, slot) + tie%weights(j, i)*force
             if (.not. rotations) cycle
-            ties%extra_inertia(primary) = ties%extra_inertia(primary) + tie%weights(j, i)*rotary_inertia(node)
-            ties%extra_moment(:, primary) = ties%extra_moment(:, primary) + tie%weights(j, i)*moment
+            ties%extra_inertia(slot) = ties%extra_inertia(slot) + tie%weights(j, i)*rotary_inertia(node)
+            ties%extra_moment(:, slot) = ties%extra_moment(:, slot) + tie%weights(j, i)*moment
           end do
+          corner = corner + 4
         end do
       end associate
     end do
     ! the segments' nodes accelerate with what they carry
     do k = 1, size(ties%primary_nodes)
       node = ties%primary_nodes(k)
-      total = mass(node) + ties%extra_mass(node)
-      if (total > 0.0_wp) acceleration(:, node) = (mass(node)*acceleration(:, node) + ties%extra_force(:, node))/total
+      total = mass(node) + ties%extra_mass(k)
+      if (total > 0.0_wp) acceleration(:, node) = (mass(node)*acceleration(:, node) + ties%extra_force(:, k))/total
       where (fixed(:, node)) acceleration(:, node) = 0.0_wp
-      total = rotary_inertia(node) + ties%extra_inertia(node)
-      if (ties%extra_inertia(node) > 0.0_wp .and. total > 0.0_wp) &
+      total = rotary_inertia(node) + ties%extra_inertia(k)
+      if (ties%extra_inertia(k) > 0.0_wp .and. total > 0.0_wp) &
         angular_acceleration(:, node) = (rotary_inertia(node)*angular_acceleration(:, node) + &
-                                         ties%extra_moment(:, node))/total
+                                         ties%extra_moment(:, k))/total
       where (fixed_rotation(:, node)) angular_acceleration(:, node) = 0.0_wp
     end do
   end subroutine distribute_tied_nodes

@@ -164,17 +164,24 @@ contains
   !> Write `text` as the whole content of the file `path` (created or replaced), and say when
   !> any of it could not be written ("... /results.xdmf.tmp: No space left on device").
   !> Through C's stdio rather than a Fortran unit: gfortran's formatted writes and CLOSE report
-  !> no error when the disk is full, and the file is silently cut short.
-  subroutine write_text_file(path, text, error)
+  !> no error when the disk is full, and the file is silently cut short. With `append` true,
+  !> `text` goes after the file's content instead (a file written piece by piece).
+  subroutine write_text_file(path, text, error, append)
     character(len=*), intent(in) :: path, text
     type(error_t), allocatable, intent(out) :: error
+    logical, intent(in), optional :: append
     type(c_ptr) :: stream
     integer(c_size_t) :: written
     integer(c_int) :: flushed, closed
     integer :: number
+    character(len=1) :: mode
 
+    mode = "w"
+    if (present(append)) then
+      if (append) mode = "a"
+    end if
     call clear_system_error()
-    stream = c_fopen(path//c_null_char, "w"//c_null_char)
+    stream = c_fopen(path//c_null_char, mode//c_null_char)
     if (.not. c_associated(stream)) then
       call make_error(error, "cannot write "//path//": "//system_error_text(system_error_number()))
       return

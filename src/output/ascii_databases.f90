@@ -5,9 +5,11 @@
 !> *DATABASE_<name> keyword with BINARY 1 or 3 (blank or 0: 1); results.h5 holds every history
 !> whatever BINARY says. The layouts are documented in docs/output.md.
 !>
-!> The files are written whole at the end of the run (normal or error termination) from the
+!> The files are written at the end of the run (normal or error termination) from the
 !> in-memory histories, so that a restart, which continues those histories, writes complete
-!> files too.
+!> files too. Their text goes to the file as it is produced, through a buffer of bounded size
+!> (text_writer_t): a file is never held whole in memory (d3hsp echoes the whole deck, which
+!> is gigabytes for a full vehicle).
 module ascii_databases
   use kinds, only: wp
   use error_handling, only: error_t, make_error
@@ -18,14 +20,24 @@ module ascii_databases
   implicit none
   private
 
-  public :: write_ascii_databases, lsdyna_file_path, c_exponential, text_buffer_t, add_line, start_database, &
-            finish_database
+  public :: write_ascii_databases, lsdyna_file_path, c_exponential, text_writer_t, begin_text, add_line, add_text, &
+            start_database, finish_database
 
-  !> The text of a file being written, `text(1:length)`; lines are appended with add_line.
-  type :: text_buffer_t
-    character(len=:), allocatable :: text
+  !> Bytes a text_writer_t holds before it hands them to its file.
+  integer, parameter :: writer_capacity = 1048576
+
+  !> A text file being written: `begin_text` names it, `add_line` and `add_text` append to
+  !> `buffer(1:length)`, which goes to the file (created by the first write, appended to by the
+  !> next) whenever the next piece would not fit, and `finish_database` writes the rest and
+  !> reports the first failure. The memory it takes is at most writer_capacity whatever the size
+  !> of the file.
+  type :: text_writer_t
+    character(len=:), allocatable :: path
+    character(len=:), allocatable :: buffer
     integer :: length = 0
-  end type text_buffer_t
+    logical :: created = .false.                  !< the file has been created (next writes append)
+    type(error_t), allocatable :: error           !< the first write that failed (later ones skipped)
+  end type text_writer_t
 
 contains
 
@@ -158,11 +170,14 @@ contains
     value_of = series%rows(position, row)
   end function value_of
 
-  !> LS-DYNA's first two lines: the title, then the program, its version and the date.
-  subroutine start_database(model, out)
+  !> The file `path` begun (begin_text) with LS-DYNA's first two lines: the title, then the
+  !> program, its version and the date.
+  subroutine start_database(model, out, path)
     type(model_t), intent(in) :: model
-    type(text_buffer_t), intent(inout) :: out
+    type(text_writer_t), intent(out) :: out
+    character(len=*), intent(in) :: path
     character(len=8) :: date
+    call begin_text(out, path)
     call date_and_time(date=date)
     if (allocated(model%title)) then
       call add_line(out, " "//model%title(1:min(len(model%title), 72)))
@@ -173,7 +188,6 @@ contains
       date(5:6)//"/"//date(7:8)//"/"//date(1:4))
   end subroutine start_database
 
-  !> Append one line (and its new line) to `out`, doubling the buffer when it is full.
   !> The history series "<database>/<id>" of each id, and the rows all of them hold; false when
   !> one of them was not recorded.
   logical function series_of(histories, database, ids, series, rows) result(found)
@@ -196,35 +210,70 @@ contains
     found = .true.
   end function series_of
 
+  !> A writer for the file `path` (nothing is written before the first buffer is full or
+  !> finish_database is called).
+  subroutine begin_text(out, path)
+    type(text_writer_t), intent(out) :: out
+    character(len=*), intent(in) :: path
+    out%path = path
+  end subroutine begin_text
+
+  !> Append one line and its new line to the file of `out`.
   subroutine add_line(out, line)
-    type(text_buffer_t), intent(inout) :: out
+    type(text_writer_t), intent(inout) :: out
     character(len=*), intent(in) :: line
-    character(len=:), allocatable :: grown
-    integer :: needed
-    needed = out%length + len(line) + 1
-    if (.not. allocated(out%text)) allocate (character(len=max(4096, needed)) :: out%text)
-    if (needed > len(out%text)) then
-      allocate (character(len=max(2*len(out%text), needed)) :: grown)
-      grown(1:out%length) = out%text(1:out%length)
-      call move_alloc(grown, out%text)
-    end if
-    out%text(out%length + 1:needed) = line//new_line("a")
-    out%length = needed
+    call add_text(out, line)
+    call add_text(out, new_line("a"))
   end subroutine add_line
 
-  !> The whole text to `path` through C's stdio (file_system's write_text_file), which reports
-  !> a full disk; gfortran's formatted writes would cut the file short without a word.
-  subroutine finish_database(out, path, error)
-    type(text_buffer_t), intent(in) :: out
-    character(len=*), intent(in) :: path
+  !> Append `text` as it is (no new line added) to the file of `out`: into the buffer, which is
+  !> written out first when `text` does not fit; a text longer than the buffer goes straight to
+  !> the file.
+  subroutine add_text(out, text)
+    type(text_writer_t), intent(inout) :: out
+    character(len=*), intent(in) :: text
+    if (.not. allocated(out%buffer)) allocate (character(len=writer_capacity) :: out%buffer)
+    if (out%length + len(text) > len(out%buffer)) then
+      call write_buffer(out)
+      if (len(text) > len(out%buffer)) then
+        call write_piece(out, text)
+        return
+      end if
+    end if
+    out%buffer(out%length + 1:out%length + len(text)) = text
+    out%length = out%length + len(text)
+  end subroutine add_text
+
+  !> The buffer to the file, emptied.
+  subroutine write_buffer(out)
+    type(text_writer_t), intent(inout) :: out
+    if (out%length > 0) call write_piece(out, out%buffer(1:out%length))
+    out%length = 0
+  end subroutine write_buffer
+
+  !> `text` to the file: the first piece creates (or replaces) it, the next ones are appended;
+  !> after a failure nothing more is written.
+  subroutine write_piece(out, text)
+    type(text_writer_t), intent(inout) :: out
+    character(len=*), intent(in) :: text
+    if (allocated(out%error)) return
+    call write_text_file(out%path, text, out%error, append=out%created)
+    out%created = .true.
+  end subroutine write_piece
+
+  !> The rest of the text to the file (an empty file when nothing was added), the buffer
+  !> released, and the first failure of the file's writes reported. Writes go through C's stdio
+  !> (file_system's write_text_file), which reports a full disk; gfortran's formatted writes
+  !> would cut the file short without a word.
+  subroutine finish_database(out, error)
+    type(text_writer_t), intent(inout) :: out
     type(error_t), allocatable, intent(out) :: error
     integer :: mark
-    if (allocated(out%text)) then
-      call write_text_file(path, out%text(1:out%length), error)
-    else
-      call write_text_file(path, "", error)
-    end if
-    if (.not. allocated(error)) return
+    if (allocated(out%buffer)) call write_buffer(out)
+    if (.not. out%created) call write_piece(out, "")
+    if (allocated(out%buffer)) deallocate (out%buffer)
+    if (.not. allocated(out%error)) return
+    call move_alloc(out%error, error)
     ! "...: no space left on device", as the results file's messages say it
     mark = index(error%message, ": ", back=.true.) + 2
     if (mark > 2 .and. mark <= len(error%message)) then
@@ -235,7 +284,7 @@ contains
 
   !> A glstat line: the label padded with dots to 31 characters after a blank, then %14.5E.
   subroutine glstat_line(out, label, value)
-    type(text_buffer_t), intent(inout) :: out
+    type(text_writer_t), intent(inout) :: out
     character(len=*), intent(in) :: label
     real(wp), intent(in) :: value
     character(len=32) :: padded
@@ -249,12 +298,12 @@ contains
     type(history_set_t), intent(in) :: histories
     character(len=*), intent(in) :: path
     type(error_t), allocatable, intent(out) :: error
-    type(text_buffer_t) :: out
+    type(text_writer_t) :: out
     integer :: s, row
     character(len=32) :: cycle_text
     s = series_index(histories, "glstat")
     if (s == 0) return
-    call start_database(model, out)
+    call start_database(model, out, path)
     associate (series => histories%series(s))
       do row = 1, series%count
         write (cycle_text, '(i8)') nint(value_of(series, "cycle", row))
@@ -287,7 +336,7 @@ contains
         call glstat_line(out, "percentage increase", value_of(series, "percent_mass_increase", row))
       end do
     end associate
-    call finish_database(out, path, error)
+    call finish_database(out, error)
   end subroutine write_glstat
 
   !> The end of glstat's "dt of cycle" line: " is controlled by solid   <id> of part   <id>", as
@@ -309,7 +358,7 @@ contains
 
   !> The legend of part, wall or contact titles LS-DYNA writes after the header.
   subroutine write_legend(out, ids, titles)
-    type(text_buffer_t), intent(inout) :: out
+    type(text_writer_t), intent(inout) :: out
     integer, intent(in) :: ids(:)
     character(len=*), intent(in) :: titles(:)
     integer :: k
@@ -336,7 +385,7 @@ contains
     integer, allocatable :: part_series(:)
     character(len=70), allocatable :: titles(:)
     character(len=16) :: id_text
-    type(text_buffer_t) :: out
+    type(text_writer_t) :: out
     integer :: k, row, rows
     allocate (titles(size(model%parts)))
     if (.not. series_of(histories, "matsum", model%parts%id, part_series, rows)) return
@@ -345,7 +394,7 @@ contains
       if (allocated(model%parts(k)%title)) titles(k) = model%parts(k)%title
     end do
     if (size(model%parts) == 0) return
-    call start_database(model, out)
+    call start_database(model, out, path)
     call write_legend(out, model%parts%id, titles)
     do row = 1, rows
       call add_line(out, "")
@@ -373,7 +422,7 @@ contains
         end associate
       end do
     end do
-    call finish_database(out, path, error)
+    call finish_database(out, error)
   end subroutine write_matsum
 
   !> nodout: per sample the "n o d a l   p r i n t   o u t" block, one line per history node.
@@ -385,13 +434,13 @@ contains
     integer, allocatable :: node_series(:)
     character(len=9) :: node_text
     character(len=8) :: cycle_text
-    type(text_buffer_t) :: out
+    type(text_writer_t) :: out
     integer :: k, j, row, rows, node
     character(len=:), allocatable :: line
     if (.not. allocated(model%output%history_nodes)) return
     if (size(model%output%history_nodes) == 0) return
     if (.not. series_of(histories, "nodout", model%node_ids(model%output%history_nodes), node_series, rows)) return
-    call start_database(model, out)
+    call start_database(model, out, path)
     do row = 1, rows
       associate (first => histories%series(node_series(1)))
         write (cycle_text, '(i8)') nint(value_of(first, "cycle", row))
@@ -425,7 +474,7 @@ contains
         end associate
       end do
     end do
-    call finish_database(out, path, error)
+    call finish_database(out, error)
   end subroutine write_nodout
 
   !> rwforc: one line per sample and wall: time, wall id, normal force, x, y, z force (the
@@ -438,7 +487,7 @@ contains
     integer, allocatable :: wall_series(:)
     character(len=70), allocatable :: titles(:)
     character(len=8) :: wall_text
-    type(text_buffer_t) :: out
+    type(text_writer_t) :: out
     integer :: k, j, row, rows
     character(len=:), allocatable :: line
     allocate (titles(size(model%walls)))
@@ -447,7 +496,7 @@ contains
       titles(k) = ""
       if (allocated(model%walls(k)%title)) titles(k) = model%walls(k)%title
     end do
-    call start_database(model, out)
+    call start_database(model, out, path)
     call write_legend(out, model%walls%id, titles)
     call add_line(out, "")
     call add_line(out, "")
@@ -465,7 +514,7 @@ contains
         end associate
       end do
     end do
-    call finish_database(out, path, error)
+    call finish_database(out, error)
   end subroutine write_rwforc
 
   !> rcforc: per sample and contact a "slave" line (the force on SURFA) and a "master" line
@@ -478,7 +527,7 @@ contains
     integer, allocatable :: contact_series(:)
     character(len=70), allocatable :: titles(:)
     character(len=11) :: contact_text
-    type(text_buffer_t) :: out
+    type(text_writer_t) :: out
     integer :: k, row, rows
     allocate (titles(size(model%contacts)))
     if (.not. series_of(histories, "rcforc", model%contacts%id, contact_series, rows)) return
@@ -486,7 +535,7 @@ contains
       titles(k) = ""
       if (allocated(model%contacts(k)%title)) titles(k) = model%contacts(k)%title
     end do
-    call start_database(model, out)
+    call start_database(model, out, path)
     call write_legend(out, model%contacts%id, titles)
     do row = 1, rows
       do k = 1, size(model%contacts)
@@ -505,12 +554,12 @@ contains
         end associate
       end do
     end do
-    call finish_database(out, path, error)
+    call finish_database(out, error)
   end subroutine write_rcforc
 
   !> One rbdout line: a label right-aligned in 15 columns, then the values, %12.4E each.
   subroutine rbdout_line(out, label, values)
-    type(text_buffer_t), intent(inout) :: out
+    type(text_writer_t), intent(inout) :: out
     character(len=*), intent(in) :: label
     real(wp), intent(in) :: values(:)
     character(len=15) :: padded
@@ -540,7 +589,7 @@ contains
     character(len=12), parameter :: local_titles(6) = [character(len=12) :: "a", "b", "c", "a-rot", "b-rot", "c-rot"]
     character(len=:), allocatable :: header, local_header
     real(wp) :: axes(3, 3), displacement(6), velocity(6), acceleration(6)
-    type(text_buffer_t) :: out
+    type(text_writer_t) :: out
     integer :: k, j, i, row, rows
     ! (the ids as an array expression: a component of an array of types is not contiguous)
     if (.not. series_of(histories, "rbdout", [(model%rigid_bodies(k)%id, k = 1, size(model%rigid_bodies))], &
@@ -553,7 +602,7 @@ contains
       header = header//adjustr(titles(j))
       local_header = local_header//adjustr(local_titles(j))
     end do
-    call start_database(model, out)
+    call start_database(model, out, path)
     do row = 1, rows
       associate (first => histories%series(body_series(1)))
         write (cycle_text, '(i8)') nint(value_of(first, "cycle", row))
@@ -605,6 +654,6 @@ contains
         end associate
       end do
     end do
-    call finish_database(out, path, error)
+    call finish_database(out, error)
   end subroutine write_rbdout
 end module ascii_databases

@@ -15,7 +15,8 @@ module ascii_run_summary
   use energy_balance, only: part_momenta
   use run_summary, only: run_summary_t, status_normal
   use history_buffer, only: history_set_t
-  use ascii_databases, only: lsdyna_file_path, c_exponential, text_buffer_t, add_line, finish_database
+  use ascii_databases, only: lsdyna_file_path, c_exponential, text_writer_t, begin_text, add_line, add_text, &
+                             finish_database
   use version, only: crashfree_version
   use deck_signature, only: deck_source_t
   implicit none
@@ -44,7 +45,8 @@ contains
     character(len=*), intent(in) :: directory, job_id, messages
     type(run_summary_t), intent(in) :: summary
     type(error_t), allocatable, intent(out) :: error
-    type(text_buffer_t) :: out
+    type(text_writer_t) :: out
+    call begin_text(out, lsdyna_file_path(directory, job_id, "messag"))
     call add_line(out, " crashfree (version "//crashfree_version//") messages")
     call add_line(out, "")
     if (len(messages) > 0) call add_line(out, messages)
@@ -53,7 +55,7 @@ contains
     if (allocated(summary%message)) then
       if (len(summary%message) > 0) call add_line(out, " "//summary%message)
     end if
-    call finish_database(out, lsdyna_file_path(directory, job_id, "messag"), error)
+    call finish_database(out, error)
   end subroutine write_messag
 
   !> `d3hsp` (`JOB.d3hsp` with jobid=).
@@ -67,9 +69,10 @@ contains
     type(error_t), allocatable, intent(out) :: error
     !> the deck's files as read (the main deck, then its includes, paths resolved): echoed
     type(deck_source_t), intent(in), optional :: sources(:)
-    type(text_buffer_t) :: out
+    type(text_writer_t) :: out
     character(len=8) :: date
     character(len=16) :: cycles
+    call begin_text(out, lsdyna_file_path(directory, job_id, "d3hsp"))
     call date_and_time(date=date)
     call add_line(out, " crashfree (version "//crashfree_version//")     date "//date(5:6)//"/"//date(7:8)//"/"// &
       date(1:4))
@@ -90,12 +93,12 @@ contains
     if (allocated(summary%message)) then
       if (len(summary%message) > 0) call add_line(out, " "//summary%message)
     end if
-    call finish_database(out, lsdyna_file_path(directory, job_id, "d3hsp"), error)
+    call finish_database(out, error)
   end subroutine write_d3hsp
 
   !> The domain partition of an MPI run (or partition=N), as printed at set-up.
   subroutine write_partition(out, summary)
-    type(text_buffer_t), intent(inout) :: out
+    type(text_writer_t), intent(inout) :: out
     type(run_summary_t), intent(in) :: summary
     character(len=:), allocatable :: text
     integer :: start, finish
@@ -113,12 +116,16 @@ contains
   end subroutine write_partition
 
   !> The input as read, file by file (LS-DYNA's d3hsp echoes its input too): each file's text
-  !> under a line naming it. A file that cannot be read any more is named as such.
+  !> under a line naming it, copied in pieces of at most echo_piece bytes (a vehicle's deck is
+  !> gigabytes), with a new line after a last line that has none. A file that cannot be read
+  !> any more is named as such (after the part that was read, if it fails midway).
   subroutine echo_deck(out, sources)
-    type(text_buffer_t), intent(inout) :: out
+    type(text_writer_t), intent(inout) :: out
     type(deck_source_t), intent(in) :: sources(:)
-    character(len=:), allocatable :: text
-    integer :: k, unit, status, bytes
+    integer, parameter :: echo_piece = 1048576
+    character(len=:), allocatable :: piece
+    character(len=1) :: last
+    integer :: k, unit, status, bytes, done, size_read
     call add_line(out, "")
     call add_line(out, " i n p u t   d e c k   a s   r e a d   (file by file, include paths resolved)")
     do k = 1, size(sources)
@@ -126,29 +133,33 @@ contains
       call add_line(out, " ---- "//sources(k)%path)
       open (newunit=unit, file=sources(k)%path, access="stream", form="unformatted", action="read", &
             status="old", iostat=status)
-      if (status == 0) inquire (unit=unit, size=bytes, iostat=status)
-      if (status == 0) then
-        allocate (character(len=max(bytes, 0)) :: text)
-        if (bytes > 0) read (unit, iostat=status) text
-        close (unit)
-      end if
       if (status /= 0) then
         call add_line(out, " (cannot be read now)")
-      else if (len(text) > 0) then
-        ! the text as it is, without a second new line after its last one
-        if (text(len(text):len(text)) == new_line("a")) then
-          call add_line(out, text(1:len(text) - 1))
-        else
-          call add_line(out, text)
-        end if
+        cycle
       end if
-      if (allocated(text)) deallocate (text)
+      bytes = 0
+      inquire (unit=unit, size=bytes, iostat=status)
+      done = 0
+      last = new_line("a")
+      if (status == 0 .and. bytes > 0) allocate (character(len=min(bytes, echo_piece)) :: piece)
+      do while (status == 0 .and. done < bytes)
+        size_read = min(bytes - done, len(piece))
+        read (unit, iostat=status) piece(1:size_read)
+        if (status /= 0) exit
+        call add_text(out, piece(1:size_read))
+        last = piece(size_read:size_read)
+        done = done + size_read
+      end do
+      close (unit)
+      if (allocated(piece)) deallocate (piece)
+      if (last /= new_line("a")) call add_text(out, new_line("a"))
+      if (status /= 0) call add_line(out, " (cannot be read now)")
     end do
   end subroutine echo_deck
 
   !> One "label ..... value" line of the control section.
   subroutine control_line(out, label, value)
-    type(text_buffer_t), intent(inout) :: out
+    type(text_writer_t), intent(inout) :: out
     character(len=*), intent(in) :: label, value
     character(len=48) :: padded
     padded = "   "//label//" "//repeat(".", 48)
@@ -170,7 +181,7 @@ contains
   end function integer_field
 
   subroutine write_controls(out, model)
-    type(text_buffer_t), intent(inout) :: out
+    type(text_writer_t), intent(inout) :: out
     type(model_t), intent(in) :: model
     call add_line(out, "")
     call add_line(out, " c o n t r o l   i n f o r m a t i o n")
@@ -205,7 +216,7 @@ contains
   !> and beams, its mass (the nodal masses its elements give, a rigid part its body's), title;
   !> then the totals.
   subroutine write_parts(out, model, state)
-    type(text_buffer_t), intent(inout) :: out
+    type(text_writer_t), intent(inout) :: out
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(in) :: state
     real(wp), allocatable :: momentum(:, :), mass(:), rigid_velocity(:, :)
@@ -257,7 +268,7 @@ contains
   !> recorded at cycle 0) and the smallest stable step of each element kind with its element
   !> at the last cycle.
   subroutine write_time_steps(out, model, state, histories, initial_time_steps)
-    type(text_buffer_t), intent(inout) :: out
+    type(text_writer_t), intent(inout) :: out
     type(model_t), intent(in) :: model
     type(explicit_state_t), intent(in) :: state
     type(history_set_t), intent(in) :: histories

@@ -10,6 +10,7 @@ its time integral is the block's momentum change; rcforc's two sides are opposit
 the warnings with file:line, d3hsp the parts and masses and the deck as read; BINARY=2 writes no
 ASCII file.
 """
+import os
 import re
 import subprocess
 
@@ -335,6 +336,42 @@ def test_log_of_both_streams_is_in_order(tmp_path):
     summary = next(k for k, text in enumerate(lines) if text.startswith("model:"))
     progress = next(k for k, text in enumerate(lines) if text.strip().startswith("cycle"))
     assert lines[0].startswith("crashfree ") and 0 < warning < summary < progress
+
+
+def peak_memory_of_run(deck, output):
+    """Exit status and peak resident memory (kB) of one run of the solver on one thread, as
+    GNU time measures it (a child of this process would count the test's own memory: Linux
+    keeps the largest resident size of a process across exec)."""
+    from conftest import BINARY
+    command = ["/usr/bin/time", "-f", "peak %M", str(BINARY), f"i={deck}", f"outdir={output}", "ncpu=1"]
+    process = subprocess.run(command, capture_output=True, text=True, env=dict(os.environ, OMP_NUM_THREADS="1"),
+                             timeout=300)
+    return process.returncode, int(process.stderr.splitlines()[-1].split()[-1])
+
+
+def test_d3hsp_echoes_a_large_include_exactly_in_bounded_memory(tmp_path):
+    """d3hsp echoes the deck file by file (a vehicle's deck is gigabytes) through a writer of
+    bounded size: an include of 32 MiB (comment lines, the last without a new line) is in d3hsp
+    byte for byte with a new line added, and the run's peak memory is that of the same deck with
+    a one-line include within 16 MB (building d3hsp whole in memory took three times the
+    include: 95 MB more)."""
+    if not os.access("/usr/bin/time", os.X_OK):
+        pytest.skip("GNU time (/usr/bin/time) measures the peak memory")
+    line = "$ " + "padding " * 9 + "\n"
+    padding = (line * (32 * 2**20 // len(line))).encode() + b"$ the last line, without a new line"
+    (tmp_path / "large_padding.k").write_bytes(padding)
+    (tmp_path / "small_padding.k").write_text("$ padding\n")
+    peaks = {}
+    for size in ("small", "large"):
+        deck = wall_deck(tmp_path / f"{size}.k", extra=f"*INCLUDE\n{size}_padding.k")
+        status, peaks[size] = peak_memory_of_run(deck, tmp_path / f"out_{size}")
+        assert status == 0, size
+    d3hsp = (tmp_path / "out_large" / "d3hsp").read_bytes()
+    name = f" ---- {tmp_path / 'large_padding.k'}\n".encode()
+    start = d3hsp.index(name, d3hsp.index(b"i n p u t   d e c k   a s   r e a d")) + len(name)
+    assert d3hsp[start:start + len(padding) + 11] == padding + b"\n\n cycles: "
+    assert d3hsp.endswith(b" N o r m a l    t e r m i n a t i o n\n")
+    assert peaks["large"] - peaks["small"] < 16 * 1024, peaks
 
 
 # ------------------------------------------------------------------ d3hsp: 100 smallest timesteps
