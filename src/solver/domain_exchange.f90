@@ -431,10 +431,12 @@ contains
       call gather_reals_to_first(exchange%store%memory(1:max(1, exchange%store%position)), counts, offsets, received)
       if (exchange%rank /= 0) return
     end if
+    ! (read where each rank's values start in what was received: no copy)
+    call move_alloc(received, reader%memory)
+    call start_memory_store(reader, .false.)
     do r = 0, exchange%rank_count - 1
       if (r == exchange%rank) cycle
-      reader%memory = received(offsets(r + 1) + 1:offsets(r + 1) + max(1, counts(r + 1)))
-      call start_memory_store(reader, .false.)
+      reader%position = offsets(r + 1)
       do k = 1, size(groups)
         if (.not. groups(k)%group%distributes_blocks()) cycle
         do b = 1, size(partition%groups(k)%owner)
@@ -444,9 +446,9 @@ contains
       end do
       ! (ranks that disagree on the blocks' shapes run different builds or decks: no result can
       ! be trusted, and the others may wait for ever)
-      if (reader%position /= counts(r + 1)) &
+      if (reader%position - offsets(r + 1) /= counts(r + 1)) &
         call abort_ranks("block state from rank "//integer_text(r)//": "//integer_text(counts(r + 1))// &
-                         " values received, "//integer_text(reader%position)//" expected", 1)
+                         " values received, "//integer_text(reader%position - offsets(r + 1))//" expected", 1)
     end do
     exchange%gathered_values = exchange%gathered_values + real(sum(counts) - counts(exchange%rank + 1), wp)
   end subroutine bring_blocks_together
