@@ -670,8 +670,8 @@ contains
     real(wp), parameter :: dt = 1.0e-7_wp
     ! mm/s: the plate's and the block's 20 m/s of test_threads' contact model, and sideways
     real(wp), parameter :: flight(3) = [5300.0_wp, -1700.0_wp, -20100.0_wp]
-    integer, parameter :: cases = 3
-    integer, parameter :: formulations(cases) = [1, 1, 2], hourglass_types(cases) = [1, 5, 1]
+    integer, parameter :: variants = 3
+    integer, parameter :: formulations(variants) = [1, 1, 2], hourglass_types(variants) = [1, 5, 1]
     type(model_t) :: model
     type(solid_block_t), allocatable :: blocks(:)
     real(wp) :: reference(3, 8*elements), current(3, 8*elements), velocities(3, 8*elements)
@@ -679,7 +679,7 @@ contains
     real(wp) :: vx(block_size, 8), vy(block_size, 8), vz(block_size, 8)
     real(wp) :: gradient(block_size, 9), volume(block_size), at_rest(block_size), recent(3)
     real(wp) :: force(block_size, 8, 3), critical, deviation
-    integer :: connectivity(8, elements), element, node, step, case, critical_element, inverted
+    integer :: connectivity(8, elements), element, node, step, variant, critical_element, inverted
     character(len=40) :: label
 
     do element = 1, elements
@@ -702,9 +702,9 @@ contains
     call hex8_velocity_gradient(elements, -0.5_wp*dt, x, y, z, vx, vy, vz, gradient, volume)
     call check(suite, "free flight: velocity gradient exactly zero", all(gradient(1:elements, :) == 0.0_wp))
 
-    do case = 1, cases
-      write (label, '(a, i0, a, i0)') "free flight, ELFORM ", formulations(case), ", IHQ ", hourglass_types(case)
-      call make_model(model, reference, connectivity, elastic_steel(), formulations(case), hourglass_types(case))
+    do variant = 1, variants
+      write (label, '(a, i0, a, i0)') "free flight, ELFORM ", formulations(variant), ", IHQ ", hourglass_types(variant)
+      call make_model(model, reference, connectivity, elastic_steel(), formulations(variant), hourglass_types(variant))
       call build_solid_blocks(model, blocks)
       call check(suite, trim(label)//": one block, every element exposed", &
                  size(blocks) == 1 .and. blocks(1)%exposed_count == elements)
