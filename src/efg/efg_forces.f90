@@ -424,7 +424,13 @@ contains
   end subroutine update_with_host_law
 
   !> Fbar at the end of the step, its rate, J, J at mid-step and the velocity gradient at
-  !> mid-step (row-major: gradient(3 (i - 1) + j) = dv_i / dx_j).
+  !> mid-step (row-major: gradient(3 (i - 1) + j) = dv_i / dx_j). The rate sums the velocities
+  !> relative to the point's first node's (the same value, as the gradients of the shape
+  !> functions sum to zero): a translating part then gets exactly L = 0. With the absolute
+  !> velocities tr D was round-off of either sign, and a negative one lowered the point's stable
+  !> step by the linear bulk viscosity's 6% (Q2 = 0.06; hex8_geometry's hex8_velocity_gradient
+  !> says more). (Fbar keeps the absolute displacements: its round-off only moves J, by far less,
+  !> and the pair loop is the meshfree update's hot spot.)
   subroutine point_kinematics(geometry, g, displacement, velocity, dt, deformation, rate, jacobian, &
                               mid_jacobian, gradient)
     type(efg_part_t), intent(in) :: geometry
@@ -435,12 +441,22 @@ contains
     real(wp) :: middle(3, 3), inverse(3, 3), velocity_gradient(3, 3)
     real(wp) :: f11, f21, f31, f12, f22, f32, f13, f23, f33
     real(wp) :: r11, r21, r31, r12, r22, r32, r13, r23, r33, bx, by, bz, dx, dy, dz, vx, vy, vz
+    real(wp) :: base_vx, base_vy, base_vz
     integer :: k, node, i, j
     ! scalar accumulators: the pair loop is the hot spot of the meshfree update
     f11 = 0.0_wp; f21 = 0.0_wp; f31 = 0.0_wp; f12 = 0.0_wp; f22 = 0.0_wp; f32 = 0.0_wp
     f13 = 0.0_wp; f23 = 0.0_wp; f33 = 0.0_wp
     r11 = 0.0_wp; r21 = 0.0_wp; r31 = 0.0_wp; r12 = 0.0_wp; r22 = 0.0_wp; r32 = 0.0_wp
     r13 = 0.0_wp; r23 = 0.0_wp; r33 = 0.0_wp
+    base_vx = 0.0_wp
+    base_vy = 0.0_wp
+    base_vz = 0.0_wp
+    if (geometry%point_offsets(g + 1) > geometry%point_offsets(g)) then
+      node = geometry%pair_node(geometry%point_offsets(g))
+      base_vx = velocity(1, node)
+      base_vy = velocity(2, node)
+      base_vz = velocity(3, node)
+    end if
     do k = geometry%point_offsets(g), geometry%point_offsets(g + 1) - 1
       node = geometry%pair_node(k)
       bx = geometry%pair_gradient(1, k)
@@ -449,9 +465,9 @@ contains
       dx = displacement(1, node)
       dy = displacement(2, node)
       dz = displacement(3, node)
-      vx = velocity(1, node)
-      vy = velocity(2, node)
-      vz = velocity(3, node)
+      vx = velocity(1, node) - base_vx
+      vy = velocity(2, node) - base_vy
+      vz = velocity(3, node) - base_vz
       f11 = f11 + dx*bx; f21 = f21 + dy*bx; f31 = f31 + dz*bx
       f12 = f12 + dx*by; f22 = f22 + dy*by; f32 = f32 + dz*by
       f13 = f13 + dx*bz; f23 = f23 + dy*bz; f33 = f33 + dz*bz

@@ -19,28 +19,34 @@ module hex8_full
 
 contains
 
-  !> Velocity gradient at one point, L_ij = sum_I v_iI dN_I/dx_j, stored row by row.
+  !> Velocity gradient at one point, L_ij = sum_I v_iI dN_I/dx_j, stored row by row. Summed
+  !> over the velocities relative to node 1's (the same value, as sum_I dN_I/dx_j = 0), so that a
+  !> translating element gets exactly L = 0 in every build (hex8_geometry's
+  !> hex8_velocity_gradient says why that matters).
   subroutine point_velocity_gradient(nel, dndx, dndy, dndz, vx, vy, vz, gradient)
     integer, intent(in) :: nel
     real(wp), intent(in) :: dndx(block_size, 8), dndy(block_size, 8), dndz(block_size, 8)
     real(wp), intent(in) :: vx(block_size, 8), vy(block_size, 8), vz(block_size, 8)
     real(wp), intent(out) :: gradient(block_size, 9)
-    real(wp) :: l11, l12, l13, l21, l22, l23, l31, l32, l33
+    real(wp) :: l11, l12, l13, l21, l22, l23, l31, l32, l33, rx, ry, rz
     integer :: node, i
     do i = 1, nel
       l11 = 0.0_wp; l12 = 0.0_wp; l13 = 0.0_wp
       l21 = 0.0_wp; l22 = 0.0_wp; l23 = 0.0_wp
       l31 = 0.0_wp; l32 = 0.0_wp; l33 = 0.0_wp
       do node = 1, 8
-        l11 = l11 + vx(i, node)*dndx(i, node)
-        l12 = l12 + vx(i, node)*dndy(i, node)
-        l13 = l13 + vx(i, node)*dndz(i, node)
-        l21 = l21 + vy(i, node)*dndx(i, node)
-        l22 = l22 + vy(i, node)*dndy(i, node)
-        l23 = l23 + vy(i, node)*dndz(i, node)
-        l31 = l31 + vz(i, node)*dndx(i, node)
-        l32 = l32 + vz(i, node)*dndy(i, node)
-        l33 = l33 + vz(i, node)*dndz(i, node)
+        rx = vx(i, node) - vx(i, 1)
+        ry = vy(i, node) - vy(i, 1)
+        rz = vz(i, node) - vz(i, 1)
+        l11 = l11 + rx*dndx(i, node)
+        l12 = l12 + rx*dndy(i, node)
+        l13 = l13 + rx*dndz(i, node)
+        l21 = l21 + ry*dndx(i, node)
+        l22 = l22 + ry*dndy(i, node)
+        l23 = l23 + ry*dndz(i, node)
+        l31 = l31 + rz*dndx(i, node)
+        l32 = l32 + rz*dndy(i, node)
+        l33 = l33 + rz*dndz(i, node)
       end do
       gradient(i, 1) = l11
       gradient(i, 2) = l12

@@ -1,6 +1,7 @@
 !> Unit tests of the hexahedral solid elements through the block API (solid_block) and the
 !> geometry kernels: volumes and time steps, patch tests (linear velocity fields on distorted
 !> elements give the exact D and spin and no hourglass force), objectivity under rigid rotation,
+!> free flight (no strain, and the step at rest, in every build),
 !> bulk viscosity, hourglass forces and energies, conservation of linear and angular momentum,
 !> inverted elements, block building, the elements at a mesh's corners and edges (which get the
 !> eigenvalue bound on their step) and element results.
@@ -38,6 +39,7 @@ program test_solid_elements
   call test_patch_single_elements()
   call test_patch_irregular_block()
   call test_rigid_rotation()
+  call test_free_flight()
   call test_selective_reduced_pressure()
   call test_bulk_viscosity()
   call test_hourglass_forces()
@@ -657,6 +659,78 @@ contains
                        rel=1e-13_wp)
     end do
   end subroutine test_rigid_rotation
+
+  !> Distorted hexahedra far from the origin in free flight (every node at the same velocity):
+  !> the velocity gradient is exactly zero, so no stress arises, and the stable step is the step
+  !> at rest. With the absolute velocities in the gradient sums, tr D was the round-off
+  !> v . sum_I b_I / V, of either sign and different with and without FMA contraction; when
+  !> negative it switched on the linear bulk viscosity's term of the step (6% at Q2 = 0.06), and
+  !> the release and the debug build of the contact model of test_threads took different steps
+  !> before the impact (docs/solver.md, "Why two builds differ").
+  subroutine test_free_flight()
+    integer, parameter :: elements = 32, steps = 12
+    real(wp), parameter :: dt = 1.0e-7_wp
+    ! mm/s: the plate's and the block's 20 m/s of test_threads' contact model, and sideways
+    real(wp), parameter :: flight(3) = [5300.0_wp, -1700.0_wp, -20100.0_wp]
+    integer, parameter :: variants = 3
+    integer, parameter :: formulations(variants) = [1, 1, 2], hourglass_types(variants) = [1, 5, 1]
+    type(model_t) :: model
+    type(solid_block_t), allocatable :: blocks(:)
+    real(wp) :: reference(3, 8*elements), current(3, 8*elements), velocities(3, 8*elements)
+    real(wp) :: x(block_size, 8), y(block_size, 8), z(block_size, 8)
+    real(wp) :: vx(block_size, 8), vy(block_size, 8), vz(block_size, 8)
+    real(wp) :: gradient(block_size, 9), volume(block_size), at_rest(block_size), recent(3)
+    real(wp) :: force(block_size, 8, 3), critical, deviation
+    integer :: connectivity(8, elements), element, node, step, variant, critical_element, inverted
+    character(len=40) :: label
+
+    do element = 1, elements
+      reference(:, 8*element - 7:8*element) = distorted_cube(0.2_wp) &
+                                               + spread([101.3_wp, -47.9_wp, 55.7_wp + 1.1_wp*element], 2, 8)
+      connectivity(:, element) = [(8*(element - 1) + node, node=1, 8)]
+    end do
+    velocities = spread(flight, 2, 8*elements)
+
+    ! the one-point element's gradient kernel, on the mid-step configuration
+    x = 0.0_wp; y = 0.0_wp; z = 0.0_wp; vx = 0.0_wp; vy = 0.0_wp; vz = 0.0_wp
+    do element = 1, elements
+      x(element, :) = reference(1, connectivity(:, element))
+      y(element, :) = reference(2, connectivity(:, element))
+      z(element, :) = reference(3, connectivity(:, element))
+      vx(element, :) = flight(1)
+      vy(element, :) = flight(2)
+      vz(element, :) = flight(3)
+    end do
+    call hex8_velocity_gradient(elements, -0.5_wp*dt, x, y, z, vx, vy, vz, gradient, volume)
+    call check(suite, "free flight: velocity gradient exactly zero", all(gradient(1:elements, :) == 0.0_wp))
+
+    do variant = 1, variants
+      write (label, '(a, i0, a, i0)') "free flight, ELFORM ", formulations(variant), ", IHQ ", hourglass_types(variant)
+      call make_model(model, reference, connectivity, elastic_steel(), formulations(variant), hourglass_types(variant))
+      call build_solid_blocks(model, blocks)
+      call check(suite, trim(label)//": one block, every element exposed", &
+                 size(blocks) == 1 .and. blocks(1)%exposed_count == elements)
+      ! the solver's start (no step taken), then steps of free flight
+      call compute_solid_block(blocks(1), model%materials(1), reference, velocities, 0.0_wp, force, critical, &
+                               critical_element, inverted)
+      recent = huge(1.0_wp)
+      deviation = 0.0_wp
+      do step = 1, steps
+        current = reference + (step*dt)*velocities
+        call compute_solid_block(blocks(1), model%materials(1), current, velocities, dt, force, critical, &
+                                 critical_element, inverted)
+        ! the block's step is the smallest of its last three calls (solid_block), each at rest
+        call solid_block_time_steps(blocks(1), model%materials(1), current, at_rest)
+        recent = [minval(at_rest(1:elements)), recent(1:2)]
+        deviation = max(deviation, abs(critical/minval(recent) - 1.0_wp))
+      end do
+      ! (round-off of the configuration about 100 mm from the origin moves the steps by ~1e-12)
+      call check_close(suite, trim(label)//": stable step is the step at rest", deviation, 0.0_wp, thr=1e-9_wp)
+      call check(suite, trim(label)//": no stress", all(blocks(1)%stress(1:elements, :, :) == 0.0_wp))
+      call check_close(suite, trim(label)//": no internal energy", &
+                       maxval(abs(blocks(1)%internal_energy(1:elements))), 0.0_wp, thr=1e-30_wp)
+    end do
+  end subroutine test_free_flight
 
   !> ELFORM 2 under a non-linear velocity field: the volumetric strain comes from the element
   !> mean, so the pressure is the same at all eight points and equals K tr(L_mean) dt with
