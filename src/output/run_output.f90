@@ -42,6 +42,11 @@ contains
     logical :: glstat_due, matsum_due, nodout_due, states_due
     integer :: k
 
+    ! the other ranks of a distributed run: the clocks only (the first rank writes every file)
+    if (.not. plan%records) then
+      call advance_clocks(plan, state%time, last)
+      return
+    end if
     if (state%cycle == 0 .and. .not. allocated(plan%initial_time_steps)) &
       plan%initial_time_steps = initial_time_step_tables(model, state)
     glstat_due = clock_due(plan%glstat, state%time, last)
@@ -97,6 +102,17 @@ contains
         call write_binout(model, histories, binout_path(results), error)
     end if
   end subroutine write_due_output
+
+  !> Every clock past the state's time moves on, as recording the output would move it.
+  subroutine advance_clocks(plan, time, last)
+    type(output_plan_t), intent(inout) :: plan
+    real(wp), intent(in) :: time
+    logical, intent(in) :: last
+    logical :: due(7)
+    due = [clock_due(plan%glstat, time, last), clock_due(plan%matsum, time, last), &
+           clock_due(plan%nodout, time, last), clock_due(plan%states, time, last), &
+           clock_due(plan%rwforc, time, last), clock_due(plan%rcforc, time, last), clock_due(plan%rbdout, time, last)]
+  end subroutine advance_clocks
 
   !> binout beside the results file (results_file's DIR/JOBID.h5), named as LS-DYNA names it.
   function binout_path(results) result(path)
@@ -209,10 +225,12 @@ contains
     type(explicit_state_t), intent(in) :: state
     type(output_plan_t), intent(inout) :: plan
     integer :: k
-    plan%generalized_velocity = state%nodes%velocity + 0.5_wp*state%time_step*state%nodes%acceleration
+    plan%node_velocity = state%nodes%velocity + 0.5_wp*state%time_step*state%nodes%acceleration
     plan%node_displacement = state%nodes%displacement
-    plan%node_velocity = plan%generalized_velocity
     plan%node_acceleration = state%nodes%acceleration
+    ! (a model without meshfree parts: the solver's values are the physical ones)
+    if (.not. allocated(plan%generalized_velocity)) return
+    plan%generalized_velocity = plan%node_velocity
     do k = 1, size(state%groups)
       call state%groups(k)%group%to_physical(state%nodes%displacement, plan%node_displacement)
       call state%groups(k)%group%to_physical(plan%generalized_velocity, plan%node_velocity)

@@ -34,10 +34,12 @@ contains
     type(error_t), allocatable, intent(out) :: error
     call set_up_explicit_state(model, run%state, error)
     if (allocated(error)) return
-    call plan_output(model, run%histories, run%plan)
-    allocate (run%energy_scratch(5, chunk_count(run%state%nodes%count)))
     ! the ranks of a distributed run share out the element blocks (one rank: all of them)
     call set_up_domains(model, run%state%groups, run%state%nodes, run%partition, run%exchange, error)
+    if (allocated(error)) return
+    ! (the first rank records the histories and writes the files)
+    call plan_output(model, run%histories, run%plan, run%exchange%rank == 0)
+    allocate (run%energy_scratch(5, chunk_count(run%state%nodes%count)))
     ! (the first rank prints what the run says; the others keep it quietly)
     run%state%messages%quiet = run%exchange%rank /= 0
   end subroutine set_up_run_state

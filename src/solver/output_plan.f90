@@ -8,7 +8,7 @@
 !> can be plotted; nodout needs history nodes and *DATABASE_NODOUT.
 module output_plan
   use kinds, only: wp
-  use model, only: model_t
+  use model, only: model_t, formulation_efg
   use history_buffer, only: history_set_t, add_history_series
   use element_group, only: element_results_t, shell_output_points
   implicit none
@@ -26,6 +26,10 @@ module output_plan
   !> Clocks and the positions of the history series.
   type :: output_plan_t
     type(output_clock_t) :: states, glstat, matsum, nodout, rwforc, rbdout, rcforc
+    !> Whether this rank records the histories and writes the states: the other ranks of a
+    !> distributed run only keep the clocks (the first rank writes every file), and hold none
+    !> of the work arrays below.
+    logical :: records = .true.
     integer :: glstat_series = 0
     integer :: weld_series = 0                   !< swforc: failed spot welds (0: the model has none)
     integer, allocatable :: matsum_series(:)     !< per part
@@ -43,7 +47,7 @@ module output_plan
     type(element_results_t) :: element_results
     real(wp), allocatable :: node_velocity(:, :)     !< physical integer-step velocities of a state
     real(wp), allocatable :: node_displacement(:, :) !< physical displacements of a state
-    real(wp), allocatable :: generalized_velocity(:, :) !< integer-step solver velocities (work array)
+    real(wp), allocatable :: generalized_velocity(:, :) !< integer-step solver velocities (work array; meshfree models)
     real(wp), allocatable :: node_acceleration(:, :) !< physical accelerations (nodout)
     real(wp), allocatable :: part_kinetic(:), part_internal(:), part_hourglass(:)
     real(wp), allocatable :: part_momentum(:, :), part_mass(:), part_rigid_velocity(:, :)   !< matsum
@@ -70,10 +74,11 @@ module output_plan
 contains
 
   !> Set the clocks from the deck and create the history series.
-  subroutine plan_output(model, histories, plan)
+  subroutine plan_output(model, histories, plan, records)
     type(model_t), intent(in) :: model
     type(history_set_t), intent(inout) :: histories
     type(output_plan_t), intent(out) :: plan
+    logical, intent(in) :: records     !< output_plan_t's records
     real(wp) :: default_history
     integer :: capacity, k
     character(len=32) :: label
@@ -166,6 +171,8 @@ contains
     plan%wall_impulse = 0.0_wp
     plan%contact_impulse = 0.0_wp
     plan%rigid_impulse = 0.0_wp
+    plan%records = records
+    if (.not. records) return
     associate (results => plan%element_results)
       allocate (results%solid_stress(6, size(model%solid_ids)), results%solid_plastic_strain(size(model%solid_ids)))
       allocate (results%shell_stress(6, size(model%shell_ids)), results%shell_stress_peak(6, size(model%shell_ids)), &
@@ -202,7 +209,9 @@ contains
       results%shell_energy_density = 0.0_wp
     end associate
     allocate (plan%node_velocity(3, size(model%node_ids)), plan%node_displacement(3, size(model%node_ids)), &
-              plan%generalized_velocity(3, size(model%node_ids)), plan%node_acceleration(3, size(model%node_ids)))
+              plan%node_acceleration(3, size(model%node_ids)))
+    ! (the solver's velocities go through to_physical only where meshfree parts transform them)
+    if (any(model%parts%formulation == formulation_efg)) allocate (plan%generalized_velocity(3, size(model%node_ids)))
     allocate (plan%part_kinetic(size(model%parts)), plan%part_internal(size(model%parts)), &
               plan%part_hourglass(size(model%parts)))
     allocate (plan%part_momentum(3, size(model%parts)), plan%part_mass(size(model%parts)), &
