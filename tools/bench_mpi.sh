@@ -4,7 +4,8 @@
 # cycles (default 300), ncpu=1 per rank:
 #  1. N = 1 (no mpirun) and N = 2 (mpirun -np 2), REPEATS pairs alternating (default 1):
 #     nanoseconds per element per cycle of the slowest rank's cycle (output excluded), parallel
-#     efficiency T1 / (N TN), each rank's phases; with several pairs the medians;
+#     efficiency T1 / (N TN), each rank's phases and peak resident memory; with several pairs the
+#     medians;
 #  2. the partition for N = 2 ... 1,024 ranks (partition=N: set-up only): imbalance, ghost blocks,
 #     owned and interface nodes per rank, the communication volume per cycle per rank (stage 1's
 #     allgatherv of the owned nodes' forces; a stage-2 neighbour exchange of the interface nodes:
@@ -22,15 +23,19 @@ deck=$directory/scaling.k
 # Open MPI refuses to start as root unless told (containers, this machine)
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_NUM_THREADS=1
 
+measure=""
+[ -x /usr/bin/time ] && measure="/usr/bin/time -f peak_resident_kB=%M"
+
 # REPEATS pairs of runs, N = 1 then N = 2, alternating (the machine's load drifts: medians of
 # alternating runs compare the two under the same conditions)
 repeats=${REPEATS:-1}
 for pair in $(seq 1 "$repeats"); do
   run=$directory/pair_$pair
   mkdir -p "$run"
-  "$binary" i="$deck" outdir="$run/ranks_1" ncpu=1 > "$run/ranks_1.log" 2>&1
+  # each process's own peak resident memory (GNU time's %M), one line per rank in the log
+  $measure "$binary" i="$deck" outdir="$run/ranks_1" ncpu=1 > "$run/ranks_1.log" 2>&1
   status=0
-  mpirun -np 2 --oversubscribe "$binary" i="$deck" outdir="$run/ranks_2" ncpu=1 \
+  mpirun -np 2 --oversubscribe $measure "$binary" i="$deck" outdir="$run/ranks_2" ncpu=1 \
     > "$run/ranks_2.log" 2>&1 || status=$?
   if [ "$status" -ne 0 ]; then
     echo "N = 2 did not run (exit status $status; see $run/ranks_2.log):"

@@ -56,6 +56,15 @@ def print_phase_shares(path, cycles):
               f"{scale * sum(row[k] for k in others):>13.1f}")
 
 
+def peak_memory(log):
+    """Each process's peak resident memory in kB (bench_mpi.sh runs them under GNU time: one
+    `peak_resident_kB=` line per rank, in the order they ended); [] without it."""
+    if not log.exists():
+        return []
+    return sorted((int(line.split("=")[1]) for line in log.read_text().splitlines()
+                   if line.startswith("peak_resident_kB=")), reverse=True)
+
+
 def print_timed_runs(directory):
     """One pair of runs (ranks_1, ranks_2 in `directory`); returns {ranks: seconds per cycle}."""
     print(f"{'ranks':>6} {'cycles':>7} {'s per cycle':>12} {'ns per element per cycle':>25} {'efficiency':>11}")
@@ -75,6 +84,10 @@ def print_timed_runs(directory):
         print(f"{ranks:>6} {cycles:>7} {per_cycle:>12.4f} {1e9 * per_cycle / elements:>25.1f} {efficiency:>11}")
         print_phase_shares(path, cycles)
         log = directory / f"ranks_{ranks}.log"
+        peaks = peak_memory(log)
+        if peaks:
+            print(f"        peak resident memory per rank, largest first: "
+                  f"{', '.join(f'{peak / 2**20:.2f} GB' for peak in peaks)} ({peaks[0] / elements:.2f} kB per element)")
         if ranks > 1 and log.exists():
             for line in log.read_text().splitlines():
                 if line.strip().startswith("MPI:") and "seconds per rank" not in line:
