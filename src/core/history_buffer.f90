@@ -38,11 +38,16 @@ contains
     integer, intent(in) :: capacity
     integer, intent(out) :: index
     type(history_series_t), allocatable :: grown(:)
+    integer :: k
 
     if (.not. allocated(set%series)) allocate (set%series(8))
     if (set%count == size(set%series)) then
       allocate (grown(2*size(set%series)))
-      grown(1:set%count) = set%series(1:set%count)
+      ! each series' arrays are moved, not copied (a copy held every reserved row twice: a
+      ! thousand nodout nodes reserve hundreds of MB)
+      do k = 1, set%count
+        call move_series(set%series(k), grown(k))
+      end do
       call move_alloc(grown, set%series)
     end if
     set%count = set%count + 1
@@ -57,6 +62,17 @@ contains
       allocate (series%rows(series%row_width, max(capacity, 16)))
     end associate
   end subroutine add_history_series
+
+  !> `from` into `to`, its arrays moved (from is left empty).
+  subroutine move_series(from, to)
+    type(history_series_t), intent(inout) :: from, to
+    to%count = from%count
+    to%row_width = from%row_width
+    call move_alloc(from%group, to%group)
+    call move_alloc(from%names, to%names)
+    call move_alloc(from%widths, to%widths)
+    call move_alloc(from%rows, to%rows)
+  end subroutine move_series
 
   !> Record one row (all columns concatenated, time first).
   subroutine append_history_row(series, row)

@@ -39,18 +39,21 @@ contains
     type(error_t), allocatable, intent(out) :: error
     type(energy_totals_t) :: energy
     real(wp) :: total_mass
-    logical :: glstat_due, matsum_due, nodout_due, states_due
+    logical :: glstat_due, matsum_due, nodout_due, states_due, rwforc_due, rcforc_due, rbdout_due
     integer :: k
 
-    ! the other ranks of a distributed run: the clocks only (the first rank writes every file)
-    if (.not. plan%records) then
-      call advance_clocks(plan, state%time, last)
-      return
-    end if
-    if (state%cycle == 0 .and. .not. allocated(plan%initial_time_steps)) &
-      plan%initial_time_steps = initial_time_step_tables(model, state)
+    ! every clock moves on, on every rank (the states, glstat and matsum clocks decide when a
+    ! distributed run gathers: the ranks must agree); only the first rank records
     glstat_due = clock_due(plan%glstat, state%time, last)
     matsum_due = clock_due(plan%matsum, state%time, last)
+    nodout_due = clock_due(plan%nodout, state%time, last)
+    states_due = clock_due(plan%states, state%time, last)
+    rwforc_due = clock_due(plan%rwforc, state%time, last)
+    rcforc_due = clock_due(plan%rcforc, state%time, last)
+    rbdout_due = clock_due(plan%rbdout, state%time, last)
+    if (.not. plan%records) return
+    if (state%cycle == 0 .and. .not. allocated(plan%initial_time_steps)) &
+      plan%initial_time_steps = initial_time_step_tables(model, state)
     if (glstat_due) then
       energy = state%energy
       call measured_energies(model, state, scratch, energy)
@@ -76,8 +79,6 @@ contains
                                 plan%part_rigid_velocity(:, k), plan%part_mass(k)])
       end do
     end if
-    nodout_due = clock_due(plan%nodout, state%time, last)
-    states_due = clock_due(plan%states, state%time, last)
     if (nodout_due .or. states_due) call physical_node_fields(state, plan)
     if (nodout_due) then
       do k = 1, size(plan%nodout_series)
@@ -88,9 +89,9 @@ contains
         end associate
       end do
     end if
-    if (clock_due(plan%rwforc, state%time, last)) call record_wall_forces(model, state, plan, histories)
-    if (clock_due(plan%rcforc, state%time, last)) call record_contact_forces(state, plan, histories)
-    if (clock_due(plan%rbdout, state%time, last)) call record_rigid_bodies(model, state, plan, histories)
+    if (rwforc_due) call record_wall_forces(model, state, plan, histories)
+    if (rcforc_due) call record_contact_forces(state, plan, histories)
+    if (rbdout_due) call record_rigid_bodies(model, state, plan, histories)
     ! the state and the history rows recorded since the previous one, as one commit (a file the
     ! run has open: in a distributed run only the first rank writes)
     if (.not. results%is_open) return
@@ -102,17 +103,6 @@ contains
         call write_binout(model, histories, binout_path(results), error)
     end if
   end subroutine write_due_output
-
-  !> Every clock past the state's time moves on, as recording the output would move it.
-  subroutine advance_clocks(plan, time, last)
-    type(output_plan_t), intent(inout) :: plan
-    real(wp), intent(in) :: time
-    logical, intent(in) :: last
-    logical :: due(7)
-    due = [clock_due(plan%glstat, time, last), clock_due(plan%matsum, time, last), &
-           clock_due(plan%nodout, time, last), clock_due(plan%states, time, last), &
-           clock_due(plan%rwforc, time, last), clock_due(plan%rcforc, time, last), clock_due(plan%rbdout, time, last)]
-  end subroutine advance_clocks
 
   !> binout beside the results file (results_file's DIR/JOBID.h5), named as LS-DYNA names it.
   function binout_path(results) result(path)

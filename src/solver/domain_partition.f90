@@ -544,7 +544,7 @@ contains
     integer, intent(inout) :: block_owner(:)
     integer, allocatable :: seen_by(:), owned_blocks(:)
     real(wp), allocatable :: cost(:)
-    integer :: k, slot, node, other, target, source, best_target, sweep, empty
+    integer :: k, slot, node, other, target, source, best_target, sweep, empty_ranks
     logical :: moved
 
     allocate (cost(0:rank_count - 1), seen_by(0:rank_count - 1), owned_blocks(0:rank_count - 1))
@@ -554,6 +554,7 @@ contains
       cost(block_owner(k)) = cost(block_owner(k)) + blocks%block_cost(k)
       owned_blocks(block_owner(k)) = owned_blocks(block_owner(k)) + 1
     end do
+    empty_ranks = count(owned_blocks == 0)
     seen_by = 0
     ! (a bound on the sweeps for safety; they end long before on any mesh tried)
     do sweep = 1, 1000
@@ -583,12 +584,12 @@ contains
           end do
         end do
         ! (the first rank without blocks, if any: no cost, so it beats every neighbour)
-        empty = findloc(owned_blocks == 0, .true., dim=1) - 1
-        if (empty >= 0) best_target = empty
+        if (empty_ranks > 0) best_target = findloc(owned_blocks, 0, dim=1) - 1
         if (best_target < 0) cycle
         if (cost(source) - cost(best_target) <= blocks%block_cost(k)) cycle
         cost(source) = cost(source) - blocks%block_cost(k)
         cost(best_target) = cost(best_target) + blocks%block_cost(k)
+        if (owned_blocks(best_target) == 0) empty_ranks = empty_ranks - 1
         owned_blocks(source) = owned_blocks(source) - 1
         owned_blocks(best_target) = owned_blocks(best_target) + 1
         block_owner(k) = best_target

@@ -93,13 +93,13 @@ contains
                    size(model%output%history_nodes) > 0 .and. model%output%nodout_interval > 0.0_wp)
 
     capacity = expected_rows(model, plan%glstat)
-    call add_history_series(histories, "glstat", glstat_columns, glstat_widths, &
+    call add_series(histories, "glstat", glstat_columns, glstat_widths, &
                             capacity, plan%glstat_series)
     capacity = expected_rows(model, plan%matsum)
     allocate (plan%matsum_series(size(model%parts)))
     do k = 1, size(model%parts)
       write (label, '(i0)') model%parts(k)%id
-      call add_history_series(histories, "matsum/"//trim(label), [character(len=32) :: "time", &
+      call add_series(histories, "matsum/"//trim(label), [character(len=32) :: "time", &
                               "kinetic_energy", "internal_energy", "hourglass_energy", "momentum", &
                               "rigid_body_velocity", "mass"], [1, 1, 1, 1, 3, 3, 1], &
                               capacity, plan%matsum_series(k))
@@ -111,7 +111,7 @@ contains
       allocate (plan%nodout_series(size(model%output%history_nodes)))
       do k = 1, size(model%output%history_nodes)
         write (label, '(i0)') model%node_ids(model%output%history_nodes(k))
-        call add_history_series(histories, "nodout/"//trim(label), [character(len=32) :: "time", &
+        call add_series(histories, "nodout/"//trim(label), [character(len=32) :: "time", &
                                 "displacement", "velocity", "acceleration", "cycle"], [1, 3, 3, 3, 1], capacity, &
                                 plan%nodout_series(k))
       end do
@@ -122,13 +122,13 @@ contains
       allocate (plan%rwforc_series(size(model%walls)))
       do k = 1, size(model%walls)
         write (label, '(i0)') model%walls(k)%id
-        call add_history_series(histories, "rwforc/"//trim(label), [character(len=32) :: "time", "force", &
+        call add_series(histories, "rwforc/"//trim(label), [character(len=32) :: "time", "force", &
                                 "normal_force"], [1, 3, 1], capacity, plan%rwforc_series(k))
       end do
     end if
     ! swforc: how many spot welds have failed, at the glstat interval
     if (allocated(model%spot_welds)) then
-      if (size(model%spot_welds) > 0) call add_history_series(histories, "swforc", [character(len=32) :: "time", &
+      if (size(model%spot_welds) > 0) call add_series(histories, "swforc", [character(len=32) :: "time", &
                                         "failed_welds"], [1, 1], expected_rows(model, plan%glstat), plan%weld_series)
     end if
     ! rcforc: every contact, at the *DATABASE_RCFORC interval (else the glstat one)
@@ -141,7 +141,7 @@ contains
         allocate (plan%rcforc_series(size(model%contacts)))
         do k = 1, size(model%contacts)
           write (label, '(i0)') model%contacts(k)%id
-          call add_history_series(histories, "rcforc/"//trim(label), [character(len=32) :: "time", "force", &
+          call add_series(histories, "rcforc/"//trim(label), [character(len=32) :: "time", "force", &
                                   "surfb_force", "mass", "surfb_mass"], [1, 3, 3, 1, 1], capacity, &
                                   plan%rcforc_series(k))
         end do
@@ -158,7 +158,7 @@ contains
         do k = 1, size(model%rigid_bodies)
           write (label, '(i0)') model%rigid_bodies(k)%id
           ! (the columns after angular_momentum came with LS-DYNA's rbdout file, appended)
-          call add_history_series(histories, "rbdout/"//trim(label), [character(len=32) :: "time", &
+          call add_series(histories, "rbdout/"//trim(label), [character(len=32) :: "time", &
                                   "displacement", "velocity", "force", "angular_momentum", "coordinates", &
                                   "acceleration", "rotation", "angular_velocity", "angular_acceleration", &
                                   "direction_cosines", "cycle"], [1, 3, 3, 3, 3, 3, 3, 3, 3, 3, 9, 1], &
@@ -216,6 +216,18 @@ contains
               plan%part_hourglass(size(model%parts)))
     allocate (plan%part_momentum(3, size(model%parts)), plan%part_mass(size(model%parts)), &
               plan%part_rigid_velocity(3, size(model%parts)))
+  contains
+    !> A history series on the rank that records them (the others: none, index 0).
+    subroutine add_series(set, group, names, widths, capacity, index)
+      type(history_set_t), intent(inout) :: set
+      character(len=*), intent(in) :: group
+      character(len=*), intent(in) :: names(:)
+      integer, intent(in) :: widths(:)
+      integer, intent(in) :: capacity
+      integer, intent(out) :: index
+      index = 0
+      if (records) call add_history_series(set, group, names, widths, capacity, index)
+    end subroutine add_series
   end subroutine plan_output
 
   subroutine set_clock(clock, interval, default_interval, active)

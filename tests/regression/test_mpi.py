@@ -17,6 +17,7 @@ mpirun is missing.
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -631,3 +632,45 @@ def test_error_terminations_are_the_same_on_one_two_and_three_ranks(tmp_path):
             corner_elements = [k for k, element in enumerate(elements) if any(n + 1 in corners for n in element)]
             assert len(corner_elements) == 8
             assert len(set(solid_rank[corner_elements])) > 1, solid_rank[corner_elements]
+
+
+HISTORY_NODES = 400
+
+
+def peak_per_rank(deck, output):
+    """Each rank's peak resident set (kB) of a 2-rank run, by rank."""
+    output.mkdir()
+    command = ["mpirun", "--oversubscribe", "--tag-output", "-np", "2", "/usr/bin/time", "-f", "maxrss_kB %M",
+               str(BINARY), f"i={deck}", f"outdir={output}", "ncpu=1"]
+    process = subprocess.run(command, capture_output=True, text=True, env=environment(1), timeout=600)
+    assert process.returncode == 0, process.stdout + process.stderr
+    # (--tag-output may split a line of one rank: join the rank's pieces first)
+    text = process.stdout + process.stderr
+    peaks = {}
+    for rank in (0, 1):
+        pieces = "".join(re.findall(rf"\[1,{rank}\]<stderr>:([^\[\n]*)", text))
+        found = re.search(r"maxrss_kB (\d+)", pieces)
+        assert found, text[-2000:]
+        peaks[rank] = int(found.group(1))
+    return peaks
+
+
+def test_other_ranks_reserve_no_history_rows(tmp_path):
+    """The other ranks of a distributed run keep only the output clocks: the contact model for 5
+    cycles on 2 ranks, without and with 400 history nodes sampled every 1e-6 ms (ENDTIM 1 ms:
+    4,112 rows of 11 values reserved per node on the first rank, 145 MB): the second rank, which
+    records nothing, grows by less than 50 MB (it grew by the whole reservation when every rank
+    created the history series)."""
+    if not os.path.exists("/usr/bin/time"):
+        pytest.skip("/usr/bin/time (GNU time) is missing")
+    plain = shortened(contact_deck(tmp_path / "plain.k"), 5)
+    many = tmp_path / "many.k"
+    text = plain.read_text().replace("*DATABASE_NODOUT\n" + fields(0.001), "*DATABASE_NODOUT\n" + fields(1e-6))
+    nodes = "\n".join(fields(*range(k, k + 8)) for k in range(1, HISTORY_NODES + 1, 8))
+    many.write_text(text.replace("*PART\n", "*DATABASE_HISTORY_NODE\n" + nodes + "\n*PART\n", 1))
+    without = peak_per_rank(plain, tmp_path / "plain")
+    with_nodes = peak_per_rank(many, tmp_path / "many")
+    growth_mb = (with_nodes[1] - without[1]) / 1024.0
+    print(f"second rank's peak: {without[1] / 1024:.0f} MB without, {with_nodes[1] / 1024:.0f} MB with the history "
+          f"nodes; first rank {without[0] / 1024:.0f} and {with_nodes[0] / 1024:.0f} MB")
+    assert growth_mb < 50.0, f"the second rank grew by {growth_mb:.0f} MB for histories it never records"
