@@ -21,8 +21,9 @@ module d3plot_file
   use file_system, only: remove_file, file_size
   use model, only: model_t
   use element_group, only: shell_output_points
-  use d3plot_states, only: d3plot_layout_t, state_word_count, fill_state_words, shell_extra_values, single
-  use d3plot_strains, only: solid_hencky_strains, shell_hencky_strains
+  use d3plot_states, only: d3plot_layout_t, state_word_count, shell_extra_values, single, word_stream_t, &
+                           open_word_stream, put_values, put_words, write_buffer, put_node_vectors, put_solids, &
+                           put_beams, put_shells, put_deletion_flags
   implicit none
   private
 
@@ -37,6 +38,8 @@ module d3plot_file
   !> LS-DYNA's part-title section: type 90001, then per part its id and 18 words of title.
   integer(int32), parameter :: part_titles_type = 90001
   integer, parameter :: title_characters = 72
+  !> Words a state is written in at a time (1 MiB).
+  integer, parameter :: stream_buffer_words = 2**18
 
   !> An open d3plot family.
   type :: d3plot_file_t
@@ -53,11 +56,9 @@ module d3plot_file
     real(wp), allocatable :: reference(:, :)      !< (3, nodes) reference coordinates
     integer, allocatable :: solid_part(:), shell_part(:), beam_part(:)  !< part numbers of the elements
     real(wp), allocatable :: shell_thickness(:)   !< the deck's (mean of the corners), for shells without points
-    real(real32), allocatable :: words(:)         !< one state
-    !> with strains (layout%strains): the elements' nodes, (8, solids) and (4, shells), and the
-    !> tensors of a state, (6, solids) and (6, 2, shells)
+    !> with strains (layout%strains): the elements' nodes, (8, solids) and (4, shells); without
+    !> them none, (8, 0) and (4, 0)
     integer, allocatable :: solid_nodes(:, :), shell_nodes(:, :)
-    real(wp), allocatable :: solid_strain(:, :), shell_strain(:, :, :)
   end type d3plot_file_t
 
 contains
@@ -197,50 +198,81 @@ contains
     continued = .true.
   end subroutine continue_d3plot
 
-  !> Append one state (see d3plot_states for the arguments; `displacement` is added to the
-  !> reference coordinates, as LS-DYNA writes the current coordinates). After a failed write
+  !> Append one state: the time; the global values `globals` (kinetic, internal, total energy,
+  !> velocity (3), per part internal then kinetic energy; absent: 0); the current coordinates,
+  !> reference + `displacement`, as LS-DYNA writes them, the velocities and the accelerations
+  !> (absent: 0), all (3, nodes); the solids' stress (6, solids) and plastic strain; the beams'
+  !> resultants (6, beams) in crashfree's order N, Q_s, Q_t, T, M_s, M_t (absent: 0); the shells'
+  !> layers, resultants, thickness and energy density (see d3plot_states' put_shells); the
+  !> deletion flags from `solid_eroded`, `shell_eroded` (1: eroded) and `beam_failed` (1:
+  !> failed; one not of the beams' size is not used). The words go to the file section by
+  !> section through a buffer of bounded size, with no copy of the arrays. After a failed write
   !> the database is closed with the states before it, and later calls do nothing.
-  subroutine write_d3plot_state(plot, time, globals, displacement, velocity, acceleration, solid_stress, &
-                                solid_plastic_strain, shell_stress, shell_plastic_strain, shell_extra, beam_resultant, &
-                                error, solid_eroded, shell_eroded, beam_failed)
+  subroutine write_d3plot_state(plot, time, displacement, velocity, solid_stress, solid_plastic_strain, error, &
+                                shell_stress, shell_plastic_strain, beam_resultant, beam_failed, solid_eroded, &
+                                shell_eroded, acceleration, globals, shell_point_stress, shell_point_plastic_strain, &
+                                shell_point_count, shell_resultant, shell_thickness, shell_energy_density)
     type(d3plot_file_t), intent(inout) :: plot
     real(wp), intent(in) :: time
-    real(wp), intent(in) :: globals(:)
-    real(wp), intent(in) :: displacement(:, :), velocity(:, :), acceleration(:, :)
-    real(wp), intent(in) :: solid_stress(:, :), solid_plastic_strain(:)
-    real(wp), intent(in) :: shell_stress(:, :, :), shell_plastic_strain(:, :)
-    real(wp), intent(in) :: shell_extra(:, :)
-    real(wp), intent(in) :: beam_resultant(:, :)
+    real(wp), intent(in) :: displacement(:, :), velocity(:, :), solid_stress(:, :), solid_plastic_strain(:)
     type(error_t), allocatable, intent(out) :: error
+    real(wp), intent(in), optional :: shell_stress(:, :), shell_plastic_strain(:)
+    real(wp), intent(in), optional :: beam_resultant(:, :), beam_failed(:)
     integer, intent(in), optional :: solid_eroded(:), shell_eroded(:)
-    real(wp), intent(in), optional :: beam_failed(:)
+    real(wp), intent(in), optional :: acceleration(:, :), globals(:)
+    real(wp), intent(in), optional :: shell_point_stress(:, :, :), shell_point_plastic_strain(:, :)
+    integer, intent(in), optional :: shell_point_count(:)
+    real(wp), intent(in), optional :: shell_resultant(:, :), shell_thickness(:), shell_energy_density(:)
+    type(word_stream_t) :: stream
     integer(int64) :: state_words
     integer :: status
     character(len=256) :: message
 
     if (.not. plot%is_open .or. plot%failed) return
     state_words = state_word_count(plot%layout)
-    if (plot%layout%strains) then
-      ! the strains measured from the geometry of the state (d3plot_strains); the shells'
-      ! thickness of the state is shell_extra's ninth value
-      call solid_hencky_strains(plot%reference, plot%reference + displacement, plot%solid_nodes, plot%solid_strain)
-      call shell_hencky_strains(plot%reference, plot%reference + displacement, plot%shell_nodes, shell_extra(9, :), &
-                                plot%shell_thickness, plot%shell_strain)
-      call fill_state_words(plot%layout, time, globals, plot%reference + displacement, velocity, acceleration, &
-                            solid_stress, solid_plastic_strain, shell_stress, shell_plastic_strain, shell_extra, &
-                            beam_resultant, plot%solid_part, plot%shell_part, plot%beam_part, plot%words, &
-                            solid_eroded, shell_eroded, beam_failed, plot%solid_strain, plot%shell_strain)
-    else
-      call fill_state_words(plot%layout, time, globals, plot%reference + displacement, velocity, acceleration, &
-                            solid_stress, solid_plastic_strain, shell_stress, shell_plastic_strain, shell_extra, &
-                            beam_resultant, plot%solid_part, plot%shell_part, plot%beam_part, plot%words, &
-                            solid_eroded, shell_eroded, beam_failed)
-    end if
     status = 0
     ! a new family file when this state would pass the limit (a file holds at least one state)
     if (plot%file_words > 0 .and. plot%file_words + state_words + 1 > plot%limit_words) &
       call next_member(plot, status, message)
-    if (status == 0) write (plot%unit, pos=4_int64*plot%file_words + 1, iostat=status, iomsg=message) plot%words
+    if (status == 0) then
+      call open_word_stream(stream, plot%unit, plot%file_words, stream_buffer_words)
+      associate (layout => plot%layout)
+        call put_values(stream, [time])
+        if (present(globals)) then
+          call put_values(stream, globals(1:layout%global_count))
+        else
+          call put_words(stream, spread(0.0_real32, 1, layout%global_count))
+        end if
+        call put_node_vectors(stream, layout%node_count, plot%reference, displacement)
+        call put_node_vectors(stream, layout%node_count, velocity)
+        call put_node_vectors(stream, layout%node_count, acceleration)
+        call put_solids(stream, layout, solid_stress, solid_plastic_strain, plot%reference, displacement, &
+                        plot%solid_nodes)
+        call put_beams(stream, layout, beam_resultant)
+        call put_shells(stream, layout, plot%shell_thickness, plot%reference, displacement, plot%shell_nodes, &
+                        shell_stress, shell_plastic_strain, shell_point_stress, shell_point_plastic_strain, &
+                        shell_point_count, shell_resultant, shell_thickness, shell_energy_density)
+        ! deletion flags: solids, (thick shells: none), shells, beams
+        call put_deletion_flags(stream, plot%solid_part, solid_eroded)
+        call put_deletion_flags(stream, plot%shell_part, shell_eroded)
+        if (present(beam_failed)) then
+          if (size(beam_failed) == layout%beam_count) then
+            call put_deletion_flags(stream, plot%beam_part, failed=beam_failed)
+          else
+            call put_deletion_flags(stream, plot%beam_part)
+          end if
+        else
+          call put_deletion_flags(stream, plot%beam_part)
+        end if
+      end associate
+      call write_buffer(stream)
+      status = stream%status
+      message = stream%message
+      if (status == 0 .and. stream%written /= state_words) then
+        status = -1
+        message = "the state has "//integer_text(stream%written)//" words instead of "//integer_text(state_words)
+      end if
+    end if
     if (status == 0) then
       plot%file_words = plot%file_words + state_words
       call write_end_marker(plot, status, message)
@@ -289,14 +321,11 @@ contains
       layout%beam_values = 6
       layout%shell_values = 7*layout%shell_layers + shell_extra_values + merge(12, 0, layout%strains)
     end associate
+    plot%solid_nodes = reshape([integer ::], [8, 0])
+    plot%shell_nodes = reshape([integer ::], [4, 0])
     if (plot%layout%strains) then
-      plot%solid_nodes = reshape([integer ::], [8, 0])
       if (plot%layout%solid_count > 0) plot%solid_nodes = model%solid_nodes
-      plot%shell_nodes = reshape([integer ::], [4, 0])
       if (plot%layout%shell_count > 0) plot%shell_nodes = model%shell_nodes
-      if (allocated(plot%solid_strain)) deallocate (plot%solid_strain)
-      if (allocated(plot%shell_strain)) deallocate (plot%shell_strain)
-      allocate (plot%solid_strain(6, plot%layout%solid_count), plot%shell_strain(6, 2, plot%layout%shell_count))
     end if
     if (allocated(plot%reference)) deallocate (plot%reference)
     if (allocated(plot%shell_thickness)) deallocate (plot%shell_thickness)
@@ -319,8 +348,6 @@ contains
     end if
     plot%beam_part = [integer ::]
     if (plot%layout%beam_count > 0) plot%beam_part = model%beam_part
-    if (allocated(plot%words)) deallocate (plot%words)
-    allocate (plot%words(state_word_count(plot%layout)))
   end subroutine set_layout
 
   ! --- the first file -------------------------------------------------------------------------

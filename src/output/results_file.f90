@@ -75,7 +75,6 @@ module results_file
   use file_lock, only: file_lock_t, acquire_file_lock, release_file_lock
   use d3plot_file, only: d3plot_file_t, open_d3plot, continue_d3plot, write_d3plot_state, close_d3plot, &
                          d3plot_base_name, default_file_scale
-  use d3plot_states, only: shell_layer_values, shell_extra_values
   implicit none
   private
 
@@ -433,86 +432,16 @@ contains
     results%state_times(results%state_count) = time
 
     if (results%d3plot%is_open) then
-      call write_d3plot(results%d3plot, time, displacement, velocity, solid_stress, solid_plastic_strain, error, &
-                        shell_stress, shell_plastic_strain, beam_resultant, beam_failed, solid_eroded, shell_eroded, &
-                        acceleration, globals, shell_point_stress, shell_point_plastic_strain, shell_point_count, &
-                        shell_resultant, shell_thickness, shell_energy_density)
+      ! the state just written to results.h5; what results.h5 does not have is written as 0
+      ! (the accelerations and global values of a static state)
+      call write_d3plot_state(results%d3plot, time, displacement, velocity, solid_stress, solid_plastic_strain, &
+                              error, shell_stress, shell_plastic_strain, beam_resultant, beam_failed, solid_eroded, &
+                              shell_eroded, acceleration, globals, shell_point_stress, shell_point_plastic_strain, &
+                              shell_point_count, shell_resultant, shell_thickness, shell_energy_density)
       if (allocated(error)) return
     end if
     if (xdmf_due(results)) call write_xdmf_now(results, error)
   end subroutine write_state
-
-  !> The state just written to results.h5, into the d3plot (what results.h5 does not have is
-  !> written as 0: the accelerations and global values of a static state).
-  subroutine write_d3plot(plot, time, displacement, velocity, solid_stress, solid_plastic_strain, error, &
-                          shell_stress, shell_plastic_strain, beam_resultant, beam_failed, solid_eroded, shell_eroded, &
-                          acceleration, globals, shell_point_stress, shell_point_plastic_strain, shell_point_count, &
-                          shell_resultant, shell_thickness, shell_energy_density)
-    type(d3plot_file_t), intent(inout) :: plot
-    real(wp), intent(in) :: time
-    real(wp), intent(in) :: displacement(:, :), velocity(:, :), solid_stress(:, :), solid_plastic_strain(:)
-    type(error_t), allocatable, intent(out) :: error
-    real(wp), intent(in), optional :: shell_stress(:, :), shell_plastic_strain(:)
-    real(wp), intent(in), optional :: beam_resultant(:, :), beam_failed(:)
-    integer, intent(in), optional :: solid_eroded(:), shell_eroded(:)
-    real(wp), intent(in), optional :: acceleration(:, :), globals(:)
-    real(wp), intent(in), optional :: shell_point_stress(:, :, :), shell_point_plastic_strain(:, :)
-    integer, intent(in), optional :: shell_point_count(:)
-    real(wp), intent(in), optional :: shell_resultant(:, :), shell_thickness(:), shell_energy_density(:)
-    real(wp), allocatable :: layer_stress(:, :, :), layer_strain(:, :), resultant(:, :), global_values(:)
-    real(wp), allocatable :: shell_extra(:, :)
-    real(wp), allocatable :: node_acceleration(:, :)
-    integer :: shell, layer, points
-
-    associate (layout => plot%layout)
-      allocate (layer_stress(6, layout%shell_layers, layout%shell_count), source=0.0_wp)
-      allocate (layer_strain(layout%shell_layers, layout%shell_count), source=0.0_wp)
-      allocate (shell_extra(shell_extra_values, layout%shell_count), source=0.0_wp)
-      ! each shell's points through the thickness; a shell whose group gives none (meshfree
-      ! shells, rigid parts, a static state) has its mid-surface values in every layer
-      if (present(shell_stress) .and. layout%shell_count > 0) then
-        do shell = 1, layout%shell_count
-          points = 0
-          if (present(shell_point_count)) points = min(shell_point_count(shell), size(shell_point_stress, 2))
-          ! resultants, thickness and energy density where the group gave them, else the deck's
-          ! thickness only
-          shell_extra(9, shell) = plot%shell_thickness(shell)
-          if (points > 0) then
-            call shell_layer_values(points, shell_point_stress(:, 1:points, shell), &
-                                    shell_point_plastic_strain(1:points, shell), layer_stress(:, :, shell), &
-                                    layer_strain(:, shell))
-            if (present(shell_resultant)) then
-              shell_extra(1:8, shell) = shell_resultant(:, shell)
-              shell_extra(9, shell) = shell_thickness(shell)
-              shell_extra(12, shell) = shell_energy_density(shell)
-            end if
-          else
-            do layer = 1, layout%shell_layers
-              layer_stress(:, layer, shell) = shell_stress(:, shell)
-              layer_strain(layer, shell) = shell_plastic_strain(shell)
-            end do
-          end if
-        end do
-      end if
-      allocate (resultant(6, layout%beam_count), source=0.0_wp)
-      if (present(beam_resultant) .and. layout%beam_count > 0) resultant = beam_resultant
-      allocate (global_values(layout%global_count), source=0.0_wp)
-      if (present(globals)) global_values = globals(1:layout%global_count)
-      allocate (node_acceleration(3, layout%node_count), source=0.0_wp)
-      if (present(acceleration)) node_acceleration = acceleration
-    end associate
-    if (present(beam_failed)) then
-      if (size(beam_failed) /= plot%layout%beam_count) then
-        call write_d3plot_state(plot, time, global_values, displacement, velocity, node_acceleration, solid_stress, &
-                                solid_plastic_strain, layer_stress, layer_strain, shell_extra, resultant, error, &
-                                solid_eroded, shell_eroded)
-        return
-      end if
-    end if
-    call write_d3plot_state(plot, time, global_values, displacement, velocity, node_acceleration, solid_stress, &
-                            solid_plastic_strain, layer_stress, layer_strain, shell_extra, resultant, error, &
-                            solid_eroded, shell_eroded, beam_failed)
-  end subroutine write_d3plot
 
   !> Add the history rows recorded since the previous call (each series as
   !> `/history/<group>/<column>`), and flush. Rows already in the file are not written again;
