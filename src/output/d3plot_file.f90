@@ -53,7 +53,6 @@ module d3plot_file
     integer(int64) :: limit_words = 0             !< family file size limit
     integer :: state_count = 0                    !< states written (all files)
     type(d3plot_layout_t) :: layout
-    real(wp), allocatable :: reference(:, :)      !< (3, nodes) reference coordinates
     integer, allocatable :: solid_part(:), shell_part(:), beam_part(:)  !< part numbers of the elements
     real(wp), allocatable :: shell_thickness(:)   !< the deck's (mean of the corners), for shells without points
     !> with strains (layout%strains): the elements' nodes, (8, solids) and (4, shells); without
@@ -200,7 +199,8 @@ contains
 
   !> Append one state: the time; the global values `globals` (kinetic, internal, total energy,
   !> velocity (3), per part internal then kinetic energy; absent: 0); the current coordinates,
-  !> reference + `displacement`, as LS-DYNA writes them, the velocities and the accelerations
+  !> `reference` + `displacement` (the caller's reference coordinates: the database keeps no
+  !> copy), as LS-DYNA writes them, the velocities and the accelerations
   !> (absent: 0), all (3, nodes); the solids' stress (6, solids) and plastic strain; the beams'
   !> resultants (6, beams) in crashfree's order N, Q_s, Q_t, T, M_s, M_t (absent: 0); the shells'
   !> layers, resultants, thickness and energy density (see d3plot_states' put_shells); the
@@ -208,13 +208,14 @@ contains
   !> failed; one not of the beams' size is not used). The words go to the file section by
   !> section through a buffer of bounded size, with no copy of the arrays. After a failed write
   !> the database is closed with the states before it, and later calls do nothing.
-  subroutine write_d3plot_state(plot, time, displacement, velocity, solid_stress, solid_plastic_strain, error, &
-                                shell_stress, shell_plastic_strain, beam_resultant, beam_failed, solid_eroded, &
+  subroutine write_d3plot_state(plot, time, reference, displacement, velocity, solid_stress, solid_plastic_strain, &
+                                error, shell_stress, shell_plastic_strain, beam_resultant, beam_failed, solid_eroded, &
                                 shell_eroded, acceleration, globals, shell_point_stress, shell_point_plastic_strain, &
                                 shell_point_count, shell_resultant, shell_thickness, shell_energy_density)
     type(d3plot_file_t), intent(inout) :: plot
     real(wp), intent(in) :: time
-    real(wp), intent(in) :: displacement(:, :), velocity(:, :), solid_stress(:, :), solid_plastic_strain(:)
+    real(wp), intent(in) :: reference(:, :), displacement(:, :), velocity(:, :)
+    real(wp), intent(in) :: solid_stress(:, :), solid_plastic_strain(:)
     type(error_t), allocatable, intent(out) :: error
     real(wp), intent(in), optional :: shell_stress(:, :), shell_plastic_strain(:)
     real(wp), intent(in), optional :: beam_resultant(:, :), beam_failed(:)
@@ -243,13 +244,13 @@ contains
         else
           call put_words(stream, spread(0.0_real32, 1, layout%global_count))
         end if
-        call put_node_vectors(stream, layout%node_count, plot%reference, displacement)
+        call put_node_vectors(stream, layout%node_count, reference, displacement)
         call put_node_vectors(stream, layout%node_count, velocity)
         call put_node_vectors(stream, layout%node_count, acceleration)
-        call put_solids(stream, layout, solid_stress, solid_plastic_strain, plot%reference, displacement, &
+        call put_solids(stream, layout, solid_stress, solid_plastic_strain, reference, displacement, &
                         plot%solid_nodes)
         call put_beams(stream, layout, beam_resultant)
-        call put_shells(stream, layout, plot%shell_thickness, plot%reference, displacement, plot%shell_nodes, &
+        call put_shells(stream, layout, plot%shell_thickness, reference, displacement, plot%shell_nodes, &
                         shell_stress, shell_plastic_strain, shell_point_stress, shell_point_plastic_strain, &
                         shell_point_count, shell_resultant, shell_thickness, shell_energy_density)
         ! deletion flags: solids, (thick shells: none), shells, beams
@@ -327,10 +328,7 @@ contains
       if (plot%layout%solid_count > 0) plot%solid_nodes = model%solid_nodes
       if (plot%layout%shell_count > 0) plot%shell_nodes = model%shell_nodes
     end if
-    if (allocated(plot%reference)) deallocate (plot%reference)
     if (allocated(plot%shell_thickness)) deallocate (plot%shell_thickness)
-    allocate (plot%reference(3, plot%layout%node_count))
-    if (plot%layout%node_count > 0) plot%reference = model%coordinates
     plot%solid_part = [integer ::]
     if (plot%layout%solid_count > 0) plot%solid_part = model%solid_part
     plot%shell_part = [integer ::]
@@ -431,7 +429,7 @@ contains
         shells(5, element) = model%shell_part(element)
       end do
       status = 0
-      if (layout%node_count > 0) write (plot%unit, iostat=status, iomsg=message) single(plot%reference)
+      if (layout%node_count > 0) write (plot%unit, iostat=status, iomsg=message) single(model%coordinates)
       if (status == 0) write (plot%unit, iostat=status, iomsg=message) solids
       if (status == 0) write (plot%unit, iostat=status, iomsg=message) beams
       if (status == 0) write (plot%unit, iostat=status, iomsg=message) shells
