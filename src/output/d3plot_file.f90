@@ -21,7 +21,7 @@ module d3plot_file
   use file_system, only: remove_file, file_size
   use model, only: model_t
   use element_group, only: shell_output_points
-  use d3plot_states, only: d3plot_layout_t, state_word_count, shell_extra_values, single, word_stream_t, &
+  use d3plot_states, only: d3plot_layout_t, state_word_count, shell_extra_values, word_stream_t, &
                            open_word_stream, put_values, put_words, write_buffer, put_node_vectors, put_solids, &
                            put_beams, put_shells, put_deletion_flags
   implicit none
@@ -40,6 +40,8 @@ module d3plot_file
   integer, parameter :: title_characters = 72
   !> Words a state is written in at a time (1 MiB).
   integer, parameter :: stream_buffer_words = 2**18
+  !> Elements of the geometry written at a time.
+  integer, parameter :: geometry_chunk = 4096
 
   !> An open d3plot family.
   type :: d3plot_file_t
@@ -404,35 +406,49 @@ contains
     plot%file_words = 64
   end subroutine write_header
 
-  !> Nodes, solids, beams and shells (1-based node and part indices).
+  !> Nodes, solids, beams and shells (1-based node and part indices), written in chunks (of
+  !> `geometry_chunk` elements, of stream_buffer_words): no copy of the whole mesh.
   subroutine write_geometry(plot, model, status, message)
     type(d3plot_file_t), intent(inout) :: plot
     type(model_t), intent(in) :: model
     integer, intent(out) :: status
     character(len=*), intent(inout) :: message
-    integer(int32), allocatable :: solids(:, :), beams(:, :), shells(:, :)
-    integer :: element
+    integer(int32) :: solids(9, geometry_chunk), beams(6, geometry_chunk), shells(5, geometry_chunk)
+    type(word_stream_t) :: stream
+    integer :: first, last, element
 
     associate (layout => plot%layout)
-      allocate (solids(9, layout%solid_count), beams(6, layout%beam_count), shells(5, layout%shell_count))
-      do element = 1, layout%solid_count
-        solids(1:8, element) = model%solid_nodes(:, element)
-        solids(9, element) = model%solid_part(element)
+      ! the coordinates after the control words; the elements follow where they end
+      call open_word_stream(stream, plot%unit, plot%file_words, stream_buffer_words)
+      call put_node_vectors(stream, layout%node_count, model%coordinates)
+      call write_buffer(stream)
+      status = stream%status
+      if (status /= 0) message = stream%message
+      do first = 1, layout%solid_count, geometry_chunk
+        last = min(first + geometry_chunk - 1, layout%solid_count)
+        do element = first, last
+          solids(1:8, element - first + 1) = model%solid_nodes(:, element)
+          solids(9, element - first + 1) = model%solid_part(element)
+        end do
+        if (status == 0) write (plot%unit, iostat=status, iomsg=message) solids(:, 1:last - first + 1)
       end do
-      do element = 1, layout%beam_count
-        beams(1:3, element) = model%beam_nodes(1:3, element)
-        beams(4:5, element) = 0
-        beams(6, element) = model%beam_part(element)
+      do first = 1, layout%beam_count, geometry_chunk
+        last = min(first + geometry_chunk - 1, layout%beam_count)
+        do element = first, last
+          beams(1:3, element - first + 1) = model%beam_nodes(1:3, element)
+          beams(4:5, element - first + 1) = 0
+          beams(6, element - first + 1) = model%beam_part(element)
+        end do
+        if (status == 0) write (plot%unit, iostat=status, iomsg=message) beams(:, 1:last - first + 1)
       end do
-      do element = 1, layout%shell_count
-        shells(1:4, element) = model%shell_nodes(:, element)
-        shells(5, element) = model%shell_part(element)
+      do first = 1, layout%shell_count, geometry_chunk
+        last = min(first + geometry_chunk - 1, layout%shell_count)
+        do element = first, last
+          shells(1:4, element - first + 1) = model%shell_nodes(:, element)
+          shells(5, element - first + 1) = model%shell_part(element)
+        end do
+        if (status == 0) write (plot%unit, iostat=status, iomsg=message) shells(:, 1:last - first + 1)
       end do
-      status = 0
-      if (layout%node_count > 0) write (plot%unit, iostat=status, iomsg=message) single(model%coordinates)
-      if (status == 0) write (plot%unit, iostat=status, iomsg=message) solids
-      if (status == 0) write (plot%unit, iostat=status, iomsg=message) beams
-      if (status == 0) write (plot%unit, iostat=status, iomsg=message) shells
       plot%file_words = plot%file_words + 3_int64*layout%node_count + 9_int64*layout%solid_count + &
                         6_int64*layout%beam_count + 5_int64*layout%shell_count
     end associate
