@@ -130,12 +130,15 @@ contains
     type(word_stream_t), intent(inout) :: stream
     integer, intent(in) :: node_count
     real(wp), intent(in), optional :: base(:, :), offset(:, :)
+    real(wp) :: vector(3)
     integer :: node
     do node = 1, node_count
       if (.not. present(base)) then
         call put_words(stream, [0.0_real32, 0.0_real32, 0.0_real32])
       else if (present(offset)) then
-        call put_values(stream, base(:, node) + offset(:, node))
+        ! (a named vector: an expression as the argument would be a temporary on the heap)
+        vector = base(:, node) + offset(:, node)
+        call put_values(stream, vector)
       else
         call put_values(stream, base(:, node))
       end if
