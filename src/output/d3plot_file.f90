@@ -22,7 +22,7 @@ module d3plot_file
   use model, only: model_t
   use element_group, only: shell_output_points
   use d3plot_states, only: d3plot_layout_t, state_word_count, shell_extra_values, word_stream_t, &
-                           open_word_stream, put_values, put_words, write_buffer, put_node_vectors, put_solids, &
+                           open_word_stream, put_values, put_zeros, write_buffer, put_node_vectors, put_solids, &
                            put_beams, put_shells, put_deletion_flags
   implicit none
   private
@@ -244,7 +244,7 @@ contains
         if (present(globals)) then
           call put_values(stream, globals(1:layout%global_count))
         else
-          call put_words(stream, spread(0.0_real32, 1, layout%global_count))
+          call put_zeros(stream, layout%global_count)
         end if
         call put_node_vectors(stream, layout%node_count, reference, displacement)
         call put_node_vectors(stream, layout%node_count, velocity)

@@ -24,7 +24,7 @@ module d3plot_states
   private
 
   public :: d3plot_layout_t, state_word_count, shell_layer_values, single
-  public :: word_stream_t, open_word_stream, put_values, put_words, write_buffer
+  public :: word_stream_t, open_word_stream, put_values, put_words, put_zeros, write_buffer
   public :: put_node_vectors, put_solids, put_beams, put_shells, put_deletion_flags
 
   !> The sizes of a state, fixed when the database is opened.
@@ -111,6 +111,16 @@ contains
     end do
   end subroutine put_words
 
+  !> Append `count` zero words to the stream.
+  subroutine put_zeros(stream, count)
+    type(word_stream_t), intent(inout) :: stream
+    integer, intent(in) :: count
+    integer :: k
+    do k = 1, count
+      call put_words(stream, [0.0_real32])
+    end do
+  end subroutine put_zeros
+
   !> Write what the buffer holds: after this the file has every word put. The words written
   !> are counted in `stream%written`; after a failed write (`stream%status` /= 0) nothing more is
   !> written.
@@ -134,7 +144,7 @@ contains
     integer :: node
     do node = 1, node_count
       if (.not. present(base)) then
-        call put_words(stream, [0.0_real32, 0.0_real32, 0.0_real32])
+        call put_zeros(stream, 3)
       else if (present(offset)) then
         ! (a named vector: an expression as the argument would be a temporary on the heap)
         vector = base(:, node) + offset(:, node)
@@ -174,7 +184,7 @@ contains
       if (present(beam_resultant)) then
         call put_values(stream, beam_resultant(beam_order, element))
       else
-        call put_words(stream, spread(0.0_real32, 1, layout%beam_values))
+        call put_zeros(stream, layout%beam_values)
       end if
     end do
   end subroutine put_beams
