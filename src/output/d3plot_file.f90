@@ -21,8 +21,9 @@ module d3plot_file
   use file_system, only: remove_file, file_size
   use model, only: model_t
   use element_group, only: shell_output_points
-  use d3plot_states, only: d3plot_layout_t, state_word_count, fill_state_words, shell_extra_values, single
-  use d3plot_strains, only: solid_hencky_strains, shell_hencky_strains
+  use d3plot_states, only: d3plot_layout_t, state_word_count, shell_extra_values, word_stream_t, &
+                           open_word_stream, put_values, put_zeros, write_buffer, put_node_vectors, put_solids, &
+                           put_beams, put_shells, put_deletion_flags
   implicit none
   private
 
@@ -37,6 +38,10 @@ module d3plot_file
   !> LS-DYNA's part-title section: type 90001, then per part its id and 18 words of title.
   integer(int32), parameter :: part_titles_type = 90001
   integer, parameter :: title_characters = 72
+  !> Words a state is written in at a time (1 MiB).
+  integer, parameter :: stream_buffer_words = 2**18
+  !> Elements of the geometry written at a time.
+  integer, parameter :: geometry_chunk = 4096
 
   !> An open d3plot family.
   type :: d3plot_file_t
@@ -50,14 +55,11 @@ module d3plot_file
     integer(int64) :: limit_words = 0             !< family file size limit
     integer :: state_count = 0                    !< states written (all files)
     type(d3plot_layout_t) :: layout
-    real(wp), allocatable :: reference(:, :)      !< (3, nodes) reference coordinates
     integer, allocatable :: solid_part(:), shell_part(:), beam_part(:)  !< part numbers of the elements
     real(wp), allocatable :: shell_thickness(:)   !< the deck's (mean of the corners), for shells without points
-    real(real32), allocatable :: words(:)         !< one state
-    !> with strains (layout%strains): the elements' nodes, (8, solids) and (4, shells), and the
-    !> tensors of a state, (6, solids) and (6, 2, shells)
+    !> with strains (layout%strains): the elements' nodes, (8, solids) and (4, shells); without
+    !> them none, (8, 0) and (4, 0)
     integer, allocatable :: solid_nodes(:, :), shell_nodes(:, :)
-    real(wp), allocatable :: solid_strain(:, :), shell_strain(:, :, :)
   end type d3plot_file_t
 
 contains
@@ -197,50 +199,83 @@ contains
     continued = .true.
   end subroutine continue_d3plot
 
-  !> Append one state (see d3plot_states for the arguments; `displacement` is added to the
-  !> reference coordinates, as LS-DYNA writes the current coordinates). After a failed write
+  !> Append one state: the time; the global values `globals` (kinetic, internal, total energy,
+  !> velocity (3), per part internal then kinetic energy; absent: 0); the current coordinates,
+  !> `reference` + `displacement` (the caller's reference coordinates: the database keeps no
+  !> copy), as LS-DYNA writes them, the velocities and the accelerations
+  !> (absent: 0), all (3, nodes); the solids' stress (6, solids) and plastic strain; the beams'
+  !> resultants (6, beams) in crashfree's order N, Q_s, Q_t, T, M_s, M_t (absent: 0); the shells'
+  !> layers, resultants, thickness and energy density (see d3plot_states' put_shells); the
+  !> deletion flags from `solid_eroded`, `shell_eroded` (1: eroded) and `beam_failed` (1:
+  !> failed; one not of the beams' size is not used). The words go to the file section by
+  !> section through a buffer of bounded size, with no copy of the arrays. After a failed write
   !> the database is closed with the states before it, and later calls do nothing.
-  subroutine write_d3plot_state(plot, time, globals, displacement, velocity, acceleration, solid_stress, &
-                                solid_plastic_strain, shell_stress, shell_plastic_strain, shell_extra, beam_resultant, &
-                                error, solid_eroded, shell_eroded, beam_failed)
+  subroutine write_d3plot_state(plot, time, reference, displacement, velocity, solid_stress, solid_plastic_strain, &
+                                error, shell_stress, shell_plastic_strain, beam_resultant, beam_failed, solid_eroded, &
+                                shell_eroded, acceleration, globals, shell_point_stress, shell_point_plastic_strain, &
+                                shell_point_count, shell_resultant, shell_thickness, shell_energy_density)
     type(d3plot_file_t), intent(inout) :: plot
     real(wp), intent(in) :: time
-    real(wp), intent(in) :: globals(:)
-    real(wp), intent(in) :: displacement(:, :), velocity(:, :), acceleration(:, :)
+    real(wp), intent(in) :: reference(:, :), displacement(:, :), velocity(:, :)
     real(wp), intent(in) :: solid_stress(:, :), solid_plastic_strain(:)
-    real(wp), intent(in) :: shell_stress(:, :, :), shell_plastic_strain(:, :)
-    real(wp), intent(in) :: shell_extra(:, :)
-    real(wp), intent(in) :: beam_resultant(:, :)
     type(error_t), allocatable, intent(out) :: error
+    real(wp), intent(in), optional :: shell_stress(:, :), shell_plastic_strain(:)
+    real(wp), intent(in), optional :: beam_resultant(:, :), beam_failed(:)
     integer, intent(in), optional :: solid_eroded(:), shell_eroded(:)
-    real(wp), intent(in), optional :: beam_failed(:)
+    real(wp), intent(in), optional :: acceleration(:, :), globals(:)
+    real(wp), intent(in), optional :: shell_point_stress(:, :, :), shell_point_plastic_strain(:, :)
+    integer, intent(in), optional :: shell_point_count(:)
+    real(wp), intent(in), optional :: shell_resultant(:, :), shell_thickness(:), shell_energy_density(:)
+    type(word_stream_t) :: stream
     integer(int64) :: state_words
     integer :: status
     character(len=256) :: message
 
     if (.not. plot%is_open .or. plot%failed) return
     state_words = state_word_count(plot%layout)
-    if (plot%layout%strains) then
-      ! the strains measured from the geometry of the state (d3plot_strains); the shells'
-      ! thickness of the state is shell_extra's ninth value
-      call solid_hencky_strains(plot%reference, plot%reference + displacement, plot%solid_nodes, plot%solid_strain)
-      call shell_hencky_strains(plot%reference, plot%reference + displacement, plot%shell_nodes, shell_extra(9, :), &
-                                plot%shell_thickness, plot%shell_strain)
-      call fill_state_words(plot%layout, time, globals, plot%reference + displacement, velocity, acceleration, &
-                            solid_stress, solid_plastic_strain, shell_stress, shell_plastic_strain, shell_extra, &
-                            beam_resultant, plot%solid_part, plot%shell_part, plot%beam_part, plot%words, &
-                            solid_eroded, shell_eroded, beam_failed, plot%solid_strain, plot%shell_strain)
-    else
-      call fill_state_words(plot%layout, time, globals, plot%reference + displacement, velocity, acceleration, &
-                            solid_stress, solid_plastic_strain, shell_stress, shell_plastic_strain, shell_extra, &
-                            beam_resultant, plot%solid_part, plot%shell_part, plot%beam_part, plot%words, &
-                            solid_eroded, shell_eroded, beam_failed)
-    end if
     status = 0
     ! a new family file when this state would pass the limit (a file holds at least one state)
     if (plot%file_words > 0 .and. plot%file_words + state_words + 1 > plot%limit_words) &
       call next_member(plot, status, message)
-    if (status == 0) write (plot%unit, pos=4_int64*plot%file_words + 1, iostat=status, iomsg=message) plot%words
+    if (status == 0) then
+      call open_word_stream(stream, plot%unit, plot%file_words, stream_buffer_words)
+      associate (layout => plot%layout)
+        call put_values(stream, [time])
+        if (present(globals)) then
+          call put_values(stream, globals(1:layout%global_count))
+        else
+          call put_zeros(stream, layout%global_count)
+        end if
+        call put_node_vectors(stream, layout%node_count, reference, displacement)
+        call put_node_vectors(stream, layout%node_count, velocity)
+        call put_node_vectors(stream, layout%node_count, acceleration)
+        call put_solids(stream, layout, solid_stress, solid_plastic_strain, reference, displacement, &
+                        plot%solid_nodes)
+        call put_beams(stream, layout, beam_resultant)
+        call put_shells(stream, layout, plot%shell_thickness, reference, displacement, plot%shell_nodes, &
+                        shell_stress, shell_plastic_strain, shell_point_stress, shell_point_plastic_strain, &
+                        shell_point_count, shell_resultant, shell_thickness, shell_energy_density)
+        ! deletion flags: solids, (thick shells: none), shells, beams
+        call put_deletion_flags(stream, plot%solid_part, solid_eroded)
+        call put_deletion_flags(stream, plot%shell_part, shell_eroded)
+        if (present(beam_failed)) then
+          if (size(beam_failed) == layout%beam_count) then
+            call put_deletion_flags(stream, plot%beam_part, failed=beam_failed)
+          else
+            call put_deletion_flags(stream, plot%beam_part)
+          end if
+        else
+          call put_deletion_flags(stream, plot%beam_part)
+        end if
+      end associate
+      call write_buffer(stream)
+      status = stream%status
+      message = stream%message
+      if (status == 0 .and. stream%written /= state_words) then
+        status = -1
+        message = "the state has "//integer_text(stream%written)//" words instead of "//integer_text(state_words)
+      end if
+    end if
     if (status == 0) then
       plot%file_words = plot%file_words + state_words
       call write_end_marker(plot, status, message)
@@ -289,19 +324,13 @@ contains
       layout%beam_values = 6
       layout%shell_values = 7*layout%shell_layers + shell_extra_values + merge(12, 0, layout%strains)
     end associate
+    plot%solid_nodes = reshape([integer ::], [8, 0])
+    plot%shell_nodes = reshape([integer ::], [4, 0])
     if (plot%layout%strains) then
-      plot%solid_nodes = reshape([integer ::], [8, 0])
       if (plot%layout%solid_count > 0) plot%solid_nodes = model%solid_nodes
-      plot%shell_nodes = reshape([integer ::], [4, 0])
       if (plot%layout%shell_count > 0) plot%shell_nodes = model%shell_nodes
-      if (allocated(plot%solid_strain)) deallocate (plot%solid_strain)
-      if (allocated(plot%shell_strain)) deallocate (plot%shell_strain)
-      allocate (plot%solid_strain(6, plot%layout%solid_count), plot%shell_strain(6, 2, plot%layout%shell_count))
     end if
-    if (allocated(plot%reference)) deallocate (plot%reference)
     if (allocated(plot%shell_thickness)) deallocate (plot%shell_thickness)
-    allocate (plot%reference(3, plot%layout%node_count))
-    if (plot%layout%node_count > 0) plot%reference = model%coordinates
     plot%solid_part = [integer ::]
     if (plot%layout%solid_count > 0) plot%solid_part = model%solid_part
     plot%shell_part = [integer ::]
@@ -319,8 +348,6 @@ contains
     end if
     plot%beam_part = [integer ::]
     if (plot%layout%beam_count > 0) plot%beam_part = model%beam_part
-    if (allocated(plot%words)) deallocate (plot%words)
-    allocate (plot%words(state_word_count(plot%layout)))
   end subroutine set_layout
 
   ! --- the first file -------------------------------------------------------------------------
@@ -379,35 +406,49 @@ contains
     plot%file_words = 64
   end subroutine write_header
 
-  !> Nodes, solids, beams and shells (1-based node and part indices).
+  !> Nodes, solids, beams and shells (1-based node and part indices), written in chunks (of
+  !> `geometry_chunk` elements, of stream_buffer_words): no copy of the whole mesh.
   subroutine write_geometry(plot, model, status, message)
     type(d3plot_file_t), intent(inout) :: plot
     type(model_t), intent(in) :: model
     integer, intent(out) :: status
     character(len=*), intent(inout) :: message
-    integer(int32), allocatable :: solids(:, :), beams(:, :), shells(:, :)
-    integer :: element
+    integer(int32) :: solids(9, geometry_chunk), beams(6, geometry_chunk), shells(5, geometry_chunk)
+    type(word_stream_t) :: stream
+    integer :: first, last, element
 
     associate (layout => plot%layout)
-      allocate (solids(9, layout%solid_count), beams(6, layout%beam_count), shells(5, layout%shell_count))
-      do element = 1, layout%solid_count
-        solids(1:8, element) = model%solid_nodes(:, element)
-        solids(9, element) = model%solid_part(element)
+      ! the coordinates after the control words; the elements follow where they end
+      call open_word_stream(stream, plot%unit, plot%file_words, stream_buffer_words)
+      call put_node_vectors(stream, layout%node_count, model%coordinates)
+      call write_buffer(stream)
+      status = stream%status
+      if (status /= 0) message = stream%message
+      do first = 1, layout%solid_count, geometry_chunk
+        last = min(first + geometry_chunk - 1, layout%solid_count)
+        do element = first, last
+          solids(1:8, element - first + 1) = model%solid_nodes(:, element)
+          solids(9, element - first + 1) = model%solid_part(element)
+        end do
+        if (status == 0) write (plot%unit, iostat=status, iomsg=message) solids(:, 1:last - first + 1)
       end do
-      do element = 1, layout%beam_count
-        beams(1:3, element) = model%beam_nodes(1:3, element)
-        beams(4:5, element) = 0
-        beams(6, element) = model%beam_part(element)
+      do first = 1, layout%beam_count, geometry_chunk
+        last = min(first + geometry_chunk - 1, layout%beam_count)
+        do element = first, last
+          beams(1:3, element - first + 1) = model%beam_nodes(1:3, element)
+          beams(4:5, element - first + 1) = 0
+          beams(6, element - first + 1) = model%beam_part(element)
+        end do
+        if (status == 0) write (plot%unit, iostat=status, iomsg=message) beams(:, 1:last - first + 1)
       end do
-      do element = 1, layout%shell_count
-        shells(1:4, element) = model%shell_nodes(:, element)
-        shells(5, element) = model%shell_part(element)
+      do first = 1, layout%shell_count, geometry_chunk
+        last = min(first + geometry_chunk - 1, layout%shell_count)
+        do element = first, last
+          shells(1:4, element - first + 1) = model%shell_nodes(:, element)
+          shells(5, element - first + 1) = model%shell_part(element)
+        end do
+        if (status == 0) write (plot%unit, iostat=status, iomsg=message) shells(:, 1:last - first + 1)
       end do
-      status = 0
-      if (layout%node_count > 0) write (plot%unit, iostat=status, iomsg=message) single(plot%reference)
-      if (status == 0) write (plot%unit, iostat=status, iomsg=message) solids
-      if (status == 0) write (plot%unit, iostat=status, iomsg=message) beams
-      if (status == 0) write (plot%unit, iostat=status, iomsg=message) shells
       plot%file_words = plot%file_words + 3_int64*layout%node_count + 9_int64*layout%solid_count + &
                         6_int64*layout%beam_count + 5_int64*layout%shell_count
     end associate

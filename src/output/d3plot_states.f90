@@ -1,6 +1,8 @@
 !> What one state of LS-DYNA's d3plot database holds, and in which order: the layout of a
 !> state (counts and the values per node and element, as the control words of the header say
-!> them) and the assembly of one state's 32-bit words from crashfree's double-precision results.
+!> them) and the assembly of one state's 32-bit words from crashfree's double-precision results,
+!> section by section straight from the arrays the caller hands in, through a buffer of bounded
+!> size (word_stream_t): writing a state takes no copy of a field nor a whole state of words.
 !>
 !> A state is, in LS-DYNA's order (d3plot database manual, "STATE DATA"): the time; NGLBV
 !> global values; the nodes' current coordinates (IU), velocities (IV) and accelerations (IA);
@@ -17,10 +19,13 @@ module d3plot_states
   use, intrinsic :: ieee_arithmetic, only: ieee_is_nan, ieee_value, ieee_quiet_nan, ieee_positive_inf, &
                                            ieee_negative_inf
   use kinds, only: wp
+  use d3plot_strains, only: solid_hencky_strain, shell_hencky_strain
   implicit none
   private
 
-  public :: d3plot_layout_t, state_word_count, fill_state_words, shell_layer_values, single
+  public :: d3plot_layout_t, state_word_count, shell_layer_values, single
+  public :: word_stream_t, open_word_stream, put_values, put_words, put_zeros, write_buffer
+  public :: put_node_vectors, put_solids, put_beams, put_shells, put_deletion_flags
 
   !> The sizes of a state, fixed when the database is opened.
   type :: d3plot_layout_t
@@ -45,6 +50,18 @@ module d3plot_states
   !> energy density.
   integer, parameter, public :: shell_extra_values = 12
 
+  !> 32-bit words on their way to a file open for stream access: put into a buffer of bounded
+  !> size, written at their place in the file whenever it is full (and by write_buffer).
+  type :: word_stream_t
+    integer :: unit = -1
+    integer(int64) :: buffer_start = 0            !< word of the file (0-based) for buffer(1)
+    integer :: filled = 0                         !< words in the buffer
+    integer(int64) :: written = 0                 !< words passed to the file
+    real(real32), allocatable :: buffer(:)
+    integer :: status = 0                         !< of the first write that failed
+    character(len=256) :: message = ""
+  end type word_stream_t
+
 contains
 
   !> Words of one state (the time word included).
@@ -58,107 +75,207 @@ contains
             int(layout%solid_count + layout%shell_count + layout%beam_count, int64)
   end function state_word_count
 
-  !> The words of one state into `words` (size state_word_count). `globals` are the NGLBV
-  !> global values; `coordinates`, `velocity`, `acceleration` (3, nodes) the physical nodal
-  !> values; `shell_stress` (6, MAXINT, shells) and `shell_plastic_strain` (MAXINT, shells) the
-  !> layers; `beam_resultant` (6, beams) in crashfree's order N, Q_s, Q_t, T, M_s, M_t; the
-  !> part numbers of the elements; the eroded flags 1 for an element out of the model (absent:
-  !> none is); with layout%strains the strain tensors, `solid_strain` (6, solids) and
-  !> `shell_strain` (6, 2, shells: inner, outer surface), xx yy zz xy yz zx.
-  subroutine fill_state_words(layout, time, globals, coordinates, velocity, acceleration, solid_stress, &
-                              solid_plastic_strain, shell_stress, shell_plastic_strain, shell_extra, beam_resultant, &
-                              solid_part, shell_part, beam_part, words, solid_eroded, shell_eroded, beam_failed, &
-                              solid_strain, shell_strain)
-    type(d3plot_layout_t), intent(in) :: layout
-    real(wp), intent(in) :: time
-    real(wp), intent(in) :: globals(:)
-    real(wp), intent(in) :: coordinates(:, :), velocity(:, :), acceleration(:, :)
-    real(wp), intent(in) :: solid_stress(:, :), solid_plastic_strain(:)
-    real(wp), intent(in) :: shell_stress(:, :, :), shell_plastic_strain(:, :)
-    real(wp), intent(in) :: shell_extra(:, :)        !< (shell_extra_values, shells)
-    real(wp), intent(in) :: beam_resultant(:, :)
-    integer, intent(in) :: solid_part(:), shell_part(:), beam_part(:)   !< part numbers (1-based)
-    real(real32), intent(out) :: words(:)
-    integer, intent(in), optional :: solid_eroded(:), shell_eroded(:)
-    real(wp), intent(in), optional :: beam_failed(:)
-    real(wp), intent(in), optional :: solid_strain(:, :), shell_strain(:, :, :)
-    integer(int64) :: next
-    integer :: node, element, layer
-    ! LS-DYNA's beam resultant order from crashfree's (N, Q_s, Q_t, T, M_s, M_t)
-    integer, parameter :: beam_order(6) = [1, 2, 3, 5, 6, 4]
+  !> Start a stream at word `first_word` (0-based) of the file open on `unit`, with a buffer of
+  !> `capacity` words.
+  subroutine open_word_stream(stream, unit, first_word, capacity)
+    type(word_stream_t), intent(out) :: stream
+    integer, intent(in) :: unit
+    integer(int64), intent(in) :: first_word
+    integer, intent(in) :: capacity
+    stream%unit = unit
+    stream%buffer_start = first_word
+    allocate (stream%buffer(max(1, capacity)))
+  end subroutine open_word_stream
 
-    words = 0.0_real32
-    words(1) = single(time)
-    next = 2
-    words(next:next + layout%global_count - 1) = single(globals(1:layout%global_count))
-    next = next + layout%global_count
-    do node = 1, layout%node_count
-      words(next:next + 2) = single(coordinates(:, node))
-      next = next + 3
+  !> Append `values` (as 32-bit words, see `single`) to the stream.
+  subroutine put_values(stream, values)
+    type(word_stream_t), intent(inout) :: stream
+    real(wp), intent(in) :: values(:)
+    integer :: k
+    do k = 1, size(values)
+      if (stream%filled == size(stream%buffer)) call write_buffer(stream)
+      stream%filled = stream%filled + 1
+      stream%buffer(stream%filled) = single(values(k))
     end do
-    do node = 1, layout%node_count
-      words(next:next + 2) = single(velocity(:, node))
-      next = next + 3
+  end subroutine put_values
+
+  !> Append 32-bit words to the stream.
+  subroutine put_words(stream, words)
+    type(word_stream_t), intent(inout) :: stream
+    real(real32), intent(in) :: words(:)
+    integer :: k
+    do k = 1, size(words)
+      if (stream%filled == size(stream%buffer)) call write_buffer(stream)
+      stream%filled = stream%filled + 1
+      stream%buffer(stream%filled) = words(k)
     end do
-    do node = 1, layout%node_count
-      words(next:next + 2) = single(acceleration(:, node))
-      next = next + 3
+  end subroutine put_words
+
+  !> Append `count` zero words to the stream.
+  subroutine put_zeros(stream, count)
+    type(word_stream_t), intent(inout) :: stream
+    integer, intent(in) :: count
+    integer :: k
+    do k = 1, count
+      call put_words(stream, [0.0_real32])
     end do
-    do element = 1, layout%solid_count
-      words(next:next + 5) = single(solid_stress(:, element))
-      words(next + 6) = single(solid_plastic_strain(element))
-      if (layout%strains .and. present(solid_strain)) words(next + 7:next + 12) = single(solid_strain(:, element))
-      next = next + layout%solid_values
-    end do
-    do element = 1, layout%beam_count
-      words(next:next + 5) = single(beam_resultant(beam_order, element))
-      next = next + layout%beam_values
-    end do
-    do element = 1, layout%shell_count
-      do layer = 1, layout%shell_layers
-        words(next:next + 5) = single(shell_stress(:, layer, element))
-        words(next + 6) = single(shell_plastic_strain(layer, element))
-        next = next + 7
-      end do
-      if (layout%strains) then
-        ! resultants, thickness, the two element-dependent values; the strains; the energy density
-        words(next:next + shell_extra_values - 2) = single(shell_extra(1:shell_extra_values - 1, element))
-        next = next + shell_extra_values - 1
-        if (present(shell_strain)) then
-          words(next:next + 5) = single(shell_strain(:, 1, element))
-          words(next + 6:next + 11) = single(shell_strain(:, 2, element))
-        end if
-        next = next + 12
-        words(next) = single(shell_extra(shell_extra_values, element))
-        next = next + 1
+  end subroutine put_zeros
+
+  !> Write what the buffer holds: after this the file has every word put. The words written
+  !> are counted in `stream%written`; after a failed write (`stream%status` /= 0) nothing more is
+  !> written.
+  subroutine write_buffer(stream)
+    type(word_stream_t), intent(inout) :: stream
+    if (stream%status == 0 .and. stream%filled > 0) &
+      write (stream%unit, pos=4_int64*stream%buffer_start + 1, iostat=stream%status, iomsg=stream%message) &
+        stream%buffer(1:stream%filled)
+    stream%buffer_start = stream%buffer_start + stream%filled
+    stream%written = stream%written + stream%filled
+    stream%filled = 0
+  end subroutine write_buffer
+
+  !> Put the nodal vectors `base + offset` (3, nodes) (`offset` absent: `base`; `base` absent:
+  !> zeros) without forming the sum of the whole arrays.
+  subroutine put_node_vectors(stream, node_count, base, offset)
+    type(word_stream_t), intent(inout) :: stream
+    integer, intent(in) :: node_count
+    real(wp), intent(in), optional :: base(:, :), offset(:, :)
+    real(wp) :: vector(3)
+    integer :: node
+    do node = 1, node_count
+      if (.not. present(base)) then
+        call put_zeros(stream, 3)
+      else if (present(offset)) then
+        ! (a named vector: an expression as the argument would be a temporary on the heap)
+        vector = base(:, node) + offset(:, node)
+        call put_values(stream, vector)
       else
-        words(next:next + shell_extra_values - 1) = single(shell_extra(:, element))
-        next = next + shell_extra_values
+        call put_values(stream, base(:, node))
       end if
     end do
-    ! deletion flags: solids, (thick shells: none), shells, beams; LS-DYNA writes the element's
-    ! material (part) number, 0 for a deleted element
-    words(next:next + layout%solid_count - 1) = real(solid_part, real32)
-    if (present(solid_eroded)) then
-      do element = 1, layout%solid_count
-        if (solid_eroded(element) /= 0) words(next + element - 1) = 0.0_real32
+  end subroutine put_node_vectors
+
+  !> Per solid its NV3D values: stress, effective plastic strain, with layout%strains the
+  !> strain tensor measured from `reference` and `displacement` on `solid_nodes` (8, solids).
+  subroutine put_solids(stream, layout, solid_stress, solid_plastic_strain, reference, displacement, solid_nodes)
+    type(word_stream_t), intent(inout) :: stream
+    type(d3plot_layout_t), intent(in) :: layout
+    real(wp), intent(in) :: solid_stress(:, :), solid_plastic_strain(:)
+    real(wp), intent(in) :: reference(:, :), displacement(:, :)
+    integer, intent(in) :: solid_nodes(:, :)
+    integer :: element
+    do element = 1, layout%solid_count
+      call put_values(stream, solid_stress(:, element))
+      call put_values(stream, [solid_plastic_strain(element)])
+      if (layout%strains) &
+        call put_values(stream, solid_hencky_strain(reference, displacement, solid_nodes(:, element)))
+    end do
+  end subroutine put_solids
+
+  !> Per beam its NV1D values: LS-DYNA's resultant order from crashfree's (N, Q_s, Q_t, T, M_s,
+  !> M_t); zeros without `beam_resultant`.
+  subroutine put_beams(stream, layout, beam_resultant)
+    type(word_stream_t), intent(inout) :: stream
+    type(d3plot_layout_t), intent(in) :: layout
+    real(wp), intent(in), optional :: beam_resultant(:, :)
+    integer, parameter :: beam_order(6) = [1, 2, 3, 5, 6, 4]
+    integer :: element
+    do element = 1, layout%beam_count
+      if (present(beam_resultant)) then
+        call put_values(stream, beam_resultant(beam_order, element))
+      else
+        call put_zeros(stream, layout%beam_values)
+      end if
+    end do
+  end subroutine put_beams
+
+  !> Per shell its NV2D values: the MAXINT layers (stress, effective plastic strain), then the
+  !> resultants, thickness, two element-dependent values, (with layout%strains the strain
+  !> tensors of the inner and outer surface,) the internal energy density.
+  !>
+  !> The layers come from the shell's points through the thickness (`shell_point_stress` (6,
+  !> points, shells), `shell_point_plastic_strain`, `shell_point_count`, see
+  !> shell_layer_values); a shell without points (meshfree shells, rigid parts, a static state)
+  !> has its mid-surface values `shell_stress` (6, shells), `shell_plastic_strain` in every
+  !> layer. The resultants, thickness and energy density are the group's (`shell_resultant`
+  !> (8, shells), `shell_thickness`, `shell_energy_density`) for a shell with points, else
+  !> zeros with the deck's thickness `deck_thickness`; without `shell_stress` all are zero.
+  subroutine put_shells(stream, layout, deck_thickness, reference, displacement, shell_nodes, shell_stress, &
+                        shell_plastic_strain, shell_point_stress, shell_point_plastic_strain, shell_point_count, &
+                        shell_resultant, shell_thickness, shell_energy_density)
+    type(word_stream_t), intent(inout) :: stream
+    type(d3plot_layout_t), intent(in) :: layout
+    real(wp), intent(in) :: deck_thickness(:)
+    real(wp), intent(in) :: reference(:, :), displacement(:, :)
+    integer, intent(in) :: shell_nodes(:, :)
+    real(wp), intent(in), optional :: shell_stress(:, :), shell_plastic_strain(:)
+    real(wp), intent(in), optional :: shell_point_stress(:, :, :), shell_point_plastic_strain(:, :)
+    integer, intent(in), optional :: shell_point_count(:)
+    real(wp), intent(in), optional :: shell_resultant(:, :), shell_thickness(:), shell_energy_density(:)
+    real(wp) :: layer_stress(6, layout%shell_layers), layer_strain(layout%shell_layers)
+    real(wp) :: extra(shell_extra_values), strain(6)
+    integer :: shell, layer, points
+
+    do shell = 1, layout%shell_count
+      layer_stress = 0.0_wp
+      layer_strain = 0.0_wp
+      extra = 0.0_wp
+      if (present(shell_stress)) then
+        points = 0
+        if (present(shell_point_count)) points = min(shell_point_count(shell), size(shell_point_stress, 2))
+        extra(9) = deck_thickness(shell)
+        if (points > 0) then
+          call shell_layer_values(points, shell_point_stress(:, 1:points, shell), &
+                                  shell_point_plastic_strain(1:points, shell), layer_stress, layer_strain)
+          if (present(shell_resultant)) then
+            extra(1:8) = shell_resultant(:, shell)
+            extra(9) = shell_thickness(shell)
+            extra(12) = shell_energy_density(shell)
+          end if
+        else
+          do layer = 1, layout%shell_layers
+            layer_stress(:, layer) = shell_stress(:, shell)
+            layer_strain(layer) = shell_plastic_strain(shell)
+          end do
+        end if
+      end if
+      do layer = 1, layout%shell_layers
+        call put_values(stream, layer_stress(:, layer))
+        call put_values(stream, [layer_strain(layer)])
       end do
-    end if
-    next = next + layout%solid_count
-    words(next:next + layout%shell_count - 1) = real(shell_part, real32)
-    if (present(shell_eroded)) then
-      do element = 1, layout%shell_count
-        if (shell_eroded(element) /= 0) words(next + element - 1) = 0.0_real32
-      end do
-    end if
-    next = next + layout%shell_count
-    words(next:next + layout%beam_count - 1) = real(beam_part, real32)
-    if (present(beam_failed)) then
-      do element = 1, layout%beam_count
-        if (beam_failed(element) > 0.5_wp) words(next + element - 1) = 0.0_real32
-      end do
-    end if
-  end subroutine fill_state_words
+      if (layout%strains) then
+        ! measured with the thickness of the state, extra(9); inner then outer surface
+        strain = shell_hencky_strain(reference, displacement, shell_nodes(:, shell), extra(9), deck_thickness(shell))
+        call put_values(stream, extra(1:shell_extra_values - 1))
+        call put_values(stream, strain)
+        call put_values(stream, strain)
+        call put_values(stream, extra(shell_extra_values:shell_extra_values))
+      else
+        call put_values(stream, extra)
+      end if
+    end do
+  end subroutine put_shells
+
+  !> Deletion flags of one family: LS-DYNA writes the element's material (part) number, 0 for
+  !> a deleted element: one with `eroded` /= 0 or `failed` > 0.5 (absent: none is).
+  subroutine put_deletion_flags(stream, element_part, eroded, failed)
+    type(word_stream_t), intent(inout) :: stream
+    integer, intent(in) :: element_part(:)
+    integer, intent(in), optional :: eroded(:)
+    real(wp), intent(in), optional :: failed(:)
+    logical :: deleted
+    integer :: element
+    do element = 1, size(element_part)
+      deleted = .false.
+      if (present(eroded)) deleted = eroded(element) /= 0
+      if (present(failed)) deleted = failed(element) > 0.5_wp
+      if (deleted) then
+        call put_words(stream, [0.0_real32])
+      else
+        call put_words(stream, [real(element_part(element), real32)])
+      end if
+    end do
+  end subroutine put_deletion_flags
 
   !> One shell's layers from its `count` points through the thickness (bottom to top), as
   !> LS-DYNA writes them: with MAXINT = 3 the mid surface (the middle point, or the mean of the

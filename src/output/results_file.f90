@@ -75,7 +75,6 @@ module results_file
   use file_lock, only: file_lock_t, acquire_file_lock, release_file_lock
   use d3plot_file, only: d3plot_file_t, open_d3plot, continue_d3plot, write_d3plot_state, close_d3plot, &
                          d3plot_base_name, default_file_scale
-  use d3plot_states, only: shell_layer_values, shell_extra_values
   implicit none
   private
 
@@ -293,7 +292,7 @@ contains
                          shell_plastic_strain_peak, histories, beam_resultant, beam_plastic_strain, beam_failed, &
                          solid_eroded, shell_eroded, eroded_count, acceleration, globals, shell_point_stress, &
                          shell_point_plastic_strain, shell_point_count, shell_resultant, shell_thickness, &
-                         shell_energy_density)
+                         shell_energy_density, reference_coordinates)
     type(results_file_t), intent(inout) :: results
     real(wp), intent(in) :: time
     ! Contiguous: the solver's whole arrays go to HDF5 without a copy.
@@ -317,6 +316,10 @@ contains
     real(wp), intent(in), contiguous, optional :: shell_point_stress(:, :, :), shell_point_plastic_strain(:, :)
     integer, intent(in), contiguous, optional :: shell_point_count(:)
     real(wp), intent(in), contiguous, optional :: shell_resultant(:, :), shell_thickness(:), shell_energy_density(:)
+    !> for the d3plot, which writes reference + displacement and keeps no copy of the model's
+    !> coordinates: (3, nodes) the reference coordinates (model%coordinates); needed while a
+    !> d3plot is written
+    real(wp), intent(in), contiguous, optional :: reference_coordinates(:, :)
     real(wp) :: no_shell_stress(6, 0), no_shell_strain(0)
     real(wp), allocatable :: grown(:)
     type(error_t), allocatable :: space_error
@@ -340,6 +343,19 @@ contains
                       integer_text(results%node_count)//" nodes, "// &
                       integer_text(results%solid_count)//" solids)")
       return
+    end if
+
+    if (results%d3plot%is_open) then
+      if (.not. present(reference_coordinates)) then
+        call make_error(error, "results file "//results%h5_path//": state at time "//real_text(time)// &
+                        ": no reference coordinates for the d3plot")
+        return
+      else if (any(shape(reference_coordinates) /= [3, results%node_count])) then
+        call make_error(error, "results file "//results%h5_path//": state at time "//real_text(time)// &
+                        ": the reference coordinates do not match the mesh ("//integer_text(results%node_count)// &
+                        " nodes)")
+        return
+      end if
     end if
 
     what = "state "//integer_text(results%state_count)//" at time "//real_text(time)
@@ -433,86 +449,17 @@ contains
     results%state_times(results%state_count) = time
 
     if (results%d3plot%is_open) then
-      call write_d3plot(results%d3plot, time, displacement, velocity, solid_stress, solid_plastic_strain, error, &
-                        shell_stress, shell_plastic_strain, beam_resultant, beam_failed, solid_eroded, shell_eroded, &
-                        acceleration, globals, shell_point_stress, shell_point_plastic_strain, shell_point_count, &
-                        shell_resultant, shell_thickness, shell_energy_density)
+      ! the state just written to results.h5; what results.h5 does not have is written as 0
+      ! (the accelerations and global values of a static state)
+      call write_d3plot_state(results%d3plot, time, reference_coordinates, displacement, velocity, solid_stress, &
+                              solid_plastic_strain, error, shell_stress, shell_plastic_strain, beam_resultant, &
+                              beam_failed, solid_eroded, shell_eroded, acceleration, globals, shell_point_stress, &
+                              shell_point_plastic_strain, shell_point_count, shell_resultant, shell_thickness, &
+                              shell_energy_density)
       if (allocated(error)) return
     end if
     if (xdmf_due(results)) call write_xdmf_now(results, error)
   end subroutine write_state
-
-  !> The state just written to results.h5, into the d3plot (what results.h5 does not have is
-  !> written as 0: the accelerations and global values of a static state).
-  subroutine write_d3plot(plot, time, displacement, velocity, solid_stress, solid_plastic_strain, error, &
-                          shell_stress, shell_plastic_strain, beam_resultant, beam_failed, solid_eroded, shell_eroded, &
-                          acceleration, globals, shell_point_stress, shell_point_plastic_strain, shell_point_count, &
-                          shell_resultant, shell_thickness, shell_energy_density)
-    type(d3plot_file_t), intent(inout) :: plot
-    real(wp), intent(in) :: time
-    real(wp), intent(in) :: displacement(:, :), velocity(:, :), solid_stress(:, :), solid_plastic_strain(:)
-    type(error_t), allocatable, intent(out) :: error
-    real(wp), intent(in), optional :: shell_stress(:, :), shell_plastic_strain(:)
-    real(wp), intent(in), optional :: beam_resultant(:, :), beam_failed(:)
-    integer, intent(in), optional :: solid_eroded(:), shell_eroded(:)
-    real(wp), intent(in), optional :: acceleration(:, :), globals(:)
-    real(wp), intent(in), optional :: shell_point_stress(:, :, :), shell_point_plastic_strain(:, :)
-    integer, intent(in), optional :: shell_point_count(:)
-    real(wp), intent(in), optional :: shell_resultant(:, :), shell_thickness(:), shell_energy_density(:)
-    real(wp), allocatable :: layer_stress(:, :, :), layer_strain(:, :), resultant(:, :), global_values(:)
-    real(wp), allocatable :: shell_extra(:, :)
-    real(wp), allocatable :: node_acceleration(:, :)
-    integer :: shell, layer, points
-
-    associate (layout => plot%layout)
-      allocate (layer_stress(6, layout%shell_layers, layout%shell_count), source=0.0_wp)
-      allocate (layer_strain(layout%shell_layers, layout%shell_count), source=0.0_wp)
-      allocate (shell_extra(shell_extra_values, layout%shell_count), source=0.0_wp)
-      ! each shell's points through the thickness; a shell whose group gives none (meshfree
-      ! shells, rigid parts, a static state) has its mid-surface values in every layer
-      if (present(shell_stress) .and. layout%shell_count > 0) then
-        do shell = 1, layout%shell_count
-          points = 0
-          if (present(shell_point_count)) points = min(shell_point_count(shell), size(shell_point_stress, 2))
-          ! resultants, thickness and energy density where the group gave them, else the deck's
-          ! thickness only
-          shell_extra(9, shell) = plot%shell_thickness(shell)
-          if (points > 0) then
-            call shell_layer_values(points, shell_point_stress(:, 1:points, shell), &
-                                    shell_point_plastic_strain(1:points, shell), layer_stress(:, :, shell), &
-                                    layer_strain(:, shell))
-            if (present(shell_resultant)) then
-              shell_extra(1:8, shell) = shell_resultant(:, shell)
-              shell_extra(9, shell) = shell_thickness(shell)
-              shell_extra(12, shell) = shell_energy_density(shell)
-            end if
-          else
-            do layer = 1, layout%shell_layers
-              layer_stress(:, layer, shell) = shell_stress(:, shell)
-              layer_strain(layer, shell) = shell_plastic_strain(shell)
-            end do
-          end if
-        end do
-      end if
-      allocate (resultant(6, layout%beam_count), source=0.0_wp)
-      if (present(beam_resultant) .and. layout%beam_count > 0) resultant = beam_resultant
-      allocate (global_values(layout%global_count), source=0.0_wp)
-      if (present(globals)) global_values = globals(1:layout%global_count)
-      allocate (node_acceleration(3, layout%node_count), source=0.0_wp)
-      if (present(acceleration)) node_acceleration = acceleration
-    end associate
-    if (present(beam_failed)) then
-      if (size(beam_failed) /= plot%layout%beam_count) then
-        call write_d3plot_state(plot, time, global_values, displacement, velocity, node_acceleration, solid_stress, &
-                                solid_plastic_strain, layer_stress, layer_strain, shell_extra, resultant, error, &
-                                solid_eroded, shell_eroded)
-        return
-      end if
-    end if
-    call write_d3plot_state(plot, time, global_values, displacement, velocity, node_acceleration, solid_stress, &
-                            solid_plastic_strain, layer_stress, layer_strain, shell_extra, resultant, error, &
-                            solid_eroded, shell_eroded, beam_failed)
-  end subroutine write_d3plot
 
   !> Add the history rows recorded since the previous call (each series as
   !> `/history/<group>/<column>`), and flush. Rows already in the file are not written again;
@@ -1261,43 +1208,18 @@ contains
   ! is set, so a sequence of writes reads as a list and stops at the first failure.
 
   !> `/mesh`: nodes, solids, the (empty) shells, parts, and the beams of a model that has some.
+  !> The model's arrays are written as they are; a dataset that needs its values converted (ids
+  !> for indices, 0-based rows) is built, written and freed before the next one, so that the
+  !> mesh costs memory of one dataset at a time.
   subroutine write_mesh(file_id, model, error)
     integer(hid_t), intent(in) :: file_id
     type(model_t), intent(in) :: model
     type(error_t), allocatable, intent(inout) :: error
-    integer, allocatable :: node_ids(:), solid_ids(:), solid_part_ids(:), connectivity(:, :)
-    integer, allocatable :: connectivity_index(:, :), part_ids(:), material_ids(:)
-    real(wp), allocatable :: coordinates(:, :)
+    integer, allocatable :: values(:), rows(:, :), part_ids(:), material_ids(:)
     character(len=8), allocatable :: formulations(:)
-    integer, allocatable :: shell_ids(:), shell_part_ids(:), shell_connectivity(:, :)
     integer :: solid, part, solid_count, part_count, shell, shell_count
 
     if (allocated(error)) return
-    ! Local copies, so that a model without nodes, solids or parts still gives the full layout.
-    if (allocated(model%node_ids)) then
-      node_ids = model%node_ids
-      coordinates = model%coordinates
-    else
-      allocate (node_ids(0), coordinates(3, 0))
-    end if
-    solid_count = 0
-    if (allocated(model%solid_ids)) solid_count = size(model%solid_ids)
-    allocate (solid_ids(solid_count), solid_part_ids(solid_count), connectivity(8, solid_count), &
-              connectivity_index(8, solid_count))
-    do solid = 1, solid_count
-      solid_ids(solid) = model%solid_ids(solid)
-      solid_part_ids(solid) = model%parts(model%solid_part(solid))%id
-      connectivity(:, solid) = model%node_ids(model%solid_nodes(:, solid))
-      connectivity_index(:, solid) = model%solid_nodes(:, solid) - 1
-    end do
-    shell_count = 0
-    if (allocated(model%shell_ids)) shell_count = size(model%shell_ids)
-    allocate (shell_ids(shell_count), shell_part_ids(shell_count), shell_connectivity(4, shell_count))
-    do shell = 1, shell_count
-      shell_ids(shell) = model%shell_ids(shell)
-      shell_part_ids(shell) = model%parts(model%shell_part(shell))%id
-      shell_connectivity(:, shell) = model%node_ids(model%shell_nodes(:, shell))
-    end do
     part_count = 0
     if (allocated(model%parts)) part_count = size(model%parts)
     allocate (part_ids(part_count), material_ids(part_count), formulations(part_count))
@@ -1317,22 +1239,60 @@ contains
         return
       end select
     end do
+    solid_count = 0
+    if (allocated(model%solid_ids)) solid_count = size(model%solid_ids)
+    shell_count = 0
+    if (allocated(model%shell_ids)) shell_count = size(model%shell_ids)
 
     call create_group_path(file_id, "/mesh/nodes", error)
     call create_group_path(file_id, "/mesh/solids", error)
     call create_group_path(file_id, "/mesh/shells", error)
     call create_group_path(file_id, "/mesh/parts", error)
-    call write_integer_dataset_1d(file_id, "", "/mesh/nodes/ids", node_ids, error)
-    call write_real_dataset_2d(file_id, "", "/mesh/nodes/coordinates", coordinates, error)
-    call write_integer_dataset_1d(file_id, "", "/mesh/solids/ids", solid_ids, error)
-    call write_integer_dataset_1d(file_id, "", "/mesh/solids/part_ids", solid_part_ids, error)
-    call write_integer_dataset_2d(file_id, "", "/mesh/solids/connectivity", connectivity, error)
-    call write_integer_dataset_2d(file_id, "", "/mesh/solids/connectivity_index", &
-                                  connectivity_index, error)
-    call write_integer_dataset_1d(file_id, "", "/mesh/shells/ids", shell_ids, error)
-    call write_integer_dataset_1d(file_id, "", "/mesh/shells/part_ids", shell_part_ids, error)
-    call write_integer_dataset_2d(file_id, "", "/mesh/shells/connectivity", shell_connectivity, error)
-    call write_integer_dataset_2d(file_id, "", "/mesh/shells/connectivity_index", shell_connectivity_index(), error)
+    ! (empty datasets for a model without nodes, solids or shells: the layout is always whole)
+    if (allocated(model%node_ids)) then
+      call write_integer_dataset_1d(file_id, "", "/mesh/nodes/ids", model%node_ids, error)
+      call write_real_dataset_2d(file_id, "", "/mesh/nodes/coordinates", model%coordinates, error)
+    else
+      call write_integer_dataset_1d(file_id, "", "/mesh/nodes/ids", [integer ::], error)
+      call write_real_dataset_2d(file_id, "", "/mesh/nodes/coordinates", reshape([real(wp) ::], [3, 0]), error)
+    end if
+    allocate (values(solid_count))
+    if (solid_count > 0) values = model%solid_ids
+    call write_integer_dataset_1d(file_id, "", "/mesh/solids/ids", values, error)
+    do solid = 1, solid_count
+      values(solid) = model%parts(model%solid_part(solid))%id
+    end do
+    call write_integer_dataset_1d(file_id, "", "/mesh/solids/part_ids", values, error)
+    deallocate (values)
+    allocate (rows(8, solid_count))
+    do solid = 1, solid_count
+      rows(:, solid) = model%node_ids(model%solid_nodes(:, solid))
+    end do
+    call write_integer_dataset_2d(file_id, "", "/mesh/solids/connectivity", rows, error)
+    do solid = 1, solid_count
+      rows(:, solid) = model%solid_nodes(:, solid) - 1
+    end do
+    call write_integer_dataset_2d(file_id, "", "/mesh/solids/connectivity_index", rows, error)
+    deallocate (rows)
+    allocate (values(shell_count))
+    if (shell_count > 0) values = model%shell_ids
+    call write_integer_dataset_1d(file_id, "", "/mesh/shells/ids", values, error)
+    do shell = 1, shell_count
+      values(shell) = model%parts(model%shell_part(shell))%id
+    end do
+    call write_integer_dataset_1d(file_id, "", "/mesh/shells/part_ids", values, error)
+    deallocate (values)
+    allocate (rows(4, shell_count))
+    do shell = 1, shell_count
+      rows(:, shell) = model%node_ids(model%shell_nodes(:, shell))
+    end do
+    call write_integer_dataset_2d(file_id, "", "/mesh/shells/connectivity", rows, error)
+    ! 0-based node rows of the shells (as connectivity_index of the solids, for the XDMF file)
+    do shell = 1, shell_count
+      rows(:, shell) = model%shell_nodes(:, shell) - 1
+    end do
+    call write_integer_dataset_2d(file_id, "", "/mesh/shells/connectivity_index", rows, error)
+    deallocate (rows)
     call write_integer_dataset_1d(file_id, "", "/mesh/parts/ids", part_ids, error)
     call write_string_dataset(file_id, "/mesh/parts/formulation", formulations, error)
     call write_integer_dataset_1d(file_id, "", "/mesh/parts/material_ids", material_ids, error)
@@ -1361,14 +1321,6 @@ contains
                                     error)
       call write_integer_dataset_1d(file_id, "", "/mesh/beams/orientation_node", orientation, error)
     end subroutine write_beam_mesh
-    !> 0-based node rows of the shells (as connectivity_index of the solids, for the XDMF file).
-    function shell_connectivity_index() result(rows)
-      integer, allocatable :: rows(:, :)
-      allocate (rows(4, shell_count))
-      do shell = 1, shell_count
-        rows(:, shell) = model%shell_nodes(:, shell) - 1
-      end do
-    end function shell_connectivity_index
   end subroutine write_mesh
 
   !> `/states`, as a group whose links are kept in HDF5's "dense" form (a fractal heap and a

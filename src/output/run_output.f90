@@ -249,7 +249,8 @@ contains
                          shell_point_stress=fields%shell_point_stress, &
                          shell_point_plastic_strain=fields%shell_point_plastic_strain, &
                          shell_point_count=fields%shell_point_count, shell_resultant=fields%shell_resultant, &
-                         shell_thickness=fields%shell_thickness, shell_energy_density=fields%shell_energy_density)
+                         shell_thickness=fields%shell_thickness, shell_energy_density=fields%shell_energy_density, &
+                         reference_coordinates=model%coordinates)
       else
         ! (beam fields not allocated: a model without beams; the dummies are then absent)
         call write_state(results, state%time, plan%node_displacement, plan%node_velocity, fields%solid_stress, &
@@ -257,7 +258,8 @@ contains
                          beam_resultant=fields%beam_resultant, beam_plastic_strain=fields%beam_plastic_strain, &
                          beam_failed=fields%beam_failed, &
                          solid_eroded=fields%solid_eroded, eroded_count=state%eroded_count, &
-                         acceleration=plan%node_acceleration, globals=globals)
+                         acceleration=plan%node_acceleration, globals=globals, &
+                         reference_coordinates=model%coordinates)
       end if
     end associate
   end subroutine write_current_state

@@ -41,7 +41,7 @@ contains
     velocity = 0.0_wp
     plastic_strain = 0.0_wp
     call write_state(results, solution%time, solution%displacement, velocity, solution%solid_stress, &
-                     plastic_strain, error)
+                     plastic_strain, error, reference_coordinates=model%coordinates)
     if (allocated(error)) return
 
     ratio = 1.0_wp

@@ -216,7 +216,7 @@ contains
     if (allocated(error)) return
 
     call write_state(results, 0.0_wp, nodal_field(0.0_wp)*0.0_wp, nodal_field(0.0_wp)*0.0_wp, &
-                     stress_field(0.0_wp)*0.0_wp, [0.0_wp, 0.0_wp], error)
+                     stress_field(0.0_wp)*0.0_wp, [0.0_wp, 0.0_wp], error, reference_coordinates=model%coordinates)
     call check(suite, "write_state 0 succeeds", .not. allocated(error), error_message(error))
     call make_histories(histories, 3)
     call write_histories(results, histories, error)
@@ -224,7 +224,7 @@ contains
 
     plastic = [0.03125_wp, 0.0625_wp]
     call write_state(results, 1.5e-3_wp, nodal_field(1.0_wp), nodal_field(-20.0_wp), &
-                     stress_field(1000.0_wp), plastic, error)
+                     stress_field(1000.0_wp), plastic, error, reference_coordinates=model%coordinates)
     call check(suite, "write_state 1 succeeds", .not. allocated(error), error_message(error))
     call check(suite, "two states counted", results%state_count == 2)
     ! The second call holds more rows: the datasets must show exactly these.
@@ -444,6 +444,17 @@ contains
     if (allocated(error)) call check(suite, "size error names the mesh", &
                                      index(error%message, "12 nodes") > 0, error%message)
     call check(suite, "nothing written after a size error", results%state_count == 0)
+    ! the d3plot writes reference + displacement from the caller's coordinates: without them
+    ! (or with ones of another mesh) the state is refused before anything is written
+    call write_state(results, 0.0_wp, nodal_field(0.0_wp), nodal_field(0.0_wp), stress_field(0.0_wp), &
+                     [0.0_wp, 0.0_wp], error)
+    call check(suite, "state without reference coordinates is an error", allocated(error))
+    if (allocated(error)) call check(suite, "error names the reference coordinates", &
+                                     index(error%message, "no reference coordinates") > 0, error%message)
+    call write_state(results, 0.0_wp, nodal_field(0.0_wp), nodal_field(0.0_wp), stress_field(0.0_wp), &
+                     [0.0_wp, 0.0_wp], error, reference_coordinates=model%coordinates(:, 1:3))
+    call check(suite, "reference coordinates of another mesh are an error", allocated(error))
+    call check(suite, "nothing written without the reference coordinates", results%state_count == 0)
     call open_results(results, directory, "again", model, 1, error)
     call check(suite, "opening an open file is an error", allocated(error))
     call close_results(results, summary, error)
@@ -466,7 +477,7 @@ contains
     call check(suite, "reopen after close succeeds", .not. allocated(error), error_message(error))
     if (allocated(error)) return
     call write_state(results, 0.0_wp, nodal_field(2.0_wp), nodal_field(3.0_wp), &
-                     stress_field(4.0_wp), [0.0_wp, 0.0_wp], error)
+                     stress_field(4.0_wp), [0.0_wp, 0.0_wp], error, reference_coordinates=model%coordinates)
     call check(suite, "state in reopened file", .not. allocated(error), error_message(error))
     ! Histories written again with fewer rows shrink: the file holds the last call only.
     call make_histories(histories, 5)
@@ -531,7 +542,7 @@ contains
     if (allocated(error)) return
     call write_state(results, 0.0_wp, nodal_field(0.0_wp), nodal_field(1.0_wp), stress_field(0.0_wp), &
                      [0.0_wp, 0.0_wp], error, shell_stress, [0.5_wp, 0.25_wp], shell_stress, &
-                     [0.5_wp, 0.25_wp])
+                     [0.5_wp, 0.25_wp], reference_coordinates=mixed%coordinates)
     call check(suite, "solids and shells: state written", .not. allocated(error), error_message(error))
     summary%status = status_normal
     summary%message = ""
@@ -584,7 +595,7 @@ contains
     plate_field = 0.0_wp
     call write_state(results, 0.0_wp, plate_field, plate_field, &
                      no_solid_stress, no_solid_strain, error, shell_stress, [0.5_wp, 0.25_wp], &
-                     shell_stress, [0.5_wp, 0.25_wp])
+                     shell_stress, [0.5_wp, 0.25_wp], reference_coordinates=plates%coordinates)
     call check(suite, "shells only: state written", .not. allocated(error), error_message(error))
     call close_results(results, summary, error)
     call read_text_file(directory//"/plates.xdmf", xdmf_text)
@@ -632,7 +643,8 @@ contains
     do state = 1, 10
       call make_histories(histories, 2*state)
       call write_state(results, 0.25_wp*real(state, wp), nodal_field(real(state, wp)), nodal_field(0.0_wp), &
-                       stress_field(0.0_wp), [0.0_wp, 0.0_wp], error, histories=histories)
+                       stress_field(0.0_wp), [0.0_wp, 0.0_wp], error, histories=histories, &
+                       reference_coordinates=model%coordinates)
       all_written = all_written .and. .not. allocated(error)
       if (state == 3) call check(suite, "commits: XDMF written at states 1, 2 (not 3)", results%xdmf_writes == 2)
     end do
