@@ -56,6 +56,9 @@ module restart_file
     !> a file, and are read back in the same order (names are not kept). A distributed run
     !> moves element blocks between ranks this way with the groups' own exchange routines.
     logical :: in_memory = .false.
+    !> In memory, writing nothing: the values are only counted (`position`), the room a store
+    !> will need (start_memory_store's `room`), so that a large one is not grown by doubling
+    logical :: counting = .false.
     real(wp), allocatable :: memory(:)                !< the values so far (integers and logicals as reals)
     integer :: position = 0                           !< values written, or read, so far
   end type restart_store_t
@@ -827,14 +830,25 @@ contains
   ! In memory
 
   !> Start a store in memory: empty for writing, or (`writing` false) reading `memory` from its
-  !> first value.
-  subroutine start_memory_store(store, writing)
+  !> first value. `room`: the values it will hold when known (a counting pass): exactly that
+  !> much memory, no doubling. `counting`: count the values written, store none.
+  subroutine start_memory_store(store, writing, room, counting)
     type(restart_store_t), intent(inout) :: store
     logical, intent(in) :: writing
+    integer, intent(in), optional :: room
+    logical, intent(in), optional :: counting
     store%in_memory = .true.
     store%writing = writing
     store%is_open = .true.
     store%position = 0
+    store%counting = .false.
+    if (present(counting)) store%counting = counting .and. writing
+    if (present(room)) then
+      if (allocated(store%memory)) then
+        if (size(store%memory) /= max(room, 1)) deallocate (store%memory)
+      end if
+      if (.not. allocated(store%memory)) allocate (store%memory(max(room, 1)))
+    end if
     if (.not. allocated(store%memory)) allocate (store%memory(1024))
   end subroutine start_memory_store
 
@@ -843,7 +857,7 @@ contains
     type(restart_store_t), intent(inout) :: store
     integer, intent(in) :: count
     real(wp), allocatable :: grown(:)
-    if (store%position + count <= size(store%memory)) return
+    if (store%counting .or. store%position + count <= size(store%memory)) return
     allocate (grown(max(2*size(store%memory), store%position + count)))
     grown(1:store%position) = store%memory(1:store%position)
     call move_alloc(grown, store%memory)
@@ -856,7 +870,7 @@ contains
     real(wp), intent(inout) :: values(count)
     if (store%writing) then
       call reserve_memory(store, count)
-      store%memory(store%position + 1:store%position + count) = values
+      if (.not. store%counting) store%memory(store%position + 1:store%position + count) = values
     else
       values = store%memory(store%position + 1:store%position + count)
     end if
@@ -879,7 +893,7 @@ contains
     integer, intent(inout) :: values(count)
     if (store%writing) then
       call reserve_memory(store, count)
-      store%memory(store%position + 1:store%position + count) = real(values, wp)
+      if (.not. store%counting) store%memory(store%position + 1:store%position + count) = real(values, wp)
     else
       values = nint(store%memory(store%position + 1:store%position + count))
     end if
@@ -902,7 +916,7 @@ contains
     logical, intent(inout) :: values(count)
     if (store%writing) then
       call reserve_memory(store, count)
-      store%memory(store%position + 1:store%position + count) = merge(1.0_wp, 0.0_wp, values)
+      if (.not. store%counting) store%memory(store%position + 1:store%position + count) = merge(1.0_wp, 0.0_wp, values)
     else
       values = store%memory(store%position + 1:store%position + count) > 0.5_wp
     end if

@@ -405,15 +405,15 @@ contains
     real(wp) :: length(1)
     real(wp), allocatable :: lengths(:, :), received(:)
     integer, allocatable :: counts(:), offsets(:)
-    integer :: k, b, r
-    call start_memory_store(exchange%store, .true.)
-    do k = 1, size(groups)
-      if (.not. groups(k)%group%distributes_blocks()) cycle
-      do b = 1, size(partition%groups(k)%owner)
-        if (partition%groups(k)%owner(b) /= exchange%rank) cycle
-        call groups(k)%group%exchange_block_state(exchange%store, b, error)
-      end do
-    end do
+    integer :: k, b, r, room
+    ! the owned blocks counted, then packed into a store of exactly that size (grown by
+    ! doubling, a store of a large model's blocks held up to three times their size); the first
+    ! rank's own blocks are where a gather to it needs them: it sends none
+    call start_memory_store(exchange%store, .true., counting=.true.)
+    if (everyone .or. exchange%rank /= 0) call pack_owned_blocks()
+    room = exchange%store%position
+    call start_memory_store(exchange%store, .true., room=room)
+    if (everyone .or. exchange%rank /= 0) call pack_owned_blocks()
     length(1) = real(exchange%store%position, wp)
     allocate (lengths(1, exchange%rank_count), counts(exchange%rank_count), offsets(exchange%rank_count))
     call gather_fixed_reals(length, lengths)
@@ -451,5 +451,16 @@ contains
                          " values received, "//integer_text(reader%position - offsets(r + 1))//" expected", 1)
     end do
     exchange%gathered_values = exchange%gathered_values + real(sum(counts) - counts(exchange%rank + 1), wp)
+  contains
+    subroutine pack_owned_blocks()
+      integer :: group_index, block
+      do group_index = 1, size(groups)
+        if (.not. groups(group_index)%group%distributes_blocks()) cycle
+        do block = 1, size(partition%groups(group_index)%owner)
+          if (partition%groups(group_index)%owner(block) /= exchange%rank) cycle
+          call groups(group_index)%group%exchange_block_state(exchange%store, block, error)
+        end do
+      end do
+    end subroutine pack_owned_blocks
   end subroutine bring_blocks_together
 end module domain_exchange

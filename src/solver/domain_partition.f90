@@ -39,6 +39,7 @@ module domain_partition
   use element_group, only: group_holder_t, family_solid, family_shell, family_beam
   use run_summary, only: partition_summary_t
   use signal_hold, only: signal_mask_t, hold_termination_signal, release_held_signals
+  use rank_communication, only: rank_index, integers_from_first
   implicit none
   private
 
@@ -165,7 +166,13 @@ contains
     block_owner = 0
     partition%report%by_metis = .false.
     partition%report%method = "one rank"
-    if (rank_count > 1) call choose_owners(model, groups, blocks, rank_count, block_owner, partition%report)
+    if (rank_count > 1) then
+      ! the first process of a distributed run chooses the owners and hands them to the others
+      ! (METIS's graphs are the largest memory of a rank's set-up: about 200 MB on the
+      ! 513,600-element scaling deck); alone, or partition=N, this process chooses
+      if (rank_index() == 0) call choose_owners(model, groups, blocks, rank_count, block_owner, partition%report)
+      call share_choice(block_owner, partition%report)
+    end if
 
     allocate (partition%groups(size(groups)))
     do g = 1, size(groups)
@@ -184,6 +191,23 @@ contains
     end do
     call report_partition(model, groups, blocks, block_owner, partition%node_owner, rank_count, partition%report)
   end subroutine partition_domains
+
+  !> The first process's block owners and method to every process of a distributed run (one
+  !> process: nothing to do).
+  subroutine share_choice(block_owner, report)
+    integer, intent(inout) :: block_owner(:)
+    type(partition_summary_t), intent(inout) :: report
+    character(len=*), parameter :: methods(3) = [character(len=19) :: "contiguous", "metis_kway_elements", &
+                                                  "metis_kway_blocks"]
+    integer, allocatable :: values(:)
+    integer :: method
+    method = max(1, findloc(methods, report%method, dim=1))
+    values = [block_owner, method]
+    call integers_from_first(values)
+    block_owner = values(1:size(block_owner))
+    report%method = trim(methods(values(size(values))))
+    report%by_metis = values(size(values)) > 1
+  end subroutine share_choice
 
   !> The block owners of the better of two partitions, both METIS k-way with the same costs and
   !> both evened out by balance_owners: (a) the element graph, each block to the rank owning most

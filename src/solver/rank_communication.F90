@@ -14,8 +14,8 @@ module rank_communication
   use kinds, only: wp
 #ifdef CRASHFREE_MPI
   use mpi_f08, only: MPI_Init_thread, MPI_Initialized, MPI_Finalized, MPI_Finalize, MPI_Comm_rank, &
-                     MPI_Comm_size, MPI_Barrier, MPI_Allgatherv, MPI_Gatherv, MPI_Allgather, MPI_Allreduce, &
-                     MPI_Abort, MPI_COMM_WORLD, MPI_THREAD_FUNNELED, MPI_DOUBLE_PRECISION, MPI_LOGICAL, &
+                     MPI_Comm_size, MPI_Barrier, MPI_Allgatherv, MPI_Gatherv, MPI_Allgather, MPI_Allreduce, MPI_Bcast, &
+                     MPI_Abort, MPI_COMM_WORLD, MPI_THREAD_FUNNELED, MPI_DOUBLE_PRECISION, MPI_LOGICAL, MPI_INTEGER, &
                      MPI_MAX, MPI_LOR, MPI_IN_PLACE
 #endif
   use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
@@ -23,7 +23,7 @@ module rank_communication
   private
 
   public :: start_ranks, finish_ranks, rank_index, rank_total, mpi_built, barrier_ranks
-  public :: gather_reals, gather_reals_to_first, gather_fixed_reals, largest_over_ranks, any_rank
+  public :: gather_reals, gather_reals_to_first, gather_fixed_reals, integers_from_first, largest_over_ranks, any_rank
   public :: abort_ranks
 
   !> Whether this binary was built with MPI (mpirun -np N runs N ranks) or is one rank only.
@@ -150,6 +150,14 @@ contains
 #endif
     receive(:, 1) = send
   end subroutine gather_fixed_reals
+
+  !> Every rank's `values` become the first rank's (MPI_Bcast; the same size on every rank).
+  subroutine integers_from_first(values)
+    integer, intent(inout), contiguous :: values(:)
+#ifdef CRASHFREE_MPI
+    if (mpi_running()) call MPI_Bcast(values, size(values), MPI_INTEGER, 0, MPI_COMM_WORLD)
+#endif
+  end subroutine integers_from_first
 
   !> values(k) becomes the largest values(k) of all ranks (exact: a maximum does not depend on
   !> the order in which it is taken).
