@@ -1215,9 +1215,9 @@ contains
     integer(hid_t), intent(in) :: file_id
     type(model_t), intent(in) :: model
     type(error_t), allocatable, intent(inout) :: error
-    integer, allocatable :: values(:), rows(:, :), part_ids(:), material_ids(:)
+    integer, allocatable :: part_ids(:), material_ids(:)
     character(len=8), allocatable :: formulations(:)
-    integer :: solid, part, solid_count, part_count, shell, shell_count
+    integer :: part, solid_count, part_count, shell_count
 
     if (allocated(error)) return
     part_count = 0
@@ -1256,43 +1256,16 @@ contains
       call write_integer_dataset_1d(file_id, "", "/mesh/nodes/ids", [integer ::], error)
       call write_real_dataset_2d(file_id, "", "/mesh/nodes/coordinates", reshape([real(wp) ::], [3, 0]), error)
     end if
-    allocate (values(solid_count))
-    if (solid_count > 0) values = model%solid_ids
-    call write_integer_dataset_1d(file_id, "", "/mesh/solids/ids", values, error)
-    do solid = 1, solid_count
-      values(solid) = model%parts(model%solid_part(solid))%id
-    end do
-    call write_integer_dataset_1d(file_id, "", "/mesh/solids/part_ids", values, error)
-    deallocate (values)
-    allocate (rows(8, solid_count))
-    do solid = 1, solid_count
-      rows(:, solid) = model%node_ids(model%solid_nodes(:, solid))
-    end do
-    call write_integer_dataset_2d(file_id, "", "/mesh/solids/connectivity", rows, error)
-    do solid = 1, solid_count
-      rows(:, solid) = model%solid_nodes(:, solid) - 1
-    end do
-    call write_integer_dataset_2d(file_id, "", "/mesh/solids/connectivity_index", rows, error)
-    deallocate (rows)
-    allocate (values(shell_count))
-    if (shell_count > 0) values = model%shell_ids
-    call write_integer_dataset_1d(file_id, "", "/mesh/shells/ids", values, error)
-    do shell = 1, shell_count
-      values(shell) = model%parts(model%shell_part(shell))%id
-    end do
-    call write_integer_dataset_1d(file_id, "", "/mesh/shells/part_ids", values, error)
-    deallocate (values)
-    allocate (rows(4, shell_count))
-    do shell = 1, shell_count
-      rows(:, shell) = model%node_ids(model%shell_nodes(:, shell))
-    end do
-    call write_integer_dataset_2d(file_id, "", "/mesh/shells/connectivity", rows, error)
-    ! 0-based node rows of the shells (as connectivity_index of the solids, for the XDMF file)
-    do shell = 1, shell_count
-      rows(:, shell) = model%shell_nodes(:, shell) - 1
-    end do
-    call write_integer_dataset_2d(file_id, "", "/mesh/shells/connectivity_index", rows, error)
-    deallocate (rows)
+    if (solid_count > 0) then
+      call write_element_mesh("/mesh/solids", model%solid_ids, model%solid_part, model%solid_nodes)
+    else
+      call write_element_mesh("/mesh/solids", [integer ::], [integer ::], reshape([integer ::], [8, 0]))
+    end if
+    if (shell_count > 0) then
+      call write_element_mesh("/mesh/shells", model%shell_ids, model%shell_part, model%shell_nodes)
+    else
+      call write_element_mesh("/mesh/shells", [integer ::], [integer ::], reshape([integer ::], [4, 0]))
+    end if
     call write_integer_dataset_1d(file_id, "", "/mesh/parts/ids", part_ids, error)
     call write_string_dataset(file_id, "/mesh/parts/formulation", formulations, error)
     call write_integer_dataset_1d(file_id, "", "/mesh/parts/material_ids", material_ids, error)
@@ -1300,6 +1273,32 @@ contains
       if (size(model%beam_ids) > 0) call write_beam_mesh()
     end if
   contains
+    !> `group` (/mesh/solids, /mesh/shells): the elements' ids, part ids, node ids
+    !> (`connectivity`) and 0-based node rows (`connectivity_index`, for the XDMF file), one
+    !> converted dataset at a time.
+    subroutine write_element_mesh(group, ids, element_part, element_nodes)
+      character(len=*), intent(in) :: group
+      integer, intent(in) :: ids(:), element_part(:), element_nodes(:, :)
+      integer, allocatable :: values(:), rows(:, :)
+      integer :: element
+      call write_integer_dataset_1d(file_id, "", group//"/ids", ids, error)
+      allocate (values(size(ids)))
+      do element = 1, size(ids)
+        values(element) = model%parts(element_part(element))%id
+      end do
+      call write_integer_dataset_1d(file_id, "", group//"/part_ids", values, error)
+      deallocate (values)
+      allocate (rows(size(element_nodes, 1), size(ids)))
+      do element = 1, size(ids)
+        rows(:, element) = model%node_ids(element_nodes(:, element))
+      end do
+      call write_integer_dataset_2d(file_id, "", group//"/connectivity", rows, error)
+      do element = 1, size(ids)
+        rows(:, element) = element_nodes(:, element) - 1
+      end do
+      call write_integer_dataset_2d(file_id, "", group//"/connectivity_index", rows, error)
+    end subroutine write_element_mesh
+
     !> `/mesh/beams` (a model with beams): ids, part ids, the node ids N1 N2 (`connectivity`),
     !> their 0-based rows (`connectivity_index`) and the orientation node N3 (0: none).
     subroutine write_beam_mesh()
